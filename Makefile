@@ -1,0 +1,59 @@
+# DCOS: the single entry point for building, running and testing.
+#
+#   make          firmware images and host tools
+#   make run      boot the ISA 486 controller in the emulator, console on this terminal
+#   make test     host unit tests, then the emulator regression suite
+#   make bench    benchmarks
+#   make clean    remove build/
+#
+# 'make run' and 'make test' install the Debian packages they lack first.
+
+BUILD      := build
+# V=1 shows the full compiler command lines.
+Q          := $(if $(filter 1,$(V)),,@)
+PYTHON     := /usr/bin/python3
+JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
+
+.DEFAULT_GOAL := all
+.PHONY: all deps run test test-host test-emulator bench clean firmware host-tests FORCE
+.DELETE_ON_ERROR:
+
+include mk/firmware.mk
+include mk/host.mk
+
+all: firmware host-tests
+
+deps:
+	@mk/install-deps.sh
+
+run: deps
+	@$(MAKE) --no-print-directory firmware
+	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(IMAGE_486)
+
+# Every suite runs even when an earlier one fails; the summary line counts
+# them all and the exit status says whether anything failed.
+test: deps
+	@$(MAKE) --no-print-directory all
+	@mkdir -p $(BUILD)/reports
+	@rm -f $(BUILD)/reports/*.xml
+	@status=0; \
+	$(MAKE) --no-print-directory test-host || status=1; \
+	$(MAKE) --no-print-directory test-emulator || status=1; \
+	$(PYTHON) mk/summarize_reports.py $(BUILD)/reports || status=1; \
+	exit $$status
+
+test-host: host-tests
+	@mkdir -p $(BUILD)/reports
+	$(HOST_TEST_BINARY) --gtest_output=xml:$(BUILD)/reports/host-unit-tests.xml
+
+test-emulator: firmware
+	@mkdir -p $(BUILD)/reports
+	$(PYTHON) -m pytest -c tests_renode/pytest.ini tests_renode -n $(JOBS) \
+		--junitxml=$(BUILD)/reports/emulator-tests.xml
+
+bench:
+	@echo "make bench: no benchmarks yet. The timing tables (seed Tables 9.2-9.11) arrive with the"
+	@echo "memory, communication and synchronisation agents; see docs/performance.md when they do."
+
+clean:
+	rm -rf $(BUILD)

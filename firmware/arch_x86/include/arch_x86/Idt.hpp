@@ -1,0 +1,33 @@
+// The interrupt descriptor table and the dispatch of every vector.
+//
+// All 256 vectors enter through InterruptStubs.S and reach one dispatcher,
+// which hands exceptions (0-31) to the installed exception handler and
+// hardware interrupts to the board's interrupt controller driver. The
+// handlers are plain function pointers set at start-up: no registration
+// needs memory, and an unset vector is reported rather than ignored.
+#pragma once
+
+#include <arch_x86/InterruptFrame.hpp>
+
+namespace arch_x86 {
+
+class Idt {
+public:
+    /// Handles one vector; returns the frame to resume (normally frame).
+    using Handler = InterruptFrame* (*)(InterruptFrame* frame);
+
+    /// Fills all 256 gates with interrupt gates to the entry stubs and
+    /// loads the table. Until handlers are set, every vector panics.
+    static void install();
+
+    /// Sets the handler for the CPU exception vectors 0-31.
+    static void setExceptionHandler(Handler handler);
+
+    /// Sets the handler for vectors 32-255 (hardware and software interrupts).
+    static void setInterruptHandler(Handler handler);
+
+    /// The current nesting depth of interrupt handlers (0 in task context).
+    static unsigned nestingDepth();
+};
+
+} // namespace arch_x86

@@ -1,0 +1,71 @@
+#include <arch_x86/CpuException.hpp>
+#include <arch_x86/Gdt.hpp>
+#include <arch_x86/Idt.hpp>
+
+extern "C" const uint32_t interruptStubTable[256];
+extern "C" [[noreturn]] void dcosPanicWithFrame(const arch_x86::InterruptFrame* frame, const char* reason);
+
+namespace arch_x86 {
+
+namespace {
+
+// A 32-bit interrupt gate (Intel SDM Vol. 3, 6.11): present, DPL 0, type 0xE.
+// An interrupt gate clears IF on entry, so a handler starts with interrupts
+// off and decides itself whether to allow nesting.
+constexpr uint8_t gatePresentRing0Interrupt32 = 0x8E;
+
+struct [[gnu::packed]] Gate {
+    uint16_t offsetLow;
+    uint16_t selector;
+    uint8_t zero;
+    uint8_t typeAttributes;
+    uint16_t offsetHigh;
+};
+static_assert(sizeof(Gate) == 8);
+
+struct [[gnu::packed]] TablePointer {
+    uint16_t limit;
+    uint32_t base;
+};
+
+alignas(8) Gate gates[256];
+
+InterruptFrame* unhandled(InterruptFrame* frame)
+{
+    dcosPanicWithFrame(frame, "no handler for this vector");
+}
+
+Idt::Handler exceptionHandler = unhandled;
+Idt::Handler interruptHandler = unhandled;
+volatile unsigned depth = 0;
+
+} // namespace
+
+void Idt::install()
+{
+    for (unsigned vector = 0; vector < 256; ++vector) {
+        const uint32_t offset = interruptStubTable[vector];
+        gates[vector] = Gate{static_cast<uint16_t>(offset & 0xFFFF), Gdt::kernelCode, 0,
+                             gatePresentRing0Interrupt32, static_cast<uint16_t>(offset >> 16)};
+    }
+    const TablePointer pointer{sizeof gates - 1, static_cast<uint32_t>(reinterpret_cast<uintptr_t>(gates))};
+    asm volatile("lidt %0" : : "m"(pointer) : "memory");
+}
+
+void Idt::setExceptionHandler(Handler handler) { exceptionHandler = handler; }
+
+void Idt::setInterruptHandler(Handler handler) { interruptHandler = handler; }
+
+unsigned Idt::nestingDepth() { return depth; }
+
+} // namespace arch_x86
+
+/// The single C++ entry for every vector, called from interrupt_common.
+extern "C" arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame)
+{
+    using namespace arch_x86;
+    depth = depth + 1;
+    InterruptFrame* resume = frame->vector < exceptionVectorCount ? exceptionHandler(frame) : interruptHandler(frame);
+    depth = depth - 1;
+    return resume;
+}

@@ -1,0 +1,75 @@
+/*
+ * Interrupt and exception entry stubs for all 256 IDT vectors.
+ *
+ * Every stub makes the stack look the same, so one C++ dispatcher serves all
+ * vectors: exceptions that push no error code get a zero pushed in its
+ * place, then the vector number is pushed (Intel SDM Vol. 3, 6.13 lists the
+ * vectors that push an error code: 8, 10-14 and 17). The common path saves
+ * the general and segment registers into an InterruptFrame, loads the kernel
+ * data segments, and calls interruptEntry(frame). That function returns the
+ * frame to resume, which lets the scheduler switch to another task's saved
+ * frame at the exit of the outermost interrupt.
+ */
+    .section .text
+    .code32
+
+.macro VECTOR_STUB number
+    .align 8
+vector_stub_\number:
+    .if (\number == 8) || ((\number >= 10) && (\number <= 14)) || (\number == 17)
+    .else
+    pushl $0
+    .endif
+    pushl $\number
+    jmp interrupt_common
+.endm
+
+    .globl interrupt_common
+interrupt_common:
+    pushal
+    pushl %ds
+    pushl %es
+    pushl %fs
+    pushl %gs
+    movl $0x10, %eax            /* Gdt::kernelData */
+    movl %eax, %ds
+    movl %eax, %es
+    movl %eax, %fs
+    movl %eax, %gs
+    cld                         /* The C++ ABI expects DF clear. */
+    pushl %esp                  /* InterruptFrame* argument */
+    call interruptEntry
+    movl %eax, %esp             /* Resume the frame the dispatcher chose. */
+    popl %gs
+    popl %fs
+    popl %es
+    popl %ds
+    popal
+    addl $8, %esp               /* Drop the vector number and error code. */
+    iret
+
+    /* .altmacro makes %vector pass the counter's value, not its name. */
+    .altmacro
+    .set vector, 0
+    .rept 256
+    VECTOR_STUB %vector
+    .set vector, vector + 1
+    .endr
+
+/* The table of stub addresses Idt::install() reads. */
+    .section .rodata
+    .align 4
+    .globl interruptStubTable
+interruptStubTable:
+.macro STUB_ADDRESS number
+    .long vector_stub_\number
+.endm
+    .set vector, 0
+    .rept 256
+    STUB_ADDRESS %vector
+    .set vector, vector + 1
+    .endr
+    .noaltmacro
+
+/* The firmware has no executable stack; say so to the linker. */
+    .section .note.GNU-stack, "", @progbits

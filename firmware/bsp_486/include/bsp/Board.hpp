@@ -1,0 +1,74 @@
+// The board support interface the kernel is written against.
+//
+// Every board support package (bsp_486, bsp_p5smp) provides this same header
+// with the same functions, so the kernel and drivers compile unchanged for
+// either board. Interrupt lines are numbered per board (here the PC/AT IRQ
+// numbers); the kernel only passes the numbers through.
+#pragma once
+
+#include <stdint.h>
+
+#include <boot/BootInfo.hpp>
+#include <dcos/Status.hpp>
+#include <runtime/Format.hpp>
+
+namespace bsp {
+
+/// What the board is, for the version report.
+struct BoardIdentity {
+    const char* name;
+    const char* processor;
+};
+
+const BoardIdentity& identity();
+
+/// Number of interrupt lines the board's interrupt controller serves.
+constexpr unsigned interruptLineCount = 16;
+/// The line of the system tick timer.
+constexpr unsigned systemTickLine = 0;
+/// The line of the console UART.
+constexpr unsigned consoleLine = 4;
+
+/// The default system tick rate; "tick_hz=N" on the command line changes it.
+constexpr uint32_t defaultTickRateHz = 1000;
+/// The console's line settings: 115200 baud, 8 data bits, no parity, 1 stop bit.
+constexpr uint32_t consoleBaud = 115200;
+
+/// Brings up the interrupt controller, the console and the tick timer, in
+/// that order, with every interrupt line masked except those attached.
+/// Interrupts stay disabled in the CPU; the kernel enables them.
+void initialise(const boot::BootInfo& bootInfo);
+
+/// Called with interrupts disabled for each interrupt on a line.
+using InterruptHandler = void (*)(void* context);
+
+/// Attaches handler to line and unmasks it. Fails with InvalidArgument for
+/// a line the board does not have and Busy when a handler is attached.
+dcos::Status attachInterrupt(unsigned line, InterruptHandler handler, void* context);
+
+/// Detaches the handler of line and masks it.
+dcos::Status detachInterrupt(unsigned line);
+
+void maskInterrupt(unsigned line);
+void unmaskInterrupt(unsigned line);
+bool isInterruptMasked(unsigned line);
+
+/// True when the interrupt controller holds a request on line (IRR).
+bool isInterruptRequested(unsigned line);
+
+/// Interrupts that arrived on a line with no handler (and were masked).
+uint32_t unexpectedInterruptCount(unsigned line);
+
+/// Spurious interrupts reported by the interrupt controller.
+uint32_t spuriousInterruptCount();
+
+/// The tick rate in force and the tick's exact period.
+uint32_t tickRateHz();
+uint64_t tickPeriodNanoseconds();
+
+/// The console: output (waits while its buffer is full) and input.
+runtime::CharacterSink& console();
+bool consoleRead(char& character);
+bool consoleHasInput();
+
+} // namespace bsp

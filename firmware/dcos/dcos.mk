@@ -1,0 +1,1 @@
+DCOS_PORTABLE_SRCS := firmware/dcos/src/GregorianCalendar.cpp

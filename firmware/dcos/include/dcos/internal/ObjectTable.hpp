@@ -1,0 +1,399 @@
+// Static per-type object table (dissertation section 6.4).
+//
+// Each system agent keeps one table per object type. Storage for the whole
+// Capacity is reserved at build time, but only the first activeCount() slots
+// take part in allocation; the AddObjects configuration service activates
+// further slots in groups of eight, as the seed prescribes. The real-time
+// services (Create, Delete, resolve, ownership checks) cost O(1); the
+// configuration services (AddObjects, NameToObject, enumeration by owner)
+// cost O(N), which the seed accepts for configuration-class services.
+//
+// Stale id detection: the 12-bit index field of an ObjectId is split into a
+// slot number in its low log2(Capacity) bits and a per-slot generation in the
+// remaining high bits. Deleting an object bumps the generation of its slot,
+// so an id kept after the delete no longer matches, even when the slot has
+// since been reused. With Capacity 4096 the slot number needs all 12 bits and
+// no generation is left: only the "slot is free" check remains, so an id to a
+// deleted and reused slot then resolves to the new object. Tables that must
+// detect stale ids therefore stay below 4096 slots.
+//
+// The table does no locking; the owning agent serialises access to it.
+#pragma once
+
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/Visibility.hpp>
+
+#include <bit>
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos::internal {
+
+/// A static table of objects of one type, addressed by ObjectId.
+///
+/// T must be default constructible and copy-assignable: every slot holds a
+/// T from the start, and a deleted object is reset to T{} so that the next
+/// creator never sees the previous owner's data.
+///
+/// Services that implement a primitive of the seed keep its name
+/// (AddObjects, Create, Delete, NameToObject, XferOwnership); kernel-internal
+/// helpers use lower camel case.
+template <typename T, size_t Capacity>
+class ObjectTable {
+    static_assert(Capacity >= 8 && Capacity <= 4096, "a table holds 8 to 4096 objects (12-bit index)");
+    static_assert(std::has_single_bit(Capacity), "Capacity must be a power of two to split slot and generation bits");
+    static_assert(Capacity % 8 == 0, "objects are added in groups of eight");
+
+public:
+    /// Objects are activated by AddObjects in multiples of this count.
+    static constexpr size_t kGroupSize = 8;
+    /// Bytes reserved for a name, including the terminating NUL.
+    static constexpr size_t kNameCapacity = 16;
+    /// Longest name accepted by Create.
+    static constexpr size_t kMaxNameLength = kNameCapacity - 1;
+    /// Low bits of the index field that select the slot.
+    static constexpr unsigned kSlotBits = static_cast<unsigned>(std::countr_zero(Capacity));
+    /// High bits of the index field that carry the slot generation; 0 when Capacity is 4096.
+    static constexpr unsigned kGenerationBits = ObjectId::kIndexBits - kSlotBits;
+
+    /// Creates an empty table for objects of @p type on node @p node.
+    ///
+    /// The constructor is constexpr so that a static table is constant
+    /// initialised and needs no start-up code before the agents run.
+    constexpr ObjectTable(ObjectType type, uint16_t node) : type_(type), node_(node) {}
+
+    ObjectTable(const ObjectTable&) = delete;
+    ObjectTable& operator=(const ObjectTable&) = delete;
+
+    /// The object type this table manages; ids of other types are refused.
+    constexpr ObjectType type() const { return type_; }
+    /// The node id stamped into every id this table issues.
+    constexpr uint16_t node() const { return node_; }
+    /// Number of slots reserved at build time.
+    static constexpr size_t capacity() { return Capacity; }
+    /// Number of slots activated so far by AddObjects.
+    constexpr size_t activeCount() const { return active_; }
+    /// Number of slots that currently hold a created object.
+    constexpr size_t usedCount() const { return used_; }
+    /// Number of activated slots available to Create.
+    constexpr size_t freeCount() const { return active_ - used_; }
+
+    /// Changes the node id, for boards that learn their logical address at boot.
+    ///
+    /// Refused with Busy while objects exist, because their ids already carry
+    /// the old node id and would no longer resolve. Cost O(1).
+    Status setNode(uint16_t node)
+    {
+        if (used_ != 0) {
+            return Status::Busy;
+        }
+        node_ = node;
+        return Status::Ok;
+    }
+
+    /// Configuration service: activates @p count more slots.
+    ///
+    /// @p count must be a non-zero multiple of eight (InvalidArgument), and
+    /// the active count may not exceed Capacity (TableFull); a refused
+    /// request changes nothing. Cost O(count).
+    Status AddObjects(size_t count)
+    {
+        if (count == 0 || count % kGroupSize != 0) {
+            return Status::InvalidArgument;
+        }
+        if (count > Capacity - active_) {
+            return Status::TableFull;
+        }
+        for (size_t i = 0; i < count; ++i) {
+            pushFree(static_cast<uint16_t>(active_ + i));
+        }
+        active_ += count;
+        return Status::Ok;
+    }
+
+    /// Allocates a free slot and returns the id of the new object.
+    ///
+    /// @p owner is the creating task (type Task), or the null id for objects
+    /// owned by the system, which resource recovery never reclaims. @p name
+    /// may be null or empty for an unnamed object, otherwise at most
+    /// kMaxNameLength characters. The seed leaves unique naming to the user,
+    /// so duplicates are not searched for, which keeps Create O(1).
+    /// Fails with InvalidArgument or TableFull.
+    Result<ObjectId> Create(ObjectId owner, const char* name, Visibility visibility)
+    {
+        if (!isValidOwner(owner) || nameLength(name) > kMaxNameLength
+            || static_cast<uint8_t>(visibility) > static_cast<uint8_t>(Visibility::Global)) {
+            return Status::InvalidArgument;
+        }
+        if (freeHead_ == kNoSlot) {
+            return Status::TableFull;
+        }
+        const uint16_t slot = popFree();
+        Entry& entry = entries_[slot];
+        entry.used = true;
+        entry.owner = owner;
+        entry.visibility = visibility;
+        copyName(entry.name, name);
+        ++used_;
+        return idOf(slot);
+    }
+
+    /// Deletes the object named by @p id and frees its slot.
+    ///
+    /// The object is reset to T{} and the slot generation advances, so every
+    /// copy of @p id turns stale. Ownership is checked by the agent before,
+    /// because some primitives (KillTask by a super user) bypass it. Cost O(1).
+    Status Delete(ObjectId id)
+    {
+        const Result<uint16_t> slot = slotOf(id);
+        if (!slot.ok()) {
+            return slot.status();
+        }
+        Entry& entry = entries_[slot.value()];
+        entry.object = T{};
+        entry.used = false;
+        entry.owner = ObjectId::null();
+        entry.name[0] = '\0';
+        entry.generation = static_cast<uint16_t>((entry.generation + 1) & kGenerationMask);
+        --used_;
+        pushFree(slot.value());
+        return Status::Ok;
+    }
+
+    /// Resolves @p id to its object.
+    ///
+    /// Fails with WrongType for an id of another type, InvalidId for another
+    /// node, a slot outside the active range or a free slot, and StaleId when
+    /// the generation shows the object was deleted. Cost O(1).
+    Result<T*> resolve(ObjectId id)
+    {
+        const Result<uint16_t> slot = slotOf(id);
+        if (!slot.ok()) {
+            return slot.status();
+        }
+        return &entries_[slot.value()].object;
+    }
+
+    /// Returns the task that owns @p id (null for system objects). Cost O(1).
+    Result<ObjectId> ownerOf(ObjectId id) const
+    {
+        const Result<uint16_t> slot = slotOf(id);
+        if (!slot.ok()) {
+            return slot.status();
+        }
+        return entries_[slot.value()].owner;
+    }
+
+    /// Succeeds when @p task owns @p id, and fails with NotOwner otherwise.
+    ///
+    /// This is the legality check the seed requires before any operation a
+    /// task requests on an object. Cost O(1).
+    Status checkOwner(ObjectId id, ObjectId task) const
+    {
+        const Result<ObjectId> owner = ownerOf(id);
+        if (!owner.ok()) {
+            return owner.status();
+        }
+        return owner.value() == task ? Status::Ok : Status::NotOwner;
+    }
+
+    /// Returns the visibility @p id was created with. Cost O(1).
+    Result<Visibility> visibilityOf(ObjectId id) const
+    {
+        const Result<uint16_t> slot = slotOf(id);
+        if (!slot.ok()) {
+            return slot.status();
+        }
+        return entries_[slot.value()].visibility;
+    }
+
+    /// Returns the NUL-terminated name of @p id; empty for unnamed objects. Cost O(1).
+    Result<const char*> nameOf(ObjectId id) const
+    {
+        const Result<uint16_t> slot = slotOf(id);
+        if (!slot.ok()) {
+            return slot.status();
+        }
+        return static_cast<const char*>(entries_[slot.value()].name);
+    }
+
+    /// Transfers ownership of @p id from @p currentOwner to @p newOwner.
+    ///
+    /// Fails with NotOwner unless @p currentOwner owns the object, which
+    /// stops a task from giving away objects it does not hold, and with
+    /// InvalidArgument when @p newOwner is neither a task id nor null. Cost O(1).
+    Status XferOwnership(ObjectId id, ObjectId currentOwner, ObjectId newOwner)
+    {
+        const Result<uint16_t> slot = slotOf(id);
+        if (!slot.ok()) {
+            return slot.status();
+        }
+        Entry& entry = entries_[slot.value()];
+        if (entry.owner != currentOwner) {
+            return Status::NotOwner;
+        }
+        if (!isValidOwner(newOwner)) {
+            return Status::InvalidArgument;
+        }
+        entry.owner = newOwner;
+        return Status::Ok;
+    }
+
+    /// Configuration service: finds the object named @p name.
+    ///
+    /// Only objects visible from @p askingScope are considered, so a lookup
+    /// forwarded from a remote node never finds a local object. When the
+    /// user broke the uniqueness rule the lowest slot wins. An empty or null
+    /// name never matches, because unnamed objects must not be findable.
+    /// Fails with NotFound. Cost O(N) in the active count.
+    Result<ObjectId> NameToObject(const char* name, Visibility askingScope) const
+    {
+        if (nameLength(name) == 0 || nameLength(name) > kMaxNameLength) {
+            return Status::NotFound;
+        }
+        for (size_t slot = 0; slot < active_; ++slot) {
+            const Entry& entry = entries_[slot];
+            if (entry.used && isVisibleFrom(entry.visibility, askingScope) && namesEqual(entry.name, name)) {
+                return idOf(static_cast<uint16_t>(slot));
+            }
+        }
+        return Status::NotFound;
+    }
+
+    /// Calls @p visit(ObjectId, T&) for every object owned by @p owner.
+    ///
+    /// Resource recovery uses this when a task dies. The visitor may Delete
+    /// the object it is given, because the walk re-reads each slot's state
+    /// and a Delete touches only its own slot. Returns the number of objects
+    /// visited. Cost O(N) in the active count.
+    template <typename Visitor>
+    size_t forEachOwnedBy(ObjectId owner, Visitor&& visit)
+    {
+        size_t visited = 0;
+        for (size_t slot = 0; slot < active_; ++slot) {
+            Entry& entry = entries_[slot];
+            if (entry.used && entry.owner == owner) {
+                ++visited;
+                visit(idOf(static_cast<uint16_t>(slot)), entry.object);
+            }
+        }
+        return visited;
+    }
+
+private:
+    static constexpr uint16_t kNoSlot = 0xFFFF;
+    static constexpr uint16_t kSlotMask = static_cast<uint16_t>(Capacity - 1);
+    static constexpr uint16_t kGenerationMask = static_cast<uint16_t>((1u << kGenerationBits) - 1);
+
+    struct Entry {
+        T object{};
+        ObjectId owner{};
+        uint16_t generation = 0;
+        uint16_t nextFree = kNoSlot;
+        bool used = false;
+        Visibility visibility = Visibility::Local;
+        char name[kNameCapacity] = {};
+    };
+
+    ObjectId idOf(uint16_t slot) const
+    {
+        const uint16_t index = static_cast<uint16_t>((entries_[slot].generation << kSlotBits) | slot);
+        return ObjectId(node_, type_, index);
+    }
+
+    // Every accessor funnels through here so the rejection rules live in one place.
+    Result<uint16_t> slotOf(ObjectId id) const
+    {
+        if (id.type() != type_) {
+            return Status::WrongType;
+        }
+        if (id.node() != node_) {
+            // The agent routes ids of other nodes to the network before it
+            // consults its table, so a foreign node here means a forged id.
+            return Status::InvalidId;
+        }
+        const uint16_t slot = static_cast<uint16_t>(id.index() & kSlotMask);
+        if (slot >= active_) {
+            return Status::InvalidId;
+        }
+        const Entry& entry = entries_[slot];
+        if ((id.index() >> kSlotBits) != entry.generation) {
+            return Status::StaleId;
+        }
+        if (!entry.used) {
+            return Status::InvalidId;
+        }
+        return slot;
+    }
+
+    // Freed slots join the tail so that a slot is reused as late as possible,
+    // which keeps a stale id detectable for as many generations as possible.
+    void pushFree(uint16_t slot)
+    {
+        entries_[slot].nextFree = kNoSlot;
+        if (freeTail_ == kNoSlot) {
+            freeHead_ = slot;
+        } else {
+            entries_[freeTail_].nextFree = slot;
+        }
+        freeTail_ = slot;
+    }
+
+    uint16_t popFree()
+    {
+        const uint16_t slot = freeHead_;
+        freeHead_ = entries_[slot].nextFree;
+        if (freeHead_ == kNoSlot) {
+            freeTail_ = kNoSlot;
+        }
+        entries_[slot].nextFree = kNoSlot;
+        return slot;
+    }
+
+    static bool isValidOwner(ObjectId owner) { return owner.isNull() || owner.type() == ObjectType::Task; }
+
+    // Counts at most kNameCapacity characters so an unterminated name cannot run away.
+    static size_t nameLength(const char* name)
+    {
+        size_t length = 0;
+        if (name != nullptr) {
+            while (length < kNameCapacity && name[length] != '\0') {
+                ++length;
+            }
+        }
+        return length;
+    }
+
+    static void copyName(char (&destination)[kNameCapacity], const char* source)
+    {
+        size_t i = 0;
+        if (source != nullptr) {
+            for (; i < kMaxNameLength && source[i] != '\0'; ++i) {
+                destination[i] = source[i];
+            }
+        }
+        destination[i] = '\0';
+    }
+
+    static bool namesEqual(const char (&stored)[kNameCapacity], const char* name)
+    {
+        size_t i = 0;
+        for (; i < kMaxNameLength && stored[i] != '\0'; ++i) {
+            if (stored[i] != name[i]) {
+                return false;
+            }
+        }
+        return name[i] == '\0';
+    }
+
+    Entry entries_[Capacity] = {};
+    ObjectType type_;
+    uint16_t node_;
+    size_t active_ = 0;
+    size_t used_ = 0;
+    uint16_t freeHead_ = kNoSlot;
+    uint16_t freeTail_ = kNoSlot;
+};
+
+} // namespace dcos::internal

@@ -1,0 +1,301 @@
+// Host tests for the static per-type object table (dissertation 6.4).
+#include <dcos/internal/ObjectTable.hpp>
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+#include <vector>
+
+using dcos::ObjectId;
+using dcos::ObjectType;
+using dcos::Status;
+using dcos::Visibility;
+using dcos::internal::ObjectTable;
+
+namespace {
+
+struct Semaphore {
+    int count = 0;
+};
+
+constexpr uint16_t kNode = 0x0042;
+const ObjectId kTaskA(kNode, ObjectType::Task, 1);
+const ObjectId kTaskB(kNode, ObjectType::Task, 2);
+
+using SmallTable = ObjectTable<Semaphore, 16>;
+
+ObjectId create(SmallTable& table, const char* name = nullptr, ObjectId owner = kTaskA,
+                Visibility visibility = Visibility::Local)
+{
+    const auto result = table.Create(owner, name, visibility);
+    EXPECT_TRUE(result.ok()) << dcos::statusName(result.status());
+    return result.value();
+}
+
+} // namespace
+
+TEST(ObjectTableTest, GenerationBitsFollowCapacity)
+{
+    EXPECT_EQ((ObjectTable<Semaphore, 8>::kSlotBits), 3u);
+    EXPECT_EQ((ObjectTable<Semaphore, 8>::kGenerationBits), 9u);
+    EXPECT_EQ((ObjectTable<Semaphore, 256>::kGenerationBits), 4u);
+    EXPECT_EQ((ObjectTable<Semaphore, 4096>::kGenerationBits), 0u);
+}
+
+TEST(ObjectTableTest, StartsWithoutActiveSlots)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    EXPECT_EQ(table.activeCount(), 0u);
+    EXPECT_EQ(table.Create(kTaskA, nullptr, Visibility::Local).status(), Status::TableFull);
+}
+
+TEST(ObjectTableTest, AddObjectsGrowsInGroupsOfEightUpToCapacity)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    EXPECT_EQ(table.AddObjects(0), Status::InvalidArgument);
+    EXPECT_EQ(table.AddObjects(4), Status::InvalidArgument);
+    EXPECT_EQ(table.AddObjects(12), Status::InvalidArgument);
+    EXPECT_EQ(table.activeCount(), 0u);
+    EXPECT_EQ(table.AddObjects(8), Status::Ok);
+    EXPECT_EQ(table.activeCount(), 8u);
+    EXPECT_EQ(table.AddObjects(16), Status::TableFull);
+    EXPECT_EQ(table.activeCount(), 8u);
+    EXPECT_EQ(table.AddObjects(8), Status::Ok);
+    EXPECT_EQ(table.activeCount(), 16u);
+    EXPECT_EQ(table.AddObjects(8), Status::TableFull);
+    EXPECT_EQ(table.freeCount(), 16u);
+}
+
+TEST(ObjectTableTest, CreateFillsActiveSlotsThenReportsFullUntilGrown)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    std::set<uint32_t> ids;
+    for (int i = 0; i < 8; ++i) {
+        ids.insert(create(table).raw());
+    }
+    EXPECT_EQ(ids.size(), 8u);
+    EXPECT_EQ(table.usedCount(), 8u);
+    EXPECT_EQ(table.Create(kTaskA, nullptr, Visibility::Local).status(), Status::TableFull);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId grown = create(table);
+    EXPECT_GE(grown.index(), 8u);
+    EXPECT_LT(grown.index(), 16u);
+}
+
+TEST(ObjectTableTest, IdsCarryNodeAndTypeAndResolveToDistinctObjects)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId a = create(table);
+    const ObjectId b = create(table);
+    EXPECT_EQ(a.node(), kNode);
+    EXPECT_EQ(a.type(), ObjectType::Semaphore);
+    auto ra = table.resolve(a);
+    auto rb = table.resolve(b);
+    ASSERT_TRUE(ra.ok());
+    ASSERT_TRUE(rb.ok());
+    EXPECT_NE(ra.value(), rb.value());
+    ra.value()->count = 5;
+    EXPECT_EQ(table.resolve(a).value()->count, 5);
+}
+
+TEST(ObjectTableTest, ForgedIdsAreRejected)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId good = create(table);
+    const uint16_t generationZeroIndex = good.index();
+
+    EXPECT_EQ(table.resolve(ObjectId(kNode + 1, ObjectType::Semaphore, good.index())).status(), Status::InvalidId);
+    EXPECT_EQ(table.resolve(ObjectId(kNode, ObjectType::Timer, good.index())).status(), Status::WrongType);
+    EXPECT_EQ(table.resolve(ObjectId::null()).status(), Status::WrongType);
+    // Slot 8 is within Capacity but not yet activated by AddObjects.
+    EXPECT_EQ(table.resolve(ObjectId(kNode, ObjectType::Semaphore, 8)).status(), Status::InvalidId);
+    // A free slot with its current generation was never handed out.
+    EXPECT_EQ(table.resolve(ObjectId(kNode, ObjectType::Semaphore, generationZeroIndex + 1)).status(),
+              Status::InvalidId);
+    EXPECT_TRUE(table.resolve(good).ok());
+}
+
+TEST(ObjectTableTest, DeletedIdIsStaleEvenAfterTheSlotIsReused)
+{
+    ObjectTable<Semaphore, 8> table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    ObjectId ids[8];
+    for (ObjectId& id : ids) {
+        const auto result = table.Create(kTaskA, nullptr, Visibility::Local);
+        ASSERT_TRUE(result.ok());
+        id = result.value();
+    }
+    table.resolve(ids[3]).value()->count = 77;
+    ASSERT_EQ(table.Delete(ids[3]), Status::Ok);
+    EXPECT_EQ(table.resolve(ids[3]).status(), Status::StaleId);
+    EXPECT_EQ(table.Delete(ids[3]), Status::StaleId);
+
+    // The only free slot is the deleted one, so the next Create must reuse it.
+    const auto reused = table.Create(kTaskB, nullptr, Visibility::Local);
+    ASSERT_TRUE(reused.ok());
+    EXPECT_EQ(reused.value().index() & 7u, ids[3].index() & 7u);
+    EXPECT_NE(reused.value(), ids[3]);
+    EXPECT_EQ(table.resolve(ids[3]).status(), Status::StaleId);
+    ASSERT_TRUE(table.resolve(reused.value()).ok());
+    EXPECT_EQ(table.resolve(reused.value()).value()->count, 0) << "a reused slot starts from T{}";
+}
+
+TEST(ObjectTableTest, FreedSlotsAreReusedInFifoOrder)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId first = create(table);
+    ASSERT_EQ(table.Delete(first), Status::Ok);
+    // Seven never-used slots are queued ahead of the freed one.
+    for (int i = 0; i < 7; ++i) {
+        EXPECT_NE(create(table).index() & 15u, first.index() & 15u);
+    }
+    EXPECT_EQ(create(table).index() & 15u, first.index() & 15u);
+}
+
+TEST(ObjectTableTest, GenerationWrapsWithinItsBits)
+{
+    ObjectTable<Semaphore, 8> table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    // Keep seven slots busy so every create/delete cycles the same slot.
+    for (int i = 0; i < 7; ++i) {
+        ASSERT_TRUE(table.Create(kTaskA, nullptr, Visibility::Local).ok());
+    }
+    const ObjectId original = table.Create(kTaskA, nullptr, Visibility::Local).value();
+    ObjectId current = original;
+    for (unsigned cycle = 1; cycle < (1u << 9); ++cycle) {
+        ASSERT_EQ(table.Delete(current), Status::Ok);
+        current = table.Create(kTaskA, nullptr, Visibility::Local).value();
+        ASSERT_NE(current, original) << "cycle " << cycle;
+        ASSERT_EQ(table.resolve(original).status(), Status::StaleId);
+    }
+    ASSERT_EQ(table.Delete(current), Status::Ok);
+    current = table.Create(kTaskA, nullptr, Visibility::Local).value();
+    EXPECT_EQ(current, original) << "after 2^9 reuses the 9-bit generation wraps";
+}
+
+TEST(ObjectTableTest, FullSizeTableHasNoGenerationButDetectsFreeSlots)
+{
+    static ObjectTable<Semaphore, 4096> table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(4096), Status::Ok);
+    EXPECT_EQ(table.AddObjects(8), Status::TableFull);
+    const ObjectId id = table.Create(kTaskA, nullptr, Visibility::Local).value();
+    ASSERT_EQ(table.Delete(id), Status::Ok);
+    EXPECT_EQ(table.resolve(id).status(), Status::InvalidId);
+    EXPECT_EQ(table.resolve(ObjectId(kNode, ObjectType::Semaphore, 4095)).status(), Status::InvalidId);
+}
+
+TEST(ObjectTableTest, CreateValidatesArguments)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    EXPECT_EQ(table.Create(ObjectId(kNode, ObjectType::Timer, 1), nullptr, Visibility::Local).status(),
+              Status::InvalidArgument);
+    EXPECT_EQ(table.Create(kTaskA, "0123456789abcdef", Visibility::Local).status(), Status::InvalidArgument);
+    EXPECT_EQ(table.Create(kTaskA, nullptr, static_cast<Visibility>(3)).status(), Status::InvalidArgument);
+    EXPECT_EQ(table.usedCount(), 0u);
+    EXPECT_TRUE(table.Create(kTaskA, "0123456789abcde", Visibility::Local).ok());
+    EXPECT_TRUE(table.Create(ObjectId::null(), nullptr, Visibility::Local).ok());
+}
+
+TEST(ObjectTableTest, NameToObjectFindsByNameAndHonoursVisibility)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId local = create(table, "local", kTaskA, Visibility::Local);
+    const ObjectId regional = create(table, "regional", kTaskA, Visibility::Regional);
+    const ObjectId global = create(table, "global", kTaskA, Visibility::Global);
+    create(table);
+
+    EXPECT_EQ(table.NameToObject("local", Visibility::Local).value(), local);
+    EXPECT_EQ(table.NameToObject("regional", Visibility::Local).value(), regional);
+    EXPECT_EQ(table.NameToObject("global", Visibility::Local).value(), global);
+
+    EXPECT_EQ(table.NameToObject("local", Visibility::Regional).status(), Status::NotFound);
+    EXPECT_EQ(table.NameToObject("regional", Visibility::Regional).value(), regional);
+    EXPECT_EQ(table.NameToObject("global", Visibility::Regional).value(), global);
+
+    EXPECT_EQ(table.NameToObject("local", Visibility::Global).status(), Status::NotFound);
+    EXPECT_EQ(table.NameToObject("regional", Visibility::Global).status(), Status::NotFound);
+    EXPECT_EQ(table.NameToObject("global", Visibility::Global).value(), global);
+
+    EXPECT_EQ(table.NameToObject("glob", Visibility::Local).status(), Status::NotFound);
+    EXPECT_EQ(table.NameToObject("globalx", Visibility::Local).status(), Status::NotFound);
+    EXPECT_EQ(table.NameToObject("", Visibility::Local).status(), Status::NotFound);
+    EXPECT_EQ(table.NameToObject(nullptr, Visibility::Local).status(), Status::NotFound);
+    EXPECT_STREQ(table.nameOf(regional).value(), "regional");
+    EXPECT_EQ(table.visibilityOf(global).value(), Visibility::Global);
+
+    ASSERT_EQ(table.Delete(global), Status::Ok);
+    EXPECT_EQ(table.NameToObject("global", Visibility::Local).status(), Status::NotFound);
+}
+
+TEST(ObjectTableTest, NameToObjectMatchesFullLengthNamesExactly)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId longName = create(table, "abcdefghijklmno");
+    EXPECT_EQ(table.NameToObject("abcdefghijklmno", Visibility::Local).value(), longName);
+    EXPECT_EQ(table.NameToObject("abcdefghijklmnop", Visibility::Local).status(), Status::NotFound);
+    EXPECT_EQ(table.NameToObject("abcdefghijklmn", Visibility::Local).status(), Status::NotFound);
+}
+
+TEST(ObjectTableTest, XferOwnershipRequiresCurrentOwner)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId id = create(table, nullptr, kTaskA);
+    EXPECT_EQ(table.checkOwner(id, kTaskA), Status::Ok);
+    EXPECT_EQ(table.checkOwner(id, kTaskB), Status::NotOwner);
+    EXPECT_EQ(table.XferOwnership(id, kTaskB, kTaskB), Status::NotOwner);
+    EXPECT_EQ(table.XferOwnership(id, kTaskA, ObjectId(kNode, ObjectType::Heap, 1)), Status::InvalidArgument);
+    EXPECT_EQ(table.ownerOf(id).value(), kTaskA);
+    EXPECT_EQ(table.XferOwnership(id, kTaskA, kTaskB), Status::Ok);
+    EXPECT_EQ(table.ownerOf(id).value(), kTaskB);
+    EXPECT_EQ(table.checkOwner(id, kTaskA), Status::NotOwner);
+    EXPECT_EQ(table.XferOwnership(ObjectId(kNode, ObjectType::Semaphore, 5), kTaskA, kTaskB), Status::InvalidId);
+}
+
+TEST(ObjectTableTest, ForEachOwnedByVisitsOnlyThatOwnersObjectsAndAllowsDelete)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(16), Status::Ok);
+    std::set<uint32_t> ownedByA;
+    for (int i = 0; i < 10; ++i) {
+        const ObjectId id = create(table, nullptr, i % 2 == 0 ? kTaskA : kTaskB);
+        if (i % 2 == 0) {
+            ownedByA.insert(id.raw());
+        }
+    }
+    const ObjectId moved = create(table, nullptr, kTaskB);
+    ASSERT_EQ(table.XferOwnership(moved, kTaskB, kTaskA), Status::Ok);
+    ownedByA.insert(moved.raw());
+
+    std::set<uint32_t> visited;
+    const size_t count = table.forEachOwnedBy(kTaskA, [&](ObjectId id, Semaphore&) {
+        visited.insert(id.raw());
+        // Resource recovery deletes while it walks.
+        EXPECT_EQ(table.Delete(id), Status::Ok);
+    });
+    EXPECT_EQ(count, ownedByA.size());
+    EXPECT_EQ(visited, ownedByA);
+    EXPECT_EQ(table.usedCount(), 5u);
+    EXPECT_EQ(table.forEachOwnedBy(kTaskA, [](ObjectId, Semaphore&) {}), 0u);
+    EXPECT_EQ(table.forEachOwnedBy(kTaskB, [](ObjectId, Semaphore&) {}), 5u);
+}
+
+TEST(ObjectTableTest, SetNodeOnlyWhileEmpty)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    EXPECT_EQ(table.setNode(7), Status::Ok);
+    const ObjectId id = create(table);
+    EXPECT_EQ(id.node(), 7);
+    EXPECT_EQ(table.setNode(8), Status::Busy);
+    ASSERT_EQ(table.Delete(id), Status::Ok);
+    EXPECT_EQ(table.setNode(8), Status::Ok);
+}

@@ -1,0 +1,48 @@
+// Registration of console commands.
+//
+// A module adds a command by defining one DCOS_SHELL_COMMAND in its own
+// source file. The linker gathers every definition into one table (the
+// section dcos_shell_commands), so the shell has no central list or switch
+// to edit, and a module left out of an image takes its commands with it.
+#pragma once
+
+#include <stddef.h>
+
+namespace shell {
+
+class Shell;
+
+/// What a command reports back to the shell.
+enum class CommandResult {
+    Ok,         ///< Done.
+    Failed,     ///< Done, with an error the command has already printed.
+    UsageError, ///< The arguments were wrong; the shell prints the usage line.
+};
+
+struct ShellCommand {
+    /// The word that invokes the command.
+    const char* name;
+    /// One line for 'help'.
+    const char* summary;
+    /// The argument synopsis, e.g. "echo [text...]".
+    const char* usage;
+    /// Runs the command; argv[0] is the command name.
+    CommandResult (*run)(Shell& shell, int argc, char** argv);
+};
+
+/// The commands linked into this image, in link order.
+class CommandTable {
+public:
+    static const ShellCommand* begin();
+    static const ShellCommand* end();
+    static size_t size() { return static_cast<size_t>(end() - begin()); }
+    /// The command called name, or nullptr.
+    static const ShellCommand* find(const char* name);
+};
+
+} // namespace shell
+
+/// Defines a console command. Use once per command at namespace scope.
+#define DCOS_SHELL_COMMAND(identifier, name, summary, usage, function)                         \
+    [[gnu::used, gnu::section("dcos_shell_commands")]] constinit const ::shell::ShellCommand \
+        identifier{name, summary, usage, function}

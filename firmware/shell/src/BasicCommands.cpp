@@ -1,0 +1,65 @@
+// Commands every image has: help and echo.
+#include <shell/Shell.hpp>
+
+namespace shell {
+
+namespace {
+
+bool alphabeticallyBefore(const char* a, const char* b)
+{
+    while (*a != '\0' && *a == *b) {
+        ++a;
+        ++b;
+    }
+    return static_cast<unsigned char>(*a) < static_cast<unsigned char>(*b);
+}
+
+CommandResult help(Shell& shell, int argc, char** argv)
+{
+    if (argc > 2) {
+        return CommandResult::UsageError;
+    }
+    if (argc == 2) {
+        const ShellCommand* command = CommandTable::find(argv[1]);
+        if (command == nullptr) {
+            shell.print("error: unknown command '%s'\r\n", argv[1]);
+            return CommandResult::Failed;
+        }
+        shell.print("%s - %s\r\nusage: %s\r\n", command->name, command->summary, command->usage);
+        return CommandResult::Ok;
+    }
+    // List alphabetically. The table is in link order and small, so a
+    // selection pass per line needs no buffer and no sorting of the table.
+    const ShellCommand* previous = nullptr;
+    for (size_t listed = 0; listed < CommandTable::size(); ++listed) {
+        const ShellCommand* next = nullptr;
+        for (const ShellCommand* c = CommandTable::begin(); c != CommandTable::end(); ++c) {
+            const bool afterPrevious = previous == nullptr || alphabeticallyBefore(previous->name, c->name);
+            if (afterPrevious && (next == nullptr || alphabeticallyBefore(c->name, next->name))) {
+                next = c;
+            }
+        }
+        if (next == nullptr) {
+            break;
+        }
+        shell.print("  %-10s %s\r\n", next->name, next->summary);
+        previous = next;
+    }
+    return CommandResult::Ok;
+}
+
+CommandResult echo(Shell& shell, int argc, char** argv)
+{
+    for (int i = 1; i < argc; ++i) {
+        shell.print(i == 1 ? "%s" : " %s", argv[i]);
+    }
+    shell.print("\r\n");
+    return CommandResult::Ok;
+}
+
+} // namespace
+
+DCOS_SHELL_COMMAND(helpCommand, "help", "list commands, or show one command's usage", "help [command]", help);
+DCOS_SHELL_COMMAND(echoCommand, "echo", "print the arguments", "echo [text...]", echo);
+
+} // namespace shell

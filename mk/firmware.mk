@@ -1,0 +1,82 @@
+# Freestanding firmware for the ISA i486 board.
+#
+# The firmware is C++20 without exceptions, RTTI or the C++ runtime, built
+# for -march=i486 and linked with ld directly so that no part of the
+# distribution's 32-bit libgcc (built for i686, with CMOV) gets in.
+
+FW_BUILD := $(BUILD)/fw486
+
+FW_INCLUDES := \
+	-Ifirmware/runtime/include \
+	-Ifirmware/arch_x86/include \
+	-Ifirmware/boot/include \
+	-Ifirmware/shell/include \
+	-Ifirmware/dcos/include \
+	-Ifirmware/bsp_486/include
+
+FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
+FW_CXXFLAGS := -std=c++20 $(FW_ARCH_FLAGS) -O2 -g \
+	-ffreestanding -fno-pic -fno-pie -fno-exceptions -fno-rtti -fno-threadsafe-statics \
+	-fno-stack-protector -fno-asynchronous-unwind-tables -fno-unwind-tables \
+	-fno-omit-frame-pointer -fno-tree-loop-distribute-patterns -mgeneral-regs-only \
+	-Wall -Wextra -Werror -MMD -MP $(FW_INCLUDES)
+FW_ASFLAGS := $(FW_ARCH_FLAGS) -MMD -MP $(FW_INCLUDES)
+FW_LDFLAGS := -m elf_i386 -nostdlib -static -T firmware/boot/link.ld
+
+include firmware/dcos/dcos.mk
+
+# Sources every image contains.
+FW_SRCS := \
+	$(wildcard firmware/runtime/src/*.cpp) \
+	$(wildcard firmware/arch_x86/src/*.cpp firmware/arch_x86/src/*.S) \
+	$(wildcard firmware/boot/src/*.cpp firmware/boot/src/*.S) \
+	$(wildcard firmware/shell/src/*.cpp) \
+	$(DCOS_PORTABLE_SRCS) \
+	$(wildcard firmware/dcos/src/kernel/*.cpp) \
+	$(wildcard firmware/bsp_486/src/*.cpp)
+
+# The on-target test suite, linked only into the test image.
+FW_TARGET_TEST_SRCS := $(wildcard tests_renode/target/*.cpp)
+
+fw_objects = $(patsubst %,$(FW_BUILD)/%.o,$(1))
+FW_OBJS := $(call fw_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
+FW_TARGET_TEST_OBJS := $(call fw_objects,$(FW_TARGET_TEST_SRCS))
+
+IMAGE_486 := $(BUILD)/486/dcos486.elf
+IMAGE_486_TEST := $(BUILD)/486/dcos486-test.elf
+
+firmware: $(IMAGE_486) $(IMAGE_486_TEST)
+
+$(IMAGE_486): $(FW_OBJS) firmware/boot/link.ld
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS)
+
+$(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) firmware/boot/link.ld
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS)
+
+$(FW_BUILD)/%.cpp.o: %.cpp
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)g++ $(FW_CXXFLAGS) -c $< -o $@
+
+$(FW_BUILD)/%.S.o: %.S
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)g++ $(FW_ASFLAGS) -c $< -o $@
+
+# The revision is regenerated on every build but rewritten only when it
+# changes, so an unchanged tree does not relink.
+FW_REVISION := $(shell git describe --always --dirty 2>/dev/null || echo unknown)
+$(FW_BUILD)/generated/BuildRevision.cpp: FORCE
+	@mkdir -p $(dir $@)
+	@printf 'namespace dcos { const char* buildRevisionText = "%s"; }\n' "$(FW_REVISION)" > $@.new
+	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+
+$(FW_BUILD)/generated/BuildRevision.cpp.o: $(FW_BUILD)/generated/BuildRevision.cpp
+	@echo "  CXX     $@"
+	$(Q)g++ $(FW_CXXFLAGS) -c $< -o $@
+
+-include $(shell find $(FW_BUILD) -name '*.d' 2>/dev/null)

@@ -1,0 +1,36 @@
+# Host unit tests: the firmware's portable parts, built natively and tested
+# with GoogleTest. DCOS_HOST_BUILD swaps port I/O for a recording mock.
+
+HOST_BUILD := $(BUILD)/host
+HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES)
+
+# Firmware sources with no hardware access of their own (chip drivers go
+# through the mocked port I/O).
+HOST_PORTABLE_SRCS := \
+	firmware/arch_x86/src/CpuException.cpp \
+	firmware/runtime/src/Int64Division.cpp \
+	firmware/runtime/src/Format.cpp \
+	firmware/boot/src/CommandLine.cpp \
+	$(wildcard firmware/shell/src/*.cpp) \
+	$(DCOS_PORTABLE_SRCS) \
+	firmware/bsp_486/src/Pic8259.cpp \
+	firmware/bsp_486/src/Pit8254.cpp \
+	firmware/bsp_486/src/Uart16550.cpp
+
+HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp)
+HOST_OBJS := $(patsubst %,$(HOST_BUILD)/%.o,$(HOST_PORTABLE_SRCS) $(HOST_TEST_SRCS))
+HOST_TEST_BINARY := $(HOST_BUILD)/unit_tests
+
+host-tests: $(HOST_TEST_BINARY)
+
+$(HOST_TEST_BINARY): $(HOST_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)g++ -o $@ $^ -lgtest -lgtest_main -pthread
+
+$(HOST_BUILD)/%.cpp.o: %.cpp
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)g++ $(HOST_CXXFLAGS) -c $< -o $@
+
+-include $(shell find $(HOST_BUILD) -name '*.d' 2>/dev/null)

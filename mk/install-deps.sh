@@ -1,0 +1,60 @@
+#!/bin/sh
+# Installs the Debian packages the build and the tests need, if any are
+# missing. Called by 'make run', 'make test' and 'make deps'; does nothing
+# when everything is present.
+set -eu
+
+# What each package is for, so the message says why it is installed.
+packages="
+g++:compiles the firmware and the host tools
+g++-multilib:gives g++ the 32-bit C++ headers the firmware is compiled against (its 32-bit libgcc is never linked)
+binutils:links the firmware and disassembles it for the i486 instruction check
+make:runs the build
+libgtest-dev:GoogleTest for the host unit tests
+qemu-system-x86:the emulator that runs the ISA 486 board (qemu-system-i386)
+qemu-system-data:option ROMs the emulator loads
+seabios:the BIOS image the emulated PC boots through
+python3-pytest:runs the emulator regression suite
+python3-pytest-xdist:runs emulator tests side by side
+python3-pexpect:drives the make-run console in its test
+"
+
+missing=""
+reasons=""
+old_ifs=$IFS
+IFS='
+'
+for entry in $packages; do
+    [ -n "$entry" ] || continue
+    name=${entry%%:*}
+    why=${entry#*:}
+    status=$(dpkg-query -W -f='${Status}' "$name" 2>/dev/null || true)
+    case "$status" in
+        *"install ok installed"*) ;;
+        *) missing="$missing $name"; reasons="$reasons  $name: $why
+" ;;
+    esac
+done
+IFS=$old_ifs
+
+[ -n "$missing" ] || exit 0
+
+echo "DCOS needs these Debian packages, which are not installed:"
+printf '%s' "$reasons"
+if [ "$(id -u)" -eq 0 ]; then
+    run=""
+elif command -v sudo >/dev/null 2>&1; then
+    run="sudo"
+    echo "Installing them with sudo."
+else
+    echo "error: not root and no sudo; install them with: apt-get install$missing" >&2
+    exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+# shellcheck disable=SC2086
+if ! $run apt-get install -y -q --no-install-recommends $missing; then
+    echo "Package lists may be stale; updating them and trying again."
+    $run apt-get update -q
+    # shellcheck disable=SC2086
+    $run apt-get install -y -q --no-install-recommends $missing
+fi

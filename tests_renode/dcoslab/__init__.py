@@ -1,0 +1,1 @@
+"""The DCOS emulator lab: board definitions and emulator control for the tests and `make run`."""

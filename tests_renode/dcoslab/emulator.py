@@ -1,0 +1,182 @@
+"""Runs one emulated board and talks to its console.
+
+The console is a Unix socket the emulator serves and waits on, so not a byte
+of early output is lost. Every wait has a time-out; when one expires the error
+carries the whole console transcript, which pytest prints with the failure.
+"""
+
+import os
+import re
+import socket
+import subprocess
+import tempfile
+import threading
+import time
+
+from .board import EXIT_PANIC, EXIT_FAIL, EXIT_PASS
+
+# Generous limits: these bound a hung emulator, they do not measure speed.
+DEFAULT_TIMEOUT = 60.0
+
+
+class EmulatorError(AssertionError):
+    """A console expectation or emulator exit that did not happen."""
+
+
+class Emulator:
+    def __init__(self, board, image, append="", icount=False):
+        self.board = board
+        self.image = image
+        self.append = append
+        self.icount = icount
+        self._workdir = tempfile.TemporaryDirectory(prefix="dcos-emulator-")
+        self._socket_path = os.path.join(self._workdir.name, "console.sock")
+        self._stderr_path = os.path.join(self._workdir.name, "emulator.stderr")
+        self._buffer = bytearray()
+        self._cursor = 0
+        self._condition = threading.Condition()
+        self._closed = False
+        self._process = None
+        self._socket = None
+        self._reader = None
+        self.argv = []
+
+    # -- life cycle ---------------------------------------------------------
+
+    def start(self, timeout=DEFAULT_TIMEOUT):
+        if not os.path.exists(self.image):
+            raise EmulatorError(f"firmware image {self.image} does not exist; run 'make firmware'")
+        backend = f"socket,id=console,path={self._socket_path},server=on,wait=on"
+        command = self.board.emulator_command(
+            self.image, {"console": "chardev:console"}, append=self.append, icount=self.icount
+        )
+        command[1:1] = ["-chardev", backend]
+        self.argv = command
+        with open(self._stderr_path, "wb") as stderr:
+            self._process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=stderr, stderr=stderr)
+        deadline = time.monotonic() + timeout
+        while True:
+            if self._process.poll() is not None:
+                raise EmulatorError(f"emulator exited at start with status {self._process.returncode}:\n"
+                                    + self.emulator_messages())
+            try:
+                sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+                sock.connect(self._socket_path)
+                break
+            except (FileNotFoundError, ConnectionRefusedError):
+                sock.close()
+                if time.monotonic() > deadline:
+                    raise EmulatorError("emulator console socket never appeared") from None
+                time.sleep(0.02)
+        self._socket = sock
+        self._reader = threading.Thread(target=self._read_console, daemon=True)
+        self._reader.start()
+        return self
+
+    def _read_console(self):
+        while True:
+            try:
+                data = self._socket.recv(4096)
+            except OSError:
+                data = b""
+            with self._condition:
+                if not data:
+                    self._closed = True
+                    self._condition.notify_all()
+                    return
+                self._buffer += data
+                self._condition.notify_all()
+
+    def close(self):
+        if self._process is not None and self._process.poll() is None:
+            self._process.kill()
+            self._process.wait(timeout=DEFAULT_TIMEOUT)
+        if self._socket is not None:
+            self._socket.close()
+        if self._reader is not None:
+            self._reader.join(timeout=5)
+        self._workdir.cleanup()
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.close()
+
+    # -- console ------------------------------------------------------------
+
+    @property
+    def transcript(self):
+        """Everything the console has printed so far."""
+        with self._condition:
+            return self._buffer.decode("latin-1")
+
+    def emulator_messages(self):
+        try:
+            with open(self._stderr_path, encoding="utf-8", errors="replace") as handle:
+                return handle.read()
+        except FileNotFoundError:
+            return ""
+
+    def _failure(self, what):
+        return EmulatorError(
+            f"{what}\n----- console transcript -----\n{self.transcript}\n----- end of transcript -----\n"
+            + (f"emulator said: {self.emulator_messages()}" if self.emulator_messages() else "")
+        )
+
+    def expect(self, pattern, timeout=DEFAULT_TIMEOUT):
+        """Waits for pattern (a regex) in the output after the previous match.
+
+        Returns the match object; its text is consumed, so the next expect
+        looks only at later output.
+        """
+        regex = re.compile(pattern.encode("latin-1") if isinstance(pattern, str) else pattern)
+        deadline = time.monotonic() + timeout
+        with self._condition:
+            while True:
+                match = regex.search(self._buffer, self._cursor)
+                if match:
+                    self._cursor = match.end()
+                    return match
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise self._failure(f"timed out after {timeout:.0f} s waiting for {pattern!r}")
+                if self._closed:
+                    raise self._failure(f"console closed while waiting for {pattern!r}")
+                self._condition.wait(min(remaining, 0.5))
+
+    def output_since_mark(self):
+        """The output after the last match that has not been consumed yet."""
+        with self._condition:
+            return self._buffer[self._cursor:].decode("latin-1")
+
+    def send(self, text):
+        """Types text on the console."""
+        self._socket.sendall(text.encode("latin-1"))
+
+    def command(self, line, prompt=r"dcos> ", timeout=DEFAULT_TIMEOUT):
+        """Runs one shell command and returns its output (without echo and prompt)."""
+        self.send(line + "\r")
+        self.expect(re.escape(line) + r"\r\n", timeout)
+        start = self._cursor
+        match = self.expect(prompt, timeout)
+        with self._condition:
+            return self._buffer[start:match.start()].decode("latin-1")
+
+    # -- exit ---------------------------------------------------------------
+
+    def wait_exit(self, timeout=DEFAULT_TIMEOUT):
+        """Waits for the emulator to end and returns its exit status."""
+        try:
+            return self._process.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            raise self._failure(f"emulator still running after {timeout:.0f} s") from None
+
+    def expect_exit(self, status, timeout=DEFAULT_TIMEOUT):
+        names = {EXIT_PASS: "pass", EXIT_FAIL: "fail", EXIT_PANIC: "panic"}
+        actual = self.wait_exit(timeout)
+        if actual != status:
+            raise self._failure(
+                f"emulator exit status {actual} ({names.get(actual, 'not a test result')}), "
+                f"expected {status} ({names.get(status, '?')})"
+            )

@@ -1,0 +1,72 @@
+#include "EmulatorExit.hpp"
+#include "TargetTest.hpp"
+
+#include <arch_x86/Cpu.hpp>
+#include <arch_x86/PortIo.hpp>
+#include <boot/Panic.hpp>
+
+namespace target_test {
+
+[[noreturn]] void exitEmulator(uint8_t code)
+{
+    arch_x86::disableInterrupts();
+    arch_x86::portWrite8(debugExitPort, code);
+    // Only reached when the device is missing: stop like a panic would.
+    for (;;) {
+        arch_x86::haltUntilInterrupt();
+    }
+}
+
+namespace {
+
+extern "C" const TargetTest __start_dcos_target_tests[];
+extern "C" const TargetTest __stop_dcos_target_tests[];
+
+bool sameText(const char* a, const char* b)
+{
+    while (*a != '\0' && *a == *b) {
+        ++a;
+        ++b;
+    }
+    return *a == *b;
+}
+
+shell::CommandResult runTest(shell::Shell& shell, int argc, char** argv)
+{
+    if (argc < 2 || argc > 3 || (argc == 3 && !sameText(argv[2], "--exit"))) {
+        return shell::CommandResult::UsageError;
+    }
+    if (sameText(argv[1], "list")) {
+        for (const TargetTest* test = __start_dcos_target_tests; test != __stop_dcos_target_tests; ++test) {
+            shell.print("  %-10s %s\r\n", test->name, test->summary);
+        }
+        return shell::CommandResult::Ok;
+    }
+    for (const TargetTest* test = __start_dcos_target_tests; test != __stop_dcos_target_tests; ++test) {
+        if (sameText(test->name, argv[1])) {
+            shell.print("TEST %s: start\r\n", test->name);
+            const bool passed = test->run(shell);
+            shell.print("TEST %s: %s\r\n", test->name, passed ? "PASS" : "FAIL");
+            if (argc == 3) {
+                exitEmulator(passed ? exitPass : exitFail);
+            }
+            return passed ? shell::CommandResult::Ok : shell::CommandResult::Failed;
+        }
+    }
+    shell.print("error: no target test '%s'; 'test list' shows them\r\n", argv[1]);
+    return shell::CommandResult::Failed;
+}
+
+} // namespace
+
+DCOS_SHELL_COMMAND(testCommand, "test", "run an on-target test (test image only)", "test list | test <name> [--exit]",
+                   runTest);
+
+} // namespace target_test
+
+// In the test image a panic also ends the emulator, so the harness sees it
+// at once instead of waiting for a time-out.
+extern "C" [[noreturn]] void dcosPanicHalt()
+{
+    target_test::exitEmulator(target_test::exitPanic);
+}

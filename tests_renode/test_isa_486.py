@@ -1,0 +1,76 @@
+"""The i486 instruction check: the 486 images pass it, and it catches what it must."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from dcoslab.board import REPOSITORY, load_board
+
+CHECKER = os.path.join(REPOSITORY, "host_tools", "isa_check", "check_i486.py")
+
+
+def run_checker(*paths):
+    return subprocess.run([sys.executable, CHECKER, *paths], capture_output=True, text=True, timeout=120)
+
+
+def assemble(tmp_path, name, source):
+    """Assembles a 32-bit object file from AT&T assembly."""
+    source_path = tmp_path / f"{name}.s"
+    object_path = tmp_path / f"{name}.o"
+    source_path.write_text(".text\n.globl crafted\ncrafted:\n" + source + "\n    ret\n")
+    subprocess.run(["as", "--32", str(source_path), "-o", str(object_path)], check=True, timeout=60)
+    return str(object_path)
+
+
+@pytest.mark.parametrize("kind", ["production", "test"])
+def test_486_images_hold_only_i486_instructions(kind):
+    board = load_board("isa486")
+    result = run_checker(board.image(kind))
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "i486 clean" in result.stdout
+
+
+def test_clean_object_passes(tmp_path):
+    obj = assemble(tmp_path, "clean", "    movl %eax, %ebx\n    bswap %ecx\n    cmpxchg %edx, (%esi)\n    xadd %eax, (%edi)\n    invlpg (%eax)\n    nop\n    fsqrt")
+    result = run_checker(obj)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+@pytest.mark.parametrize(
+    "instruction, reported",
+    [
+        ("cmovne %eax, %ebx", "cmovne"),
+        ("fcmovb %st(1), %st", "fcmovb"),
+        ("fcomi %st(1), %st", "fcomi"),
+        ("rdtsc", "rdtsc"),
+        ("rdpmc", "rdpmc"),
+        ("sysenter", "sysenter"),
+        ("cpuid", "cpuid"),
+        ("cmpxchg8b (%esi)", "cmpxchg8b"),
+        ("ud2", "ud2"),
+        ("nopl 0x0(%eax)", "long NOP"),
+        ("emms", "emms"),
+        ("movq %mm0, %mm1", "MMX/SSE register"),
+        ("movd %eax, %mm0", "MMX/SSE register"),
+        ("addps %xmm1, %xmm0", "MMX/SSE register"),
+        ("movaps (%eax), %xmm0", "MMX/SSE register"),
+        ("ldmxcsr (%eax)", "ldmxcsr"),
+        ("lfence", "lfence"),
+    ],
+)
+def test_post_486_instruction_is_rejected(tmp_path, instruction, reported):
+    obj = assemble(tmp_path, "crafted", f"    movl %eax, %ebx\n    {instruction}")
+    result = run_checker(obj)
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert "in crafted" in result.stdout
+    assert reported in result.stdout
+
+
+def test_unreadable_image_is_an_error_not_a_pass(tmp_path):
+    bogus = tmp_path / "not-an-elf"
+    bogus.write_text("hello")
+    result = run_checker(str(bogus))
+    assert result.returncode == 2
+    assert "cannot disassemble" in result.stderr

@@ -1,0 +1,36 @@
+"""`make run`'s launcher boots the production image with the console on a terminal."""
+
+import os
+import sys
+
+import pexpect
+
+from dcoslab.board import REPOSITORY
+
+LAUNCHER = os.path.join(REPOSITORY, "tests_renode", "launch.py")
+
+
+def test_launcher_gives_an_interactive_console():
+    # A pseudo-terminal, like the engineer's own terminal.
+    session = pexpect.spawn(sys.executable, [LAUNCHER, "--board", "isa486"], timeout=60, encoding="latin-1")
+    try:
+        session.expect(r"DCOS \d+\.\d+\.\d+ - Distributed Controller Operating System")
+        session.expect(r"dcos> ")
+        session.send("help\r")
+        session.expect(r"uptime +show the time")
+        session.expect(r"dcos> ")
+        # Ctrl-A X leaves the emulator, as the launcher says.
+        session.send("\x01x")
+        session.expect(pexpect.EOF)
+    except (pexpect.TIMEOUT, pexpect.EOF) as error:
+        raise AssertionError(f"launcher session failed: {error}\n----- console -----\n{session.before}") from None
+    finally:
+        session.close(force=True)
+
+
+def test_unknown_board_is_refused_with_the_list():
+    session = pexpect.spawn(sys.executable, [LAUNCHER, "--board", "vax"], timeout=60, encoding="latin-1")
+    session.expect(pexpect.EOF)
+    session.close()
+    assert "unknown board 'vax'; the boards are: isa486" in session.before
+    assert session.exitstatus != 0
