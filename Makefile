@@ -20,6 +20,7 @@ JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 
 include mk/firmware.mk
 include mk/host.mk
+include mk/bench.mk
 
 all: firmware host-tests
 
@@ -51,9 +52,11 @@ test-emulator: firmware
 	$(PYTHON) -m pytest -c tests_renode/pytest.ini tests_renode -n $(JOBS) \
 		--junitxml=$(BUILD)/reports/emulator-tests.xml
 
-bench:
-	@echo "make bench: no benchmarks yet. The timing tables (seed Tables 9.2-9.11) arrive with the"
-	@echo "memory, communication and synchronisation agents; see docs/performance.md when they do."
+# Builds the bench image and runs every benchmark on the board's benchmark CPU
+# with exact instruction counting; writes $(BENCH_REPORT).
+bench: deps
+	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH)
+	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board isa486 --output $(BENCH_REPORT)
 
 clean:
 	rm -rf $(BUILD)

@@ -19,6 +19,7 @@ FW_CXXFLAGS := -std=c++20 $(FW_ARCH_FLAGS) -O2 -g \
 	-ffreestanding -fno-pic -fno-pie -fno-exceptions -fno-rtti -fno-threadsafe-statics \
 	-fno-stack-protector -fno-asynchronous-unwind-tables -fno-unwind-tables \
 	-fno-omit-frame-pointer -fno-tree-loop-distribute-patterns -mgeneral-regs-only \
+	-fno-isolate-erroneous-paths-dereference -fno-isolate-erroneous-paths-attribute \
 	-Wall -Wextra -Werror -MMD -MP $(FW_INCLUDES)
 FW_ASFLAGS := $(FW_ARCH_FLAGS) -MMD -MP $(FW_INCLUDES)
 FW_LDFLAGS := -m elf_i386 -nostdlib -static -T firmware/boot/link.ld
@@ -32,7 +33,7 @@ FW_SRCS := \
 	$(wildcard firmware/boot/src/*.cpp firmware/boot/src/*.S) \
 	$(wildcard firmware/shell/src/*.cpp) \
 	$(DCOS_PORTABLE_SRCS) \
-	$(wildcard firmware/dcos/src/kernel/*.cpp) \
+	$(DCOS_TARGET_SRCS) \
 	$(wildcard firmware/bsp_486/src/*.cpp)
 
 # The on-target test suite, linked only into the test image.
@@ -57,12 +58,20 @@ $(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) firmware/boot/link.ld
 	@echo "  LD      $@"
 	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS)
 
-$(FW_BUILD)/%.cpp.o: %.cpp
+# Objects depend on the flags they were compiled with: a change of flags
+# rebuilds everything instead of linking stale objects.
+FW_FLAGS_STAMP := $(FW_BUILD)/flags.stamp
+$(FW_FLAGS_STAMP): FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(FW_CXXFLAGS) $(FW_ASFLAGS)' > $@.new
+	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+
+$(FW_BUILD)/%.cpp.o: %.cpp $(FW_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
 	$(Q)g++ $(FW_CXXFLAGS) -c $< -o $@
 
-$(FW_BUILD)/%.S.o: %.S
+$(FW_BUILD)/%.S.o: %.S $(FW_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
 	$(Q)g++ $(FW_ASFLAGS) -c $< -o $@

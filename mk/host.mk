@@ -28,7 +28,13 @@ $(HOST_TEST_BINARY): $(HOST_OBJS)
 	@echo "  CXX     $@"
 	$(Q)g++ -o $@ $^ -lgtest -lgtest_main -pthread
 
-$(HOST_BUILD)/%.cpp.o: %.cpp
+HOST_FLAGS_STAMP := $(HOST_BUILD)/flags.stamp
+$(HOST_FLAGS_STAMP): FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(HOST_CXXFLAGS)' > $@.new
+	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+
+$(HOST_BUILD)/%.cpp.o: %.cpp $(HOST_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
 	$(Q)g++ $(HOST_CXXFLAGS) -c $< -o $@

@@ -7,7 +7,7 @@ def test_divide_by_zero_reports_vector_0_with_registers(boot, isa486):
     emulator = boot(isa486, "test")
     emulator.expect(r"dcos> ")
     emulator.send("test divzero --exit\r")
-    emulator.expect(r"\*\*\* DCOS PANIC: unhandled CPU exception")
+    emulator.expect(r"\*\*\* DCOS PANIC: CPU exception in kernel context")
     emulator.expect(r"vector 0 \(#DE divide error\) error code 00000000")
     emulator.expect(r"EIP=[0-9a-f]{8} CS=0008 EFLAGS=[0-9a-f]{8} ESP=[0-9a-f]{8}")
     # The values the test loaded just before the faulting DIV.

@@ -10,7 +10,7 @@ PROMPT = r"dcos> "
 def test_banner_and_prompt(boot, isa486):
     emulator = boot(isa486)
     emulator.expect(r"DCOS \d+\.\d+\.\d+ - Distributed Controller Operating System\r\n")
-    emulator.expect(r"board isa486 \(i486DX\), \d+ KiB memory, tick 1000 Hz\r\n")
+    emulator.expect(r"board isa486 \(i486DX\), node 1, \d+ KiB memory, tick 1000 Hz\r\n")
     emulator.expect(PROMPT)
 
 

@@ -1,1 +1,14 @@
-DCOS_PORTABLE_SRCS := firmware/dcos/src/GregorianCalendar.cpp
+# Kernel sources with no hardware access: built for the host tests and the firmware.
+DCOS_PORTABLE_SRCS := \
+	firmware/dcos/src/GregorianCalendar.cpp \
+	firmware/dcos/src/ResourceRecovery.cpp \
+	$(wildcard firmware/dcos/src/system/DeviceManager.cpp) \
+	$(wildcard firmware/dcos/src/system/DeviceCommands.cpp)
+
+# Kernel sources that run only on the target: task switching, the tick, traps.
+DCOS_TARGET_SRCS := \
+	$(wildcard firmware/dcos/src/kernel/*.cpp) \
+	$(wildcard firmware/dcos/src/task/*.cpp firmware/dcos/src/task/*.S) \
+	$(wildcard firmware/dcos/src/scheduler/*.cpp) \
+	$(wildcard firmware/dcos/src/timer/*.cpp) \
+	firmware/dcos/src/system/InterruptManager.cpp

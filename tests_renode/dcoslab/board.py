@@ -37,18 +37,19 @@ class Board:
         """Absolute path of the board's firmware image of the given kind."""
         return os.path.join(REPOSITORY, self.images[kind])
 
-    def emulator_command(self, image, serial_backends, append="", icount=False):
+    def emulator_command(self, image, serial_backends, append="", icount=False, cpu=None):
         """The emulator argv for image, with one chardev argument per serial port.
 
         serial_backends maps each name in serial_ports to a QEMU -serial value
-        (for example "mon:stdio" or "chardev:console").
+        (for example "mon:stdio" or "chardev:console"). cpu replaces the
+        board's CPU model (the bench image runs on benchmark_cpu).
         """
         command = [self.emulator]
         for path in self.bios_paths:
             command += ["-L", path]
         command += [
             "-M", self.machine,
-            "-cpu", self.cpu,
+            "-cpu", cpu or self.cpu,
             "-m", str(self.memory_mib),
             "-kernel", image,
             "-display", "none",

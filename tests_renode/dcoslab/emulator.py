@@ -24,11 +24,12 @@ class EmulatorError(AssertionError):
 
 
 class Emulator:
-    def __init__(self, board, image, append="", icount=False):
+    def __init__(self, board, image, append="", icount=False, cpu=None):
         self.board = board
         self.image = image
         self.append = append
         self.icount = icount
+        self.cpu = cpu  # None: the board's own CPU model
         self._workdir = tempfile.TemporaryDirectory(prefix="dcos-emulator-")
         self._socket_path = os.path.join(self._workdir.name, "console.sock")
         self._stderr_path = os.path.join(self._workdir.name, "emulator.stderr")
@@ -48,7 +49,7 @@ class Emulator:
             raise EmulatorError(f"firmware image {self.image} does not exist; run 'make firmware'")
         backend = f"socket,id=console,path={self._socket_path},server=on,wait=on"
         command = self.board.emulator_command(
-            self.image, {"console": "chardev:console"}, append=self.append, icount=self.icount
+            self.image, {"console": "chardev:console"}, append=self.append, icount=self.icount, cpu=self.cpu
         )
         command[1:1] = ["-chardev", backend]
         self.argv = command

@@ -4,11 +4,14 @@
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/PortIo.hpp>
 #include <boot/Panic.hpp>
+#include <bsp/Board.hpp>
 
 namespace target_test {
 
 [[noreturn]] void exitEmulator(uint8_t code)
 {
+    // Everything printed must be on the line before the emulator goes.
+    bsp::consoleFlush();
     arch_x86::disableInterrupts();
     arch_x86::portWrite8(debugExitPort, code);
     // Only reached when the device is missing: stop like a panic would.

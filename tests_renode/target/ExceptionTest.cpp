@@ -1,11 +1,21 @@
-// Deliberate CPU exceptions, to check the panic report.
+// Deliberate CPU exceptions in kernel context, to check the panic report.
+//
+// A divide error in a task is that task's exception (the task agent's
+// tests cover it); in an interrupt handler it is a kernel fault, which must
+// stop the node with a full report.
 #include "TargetTest.hpp"
+
+#include <dcos/SystemAgent.hpp>
 
 namespace {
 
+// An interrupt line no device uses on the emulated board; the test raises
+// its vector with a software interrupt.
+constexpr unsigned spareLine = 5;
+
 // Divides by zero with known values in the general registers, so the test
 // can check that the report shows the state at the faulting instruction.
-bool divideByZero(shell::Shell&)
+void divideByZeroInInterrupt(void*)
 {
     asm volatile(
         "movl $0xC0FFEE00, %%eax\n\t"
@@ -17,9 +27,20 @@ bool divideByZero(shell::Shell&)
         :
         :
         : "eax", "ebx", "ecx", "edx", "esi", "memory", "cc");
-    return false; // Not reached: #DE ends in the panic report.
+}
+
+bool divideByZero(shell::Shell& shell)
+{
+    const dcos::Status status = dcos::systemAgent.InstallISR(spareLine, divideByZeroInInterrupt, nullptr);
+    if (status != dcos::Status::Ok) {
+        shell.print("cannot install the test ISR: %s\r\n", dcos::statusName(status));
+        return false;
+    }
+    asm volatile("int $0x25" ::: "memory"); // IRQ 5's vector: 0x20 + 5.
+    return false; // Not reached: #DE in a handler ends in the panic report.
 }
 
 } // namespace
 
-DCOS_TARGET_TEST(divideByZeroTest, "divzero", "divide by zero: the panic report must show vector 0", divideByZero);
+DCOS_TARGET_TEST(divideByZeroTest, "divzero", "divide by zero in an ISR: the panic report must show vector 0",
+                 divideByZero);

@@ -4,7 +4,7 @@
 
 #include <arch_x86/Cpu.hpp>
 #include <bsp/Board.hpp>
-#include <dcos/internal/SystemTick.hpp>
+#include <dcos/internal/TimerManager.hpp>
 
 namespace {
 
@@ -15,7 +15,7 @@ constexpr uint32_t spinLimit = 200000000;
 bool maskedTickDoesNotArrive(shell::Shell& shell)
 {
     bsp::maskInterrupt(bsp::systemTickLine);
-    const uint64_t before = dcos::SystemTick::count();
+    const uint64_t before = dcos::internal::TimerManager::ticks();
 
     // Wait (interrupts enabled) until the timer has raised its request.
     uint32_t spins = 0;
@@ -27,14 +27,14 @@ bool maskedTickDoesNotArrive(shell::Shell& shell)
     for (uint32_t i = 0; i < 200000; ++i) {
         asm volatile("" ::: "memory"); // Keeps the delay loop from being optimised away.
     }
-    const uint64_t whileMasked = dcos::SystemTick::count();
+    const uint64_t whileMasked = dcos::internal::TimerManager::ticks();
 
     bsp::unmaskInterrupt(bsp::systemTickLine);
     // The pending request is delivered now; wait for it with a bound.
-    uint64_t afterUnmask = dcos::SystemTick::count();
+    uint64_t afterUnmask = dcos::internal::TimerManager::ticks();
     for (unsigned i = 0; i < 1000 && afterUnmask == whileMasked; ++i) {
         arch_x86::haltUntilInterrupt();
-        afterUnmask = dcos::SystemTick::count();
+        afterUnmask = dcos::internal::TimerManager::ticks();
     }
     shell.print("masked: request pending %s, ticks before %llu, while masked %llu, after unmask %llu\r\n",
                 requested ? "yes" : "no", static_cast<unsigned long long>(before),

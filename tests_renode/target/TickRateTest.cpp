@@ -9,7 +9,7 @@
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/PortIo.hpp>
 #include <bsp/Board.hpp>
-#include <dcos/internal/SystemTick.hpp>
+#include <dcos/internal/TimerManager.hpp>
 
 namespace {
 
@@ -43,7 +43,7 @@ uint64_t waitForSecondsEdge()
     for (;;) {
         arch_x86::haltUntilInterrupt();
         if (readSeconds() != start) {
-            return dcos::SystemTick::count();
+            return dcos::internal::TimerManager::ticks();
         }
     }
 }

@@ -35,8 +35,12 @@ InterruptFrame* unhandled(InterruptFrame* frame)
     dcosPanicWithFrame(frame, "no handler for this vector");
 }
 
+InterruptFrame* unchanged(InterruptFrame* frame) { return frame; }
+
 Idt::Handler exceptionHandler = unhandled;
 Idt::Handler interruptHandler = unhandled;
+Idt::Handler trapHandler = unhandled;
+Idt::Handler outermostExitHook = unchanged;
 volatile unsigned depth = 0;
 
 } // namespace
@@ -56,6 +60,10 @@ void Idt::setExceptionHandler(Handler handler) { exceptionHandler = handler; }
 
 void Idt::setInterruptHandler(Handler handler) { interruptHandler = handler; }
 
+void Idt::setTrapHandler(Handler handler) { trapHandler = handler; }
+
+void Idt::setOutermostExitHook(Handler hook) { outermostExitHook = hook; }
+
 unsigned Idt::nestingDepth() { return depth; }
 
 } // namespace arch_x86
@@ -65,7 +73,18 @@ extern "C" arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* fr
 {
     using namespace arch_x86;
     depth = depth + 1;
-    InterruptFrame* resume = frame->vector < exceptionVectorCount ? exceptionHandler(frame) : interruptHandler(frame);
+    const uint32_t vector = frame->vector;
+    InterruptFrame* resume;
+    if (vector < exceptionVectorCount) {
+        resume = exceptionHandler(frame);
+    } else if (vector >= Idt::firstTrapVector && vector <= Idt::lastTrapVector) {
+        resume = trapHandler(frame);
+    } else {
+        resume = interruptHandler(frame);
+    }
+    if (depth == 1) {
+        resume = outermostExitHook(resume);
+    }
     depth = depth - 1;
     return resume;
 }

@@ -40,6 +40,7 @@ interrupt_common:
     pushl %esp                  /* InterruptFrame* argument */
     call interruptEntry
     movl %eax, %esp             /* Resume the frame the dispatcher chose. */
+interrupt_return:
     popl %gs
     popl %fs
     popl %es
@@ -50,6 +51,15 @@ interrupt_common:
 
     /* .altmacro makes %vector pass the counter's value, not its name. */
     .altmacro
+/*
+ * void resumeInterruptFrame(InterruptFrame* frame): starts the first task by
+ * "returning" into its initial frame; never returns.
+ */
+    .globl resumeInterruptFrame
+resumeInterruptFrame:
+    movl 4(%esp), %esp
+    jmp interrupt_return
+
     .set vector, 0
     .rept 256
     VECTOR_STUB %vector

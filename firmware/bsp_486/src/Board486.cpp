@@ -32,6 +32,16 @@ struct Attachment {
 Attachment attachments[interruptLineCount];
 uint32_t unexpected[interruptLineCount];
 uint32_t spurious;
+uint16_t node = 1;
+
+// Interrupt level of each line: the 8259A pair's fixed priority order in
+// fully nested mode, IRQ 0, 1, then the slave's 8-15 (through IR2), then 3-7.
+// The cascade line 2 has no level of its own.
+constexpr uint8_t levelOfLine[interruptLineCount] = {0, 1, 0xFF, 10, 11, 12, 13, 14, 2, 3, 4, 5, 6, 7, 8, 9};
+
+// 1e9 / 1193182 Hz is 838.0958 ns per count; scaled by 64 it fits a 32-bit
+// product for any 16-bit count.
+constexpr uint32_t nanosecondsPerCountTimes64 = 53638;
 
 const BoardIdentity board{"isa486", "i486DX"};
 
@@ -61,7 +71,11 @@ arch_x86::InterruptFrame* dispatchInterrupt(arch_x86::InterruptFrame* frame)
     }
     const Attachment& attachment = attachments[line];
     if (attachment.handler != nullptr) {
+        // The 8259A holds back this line and every less urgent one until the
+        // EOI below, so enabling interrupts lets only more urgent lines nest.
+        arch_x86::enableInterrupts();
         attachment.handler(attachment.context);
+        arch_x86::disableInterrupts();
     } else {
         // Nobody owns this line: mask it so it cannot storm, and count it.
         ++unexpected[line];
@@ -77,6 +91,20 @@ const BoardIdentity& identity() { return board; }
 
 void initialise(const boot::BootInfo& bootInfo)
 {
+    char nodeText[8];
+    if (boot::findCommandLineOption(bootInfo.commandLine, "node", nodeText, sizeof nodeText)) {
+        uint32_t value = 0;
+        bool valid = nodeText[0] != '\0';
+        for (const char* p = nodeText; *p != '\0' && valid; ++p) {
+            valid = *p >= '0' && *p <= '9' && p - nodeText < 5;
+            value = value * 10 + static_cast<uint32_t>(*p - '0');
+        }
+        if (valid && value >= 1 && value <= 0xFFFE) {
+            node = static_cast<uint16_t>(value);
+        } else {
+            runtime::format(uart, "warning: node=%s is not a node id from 1 to 65534; using 1\r\n", nodeText);
+        }
+    }
     pic.initialise(static_cast<uint8_t>(arch_x86::firstIrqVector));
     arch_x86::Idt::setInterruptHandler(dispatchInterrupt);
 
@@ -163,11 +191,47 @@ uint32_t tickRateHz() { return pit.requestedRateHz(); }
 
 uint64_t tickPeriodNanoseconds() { return pit.tickPeriodNanoseconds(); }
 
+uint32_t nanosecondsIntoTick()
+{
+    const uint16_t divisor = pit.divisor();
+    if (divisor == 0) {
+        return 0;
+    }
+    const uint16_t count = pit.readCount();
+    uint32_t elapsed = count <= divisor ? static_cast<uint32_t>(divisor - count) : 0;
+    // A tick that has happened but is not serviced yet (interrupts are off)
+    // shows as a request: the count has already started the next period.
+    if ((pic.readRequestRegister() & (1u << systemTickLine)) != 0 && elapsed < divisor / 2u) {
+        elapsed += divisor;
+    }
+    return static_cast<uint32_t>((uint64_t{elapsed} * nanosecondsPerCountTimes64) >> 6);
+}
+
+uint8_t interruptLevelOf(unsigned line) { return line < interruptLineCount ? levelOfLine[line] : 0xFF; }
+
+void setTaskInterruptLevel(uint8_t level)
+{
+    uint16_t overlay = 0;
+    for (unsigned line = 0; line < interruptLineCount; ++line) {
+        const uint8_t lineLevel = levelOfLine[line];
+        if (lineLevel != 0 && lineLevel != 0xFF && lineLevel >= level) {
+            overlay = static_cast<uint16_t>(overlay | (1u << line));
+        }
+    }
+    pic.setOverlayMask(overlay);
+}
+
+uint16_t nodeId() { return node; }
+
 runtime::CharacterSink& console() { return uart; }
 
 bool consoleRead(char& character) { return uart.read(character); }
 
 bool consoleHasInput() { return uart.hasInput(); }
+
+void consoleFlush() { uart.flush(); }
+
+void setConsoleInputNotifier(InterruptHandler notifier, void* context) { uart.setReceiveNotifier(notifier, context); }
 
 } // namespace bsp
 

@@ -20,8 +20,19 @@ void Pic8259::initialise(uint8_t vectorBase)
 
 void Pic8259::writeMask()
 {
-    master_.write8(dataRegister, static_cast<uint8_t>(maskBits_ & 0xFF)); // OCW1
-    slave_.write8(dataRegister, static_cast<uint8_t>(maskBits_ >> 8));    // OCW1
+    const uint16_t combined = static_cast<uint16_t>(maskBits_ | overlayBits_);
+    master_.write8(dataRegister, static_cast<uint8_t>(combined & 0xFF)); // OCW1
+    slave_.write8(dataRegister, static_cast<uint8_t>(combined >> 8));    // OCW1
+}
+
+void Pic8259::setOverlayMask(uint16_t overlay)
+{
+    // The cascade input must stay open or no slave line gets through.
+    overlay = static_cast<uint16_t>(overlay & ~(1u << cascadeLine));
+    if (overlay != overlayBits_) {
+        overlayBits_ = overlay;
+        writeMask();
+    }
 }
 
 void Pic8259::mask(unsigned line)

@@ -88,6 +88,15 @@ void Uart16550::serviceTransmit()
 
 void Uart16550::handleInterrupt()
 {
+    const size_t receivedBefore = receiveRing_.size();
+    serviceEvents();
+    if (receiveNotifier_ != nullptr && receiveRing_.size() != receivedBefore) {
+        receiveNotifier_(receiveNotifierContext_);
+    }
+}
+
+void Uart16550::serviceEvents()
+{
     for (unsigned event = 0; event < maximumEventsPerInterrupt; ++event) {
         const uint8_t ident = window_.read8(interruptIdentRegister);
         if ((ident & iirNoInterruptPending) != 0) {
@@ -157,6 +166,20 @@ void Uart16550::put(char character)
     }
     if ((interruptEnable_ & ierTransmitterEmpty) == 0) {
         enableInterruptBits(ierTransmitterEmpty);
+    }
+}
+
+void Uart16550::flush()
+{
+    arch_x86::InterruptGuard guard;
+    char queued;
+    while (transmitRing_.pop(queued)) {
+        writeByteWhenReady(queued);
+    }
+    for (uint32_t poll = 0; poll < maximumFlushPolls; ++poll) {
+        if ((window_.read8(lineStatusRegister) & lsrTransmitterEmpty) != 0) {
+            return;
+        }
     }
 }
 

@@ -23,8 +23,22 @@ public:
     /// Sets the handler for the CPU exception vectors 0-31.
     static void setExceptionHandler(Handler handler);
 
-    /// Sets the handler for vectors 32-255 (hardware and software interrupts).
+    /// Sets the handler for vectors 32-255 (hardware and software interrupts)
+    /// outside the kernel trap range.
     static void setInterruptHandler(Handler handler);
+
+    /// The vectors software traps into the kernel use (int 0x30-0x3F).
+    static constexpr unsigned firstTrapVector = 0x30;
+    static constexpr unsigned lastTrapVector = 0x3F;
+
+    /// Sets the handler for the kernel trap vectors.
+    static void setTrapHandler(Handler handler);
+
+    /// Sets the function run when the outermost interrupt handler is about
+    /// to return. It receives the frame to resume and returns the frame to
+    /// resume instead: this is where the scheduler switches tasks, so that
+    /// nested handlers never dispatch.
+    static void setOutermostExitHook(Handler hook);
 
     /// The current nesting depth of interrupt handlers (0 in task context).
     static unsigned nestingDepth();

@@ -66,9 +66,36 @@ uint32_t spuriousInterruptCount();
 uint32_t tickRateHz();
 uint64_t tickPeriodNanoseconds();
 
+/// Nanoseconds elapsed since the last tick, read from the tick timer, for
+/// time measurements finer than a tick. Call with interrupts disabled.
+uint32_t nanosecondsIntoTick();
+
+/// Number of interrupt levels (seed 7.3.3). Level 0 is the system tick, which
+/// cannot be masked; a larger number is a lower priority.
+constexpr unsigned interruptLevelCount = 15;
+
+/// The interrupt level of a line.
+uint8_t interruptLevelOf(unsigned line);
+
+/// Holds off every line of the given level or below it in priority (a
+/// larger level number), on top of the lines masked for lack of a handler.
+/// 0xFF masks nothing. Applied at every task switch.
+void setTaskInterruptLevel(uint8_t level);
+
+/// This controller's node id (16 bits, never 0 or 0xFFFF), from "node=N"
+/// on the command line, 1 by default.
+uint16_t nodeId();
+
 /// The console: output (waits while its buffer is full) and input.
 runtime::CharacterSink& console();
 bool consoleRead(char& character);
 bool consoleHasInput();
+
+/// Waits until everything queued for the console has left the UART.
+void consoleFlush();
+
+/// Called from the console interrupt after bytes arrive, so a task can
+/// sleep until there is input instead of polling.
+void setConsoleInputNotifier(InterruptHandler notifier, void* context);
 
 } // namespace bsp

@@ -53,6 +53,10 @@ public:
     /// The 16-bit interrupt mask (bit n set = IRQ n masked).
     uint16_t maskBits() const { return maskBits_; }
 
+    /// Masks further lines on top of mask(), without changing what mask()
+    /// recorded: the running task's interrupt level uses it.
+    void setOverlayMask(uint16_t overlay);
+
     /// The 16-bit interrupt request register: lines asserting a request.
     uint16_t readRequestRegister() const;
     /// The 16-bit in-service register: lines being serviced.
@@ -73,6 +77,7 @@ private:
     arch_x86::IoWindow master_;
     arch_x86::IoWindow slave_;
     uint16_t maskBits_ = 0xFFFF;
+    uint16_t overlayBits_ = 0;
 };
 
 } // namespace bsp

@@ -68,6 +68,10 @@ public:
     static constexpr uint8_t lsrFramingError = 1u << 3;
     static constexpr uint8_t lsrBreak = 1u << 4;
     static constexpr uint8_t lsrTransmitterHoldingEmpty = 1u << 5; // THRE
+    static constexpr uint8_t lsrTransmitterEmpty = 1u << 6;        // TEMT
+    /// Bound on polls of the line status while flushing: far longer than a
+    /// byte takes at any baud rate, so only a dead UART reaches it.
+    static constexpr uint32_t maximumFlushPolls = 1000000;
 
     /// The 16550's transmit FIFO depth: bytes that may be written per THRE.
     static constexpr unsigned transmitFifoDepth = 16;
@@ -114,11 +118,22 @@ public:
     /// With interrupts disabled it drains the ring by polling instead.
     void put(char character) override;
 
+    /// Drains the transmit ring by polling and waits until the transmitter
+    /// shift register is empty, so the last byte is on the line.
+    void flush();
+
     /// Writes a byte by polling, first draining whatever is queued so the
     /// output stays in order. For the panic path, where interrupts are off.
     void putPolled(char character);
 
     const Statistics& statistics() const { return statistics_; }
+
+    /// Sets a function the interrupt handler calls after storing received bytes.
+    void setReceiveNotifier(void (*notifier)(void*), void* context)
+    {
+        receiveNotifier_ = notifier;
+        receiveNotifierContext_ = context;
+    }
 
 private:
     void writeByteWhenReady(char character);
@@ -126,12 +141,15 @@ private:
     void disableInterruptBits(uint8_t bits);
     void serviceReceive();
     void serviceTransmit();
+    void serviceEvents();
 
     arch_x86::IoWindow window_;
     runtime::RingBuffer<char, receiveRingSize> receiveRing_;
     runtime::RingBuffer<char, transmitRingSize> transmitRing_;
     volatile uint8_t interruptEnable_ = 0;
     Statistics statistics_{};
+    void (*receiveNotifier_)(void*) = nullptr;
+    void* receiveNotifierContext_ = nullptr;
 };
 
 } // namespace bsp

@@ -33,6 +33,7 @@ enum class Status : uint8_t {
     Deadlock = 17,        ///< The request would deadlock the caller (e.g. re-acquiring).
     NotSupported = 18,    ///< The device or object does not implement the request.
     Remote = 19,          ///< The id names an object on another node and no network is up.
+    NotOpen = 20,         ///< The device must be opened first (Read, Write, Control, Close).
 };
 
 /// Returns a short, stable English name for a status, for logs and the shell.
@@ -59,6 +60,7 @@ constexpr const char* statusName(Status status)
     case Status::Deadlock: return "would deadlock";
     case Status::NotSupported: return "not supported";
     case Status::Remote: return "remote object unreachable";
+    case Status::NotOpen: return "device not open";
     }
     return "unknown status";
 }

@@ -1,9 +1,14 @@
-// The loader-independent kernel entry and the node's idle loop.
+// The loader-independent kernel entry.
 //
-// kernelMain brings up the board, starts the system tick, prints the banner
-// and serves the console. The scheduler issue turns the console loop into
-// the shell task and this loop into the idle task.
+// kernelMain brings up the board, the timer agent and the task agent, then
+// starts scheduling. From then on the boot stack is abandoned: the console
+// shell runs as the root task, and the idle task halts the CPU whenever no
+// other task is ready.
+#include <dcos/TaskAgent.hpp>
 #include <dcos/Version.hpp>
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/TimerManager.hpp>
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/Idt.hpp>
@@ -11,8 +16,6 @@
 #include <boot/Panic.hpp>
 #include <bsp/Board.hpp>
 #include <shell/Shell.hpp>
-
-#include <dcos/internal/SystemTick.hpp>
 
 namespace dcos {
 
@@ -26,12 +29,40 @@ namespace {
 // The kernel's memory facts, kept for the 'mem' command.
 boot::BootInfo bootInfoCopy;
 
-arch_x86::InterruptFrame* unhandledException(arch_x86::InterruptFrame* frame)
+// The shell task sleeps on this event until the console has input.
+constexpr uint32_t consoleInputEvent = 1u << 0;
+ObjectId shellTask;
+
+void onConsoleInput(void*) { taskAgent.PostEvent(shellTask, consoleInputEvent); }
+
+void onSystemTick(void*) { internal::TimerManager::onTick(); }
+
+void shellTaskEntry(uintptr_t)
 {
-    dcosPanicWithFrame(frame, "unhandled CPU exception in kernel");
+    shellTask = taskAgent.IdOfSelf();
+    bsp::setConsoleInputNotifier(onConsoleInput, nullptr);
+    static shell::Shell shell(bsp::console(), "dcos> ");
+    shell.start();
+    for (;;) {
+        char character;
+        while (bsp::consoleRead(character)) {
+            shell.feed(character);
+        }
+        taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
+    }
 }
 
-void onSystemTick(void*) { SystemTick::advance(); }
+// CR0.NE (Intel SDM Vol. 3, 2.5): report x87 errors as #MF (vector 16) to
+// the task that caused them, rather than through the PC's IRQ 13 path.
+constexpr uint32_t cr0NumericError = 1u << 5;
+
+void enableNativeFpuErrors()
+{
+    uint32_t cr0;
+    asm volatile("movl %%cr0, %0" : "=r"(cr0));
+    asm volatile("movl %0, %%cr0" : : "r"(cr0 | cr0NumericError));
+    asm volatile("fninit");
+}
 
 } // namespace
 
@@ -41,35 +72,29 @@ const boot::BootInfo& bootInfo() { return bootInfoCopy; }
 
 [[noreturn]] void kernelMain(const boot::BootInfo& bootInfo)
 {
-    dcos::bootInfoCopy = bootInfo;
-    arch_x86::Idt::setExceptionHandler(dcos::unhandledException);
+    using namespace dcos;
+    bootInfoCopy = bootInfo;
+    enableNativeFpuErrors();
+    arch_x86::Idt::setExceptionHandler(internal::TaskManager::onCpuException);
+    arch_x86::Idt::setTrapHandler(internal::TaskManager::onTrap);
+    arch_x86::Idt::setOutermostExitHook(internal::Scheduler::onOutermostExit);
     bsp::initialise(bootInfo);
-    if (bsp::attachInterrupt(bsp::systemTickLine, dcos::onSystemTick, nullptr) != dcos::Status::Ok) {
+    internal::TimerManager::initialise(bsp::tickPeriodNanoseconds());
+    if (bsp::attachInterrupt(bsp::systemTickLine, onSystemTick, nullptr) != Status::Ok) {
         dcosPanic("cannot attach the system tick");
     }
 
     const bsp::BoardIdentity& board = bsp::identity();
     runtime::CharacterSink& console = bsp::console();
-    runtime::format(console, "\r\nDCOS %s - Distributed Controller Operating System\r\n", dcos::versionString);
-    runtime::format(console, "board %s (%s), %lu KiB memory, tick %lu Hz\r\n", board.name, board.processor,
+    runtime::format(console, "\r\nDCOS %s - Distributed Controller Operating System\r\n", versionString);
+    runtime::format(console, "board %s (%s), node %u, %lu KiB memory, tick %lu Hz\r\n", board.name, board.processor,
+                    static_cast<unsigned>(bsp::nodeId()),
                     static_cast<unsigned long>(bootInfo.lowerMemoryKib + bootInfo.upperMemoryKib),
                     static_cast<unsigned long>(bsp::tickRateHz()));
     if (bootInfo.commandLine[0] != '\0') {
         runtime::format(console, "command line: %s\r\n", bootInfo.commandLine);
     }
 
-    static shell::Shell shell(console, "dcos> ");
-    arch_x86::enableInterrupts();
-    shell.start();
-    for (;;) {
-        char character;
-        arch_x86::disableInterrupts();
-        if (!bsp::consoleRead(character)) {
-            // Sleep until the next interrupt; see enableInterruptsAndHalt().
-            arch_x86::enableInterruptsAndHalt();
-            continue;
-        }
-        arch_x86::enableInterrupts();
-        shell.feed(character);
-    }
+    internal::TaskManager::initialise(shellTaskEntry);
+    internal::Scheduler::start();
 }

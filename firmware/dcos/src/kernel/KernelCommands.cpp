@@ -5,7 +5,12 @@
 #include <bsp/Board.hpp>
 #include <shell/Shell.hpp>
 
-#include <dcos/internal/SystemTick.hpp>
+#include <dcos/GregorianCalendar.hpp>
+#include <dcos/TimerAgent.hpp>
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/StackArena.hpp>
+#include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/TimerManager.hpp>
 
 namespace dcos {
 
@@ -31,8 +36,8 @@ shell::CommandResult uptime(shell::Shell& shell, int argc, char**)
     if (argc != 1) {
         return shell::CommandResult::UsageError;
     }
-    const uint64_t ticks = SystemTick::count();
-    const uint64_t nanoseconds = ticks * bsp::tickPeriodNanoseconds();
+    const uint64_t ticks = internal::TimerManager::ticks();
+    const uint64_t nanoseconds = internal::TimerManager::uptimeNs();
     const uint64_t milliseconds = nanoseconds / 1000000u;
     const uint64_t seconds = milliseconds / 1000u;
     shell.print("up %lu d %02lu:%02lu:%02lu.%03lu (%llu ticks at %lu Hz)\r\n",
@@ -71,8 +76,104 @@ shell::CommandResult mem(shell::Shell& shell, int argc, char**)
     return shell::CommandResult::Ok;
 }
 
+const char* stateName(TaskState state)
+{
+    switch (state) {
+    case TaskState::NonExistent: return "gone";
+    case TaskState::Spawning: return "spawning";
+    case TaskState::Ready: return "ready";
+    case TaskState::Executing: return "executing";
+    case TaskState::Blocked: return "blocked";
+    case TaskState::Suspended: return "suspended";
+    case TaskState::Terminating: return "terminating";
+    }
+    return "?";
+}
+
+shell::CommandResult tasks(shell::Shell& shell, int argc, char**)
+{
+    if (argc != 1) {
+        return shell::CommandResult::UsageError;
+    }
+    shell.print("id         name             prio state      stack  flags\r\n");
+    internal::TaskManager::forEachTask([&shell](internal::Task& task) {
+        const Result<TaskState> state = taskAgent.GetState(task.id);
+        shell.print("%08lx   %-16s %4u %-10s %6lu %s%s%s%s\r\n", static_cast<unsigned long>(task.id.raw()),
+                    internal::TaskManager::nameOf(task.id), task.basePriority,
+                    state.ok() ? stateName(state.value()) : "?", static_cast<unsigned long>(task.stackSize),
+                    task.superUser ? "S" : "-", task.timeSlicing ? "T" : "-", task.floatingPoint ? "F" : "-",
+                    task.inDeadlineScope ? "D" : "-");
+    });
+    shell.print("%lu tasks, %lu task switches, stack arena %lu bytes free\r\n",
+                static_cast<unsigned long>(internal::TaskManager::taskCount()),
+                static_cast<unsigned long>(internal::Scheduler::switchCount()),
+                static_cast<unsigned long>(internal::StackArena::freeBytes()));
+    return shell::CommandResult::Ok;
+}
+
+// Parses "YYYY-MM-DD" and "HH:MM:SS" into a DateTime; false on any other text.
+bool parseDateTime(const char* date, const char* time, DateTime& out)
+{
+    unsigned fields[6] = {};
+    const char* texts[2] = {date, time};
+    const char separators[2] = {'-', ':'};
+    for (unsigned part = 0; part < 2; ++part) {
+        const char* p = texts[part];
+        for (unsigned field = 0; field < 3; ++field) {
+            unsigned value = 0;
+            unsigned digits = 0;
+            while (*p >= '0' && *p <= '9' && digits < 4) {
+                value = value * 10 + static_cast<unsigned>(*p - '0');
+                ++p;
+                ++digits;
+            }
+            if (digits == 0 || (field < 2 ? *p != separators[part] : *p != '\0')) {
+                return false;
+            }
+            if (field < 2) {
+                ++p;
+            }
+            fields[part * 3 + field] = value;
+        }
+    }
+    out = DateTime{};
+    out.year = static_cast<uint16_t>(fields[0]);
+    out.month = static_cast<uint8_t>(fields[1]);
+    out.day = static_cast<uint8_t>(fields[2]);
+    out.hour = static_cast<uint8_t>(fields[3]);
+    out.minute = static_cast<uint8_t>(fields[4]);
+    out.second = static_cast<uint8_t>(fields[5]);
+    return fields[1] <= 255 && fields[2] <= 255 && fields[3] <= 255 && fields[4] <= 255 && fields[5] <= 255;
+}
+
+shell::CommandResult date(shell::Shell& shell, int argc, char** argv)
+{
+    if (argc != 1 && argc != 3) {
+        return shell::CommandResult::UsageError;
+    }
+    if (argc == 3) {
+        DateTime time;
+        if (!parseDateTime(argv[1], argv[2], time)) {
+            return shell::CommandResult::UsageError;
+        }
+        const Status status = timerAgent.SetSystemClock(time);
+        if (status != Status::Ok) {
+            shell.print("error: cannot set the clock: %s\r\n", statusName(status));
+            return shell::CommandResult::Failed;
+        }
+    }
+    const Result<DateTime> now = timerAgent.GetSystemClock();
+    static constexpr const char* weekdays[] = {"Sun", "Mon", "Tue", "Wed", "Thu", "Fri", "Sat"};
+    const DateTime& t = now.value();
+    shell.print("%s %04u-%02u-%02u %02u:%02u:%02u.%03lu\r\n", weekdays[static_cast<unsigned>(t.weekday) % 7], t.year,
+                t.month, t.day, t.hour, t.minute, t.second, static_cast<unsigned long>(t.nanosecond / 1000000u));
+    return shell::CommandResult::Ok;
+}
+
 } // namespace
 
+DCOS_SHELL_COMMAND(tasksCommand, "tasks", "list the tasks and their states", "tasks", tasks);
+DCOS_SHELL_COMMAND(dateCommand, "date", "show or set the time of day", "date [YYYY-MM-DD HH:MM:SS]", date);
 DCOS_SHELL_COMMAND(versionCommand, "version", "show the DCOS release, board and build", "version", version);
 DCOS_SHELL_COMMAND(uptimeCommand, "uptime", "show the time since the system tick started", "uptime", uptime);
 DCOS_SHELL_COMMAND(memCommand, "mem", "show the memory map", "mem", mem);

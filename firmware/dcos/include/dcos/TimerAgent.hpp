@@ -1,0 +1,55 @@
+// The timer agent's application interface (seed 7.5).
+#pragma once
+
+#include <dcos/DateTime.hpp>
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/Visibility.hpp>
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos {
+
+/// How an alarm tells the timer's owner that it went off.
+struct AlarmNotification {
+    enum class Kind : uint8_t {
+        Event,  ///< Post event flags (value = the event set).
+        Signal, ///< Send a signal (value = the signal number).
+    };
+    Kind kind = Kind::Event;
+    uint32_t value = 1;
+
+    static constexpr AlarmNotification event(uint32_t events) { return {Kind::Event, events}; }
+    static constexpr AlarmNotification signal(unsigned number) { return {Kind::Signal, number}; }
+};
+
+/// The timer agent interface object.
+class TimerAgent {
+public:
+    /// The time of day in the Gregorian calendar.
+    Result<DateTime> GetSystemClock() const;
+    /// Sets the time of day (privileged). Only the clock's base changes, so
+    /// intervals already running are not disturbed.
+    Status SetSystemClock(const DateTime& time) const;
+    /// Nanoseconds since the system tick started (monotonic).
+    uint64_t Uptime() const;
+    /// Creates a software timer owned by the caller.
+    Result<ObjectId> Create(const char* name, Visibility visibility) const;
+    Status Delete(ObjectId timer) const;
+    /// Goes off once, after an interval.
+    Status SetWatchDogAlarm(ObjectId timer, uint64_t intervalNs, AlarmNotification notification) const;
+    /// Goes off once, at a time of day.
+    Status SetDayClockAlarm(ObjectId timer, const DateTime& time, AlarmNotification notification) const;
+    /// Goes off every period, first one period from now.
+    Status SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNotification notification) const;
+    /// Disarms a set alarm.
+    Status CancelAlarm(ObjectId timer) const;
+    Result<ObjectId> NameToObject(const char* name) const;
+    /// Activates count more timer slots (privileged configuration service).
+    Status AddObjects(size_t count) const;
+};
+
+inline constexpr TimerAgent timerAgent{};
+
+} // namespace dcos

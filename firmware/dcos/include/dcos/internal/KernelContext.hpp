@@ -1,0 +1,30 @@
+// What an agent needs to know about the caller of a service.
+//
+// Every agent checks privileges, ownership and context the same way, so the
+// questions are answered in one place (the task agent implements them). Host
+// unit tests of an agent supply their own definitions to play any caller.
+#pragma once
+
+#include <dcos/ObjectId.hpp>
+
+#include <stdint.h>
+
+namespace dcos::internal {
+
+/// The id of the task on whose behalf the current service runs. Inside an
+/// interrupt handler it is the interrupted task.
+ObjectId currentTaskId();
+
+/// True when the calling task has super-user privilege (seed 6.4, layer 2).
+/// Privileged services (Create and Delete of devices, InstallISR, the legal
+/// interrupt limit, SetSystemClock, the time-slice quantum) check it.
+bool currentTaskIsSuperUser();
+
+/// True while an interrupt handler runs. Blocking services refuse to run
+/// there with Status::InInterrupt.
+bool inInterruptContext();
+
+/// The node id of this controller, stamped into every object id it issues.
+uint16_t localNode();
+
+} // namespace dcos::internal

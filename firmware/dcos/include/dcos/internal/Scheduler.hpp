@@ -1,0 +1,91 @@
+// The scheduler agent's kernel side (seed 7.4).
+//
+// Two mechanisms, chosen per task: tasks inside a deadline scope sit in a
+// binary heap ordered by (static priority, latest start time) with the
+// seed's tie-breaks, and run before every other task; all other tasks sit in
+// 32 FIFO ready queues under a ready bitmap, so selecting the next one is a
+// single bit scan. The running task stays at the head of its queue, so a
+// preempted task resumes before its equals.
+//
+// Task switches happen in exactly one place: at the exit of the outermost
+// interrupt (onOutermostExit). A task that blocks or yields enters that path
+// through the dispatch trap (int 0x30); an interrupt handler that readies a
+// task only marks a dispatch as pending, and the switch happens when the
+// last nested handler returns.
+#pragma once
+
+#include <dcos/internal/DeadlineQueue.hpp>
+#include <dcos/internal/IntrusiveList.hpp>
+#include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/ReadyBitmap.hpp>
+#include <dcos/internal/Task.hpp>
+
+#include <arch_x86/InterruptFrame.hpp>
+
+namespace dcos::internal {
+
+class Scheduler {
+public:
+    /// The software interrupt a task uses to enter the dispatcher.
+    static constexpr uint8_t kDispatchTrapVector = 0x30;
+
+    /// Makes idle the task that runs when nothing else is ready.
+    static void setIdleTask(Task& idle);
+
+    /// The running task (the idle task when nothing else runs).
+    static Task& current() { return *current_; }
+    static bool started() { return current_ != nullptr; }
+
+    /// Puts a task that may run into its ready queue or the deadline heap,
+    /// and asks for a dispatch when it is more urgent than the running one. O(1) / O(log N).
+    static void makeReady(Task& task);
+    /// Takes a task out of its ready queue or the deadline heap. O(1) / O(log N).
+    /// It never dispatches by itself: a caller taking the running task out
+    /// finishes its bookkeeping first, then calls requestDispatch().
+    static void makeUnready(Task& task);
+    /// Puts back a task taken out with makeUnready after its priority or
+    /// scope changed, dispatching if the running task is no longer first.
+    static void requeue(Task& task);
+
+    /// True when a is to run before b.
+    static bool isMoreUrgent(const Task& a, const Task& b);
+
+    /// Asks for a task switch: at once from task context (through the
+    /// dispatch trap), or at the outermost interrupt exit from a handler.
+    static void requestDispatch();
+
+    /// Moves the running task behind its equals (Yield, end of time slice).
+    /// Returns true when another task of the same priority was waiting.
+    static bool rotateCurrent();
+
+    /// Counts a tick against the running task's time slice.
+    static void onTick();
+
+    /// Sets the time-slice length in ticks (at least 1).
+    static void setQuantumTicks(uint32_t ticks);
+    static uint32_t quantumTicks() { return quantumTicks_; }
+
+    /// Called at the exit of the outermost interrupt with the interrupted
+    /// frame; returns the frame to resume.
+    static arch_x86::InterruptFrame* onOutermostExit(arch_x86::InterruptFrame* frame);
+
+    /// Starts scheduling by switching from the boot stack to the most urgent task.
+    [[noreturn]] static void start();
+
+    /// Number of task switches so far, for diagnostics and tests.
+    static uint32_t switchCount() { return switchCount_; }
+
+private:
+    static Task* pickNext();
+
+    static Task* current_;
+    static Task* idle_;
+    static volatile bool dispatchPending_;
+    static uint32_t quantumTicks_;
+    static uint32_t switchCount_;
+    static ReadyBitmap readyBitmap_;
+    static IntrusiveList<Task, ReadyQueueTag> readyQueues_[32];
+    static DeadlineQueue<Task, kTaskCapacity> deadlineQueue_;
+};
+
+} // namespace dcos::internal

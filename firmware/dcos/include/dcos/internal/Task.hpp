@@ -1,0 +1,117 @@
+// The task object: everything the kernel keeps about one task (seed 7.6).
+//
+// Task objects live in a static array beside the task table; an id resolves
+// to one in O(1). All lists a task joins are intrusive (ready queue, wait
+// list, time wheel, deadline heap), so blocking and readying never allocate.
+#pragma once
+
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/TaskAgent.hpp>
+#include <dcos/internal/DeadlineQueue.hpp>
+#include <dcos/internal/IntrusiveList.hpp>
+#include <dcos/internal/TimeoutEntry.hpp>
+
+#include <arch_x86/InterruptFrame.hpp>
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos::internal {
+
+struct ReadyQueueTag;
+
+/// Why a blocked task waits.
+enum class WaitReason : uint8_t {
+    None,
+    Sleep,
+    Events,
+    Object, ///< A wait list of another agent (semaphore, port, ...).
+};
+
+/// The i387 state FSAVE stores in 32-bit protected mode (108 bytes).
+struct FpuState {
+    uint8_t bytes[108];
+};
+
+struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode {
+    Task() : wakeTimeout(TimeoutEntry::Kind::TaskWake, this), deadlineTimeout(TimeoutEntry::Kind::DeadlineMiss, this) {}
+
+    ObjectId id;
+    /// Ready also for the running task: Executing is reported for the
+    /// scheduler's current task, not stored, so no transition is missed.
+    TaskState state = TaskState::NonExistent;
+    bool suspended = false;     ///< Suspend() holds the task even when it could run.
+    uint8_t basePriority = 0;   ///< The static priority set by Create and ChangePriority.
+    uint8_t priority = 0;       ///< The priority it runs at (inheritance may raise it).
+    bool timeSlicing = false;
+    bool floatingPoint = false;
+    bool superUser = false;
+    bool idle = false;          ///< The idle task: never queued, runs when nothing else can.
+    ObjectId process;           ///< The process the task belongs to.
+
+    // Execution context.
+    arch_x86::InterruptFrame* savedFrame = nullptr;
+    uint8_t* stackBase = nullptr;
+    size_t stackSize = 0;
+    TaskEntry entry = nullptr;
+    uintptr_t argument = 0;
+    FpuState fpu{};
+
+    // Time slicing.
+    uint32_t sliceTicksLeft = 0;
+
+    // Blocking.
+    WaitReason waitReason = WaitReason::None;
+    Status wakeStatus = Status::Ok;
+    TimeoutEntry wakeTimeout;
+
+    // Event flags.
+    uint32_t events = 0;
+    uint32_t awaitedEvents = 0;
+    EventWait awaitedMode = EventWait::Any;
+    uint32_t receivedEvents = 0;
+
+    // Signals.
+    uint32_t pendingSignals = 0;
+    uint32_t signalMask = 0;
+    SignalHandler signalHandler = nullptr;
+    // While a signal handler runs, the interrupted frame's registers wait
+    // here; the frame's stack slot is where the handler's trap comes back.
+    bool inSignalHandler = false;
+    arch_x86::InterruptFrame signalSavedFrame{};
+    uintptr_t signalFrameAddress = 0;
+    Status signalSavedWakeStatus = Status::Ok;
+
+    // Exceptions.
+    ExceptionHandler exceptionHandler = nullptr;
+    bool exceptionPending = false;
+    ExceptionInfo pendingException{};
+    bool inExceptionHandler = false;
+    arch_x86::InterruptFrame exceptionSavedFrame{};
+    uintptr_t exceptionFrameAddress = 0;
+    ExceptionInfo activeException{};
+    Status exceptionSavedWakeStatus = Status::Ok;
+
+    // Deadline scope (seed 7.4.1).
+    bool inDeadlineScope = false;
+    bool deadlineAtNextBlock = false;
+    uint64_t executionPeriodNs = 0;
+    uint64_t deadlinePeriodNs = 0;
+    uint64_t deadlineNs = 0;
+    TimeoutEntry deadlineTimeout;
+
+    // Interrupt level (seed 7.3.3); kNoInterruptLevel masks nothing.
+    uint8_t interruptLevel = 0xFF;
+
+    // Profiling (seed 7.4.2).
+    bool profiling = false;
+    uint64_t runStartedNs = 0;
+    uint64_t profileAccumulatedNs = 0;
+    uint32_t profileSamples = 0;
+    uint64_t profileMinimumNs = 0;
+    uint64_t profileMaximumNs = 0;
+    uint64_t profileTotalNs = 0;
+};
+
+} // namespace dcos::internal

@@ -1,0 +1,82 @@
+// The task agent's kernel side (seed 7.6): the task table, the life cycle
+// of tasks, blocking and waking, events, signals and exceptions.
+#pragma once
+
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/TaskAgent.hpp>
+#include <dcos/internal/Task.hpp>
+
+#include <arch_x86/InterruptFrame.hpp>
+
+namespace dcos::internal {
+
+class TaskManager {
+public:
+    /// Software interrupts the handler trampolines use to return to the kernel.
+    static constexpr uint8_t kSignalReturnVector = 0x31;
+    static constexpr uint8_t kExceptionReturnVector = 0x32;
+
+    /// Sets up the task table, the idle task and the root (super-user) task,
+    /// which will run rootEntry. Called once at boot.
+    static void initialise(TaskEntry rootEntry);
+
+    /// Resolves a task id (O(1)); remote ids give Status::Remote.
+    static Result<Task*> resolve(ObjectId id);
+
+    static Result<ObjectId> create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument);
+    static Status kill(Task& task);
+    [[noreturn]] static void exitCurrent();
+    static Status suspend(Task& task);
+    static Status resume(Task& task);
+    static Status changePriority(Task& task, uint8_t priority);
+
+    /// Blocks the running task until wake() or the time-out (kWaitForever
+    /// for none). Returns the status wake() gave, or Timeout. Must be called
+    /// with interrupts disabled, from task context.
+    static Status blockCurrent(WaitReason reason, uint64_t timeoutNs);
+    /// Makes a blocked task ready with the given result. O(1).
+    static void wake(Task& task, Status result);
+
+    static void postEvent(Task& task, uint32_t events);
+    static void sendSignal(Task& task, unsigned signal);
+    /// Marks an exception for delivery to task when it next runs.
+    static void raiseException(Task& task, const ExceptionInfo& info);
+
+    /// Saves and restores what a task switch must carry beyond the frame.
+    static void switchContext(Task& from, Task& to);
+    /// Runs before returning to task: reaps ended tasks and arranges
+    /// delivery of pending exceptions and signals. Returns the frame to resume.
+    static arch_x86::InterruptFrame* prepareReturn(Task& task, arch_x86::InterruptFrame* frame);
+
+    /// CPU exceptions (vectors 0-31).
+    static arch_x86::InterruptFrame* onCpuException(arch_x86::InterruptFrame* frame);
+    /// Software traps (vectors 0x30-0x3F).
+    static arch_x86::InterruptFrame* onTrap(arch_x86::InterruptFrame* frame);
+
+    /// Visits every task in use, for the console's task list.
+    template <typename Visitor>
+    static void forEachTask(Visitor&& visit);
+
+    static size_t taskCount();
+    static Status addObjects(size_t count);
+    static Result<ObjectId> nameToObject(const char* name);
+    static const char* nameOf(ObjectId id);
+
+    /// The task array, for forEachTask.
+    static Task* taskArray();
+    static size_t taskArraySize();
+};
+
+template <typename Visitor>
+void TaskManager::forEachTask(Visitor&& visit)
+{
+    Task* tasks = taskArray();
+    for (size_t i = 0; i < taskArraySize(); ++i) {
+        if (tasks[i].state != TaskState::NonExistent) {
+            visit(tasks[i]);
+        }
+    }
+}
+
+} // namespace dcos::internal

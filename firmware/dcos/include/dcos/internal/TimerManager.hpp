@@ -1,0 +1,69 @@
+// The timer agent's kernel side (seed 7.5): the system clock, the time
+// wheel of time-outs and the software timer objects.
+//
+// The clock is two 64-bit nanosecond counts, as the seed's Fig. 7.8 shows:
+// the base (time of day at the moment the tick started) and the increment
+// (nanoseconds ticked since). SetSystemClock changes only the base, so every
+// interval and time-out in progress is undisturbed.
+#pragma once
+
+#include <dcos/DateTime.hpp>
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/TimerAgent.hpp>
+#include <dcos/Visibility.hpp>
+#include <dcos/internal/TimeoutEntry.hpp>
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos::internal {
+
+class TimerManager {
+public:
+    /// Starts the clock with the board's exact tick period.
+    static void initialise(uint64_t tickPeriodNs);
+
+    /// The tick interrupt's work: advance the clock, fire due time-outs,
+    /// count the running task's time slice. O(1) per tick plus O(1) per
+    /// expiring time-out.
+    static void onTick();
+
+    static uint64_t ticks();
+    static uint64_t tickPeriodNs() { return tickPeriodNs_; }
+    /// Nanoseconds since the tick started, at tick granularity.
+    static uint64_t uptimeNs();
+    /// Nanoseconds since the tick started, refined within the tick by the board.
+    static uint64_t preciseUptimeNs();
+
+    /// The absolute tick at which an interval of ns from now has fully
+    /// passed: rounded up, and one tick more, because the current tick is
+    /// already partly over.
+    static uint64_t tickAfter(uint64_t ns);
+    /// Arms entry for the absolute tick dueTick.
+    static void arm(TimeoutEntry& entry, uint64_t dueTick);
+    static void cancel(TimeoutEntry& entry);
+
+    /// Nanoseconds since 1970-01-01 now (base + increment).
+    static uint64_t timeOfDayNs();
+    static Result<DateTime> getSystemClock();
+    static Status setSystemClock(const DateTime& time);
+    /// Ticks from now until a time of day; 0 when it has passed.
+    static Result<uint64_t> nanosecondsUntil(const DateTime& time);
+
+    // Timer objects.
+    static Result<ObjectId> createTimer(ObjectId owner, const char* name, Visibility visibility);
+    static Status deleteTimer(ObjectId timer, ObjectId caller);
+    static Status setWatchDogAlarm(ObjectId timer, ObjectId caller, uint64_t intervalNs, AlarmNotification n);
+    static Status setDayClockAlarm(ObjectId timer, ObjectId caller, const DateTime& time, AlarmNotification n);
+    static Status setPeriodicAlarm(ObjectId timer, ObjectId caller, uint64_t periodNs, AlarmNotification n);
+    static Status cancelAlarm(ObjectId timer, ObjectId caller);
+    static Result<ObjectId> timerNameToObject(const char* name);
+    static Status addTimerObjects(size_t count);
+    static size_t timerCount();
+
+private:
+    static uint64_t tickPeriodNs_;
+};
+
+} // namespace dcos::internal

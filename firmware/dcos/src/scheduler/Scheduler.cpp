@@ -1,0 +1,169 @@
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/TaskManager.hpp>
+
+#include <arch_x86/Cpu.hpp>
+#include <arch_x86/Idt.hpp>
+
+extern "C" [[noreturn]] void resumeInterruptFrame(arch_x86::InterruptFrame* frame);
+
+namespace dcos::internal {
+
+Task* Scheduler::current_ = nullptr;
+Task* Scheduler::idle_ = nullptr;
+volatile bool Scheduler::dispatchPending_ = false;
+uint32_t Scheduler::quantumTicks_ = 10;
+uint32_t Scheduler::switchCount_ = 0;
+ReadyBitmap Scheduler::readyBitmap_;
+IntrusiveList<Task, ReadyQueueTag> Scheduler::readyQueues_[32];
+DeadlineQueue<Task, kTaskCapacity> Scheduler::deadlineQueue_;
+
+void Scheduler::setIdleTask(Task& idle)
+{
+    idle.idle = true;
+    idle_ = &idle;
+}
+
+bool Scheduler::isMoreUrgent(const Task& a, const Task& b)
+{
+    if (b.idle) {
+        return !a.idle;
+    }
+    if (a.idle) {
+        return false;
+    }
+    if (a.inDeadlineScope != b.inDeadlineScope) {
+        return a.inDeadlineScope; // Deadline-driven tasks come first (seed 7.4.1).
+    }
+    if (a.inDeadlineScope) {
+        return a.deadlineKey().precedes(b.deadlineKey());
+    }
+    return a.priority < b.priority;
+}
+
+void Scheduler::makeReady(Task& task)
+{
+    if (task.idle) {
+        return;
+    }
+    if (task.inDeadlineScope) {
+        const DeadlineKey key = DeadlineKey::make(task.priority, task.deadlineNs - task.deadlinePeriodNs,
+                                                  task.deadlinePeriodNs, task.executionPeriodNs);
+        deadlineQueue_.insert(task, key);
+    } else {
+        readyQueues_[task.priority].pushBack(task);
+        readyBitmap_.set(task.priority);
+    }
+    if (current_ != nullptr && &task != current_ && isMoreUrgent(task, *current_)) {
+        requestDispatch();
+    }
+}
+
+void Scheduler::makeUnready(Task& task)
+{
+    if (task.idle) {
+        return;
+    }
+    if (task.isQueued()) {
+        deadlineQueue_.remove(task);
+    }
+    if (static_cast<IntrusiveListNode<ReadyQueueTag>&>(task).isLinked()) {
+        readyQueues_[task.priority].remove(task);
+        if (readyQueues_[task.priority].isEmpty()) {
+            readyBitmap_.clear(task.priority);
+        }
+    }
+}
+
+void Scheduler::requeue(Task& task)
+{
+    // The queues are keyed by priority and scope, so a change means leaving
+    // under the old values; callers update the task between the two steps.
+    makeReady(task);
+    if (&task == current_ && pickNext() != current_) {
+        requestDispatch(); // Someone else is now more urgent than the runner.
+    }
+}
+
+void Scheduler::requestDispatch()
+{
+    dispatchPending_ = true;
+    if (current_ != nullptr && arch_x86::Idt::nestingDepth() == 0) {
+        asm volatile("int %0" : : "i"(kDispatchTrapVector) : "memory");
+    }
+}
+
+bool Scheduler::rotateCurrent()
+{
+    Task& task = *current_;
+    if (task.idle || task.inDeadlineScope || !static_cast<IntrusiveListNode<ReadyQueueTag>&>(task).isLinked()) {
+        return false;
+    }
+    auto& queue = readyQueues_[task.priority];
+    if (&queue.front() == &task && &queue.back() == &task) {
+        return false;
+    }
+    queue.remove(task);
+    queue.pushBack(task);
+    requestDispatch();
+    return true;
+}
+
+void Scheduler::setQuantumTicks(uint32_t ticks) { quantumTicks_ = ticks == 0 ? 1 : ticks; }
+
+void Scheduler::onTick()
+{
+    Task* task = current_;
+    if (task == nullptr || task->idle || !task->timeSlicing) {
+        return;
+    }
+    if (task->sliceTicksLeft > 1) {
+        --task->sliceTicksLeft;
+        return;
+    }
+    task->sliceTicksLeft = quantumTicks_;
+    rotateCurrent();
+}
+
+Task* Scheduler::pickNext()
+{
+    if (Task* deadlineTask = deadlineQueue_.peek()) {
+        return deadlineTask;
+    }
+    const unsigned priority = readyBitmap_.highest();
+    if (priority == ReadyBitmap::kNone) {
+        return idle_;
+    }
+    return &readyQueues_[priority].front();
+}
+
+arch_x86::InterruptFrame* Scheduler::onOutermostExit(arch_x86::InterruptFrame* frame)
+{
+    if (current_ == nullptr) {
+        return frame;
+    }
+    if (dispatchPending_) {
+        dispatchPending_ = false;
+        Task* next = pickNext();
+        if (next != current_) {
+            Task* previous = current_;
+            previous->savedFrame = frame;
+            current_ = next;
+            ++switchCount_;
+            TaskManager::switchContext(*previous, *next);
+            frame = next->savedFrame;
+        }
+    }
+    return TaskManager::prepareReturn(*current_, frame);
+}
+
+void Scheduler::start()
+{
+    arch_x86::disableInterrupts();
+    Task* first = pickNext();
+    current_ = first;
+    dispatchPending_ = false;
+    TaskManager::switchContext(*first, *first);
+    resumeInterruptFrame(first->savedFrame);
+}
+
+} // namespace dcos::internal

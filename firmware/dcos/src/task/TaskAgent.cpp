@@ -1,0 +1,257 @@
+// The task agent's interface object: argument checks and id resolution in
+// front of TaskManager. Every method is what a ring-3 trap will call later.
+#include <dcos/TaskAgent.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/TimerManager.hpp>
+
+#include <arch_x86/Cpu.hpp>
+
+namespace dcos {
+
+using internal::Scheduler;
+using internal::Task;
+using internal::TaskManager;
+
+namespace {
+
+// Killing, suspending or re-prioritising another task is allowed within the
+// caller's process, or for a super user anywhere (seed 7.6).
+Status checkControl(const Task& target)
+{
+    const Task& caller = Scheduler::current();
+    if (&target == &caller || caller.superUser || caller.process == target.process) {
+        return Status::Ok;
+    }
+    return Status::NotPermitted;
+}
+
+} // namespace
+
+Result<ObjectId> TaskAgent::Create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument) const
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    return TaskManager::create(attributes, entry, argument);
+}
+
+Status TaskAgent::Delete() const
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    TaskManager::exitCurrent();
+}
+
+Status TaskAgent::KillTask(ObjectId id) const
+{
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    const Status allowed = checkControl(*task.value());
+    return allowed != Status::Ok ? allowed : TaskManager::kill(*task.value());
+}
+
+Status TaskAgent::Suspend(ObjectId id) const
+{
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    const Status allowed = checkControl(*task.value());
+    return allowed != Status::Ok ? allowed : TaskManager::suspend(*task.value());
+}
+
+Status TaskAgent::Resume(ObjectId id) const
+{
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    const Status allowed = checkControl(*task.value());
+    return allowed != Status::Ok ? allowed : TaskManager::resume(*task.value());
+}
+
+Status TaskAgent::ChangePriority(ObjectId id, uint8_t priority) const
+{
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    const Status allowed = checkControl(*task.value());
+    return allowed != Status::Ok ? allowed : TaskManager::changePriority(*task.value(), priority);
+}
+
+Status TaskAgent::SleepFor(uint64_t nanoseconds) const
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    if (nanoseconds == kWaitForever) {
+        return Status::InvalidArgument;
+    }
+    arch_x86::InterruptGuard guard;
+    const Status status = TaskManager::blockCurrent(internal::WaitReason::Sleep, nanoseconds);
+    return status == Status::Timeout ? Status::Ok : status;
+}
+
+Status TaskAgent::SleepTill(const DateTime& time) const
+{
+    const Result<uint64_t> interval = internal::TimerManager::nanosecondsUntil(time);
+    if (!interval.ok()) {
+        return interval.status();
+    }
+    return SleepFor(interval.value());
+}
+
+Status TaskAgent::PostEvent(ObjectId id, uint32_t events) const
+{
+    if (events == 0) {
+        return Status::InvalidArgument;
+    }
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    TaskManager::postEvent(*task.value(), events);
+    return Status::Ok;
+}
+
+Result<uint32_t> TaskAgent::ReceiveEvent(uint32_t events, EventWait mode, uint64_t timeout) const
+{
+    if (events == 0) {
+        return Status::InvalidArgument;
+    }
+    arch_x86::InterruptGuard guard;
+    Task& task = Scheduler::current();
+    const uint32_t present = task.events & events;
+    if (mode == EventWait::All ? present == events : present != 0) {
+        task.events &= ~present;
+        return present;
+    }
+    if (timeout == kPoll) {
+        return Status::WouldBlock;
+    }
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    task.awaitedEvents = events;
+    task.awaitedMode = mode;
+    const Status status = TaskManager::blockCurrent(internal::WaitReason::Events, timeout);
+    if (status != Status::Ok) {
+        return status;
+    }
+    return task.receivedEvents;
+}
+
+Status TaskAgent::SendSignal(ObjectId id, unsigned signal) const
+{
+    if (signal >= 32) {
+        return Status::InvalidArgument;
+    }
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    TaskManager::sendSignal(*task.value(), signal);
+    return Status::Ok;
+}
+
+Status TaskAgent::SetSignalHandler(SignalHandler handler) const
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    arch_x86::InterruptGuard guard;
+    Task& task = Scheduler::current();
+    task.signalHandler = handler;
+    if (handler != nullptr && (task.pendingSignals & ~task.signalMask) != 0) {
+        Scheduler::requestDispatch(); // Signals left pending are delivered now.
+    }
+    return Status::Ok;
+}
+
+Result<uint32_t> TaskAgent::SetSignalMask(uint32_t mask) const
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    arch_x86::InterruptGuard guard;
+    Task& task = Scheduler::current();
+    const uint32_t previous = task.signalMask;
+    task.signalMask = mask;
+    if (task.signalHandler != nullptr && (task.pendingSignals & ~mask) != 0) {
+        Scheduler::requestDispatch();
+    }
+    return previous;
+}
+
+Status TaskAgent::SetExceptionHandler(ExceptionHandler handler) const
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    arch_x86::InterruptGuard guard;
+    Scheduler::current().exceptionHandler = handler;
+    return Status::Ok;
+}
+
+Status TaskAgent::ThrowException(ObjectId id, ExceptionClass exceptionClass, uint32_t code) const
+{
+    if (static_cast<uint8_t>(exceptionClass) > static_cast<uint8_t>(ExceptionClass::Fatal)) {
+        return Status::InvalidArgument;
+    }
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    const Status allowed = checkControl(*task.value());
+    if (allowed != Status::Ok) {
+        return allowed;
+    }
+    if (task.value()->idle) {
+        return Status::NotPermitted;
+    }
+    TaskManager::raiseException(*task.value(), ExceptionInfo{exceptionClass, 0xFF, code, 0, nullptr});
+    return Status::Ok;
+}
+
+ObjectId TaskAgent::IdOfSelf() const { return internal::currentTaskId(); }
+
+Result<ObjectId> TaskAgent::NameToObject(const char* name) const { return TaskManager::nameToObject(name); }
+
+Result<TaskState> TaskAgent::GetState(ObjectId id) const
+{
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    arch_x86::InterruptGuard guard;
+    const Task& t = *task.value();
+    if (&t == &Scheduler::current()) {
+        return TaskState::Executing;
+    }
+    return t.suspended && t.state != TaskState::Terminating ? TaskState::Suspended : t.state;
+}
+
+Result<uint8_t> TaskAgent::GetPriority(ObjectId id) const
+{
+    const Result<Task*> task = TaskManager::resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    return task.value()->basePriority;
+}
+
+Status TaskAgent::AddObjects(size_t count) const
+{
+    if (!internal::currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    return TaskManager::addObjects(count);
+}
+
+} // namespace dcos

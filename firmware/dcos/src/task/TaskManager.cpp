@@ -1,0 +1,641 @@
+#include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/ObjectTable.hpp>
+#include <dcos/internal/ResourceRecovery.hpp>
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/StackArena.hpp>
+#include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/TimerManager.hpp>
+#include <dcos/internal/InterruptManager.hpp>
+
+#include <arch_x86/Cpu.hpp>
+#include <arch_x86/CpuException.hpp>
+#include <arch_x86/Gdt.hpp>
+#include <arch_x86/Idt.hpp>
+#include <boot/Panic.hpp>
+#include <bsp/Board.hpp>
+
+#include <new>
+
+extern "C" {
+// Handler trampolines (TaskTrampolines.S).
+void signalTrampoline();
+void exceptionTrampoline();
+void resumeTrampoline();
+}
+
+namespace dcos::internal {
+
+namespace {
+
+constexpr uint32_t kEflagsReservedBit = 1u << 1;
+constexpr size_t kIdleStackSize = 2048;
+constexpr size_t kRootStackSize = 16384;
+// A handler frame is refused when it would leave less than this below it.
+constexpr size_t kHandlerStackReserve = 512;
+
+ObjectTable<Task*, kTaskCapacity> table(ObjectType::Task, 0);
+Task tasks[kTaskCapacity];
+// Tasks that ended while running; their stack and slot are freed once
+// another task runs (the dying task's own stack is in use until then).
+IntrusiveList<Task, ReadyQueueTag> reapList;
+
+size_t slotOf(ObjectId id) { return id.index() & (kTaskCapacity - 1); }
+
+bool inInterrupt() { return arch_x86::Idt::nestingDepth() > 0; }
+
+arch_x86::InterruptFrame* initialFrame(uint8_t* stackTop, void (*entry)())
+{
+    auto* frame = reinterpret_cast<arch_x86::InterruptFrame*>(stackTop - sizeof(arch_x86::InterruptFrame));
+    *frame = {};
+    frame->ds = frame->es = frame->fs = frame->gs = arch_x86::Gdt::kernelData;
+    frame->cs = arch_x86::Gdt::kernelCode;
+    frame->eflags = arch_x86::eflagsInterruptEnable | kEflagsReservedBit;
+    frame->eip = static_cast<uint32_t>(reinterpret_cast<uintptr_t>(entry));
+    return frame;
+}
+
+// The FPU state FNINIT leaves, in FSAVE's 32-bit layout: control word 0x037F
+// (all exceptions masked, extended precision), all registers tagged empty.
+void initialiseFpuState(FpuState& state)
+{
+    for (uint8_t& byte : state.bytes) {
+        byte = 0;
+    }
+    state.bytes[0] = 0x7F;
+    state.bytes[1] = 0x03;
+    state.bytes[8] = 0xFF;
+    state.bytes[9] = 0xFF;
+}
+
+// Where every task starts: run the entry, then end the task.
+void taskEntryTrampoline()
+{
+    Task& task = Scheduler::current();
+    task.entry(task.argument);
+    TaskManager::exitCurrent();
+}
+
+void idleLoop(uintptr_t)
+{
+    for (;;) {
+        arch_x86::enableInterruptsAndHalt();
+    }
+}
+
+ExceptionClass classify(unsigned vector)
+{
+    switch (static_cast<arch_x86::CpuException>(vector)) {
+    case arch_x86::CpuException::DivideError:
+    case arch_x86::CpuException::Overflow:
+    case arch_x86::CpuException::BoundRangeExceeded:
+    case arch_x86::CpuException::FloatingPointError:
+    case arch_x86::CpuException::AlignmentCheck:
+    case arch_x86::CpuException::Breakpoint:
+        return ExceptionClass::Synchronous;
+    case arch_x86::CpuException::NonMaskableInterrupt:
+    case arch_x86::CpuException::MachineCheck:
+        return ExceptionClass::Asynchronous;
+    default:
+        return ExceptionClass::Fatal;
+    }
+}
+
+const char* className(ExceptionClass c)
+{
+    switch (c) {
+    case ExceptionClass::Timing: return "timing";
+    case ExceptionClass::Synchronous: return "synchronous";
+    case ExceptionClass::Asynchronous: return "asynchronous";
+    case ExceptionClass::Fatal: return "fatal";
+    }
+    return "?";
+}
+
+// Turns the interrupted frame into one that runs a handler trampoline with
+// eax and ebx preset, keeping the original registers in saved. The handler
+// runs on the task's stack from where the task was interrupted; when it
+// returns, its trap arrives with a frame at this same address, which
+// restoreFrame() refills. Working in place matters: the kernel code building
+// the frame is itself running on the stack just below it.
+bool enterHandler(Task& task, arch_x86::InterruptFrame* frame, arch_x86::InterruptFrame& saved, uintptr_t& address,
+                  void (*trampoline)(), uint32_t eax, uint32_t ebx)
+{
+    if (reinterpret_cast<uintptr_t>(frame) < reinterpret_cast<uintptr_t>(task.stackBase) + kHandlerStackReserve) {
+        return false; // Too little stack left for a handler.
+    }
+    saved = *frame;
+    address = reinterpret_cast<uintptr_t>(frame);
+    frame->eip = static_cast<uint32_t>(reinterpret_cast<uintptr_t>(trampoline));
+    frame->eflags = arch_x86::eflagsInterruptEnable | kEflagsReservedBit;
+    frame->cs = arch_x86::Gdt::kernelCode;
+    frame->ds = frame->es = frame->fs = frame->gs = arch_x86::Gdt::kernelData;
+    frame->eax = eax;
+    frame->ebx = ebx;
+    return true;
+}
+
+// Puts back the registers a handler interrupted, in the frame its trap made.
+arch_x86::InterruptFrame* restoreFrame(arch_x86::InterruptFrame* trapFrame, const arch_x86::InterruptFrame& saved,
+                                       uintptr_t address)
+{
+    if (reinterpret_cast<uintptr_t>(trapFrame) != address) {
+        dcosPanicWithFrame(trapFrame, "a signal or exception handler returned with its stack unbalanced");
+    }
+    *trapFrame = saved;
+    return trapFrame;
+}
+
+void releaseTask(Task& task)
+{
+    StackArena::release(task.stackBase, task.stackSize);
+    table.Delete(task.id);
+    task.state = TaskState::NonExistent;
+}
+
+void reapEndedTasks()
+{
+    while (!reapList.isEmpty() && &reapList.front() != &Scheduler::current()) {
+        Task* task = reapList.popFront();
+        releaseTask(*task);
+    }
+}
+
+// Takes a task out of every structure, recovers what it owns and marks it
+// as terminating. The caller frees its stack and slot, now or (for the
+// running task) after the switch away.
+void terminate(Task& task)
+{
+    task.state = TaskState::Terminating;
+    Scheduler::makeUnready(task);
+    TimerManager::cancel(task.wakeTimeout);
+    TimerManager::cancel(task.deadlineTimeout);
+    task.inDeadlineScope = false;
+    task.deadlineAtNextBlock = false;
+    recoverResourcesOf(task.id);
+}
+
+void reportTermination(Task& task, const ExceptionInfo& info)
+{
+    const char* name = TaskManager::nameOf(task.id);
+    if (info.vector != 0xFF) {
+        runtime::format(bsp::console(), "task %s (0x%08lx) terminated: %s exception, vector %u (%s %s) at EIP=%08lx\r\n",
+                        name[0] != '\0' ? name : "(unnamed)", static_cast<unsigned long>(task.id.raw()),
+                        className(info.exceptionClass), info.vector, arch_x86::exceptionMnemonic(info.vector),
+                        arch_x86::exceptionName(info.vector), static_cast<unsigned long>(info.instruction));
+    } else {
+        runtime::format(bsp::console(), "task %s (0x%08lx) terminated: %s exception, code %lu\r\n",
+                        name[0] != '\0' ? name : "(unnamed)", static_cast<unsigned long>(task.id.raw()),
+                        className(info.exceptionClass), static_cast<unsigned long>(info.errorCode));
+    }
+}
+
+// Ends the running task from interrupt context (exception or trap); the
+// switch away happens at the outermost exit.
+void terminateCurrentFromInterrupt()
+{
+    Task& task = Scheduler::current();
+    terminate(task);
+    reapList.pushBack(task);
+    Scheduler::requestDispatch();
+}
+
+} // namespace
+
+void TaskManager::initialise(TaskEntry rootEntry)
+{
+    table.setNode(bsp::nodeId());
+    table.AddObjects(kTasksActiveAtBoot);
+
+    TaskAttributes idle;
+    idle.name = "idle";
+    idle.priority = kLowestPriority;
+    idle.stackSize = kIdleStackSize;
+    idle.superUser = true;
+    const Result<ObjectId> idleId = create(idle, idleLoop, 0);
+    if (!idleId.ok()) {
+        dcosPanic("cannot create the idle task: %s", statusName(idleId.status()));
+    }
+    Task& idleTask = tasks[slotOf(idleId.value())];
+    Scheduler::makeUnready(idleTask);
+    Scheduler::setIdleTask(idleTask);
+
+    TaskAttributes root;
+    root.name = "shell";
+    root.priority = 24;
+    root.stackSize = kRootStackSize;
+    root.superUser = true;
+    const Result<ObjectId> rootId = create(root, rootEntry, 0);
+    if (!rootId.ok()) {
+        dcosPanic("cannot create the root task: %s", statusName(rootId.status()));
+    }
+}
+
+Result<Task*> TaskManager::resolve(ObjectId id)
+{
+    if (id.isNull()) {
+        return Status::InvalidId;
+    }
+    if (id.type() == ObjectType::Task && id.node() != table.node()) {
+        return Status::Remote;
+    }
+    const Result<Task**> entry = table.resolve(id);
+    if (!entry.ok()) {
+        return entry.status();
+    }
+    return *entry.value();
+}
+
+Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument)
+{
+    if (entry == nullptr || attributes.priority > kLowestPriority || attributes.stackSize < kMinimumStackSize ||
+        attributes.stackSize > kStackArenaBytes) {
+        return Status::InvalidArgument;
+    }
+    const bool started = Scheduler::started();
+    if (attributes.superUser && started && !Scheduler::current().superUser) {
+        return Status::NotPermitted;
+    }
+    arch_x86::InterruptGuard guard;
+    const ObjectId creator = started ? Scheduler::current().id : ObjectId::null();
+    const Result<ObjectId> id = table.Create(creator, attributes.name, attributes.visibility);
+    if (!id.ok()) {
+        return id.status();
+    }
+    const Result<uint8_t*> stack = StackArena::allocate(attributes.stackSize);
+    if (!stack.ok()) {
+        table.Delete(id.value());
+        return stack.status();
+    }
+    // A task owns itself, so that its creator's death does not end it.
+    table.XferOwnership(id.value(), creator, id.value());
+
+    Task& task = tasks[slotOf(id.value())];
+    task.~Task();
+    new (&task) Task();
+    *table.resolve(id.value()).value() = &task;
+    task.id = id.value();
+    task.state = TaskState::Spawning;
+    task.basePriority = task.priority = attributes.priority;
+    task.timeSlicing = attributes.timeSlicing;
+    task.floatingPoint = attributes.floatingPoint;
+    task.superUser = attributes.superUser;
+    task.process = attributes.newProcess || !started ? task.id : Scheduler::current().process;
+    task.stackBase = stack.value();
+    task.stackSize = attributes.stackSize;
+    task.entry = entry;
+    task.argument = argument;
+    task.sliceTicksLeft = Scheduler::quantumTicks();
+    if (task.floatingPoint) {
+        initialiseFpuState(task.fpu);
+    }
+    task.savedFrame = initialFrame(task.stackBase + task.stackSize, taskEntryTrampoline);
+    task.state = TaskState::Ready;
+    Scheduler::makeReady(task);
+    return task.id;
+}
+
+Status TaskManager::kill(Task& task)
+{
+    if (task.idle) {
+        return Status::NotPermitted;
+    }
+    arch_x86::InterruptGuard guard;
+    if (&task == &Scheduler::current()) {
+        if (inInterrupt()) {
+            terminateCurrentFromInterrupt();
+            return Status::Ok;
+        }
+        exitCurrent();
+    }
+    terminate(task);
+    releaseTask(task);
+    return Status::Ok;
+}
+
+void TaskManager::exitCurrent()
+{
+    arch_x86::disableInterrupts();
+    Task& task = Scheduler::current();
+    terminate(task);
+    reapList.pushBack(task);
+    Scheduler::requestDispatch();
+    dcosPanic("a deleted task was resumed");
+}
+
+Status TaskManager::suspend(Task& task)
+{
+    if (task.idle) {
+        return Status::NotPermitted;
+    }
+    arch_x86::InterruptGuard guard;
+    if (task.suspended) {
+        return Status::Ok;
+    }
+    task.suspended = true;
+    if (task.state == TaskState::Ready) {
+        Scheduler::makeUnready(task);
+        task.state = TaskState::Suspended;
+        if (&task == &Scheduler::current()) {
+            Scheduler::requestDispatch();
+        }
+    }
+    return Status::Ok;
+}
+
+Status TaskManager::resume(Task& task)
+{
+    arch_x86::InterruptGuard guard;
+    if (!task.suspended) {
+        return Status::InvalidArgument;
+    }
+    task.suspended = false;
+    if (task.state == TaskState::Suspended) {
+        task.state = TaskState::Ready;
+        Scheduler::makeReady(task);
+    }
+    return Status::Ok;
+}
+
+Status TaskManager::changePriority(Task& task, uint8_t priority)
+{
+    if (priority > kLowestPriority) {
+        return Status::InvalidArgument;
+    }
+    if (task.idle) {
+        return Status::NotPermitted;
+    }
+    arch_x86::InterruptGuard guard;
+    task.basePriority = priority;
+    if (task.state == TaskState::Ready) {
+        Scheduler::makeUnready(task);
+        task.priority = priority;
+        Scheduler::requeue(task);
+    } else {
+        task.priority = priority;
+    }
+    return Status::Ok;
+}
+
+Status TaskManager::blockCurrent(WaitReason reason, uint64_t timeoutNs)
+{
+    Task& task = Scheduler::current();
+    task.state = TaskState::Blocked;
+    task.waitReason = reason;
+    task.wakeStatus = Status::Ok;
+    Scheduler::makeUnready(task);
+    if (timeoutNs != kWaitForever) {
+        TimerManager::arm(task.wakeTimeout, TimerManager::tickAfter(timeoutNs));
+    }
+    Scheduler::requestDispatch();
+    return task.wakeStatus;
+}
+
+void TaskManager::wake(Task& task, Status result)
+{
+    if (task.state != TaskState::Blocked) {
+        return;
+    }
+    TimerManager::cancel(task.wakeTimeout);
+    task.waitReason = WaitReason::None;
+    task.wakeStatus = result;
+    if (task.deadlineAtNextBlock) {
+        // "Set later": the real-time scope starts as the task is readied.
+        task.deadlineAtNextBlock = false;
+        task.inDeadlineScope = true;
+        task.deadlineNs = TimerManager::uptimeNs() + task.deadlinePeriodNs;
+        TimerManager::arm(task.deadlineTimeout, TimerManager::tickAfter(task.deadlinePeriodNs));
+    }
+    if (task.suspended) {
+        task.state = TaskState::Suspended;
+        return;
+    }
+    task.state = TaskState::Ready;
+    Scheduler::makeReady(task);
+}
+
+void TaskManager::postEvent(Task& task, uint32_t events)
+{
+    arch_x86::InterruptGuard guard;
+    task.events |= events;
+    if (task.state != TaskState::Blocked || task.waitReason != WaitReason::Events) {
+        return;
+    }
+    const uint32_t present = task.events & task.awaitedEvents;
+    const bool satisfied = task.awaitedMode == EventWait::All ? present == task.awaitedEvents : present != 0;
+    if (satisfied) {
+        task.events &= ~present;
+        task.receivedEvents = present;
+        wake(task, Status::Ok);
+    }
+}
+
+void TaskManager::sendSignal(Task& task, unsigned signal)
+{
+    arch_x86::InterruptGuard guard;
+    task.pendingSignals |= 1u << signal;
+    // A signal readies a suspended task (seed 7.6.1).
+    if (task.suspended) {
+        task.suspended = false;
+        if (task.state == TaskState::Suspended) {
+            task.state = TaskState::Ready;
+            Scheduler::makeReady(task);
+        }
+    }
+    if (&task == &Scheduler::current()) {
+        Scheduler::requestDispatch(); // Deliver on the way back to the task.
+    }
+}
+
+void TaskManager::raiseException(Task& task, const ExceptionInfo& info)
+{
+    arch_x86::InterruptGuard guard;
+    if (info.exceptionClass == ExceptionClass::Fatal) {
+        reportTermination(task, info);
+        kill(task);
+        return;
+    }
+    task.exceptionPending = true;
+    task.pendingException = info;
+    if (&task == &Scheduler::current()) {
+        Scheduler::requestDispatch();
+    }
+}
+
+void TaskManager::switchContext(Task& from, Task& to)
+{
+    if (&from != &to && from.floatingPoint && from.state != TaskState::Terminating) {
+        asm volatile("fnsave %0" : "=m"(from.fpu) : : "memory");
+    }
+    if (to.floatingPoint) {
+        asm volatile("frstor %0" : : "m"(to.fpu) : "memory");
+    }
+    if (from.profiling || to.profiling) {
+        const uint64_t now = TimerManager::preciseUptimeNs();
+        if (from.profiling && &from != &to) {
+            from.profileAccumulatedNs += now - from.runStartedNs;
+        }
+        to.runStartedNs = now;
+    }
+    if (from.interruptLevel != to.interruptLevel || &from == &to) {
+        InterruptManager::applyTaskLevel(to.interruptLevel);
+    }
+    if (to.sliceTicksLeft == 0) {
+        to.sliceTicksLeft = Scheduler::quantumTicks();
+    }
+}
+
+arch_x86::InterruptFrame* TaskManager::prepareReturn(Task& task, arch_x86::InterruptFrame* frame)
+{
+    reapEndedTasks();
+    if (task.idle || task.state == TaskState::Terminating) {
+        return frame;
+    }
+    if (task.exceptionPending && !task.inExceptionHandler) {
+        task.exceptionPending = false;
+        if (task.exceptionHandler == nullptr) {
+            if (task.pendingException.exceptionClass == ExceptionClass::Timing) {
+                return frame; // Ignored without a handler (seed 7.4.2).
+            }
+            reportTermination(task, task.pendingException);
+            terminateCurrentFromInterrupt();
+            return Scheduler::onOutermostExit(frame);
+        }
+        task.activeException = task.pendingException;
+        if (enterHandler(task, frame, task.exceptionSavedFrame, task.exceptionFrameAddress, exceptionTrampoline,
+                         static_cast<uint32_t>(reinterpret_cast<uintptr_t>(&task.activeException)),
+                         static_cast<uint32_t>(reinterpret_cast<uintptr_t>(task.exceptionHandler)))) {
+            task.inExceptionHandler = true;
+            task.exceptionSavedWakeStatus = task.wakeStatus;
+            return frame;
+        }
+        reportTermination(task, task.activeException);
+        terminateCurrentFromInterrupt();
+        return Scheduler::onOutermostExit(frame);
+    }
+    const uint32_t deliverable = task.pendingSignals & ~task.signalMask;
+    if (deliverable != 0 && task.signalHandler != nullptr && !task.inSignalHandler && !task.inExceptionHandler) {
+        // Signal 0 has the highest priority; one handler runs at a time.
+        const unsigned signal = static_cast<unsigned>(__builtin_ctz(deliverable));
+        if (enterHandler(task, frame, task.signalSavedFrame, task.signalFrameAddress, signalTrampoline, signal,
+                         static_cast<uint32_t>(reinterpret_cast<uintptr_t>(task.signalHandler)))) {
+            task.pendingSignals &= ~(1u << signal);
+            task.inSignalHandler = true;
+            task.signalSavedWakeStatus = task.wakeStatus;
+        }
+    }
+    return frame;
+}
+
+arch_x86::InterruptFrame* TaskManager::onCpuException(arch_x86::InterruptFrame* frame)
+{
+    // Exceptions in interrupt handlers, before scheduling starts, or in the
+    // idle task are kernel faults.
+    if (!Scheduler::started() || arch_x86::Idt::nestingDepth() > 1 || Scheduler::current().idle) {
+        dcosPanicWithFrame(frame, "CPU exception in kernel context");
+    }
+    Task& task = Scheduler::current();
+    ExceptionInfo info{classify(frame->vector), static_cast<uint8_t>(frame->vector), frame->errorCode, frame->eip,
+                       nullptr};
+    if (info.exceptionClass == ExceptionClass::Fatal || task.exceptionHandler == nullptr || task.inExceptionHandler) {
+        // No handler, or an exception inside the exception handler (a double
+        // exception): the task ends, the node carries on.
+        reportTermination(task, info);
+        terminateCurrentFromInterrupt();
+        return frame;
+    }
+    task.activeException = info;
+    if (!enterHandler(task, frame, task.exceptionSavedFrame, task.exceptionFrameAddress, exceptionTrampoline,
+                      static_cast<uint32_t>(reinterpret_cast<uintptr_t>(&task.activeException)),
+                      static_cast<uint32_t>(reinterpret_cast<uintptr_t>(task.exceptionHandler)))) {
+        reportTermination(task, info);
+        terminateCurrentFromInterrupt();
+        return frame;
+    }
+    task.inExceptionHandler = true;
+    task.exceptionSavedWakeStatus = task.wakeStatus;
+    return frame;
+}
+
+arch_x86::InterruptFrame* TaskManager::onTrap(arch_x86::InterruptFrame* frame)
+{
+    if (!Scheduler::started()) {
+        dcosPanicWithFrame(frame, "software trap before scheduling started");
+    }
+    Task& task = Scheduler::current();
+    switch (frame->vector) {
+    case Scheduler::kDispatchTrapVector:
+        return frame; // The switch itself happens at the outermost exit.
+    case kSignalReturnVector: {
+        if (!task.inSignalHandler) {
+            dcosPanicWithFrame(frame, "signal return without a signal");
+        }
+        task.inSignalHandler = false;
+        task.wakeStatus = task.signalSavedWakeStatus;
+        return restoreFrame(frame, task.signalSavedFrame, task.signalFrameAddress);
+    }
+    case kExceptionReturnVector: {
+        if (!task.inExceptionHandler) {
+            dcosPanicWithFrame(frame, "exception return without an exception");
+        }
+        task.inExceptionHandler = false;
+        task.wakeStatus = task.exceptionSavedWakeStatus;
+        const auto action = static_cast<ExceptionAction>(frame->eax & 0xFF);
+        arch_x86::InterruptFrame* resumed = restoreFrame(frame, task.exceptionSavedFrame, task.exceptionFrameAddress);
+        const ExceptionInfo& info = task.activeException;
+        if (action == ExceptionAction::Terminate) {
+            terminateCurrentFromInterrupt();
+            return resumed;
+        }
+        if (info.exceptionClass == ExceptionClass::Synchronous) {
+            if (info.resumeIn == nullptr) {
+                // Retrying the faulting instruction would fault again.
+                terminateCurrentFromInterrupt();
+                return resumed;
+            }
+            resumed->eip = static_cast<uint32_t>(reinterpret_cast<uintptr_t>(resumeTrampoline));
+            resumed->ebx = static_cast<uint32_t>(reinterpret_cast<uintptr_t>(info.resumeIn));
+        }
+        return resumed;
+    }
+    default:
+        dcosPanicWithFrame(frame, "unknown software trap");
+    }
+}
+
+size_t TaskManager::taskCount() { return table.usedCount(); }
+
+Status TaskManager::addObjects(size_t count)
+{
+    arch_x86::InterruptGuard guard;
+    return table.AddObjects(count);
+}
+
+Result<ObjectId> TaskManager::nameToObject(const char* name)
+{
+    arch_x86::InterruptGuard guard;
+    return table.NameToObject(name, Visibility::Local);
+}
+
+const char* TaskManager::nameOf(ObjectId id)
+{
+    const Result<const char*> name = table.nameOf(id);
+    return name.ok() ? name.value() : "";
+}
+
+Task* TaskManager::taskArray() { return tasks; }
+
+size_t TaskManager::taskArraySize() { return kTaskCapacity; }
+
+// The caller questions every agent asks (KernelContext.hpp).
+ObjectId currentTaskId() { return Scheduler::started() ? Scheduler::current().id : ObjectId::null(); }
+
+bool currentTaskIsSuperUser() { return !Scheduler::started() || Scheduler::current().superUser; }
+
+bool inInterruptContext() { return inInterrupt(); }
+
+uint16_t localNode() { return bsp::nodeId(); }
+
+} // namespace dcos::internal
+
+extern "C" void taskExitFromTrampoline() { dcos::internal::TaskManager::exitCurrent(); }

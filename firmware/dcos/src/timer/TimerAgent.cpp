@@ -1,0 +1,56 @@
+// The timer agent's interface object (seed 7.5).
+#include <dcos/TimerAgent.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/TimerManager.hpp>
+
+namespace dcos {
+
+using internal::TimerManager;
+
+Result<DateTime> TimerAgent::GetSystemClock() const { return TimerManager::getSystemClock(); }
+
+Status TimerAgent::SetSystemClock(const DateTime& time) const
+{
+    if (!internal::currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    return TimerManager::setSystemClock(time);
+}
+
+uint64_t TimerAgent::Uptime() const { return TimerManager::preciseUptimeNs(); }
+
+Result<ObjectId> TimerAgent::Create(const char* name, Visibility visibility) const
+{
+    return TimerManager::createTimer(internal::currentTaskId(), name, visibility);
+}
+
+Status TimerAgent::Delete(ObjectId timer) const { return TimerManager::deleteTimer(timer, internal::currentTaskId()); }
+
+Status TimerAgent::SetWatchDogAlarm(ObjectId timer, uint64_t intervalNs, AlarmNotification notification) const
+{
+    return TimerManager::setWatchDogAlarm(timer, internal::currentTaskId(), intervalNs, notification);
+}
+
+Status TimerAgent::SetDayClockAlarm(ObjectId timer, const DateTime& time, AlarmNotification notification) const
+{
+    return TimerManager::setDayClockAlarm(timer, internal::currentTaskId(), time, notification);
+}
+
+Status TimerAgent::SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNotification notification) const
+{
+    return TimerManager::setPeriodicAlarm(timer, internal::currentTaskId(), periodNs, notification);
+}
+
+Status TimerAgent::CancelAlarm(ObjectId timer) const { return TimerManager::cancelAlarm(timer, internal::currentTaskId()); }
+
+Result<ObjectId> TimerAgent::NameToObject(const char* name) const { return TimerManager::timerNameToObject(name); }
+
+Status TimerAgent::AddObjects(size_t count) const
+{
+    if (!internal::currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    return TimerManager::addTimerObjects(count);
+}
+
+} // namespace dcos

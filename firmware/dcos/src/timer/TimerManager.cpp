@@ -1,0 +1,353 @@
+#include <dcos/GregorianCalendar.hpp>
+#include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/ObjectTable.hpp>
+#include <dcos/internal/ResourceRecovery.hpp>
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/TimeWheel.hpp>
+#include <dcos/internal/TimerManager.hpp>
+
+#include <arch_x86/Cpu.hpp>
+#include <bsp/Board.hpp>
+
+namespace dcos::internal {
+
+namespace {
+
+enum class AlarmKind : uint8_t { None, WatchDog, DayClock, Periodic };
+
+// A software timer object (seed 7.5).
+struct TimerObject {
+    TimerObject() : entry(TimeoutEntry::Kind::Alarm, this) {}
+    ObjectId id;
+    AlarmKind kind = AlarmKind::None;
+    AlarmNotification notification;
+    uint64_t periodNs = 0;
+    uint64_t nextDueNs = 0;  ///< Uptime of a periodic alarm's next expiry.
+    uint64_t dayClockNs = 0; ///< Time of day of a day-clock alarm, re-armed when the clock is set.
+    TimeoutEntry entry;
+};
+
+TimeWheel<TimeoutEntry, kTimeWheelSlots> wheel;
+volatile uint64_t tickCount = 0;
+volatile uint64_t incrementNs = 0; // Nanoseconds ticked since the tick started.
+uint64_t baseNs = 0;               // Time of day, in ns since 1970, when the tick started.
+
+ObjectTable<TimerObject*, kTimerCapacity> timerTable(ObjectType::Timer, 0);
+TimerObject timers[kTimerCapacity];
+
+size_t timerSlotOf(ObjectId id) { return id.index() & (kTimerCapacity - 1); }
+
+// The first tick whose time (uptime) is at or after ns.
+uint64_t firstTickAtOrAfter(uint64_t ns)
+{
+    const uint64_t period = TimerManager::tickPeriodNs();
+    return (ns + period - 1) / period;
+}
+
+void notifyOwner(TimerObject& timer)
+{
+    const Result<ObjectId> owner = timerTable.ownerOf(timer.id);
+    if (!owner.ok()) {
+        return;
+    }
+    const Result<Task*> task = TaskManager::resolve(owner.value());
+    if (!task.ok()) {
+        return;
+    }
+    if (timer.notification.kind == AlarmNotification::Kind::Event) {
+        TaskManager::postEvent(*task.value(), timer.notification.value);
+    } else {
+        TaskManager::sendSignal(*task.value(), timer.notification.value);
+    }
+}
+
+void expire(TimeoutEntry& entry)
+{
+    switch (entry.kind) {
+    case TimeoutEntry::Kind::TaskWake:
+        TaskManager::wake(*static_cast<Task*>(entry.owner), Status::Timeout);
+        break;
+    case TimeoutEntry::Kind::DeadlineMiss: {
+        Task& task = *static_cast<Task*>(entry.owner);
+        if (task.inDeadlineScope) {
+            TaskManager::raiseException(task, ExceptionInfo{ExceptionClass::Timing, 0xFF, 0, 0, nullptr});
+        }
+        break;
+    }
+    case TimeoutEntry::Kind::Alarm: {
+        TimerObject& timer = *static_cast<TimerObject*>(entry.owner);
+        if (timer.kind == AlarmKind::Periodic) {
+            // Keep the schedule in nanoseconds and go off at the first tick
+            // at or after each due time: never early, and no drift although
+            // the tick is not a whole number of nanoseconds of the period.
+            timer.nextDueNs += timer.periodNs;
+            wheel.insert(timer.entry, firstTickAtOrAfter(timer.nextDueNs));
+        } else {
+            timer.kind = AlarmKind::None;
+        }
+        notifyOwner(timer);
+        break;
+    }
+    }
+}
+
+Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
+{
+    if (id.type() == ObjectType::Timer && id.node() != timerTable.node()) {
+        return Status::Remote;
+    }
+    const Result<TimerObject**> entry = timerTable.resolve(id);
+    if (!entry.ok()) {
+        return entry.status();
+    }
+    const Status owner = timerTable.checkOwner(id, caller);
+    if (owner != Status::Ok && !currentTaskIsSuperUser()) {
+        return owner;
+    }
+    return *entry.value();
+}
+
+Status validNotification(const AlarmNotification& n)
+{
+    if (n.kind == AlarmNotification::Kind::Signal) {
+        return n.value < 32 ? Status::Ok : Status::InvalidArgument;
+    }
+    return n.value != 0 ? Status::Ok : Status::InvalidArgument;
+}
+
+unsigned recoverTimers(ObjectId deadTask)
+{
+    arch_x86::InterruptGuard guard;
+    return static_cast<unsigned>(timerTable.forEachOwnedBy(deadTask, [](ObjectId id, TimerObject*& timer) {
+        wheel.cancel(timer->entry);
+        timer->kind = AlarmKind::None;
+        timerTable.Delete(id);
+    }));
+}
+
+} // namespace
+
+uint64_t TimerManager::tickPeriodNs_ = 1000000;
+
+void TimerManager::initialise(uint64_t tickPeriodNs)
+{
+    tickPeriodNs_ = tickPeriodNs;
+    timerTable.setNode(bsp::nodeId());
+    timerTable.AddObjects(kTimersActiveAtBoot);
+}
+
+void TimerManager::onTick()
+{
+    tickCount = tickCount + 1;
+    incrementNs = incrementNs + tickPeriodNs_;
+    wheel.advance(tickCount, expire);
+    Scheduler::onTick();
+}
+
+uint64_t TimerManager::ticks()
+{
+    arch_x86::InterruptGuard guard;
+    return tickCount;
+}
+
+uint64_t TimerManager::uptimeNs()
+{
+    arch_x86::InterruptGuard guard;
+    return incrementNs;
+}
+
+uint64_t TimerManager::preciseUptimeNs()
+{
+    arch_x86::InterruptGuard guard;
+    return incrementNs + bsp::nanosecondsIntoTick();
+}
+
+uint64_t TimerManager::tickAfter(uint64_t ns)
+{
+    const uint64_t wholeTicks = (ns + tickPeriodNs_ - 1) / tickPeriodNs_;
+    arch_x86::InterruptGuard guard;
+    return tickCount + wholeTicks + 1;
+}
+
+void TimerManager::arm(TimeoutEntry& entry, uint64_t dueTick)
+{
+    arch_x86::InterruptGuard guard;
+    wheel.cancel(entry);
+    wheel.insert(entry, dueTick);
+}
+
+void TimerManager::cancel(TimeoutEntry& entry)
+{
+    arch_x86::InterruptGuard guard;
+    wheel.cancel(entry);
+}
+
+uint64_t TimerManager::timeOfDayNs()
+{
+    arch_x86::InterruptGuard guard;
+    return baseNs + incrementNs + bsp::nanosecondsIntoTick();
+}
+
+Result<DateTime> TimerManager::getSystemClock() { return GregorianCalendar::fromNanoseconds(timeOfDayNs()); }
+
+Status TimerManager::setSystemClock(const DateTime& time)
+{
+    const Result<uint64_t> target = GregorianCalendar::toNanoseconds(time);
+    if (!target.ok()) {
+        return target.status();
+    }
+    arch_x86::InterruptGuard guard;
+    const uint64_t elapsed = incrementNs + bsp::nanosecondsIntoTick();
+    if (target.value() < elapsed) {
+        return Status::InvalidArgument; // Before the node was started.
+    }
+    baseNs = target.value() - elapsed;
+    // Day-clock alarms are times of day: move them with the clock. This is
+    // a configuration service, so the O(N) walk is acceptable.
+    for (TimerObject& timer : timers) {
+        if (timer.kind == AlarmKind::DayClock) {
+            wheel.cancel(timer.entry);
+            const uint64_t due = timer.dayClockNs > baseNs + incrementNs
+                                     ? tickAfter(timer.dayClockNs - baseNs - incrementNs) - 1
+                                     : tickCount;
+            wheel.insert(timer.entry, due);
+        }
+    }
+    return Status::Ok;
+}
+
+Result<uint64_t> TimerManager::nanosecondsUntil(const DateTime& time)
+{
+    const Result<uint64_t> target = GregorianCalendar::toNanoseconds(time);
+    if (!target.ok()) {
+        return target.status();
+    }
+    const uint64_t now = timeOfDayNs();
+    return target.value() > now ? target.value() - now : 0;
+}
+
+Result<ObjectId> TimerManager::createTimer(ObjectId owner, const char* name, Visibility visibility)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<ObjectId> id = timerTable.Create(owner, name, visibility);
+    if (!id.ok()) {
+        return id.status();
+    }
+    TimerObject& timer = timers[timerSlotOf(id.value())];
+    timer.id = id.value();
+    timer.kind = AlarmKind::None;
+    *timerTable.resolve(id.value()).value() = &timer;
+    return id.value();
+}
+
+Status TimerManager::deleteTimer(ObjectId id, ObjectId caller)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
+    if (!timer.ok()) {
+        return timer.status();
+    }
+    wheel.cancel(timer.value()->entry);
+    timer.value()->kind = AlarmKind::None;
+    return timerTable.Delete(id);
+}
+
+Status TimerManager::setWatchDogAlarm(ObjectId id, ObjectId caller, uint64_t intervalNs, AlarmNotification n)
+{
+    if (validNotification(n) != Status::Ok) {
+        return Status::InvalidArgument;
+    }
+    arch_x86::InterruptGuard guard;
+    const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
+    if (!timer.ok()) {
+        return timer.status();
+    }
+    TimerObject& t = *timer.value();
+    wheel.cancel(t.entry);
+    t.kind = AlarmKind::WatchDog;
+    t.notification = n;
+    wheel.insert(t.entry, tickAfter(intervalNs));
+    return Status::Ok;
+}
+
+Status TimerManager::setDayClockAlarm(ObjectId id, ObjectId caller, const DateTime& time, AlarmNotification n)
+{
+    if (validNotification(n) != Status::Ok) {
+        return Status::InvalidArgument;
+    }
+    const Result<uint64_t> target = GregorianCalendar::toNanoseconds(time);
+    if (!target.ok()) {
+        return target.status();
+    }
+    arch_x86::InterruptGuard guard;
+    const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
+    if (!timer.ok()) {
+        return timer.status();
+    }
+    TimerObject& t = *timer.value();
+    wheel.cancel(t.entry);
+    t.kind = AlarmKind::DayClock;
+    t.notification = n;
+    t.dayClockNs = target.value();
+    const uint64_t now = baseNs + incrementNs;
+    // A time already past goes off at the next tick.
+    wheel.insert(t.entry, target.value() > now ? tickAfter(target.value() - now) - 1 : tickCount);
+    return Status::Ok;
+}
+
+Status TimerManager::setPeriodicAlarm(ObjectId id, ObjectId caller, uint64_t periodNs, AlarmNotification n)
+{
+    if (validNotification(n) != Status::Ok || periodNs < tickPeriodNs_) {
+        return Status::InvalidArgument; // A period shorter than a tick cannot be kept.
+    }
+    arch_x86::InterruptGuard guard;
+    const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
+    if (!timer.ok()) {
+        return timer.status();
+    }
+    TimerObject& t = *timer.value();
+    wheel.cancel(t.entry);
+    t.kind = AlarmKind::Periodic;
+    t.notification = n;
+    t.periodNs = periodNs;
+    // The schedule starts from the current tick's time, the base of every
+    // interval measured in ticks.
+    t.nextDueNs = incrementNs + periodNs;
+    wheel.insert(t.entry, firstTickAtOrAfter(t.nextDueNs));
+    return Status::Ok;
+}
+
+Status TimerManager::cancelAlarm(ObjectId id, ObjectId caller)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
+    if (!timer.ok()) {
+        return timer.status();
+    }
+    if (timer.value()->kind == AlarmKind::None) {
+        return Status::InvalidArgument; // No alarm is set.
+    }
+    wheel.cancel(timer.value()->entry);
+    timer.value()->kind = AlarmKind::None;
+    return Status::Ok;
+}
+
+Result<ObjectId> TimerManager::timerNameToObject(const char* name)
+{
+    arch_x86::InterruptGuard guard;
+    return timerTable.NameToObject(name, Visibility::Local);
+}
+
+Status TimerManager::addTimerObjects(size_t count)
+{
+    arch_x86::InterruptGuard guard;
+    return timerTable.AddObjects(count);
+}
+
+size_t TimerManager::timerCount() { return timerTable.usedCount(); }
+
+DCOS_RESOURCE_RECOVERY(timerRecovery, "timer", recoverTimers);
+
+} // namespace dcos::internal
