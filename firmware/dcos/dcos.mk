@@ -2,6 +2,7 @@
 DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/GregorianCalendar.cpp \
 	firmware/dcos/src/ResourceRecovery.cpp \
+	firmware/dcos/src/StackArena.cpp \
 	$(wildcard firmware/dcos/src/system/DeviceManager.cpp) \
 	$(wildcard firmware/dcos/src/system/DeviceCommands.cpp)
 

@@ -108,6 +108,12 @@ bool alarms(shell::Shell& shell)
     invalid.day = 29;
     ok = checkStatus(shell, timerAgent.SetDayClockAlarm(timer, invalid, AlarmNotification::event(1)),
                      Status::InvalidArgument, "29 February 2026") && ok;
+    ok = checkStatus(shell, timerAgent.XferOwnership(timer, ObjectId(1, dcos::ObjectType::Task, 0x0F0)),
+                     Status::InvalidId, "XferOwnership to no task") && ok;
+    ok = checkStatus(shell, timerAgent.XferOwnership(timer, taskAgent.NameToObject("idle").value()), Status::Ok,
+                     "XferOwnership to another task") && ok;
+    ok = checkStatus(shell, timerAgent.XferOwnership(timer, taskAgent.IdOfSelf()), Status::Ok,
+                     "a super user takes it back") && ok;
     ok = checkStatus(shell, timerAgent.Delete(timer), Status::Ok, "Delete") && ok;
     ok = checkStatus(shell, timerAgent.SetWatchDogAlarm(timer, kMillisecond, AlarmNotification::event(1)),
                      Status::StaleId, "use after Delete") && ok;

@@ -46,6 +46,9 @@ public:
     /// Disarms a set alarm.
     Status CancelAlarm(ObjectId timer) const;
     Result<ObjectId> NameToObject(const char* name) const;
+    /// Hands a timer the caller owns to another task (or to the system, with
+    /// the null id), which then receives its alarms and owns it for recovery.
+    Status XferOwnership(ObjectId timer, ObjectId newOwner) const;
     /// Activates count more timer slots (privileged configuration service).
     Status AddObjects(size_t count) const;
 };

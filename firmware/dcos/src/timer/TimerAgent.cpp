@@ -45,6 +45,11 @@ Status TimerAgent::CancelAlarm(ObjectId timer) const { return TimerManager::canc
 
 Result<ObjectId> TimerAgent::NameToObject(const char* name) const { return TimerManager::timerNameToObject(name); }
 
+Status TimerAgent::XferOwnership(ObjectId timer, ObjectId newOwner) const
+{
+    return TimerManager::xferOwnership(timer, internal::currentTaskId(), newOwner);
+}
+
 Status TimerAgent::AddObjects(size_t count) const
 {
     if (!internal::currentTaskIsSuperUser()) {

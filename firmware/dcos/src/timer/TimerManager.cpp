@@ -340,6 +340,23 @@ Result<ObjectId> TimerManager::timerNameToObject(const char* name)
     return timerTable.NameToObject(name, Visibility::Local);
 }
 
+Status TimerManager::xferOwnership(ObjectId id, ObjectId caller, ObjectId newOwner)
+{
+    if (!newOwner.isNull()) {
+        const Result<Task*> task = TaskManager::resolve(newOwner);
+        if (!task.ok()) {
+            return task.status(); // The new owner must be a live local task.
+        }
+    }
+    arch_x86::InterruptGuard guard;
+    const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
+    if (!timer.ok()) {
+        return timer.status();
+    }
+    const Result<ObjectId> owner = timerTable.ownerOf(id);
+    return timerTable.XferOwnership(id, owner.value(), newOwner);
+}
+
 Status TimerManager::addTimerObjects(size_t count)
 {
     arch_x86::InterruptGuard guard;

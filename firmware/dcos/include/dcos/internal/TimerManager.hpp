@@ -59,6 +59,7 @@ public:
     static Status setPeriodicAlarm(ObjectId timer, ObjectId caller, uint64_t periodNs, AlarmNotification n);
     static Status cancelAlarm(ObjectId timer, ObjectId caller);
     static Result<ObjectId> timerNameToObject(const char* name);
+    static Status xferOwnership(ObjectId timer, ObjectId caller, ObjectId newOwner);
     static Status addTimerObjects(size_t count);
     static size_t timerCount();
 

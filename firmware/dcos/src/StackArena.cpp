@@ -17,6 +17,8 @@ alignas(StackArena::kAlignment) uint8_t arena[kStackArenaBytes];
 FreeBlock* freeList = nullptr;
 bool initialised = false;
 
+static_assert(sizeof(FreeBlock) <= StackArena::kAlignment, "every remainder must hold a free block header");
+
 size_t roundUp(size_t size) { return (size + StackArena::kAlignment - 1) & ~(StackArena::kAlignment - 1); }
 
 void initialiseOnce()
@@ -41,8 +43,11 @@ Result<uint8_t*> StackArena::allocate(size_t size)
         if (block->size < size) {
             continue;
         }
-        // Take the block's top end, so the free block keeps its place in the list.
-        if (block->size - size >= sizeof(FreeBlock) + kAlignment) {
+        // Take the block's top end, so the free block keeps its place in the
+        // list. Sizes are multiples of the alignment, which a free block's
+        // header fits in, so any remainder can stay a free block: a block
+        // is never handed out larger than asked, which release() relies on.
+        if (block->size > size) {
             block->size -= size;
             return reinterpret_cast<uint8_t*>(block) + block->size;
         }
