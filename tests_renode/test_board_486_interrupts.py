@@ -6,6 +6,9 @@ import pytest
 
 from dcoslab.board import EXIT_PASS
 
+# On-target tests this module runs (see test_kernel_core.test_every_target_test_is_run).
+BOARD_TARGET_TESTS = ["tick", "irqmask"]
+
 
 def run_target_test(boot, board, name, append="", icount=False):
     emulator = boot(board, "test", append=append, icount=icount)

@@ -2,6 +2,9 @@
 
 from dcoslab.board import EXIT_PANIC
 
+# On-target tests this module runs (see test_kernel_core.test_every_target_test_is_run).
+BOARD_TARGET_TESTS = ["divzero"]
+
 
 def test_divide_by_zero_reports_vector_0_with_registers(boot, isa486):
     emulator = boot(isa486, "test")

@@ -6,6 +6,9 @@ from dcoslab.board import EXIT_PASS
 
 PROMPT = r"dcos> "
 
+# On-target tests this module runs (see test_kernel_core.test_every_target_test_is_run).
+BOARD_TARGET_TESTS = ["txflood"]
+
 
 def test_banner_and_prompt(boot, isa486):
     emulator = boot(isa486)
