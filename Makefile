@@ -57,6 +57,7 @@ test-emulator: firmware
 bench: deps
 	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH)
 	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board isa486 --output $(BENCH_REPORT)
+	@$(PYTHON) tests_renode/thread_metric/run_thread_metric.py --board isa486 --output $(THREAD_METRIC_REPORT)
 
 clean:
 	rm -rf $(BUILD)

@@ -1,21 +1,79 @@
 # The bench image and 'make bench'.
 #
-# dcos486-bench.elf is the production firmware (FW_OBJS, mk/firmware.mk)
-# plus the benchmark framework and cases in tests_renode/bench/. It reads the
-# time-stamp counter with RDTSC, which no i486 has, so it is exempt from the
-# i486 check and runs on the board's "benchmark_cpu" (a Pentium model; see
+# dcos486-bench.elf is the production firmware plus the benchmark framework
+# and cases in tests_renode/bench/. It reads the time-stamp counter with
+# RDTSC, which no i486 has, so it is exempt from the i486 check and runs on
+# the board's "benchmark_cpu" (a Pentium model; see
 # tests_renode/boards/isa486.json and docs/performance.md).
+#
+# Every benchmark runs once with 8 and once with 4096 objects of its type,
+# so the bench image is compiled with kernel tables of 4096 slots (the 12-bit
+# index limit) and a stack arena for 4096 tasks of kMinimumStackSize (2 KiB)
+# besides the shell's 16 KiB. The kernel's table sizes are compile-time
+# constants (dcos/internal/KernelConfig.hpp), so every firmware source is
+# compiled a second time with them into $(FW_BENCH_BUILD); the production
+# and test images are unchanged. The tables still start with the production
+# image's active slots (64 tasks, 32 timers, 8 devices): the benchmarks grow
+# them with AddObjects, as an application would.
 
-FW_BENCH_SRCS := $(wildcard tests_renode/bench/*.cpp)
-FW_BENCH_OBJS := $(call fw_objects,$(FW_BENCH_SRCS))
+FW_BENCH_BUILD := $(BUILD)/fw486-bench
+FW_BENCH_DEFINES := \
+	-DDCOS_CONFIG_TASK_CAPACITY=4096 \
+	-DDCOS_CONFIG_TIMER_CAPACITY=4096 \
+	-DDCOS_CONFIG_DEVICE_CAPACITY=4096 \
+	-DDCOS_CONFIG_STACK_ARENA_KIB=8256
+FW_BENCH_CXXFLAGS := $(FW_CXXFLAGS) $(FW_BENCH_DEFINES)
+FW_BENCH_ASFLAGS := $(FW_ASFLAGS) $(FW_BENCH_DEFINES)
+
+# Benchmarks run in link order (files in this order, any file not listed
+# after them). ConfigurationBench measures AddObjects, which needs tables
+# that no other benchmark has fully activated yet, so it comes before every
+# file that fills a table.
+FW_BENCH_ORDER := \
+	tests_renode/bench/BenchmarkRunner.cpp \
+	tests_renode/bench/BenchSupport.cpp \
+	tests_renode/bench/KernelStructuresBench.cpp \
+	tests_renode/bench/ConfigurationBench.cpp \
+	tests_renode/bench/TaskBench.cpp \
+	tests_renode/bench/SchedulerBench.cpp \
+	tests_renode/bench/KernelSwitchBench.cpp \
+	tests_renode/bench/TimerBench.cpp \
+	tests_renode/bench/SystemBench.cpp
+FW_BENCH_SRCS := $(filter $(wildcard tests_renode/bench/*.cpp),$(FW_BENCH_ORDER)) \
+	$(filter-out $(FW_BENCH_ORDER),$(sort $(wildcard tests_renode/bench/*.cpp))) \
+	$(wildcard tests_renode/thread_metric/*.cpp)
+
+fw_bench_objects = $(patsubst %,$(FW_BENCH_BUILD)/%.o,$(1))
+# The revision stamp does not depend on the configuration: the production object serves.
+FW_BENCH_KERNEL_OBJS := $(call fw_bench_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
+FW_BENCH_OBJS := $(call fw_bench_objects,$(FW_BENCH_SRCS))
 
 IMAGE_486_BENCH := $(BUILD)/486/dcos486-bench.elf
 BENCH_REPORT := $(BUILD)/bench/kernel.json
+THREAD_METRIC_REPORT := $(BUILD)/bench/thread_metric.json
 
 # Built with the other images, so the emulator suite can check the framework.
 firmware: $(IMAGE_486_BENCH)
 
-$(IMAGE_486_BENCH): $(FW_OBJS) $(FW_BENCH_OBJS) firmware/boot/link.ld
+$(IMAGE_486_BENCH): $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS) firmware/boot/link.ld
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_BENCH_OBJS)
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS)
+
+FW_BENCH_FLAGS_STAMP := $(FW_BENCH_BUILD)/flags.stamp
+$(FW_BENCH_FLAGS_STAMP): FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(FW_BENCH_CXXFLAGS) $(FW_BENCH_ASFLAGS)' > $@.new
+	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+
+$(FW_BENCH_BUILD)/%.cpp.o: %.cpp $(FW_BENCH_FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)g++ $(FW_BENCH_CXXFLAGS) -c $< -o $@
+
+$(FW_BENCH_BUILD)/%.S.o: %.S $(FW_BENCH_FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)g++ $(FW_BENCH_ASFLAGS) -c $< -o $@
+
+-include $(shell find $(FW_BENCH_BUILD) -name '*.d' 2>/dev/null)

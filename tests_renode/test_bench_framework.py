@@ -69,3 +69,31 @@ def test_bench_refuses_to_run_without_a_time_stamp_counter(boot_bench, isa486):
     # so instead of taking an invalid-opcode exception.
     output = boot_bench(cpu=isa486.cpu, icount=False).command("bench run Kernel.ResolveId")
     assert "BENCH error no time-stamp counter" in output
+
+
+def test_agent_benchmarks_are_registered_under_the_seed_names(boot_bench):
+    output = boot_bench().command("bench list")
+    names = {entry["name"] for entry in LIST_LINE.finditer(output)}
+    for name in ("Kernel.ContextSwitch", "Kernel.InterruptLatency", "Kernel.StaticScheduling",
+                 "Kernel.DynamicScheduling", "Kernel.FloatingPointContext", "Task.Create", "Task.PostEvent",
+                 "Task.PendOnEvents", "Scheduler.Yield", "Scheduler.SetDeadline", "Timer.SetWatchDogAlarm",
+                 "Timer.CancelAlarm", "System.Open", "System.InstallISR"):
+        assert name in names, f"{name} is missing from 'bench list':\n{output}"
+
+
+def test_self_timed_switch_benchmarks_report_exact_flat_counts_with_4096_tasks(boot_bench):
+    # Self-timed benchmarks (the interval runs from one task into another, or
+    # into an interrupt handler) must mark an interval for both object
+    # counts, including the 4096-task population the bench image's larger
+    # tables allow. Only the design's O(1) claim is checked, not a speed.
+    output = boot_bench().command("bench run Kernel", timeout=120)
+    assert output.splitlines()[-1] == "BENCH done", output
+    assert " error=" not in output, output
+    _, results = parse_run(output)
+    for name in ("Kernel.ContextSwitch", "Kernel.InterruptLatency", "Kernel.StaticScheduling"):
+        entry = results[name]
+        assert entry["cost"] == "constant"
+        (min_8, _), (min_4096, _) = entry[8], entry[4096]
+        assert min_8 > 0, f"{name}: an interval was marked"
+        assert min_8 == min_4096, f"{name} must not depend on the number of tasks: {min_8} vs {min_4096}"
+    assert results["Kernel.DynamicScheduling"]["cost"] == "log"

@@ -3,6 +3,10 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/GregorianCalendar.cpp \
 	firmware/dcos/src/ResourceRecovery.cpp \
 	firmware/dcos/src/StackArena.cpp \
+	firmware/dcos/src/memory/BufferPool.cpp \
+	firmware/dcos/src/memory/SegmentedHeap.cpp \
+	firmware/dcos/src/MessageBufferPool.cpp \
+	firmware/dcos/src/MessageQueue.cpp \
 	$(wildcard firmware/dcos/src/system/DeviceManager.cpp) \
 	$(wildcard firmware/dcos/src/system/DeviceCommands.cpp)
 
@@ -12,4 +16,9 @@ DCOS_TARGET_SRCS := \
 	$(wildcard firmware/dcos/src/task/*.cpp firmware/dcos/src/task/*.S) \
 	$(wildcard firmware/dcos/src/scheduler/*.cpp) \
 	$(wildcard firmware/dcos/src/timer/*.cpp) \
-	firmware/dcos/src/system/InterruptManager.cpp
+	$(wildcard firmware/dcos/src/memory/*Manager.cpp firmware/dcos/src/memory/*Agent.cpp) \
+	$(wildcard firmware/dcos/src/memory/MemoryCommands.cpp) \
+	firmware/dcos/src/system/InterruptManager.cpp \
+	$(wildcard firmware/dcos/src/port/*.cpp) \
+	$(wildcard firmware/dcos/src/dsm/*.cpp) \
+	$(wildcard firmware/dcos/src/semaphore/*.cpp)

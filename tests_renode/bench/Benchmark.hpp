@@ -25,6 +25,14 @@
 // never lands inside a measurement. A primitive that must run with
 // interrupts enabled (one that blocks or switches tasks) sets
 // options.interruptsEnabled; its maximum may then include an interrupt.
+//
+// An interval that does not begin and end in the same task around one call
+// (a task switch: from a call in task A to the first instruction of task B;
+// an interrupt: from the request to the handler's first instruction) sets
+// options.selfTimed: measure() then starts the interval with
+// bench::markStart() and something it causes ends it with bench::markEnd()
+// (in another task, or in an interrupt handler), and the figure is
+// end - start less the cost of an empty markStart(); markEnd() pair.
 #pragma once
 
 #include <dcos/Status.hpp>
@@ -52,6 +60,9 @@ struct Options {
     void (*teardown)() = nullptr;
     /// Leave interrupts enabled around the measured call.
     bool interruptsEnabled = false;
+    /// The figure is the interval from bench::markStart() to bench::markEnd(),
+    /// which measure() brings about, rather than the duration of measure().
+    bool selfTimed = false;
 };
 
 struct Benchmark {
@@ -64,6 +75,39 @@ struct Benchmark {
     Cost cost;
     Options options;
 };
+
+/// Time-stamp counter values of the current self-timed interval (Options::selfTimed).
+extern volatile uint64_t intervalStart;
+extern volatile uint64_t intervalEnd;
+
+/// Starts a self-timed interval: the time-stamp counter read is its first instruction.
+[[gnu::always_inline]] inline void markStart()
+{
+    uint64_t value;
+    asm volatile("rdtsc" : "=A"(value)::"memory");
+    intervalStart = value;
+}
+
+/// Ends a self-timed interval: everything before this read counts.
+[[gnu::always_inline]] inline void markEnd()
+{
+    uint64_t value;
+    asm volatile("rdtsc" : "=A"(value)::"memory");
+    intervalEnd = value;
+}
+
+/// The first status other than Ok that a measured call passed to check()
+/// since the runner last cleared it; the runner then reports that status
+/// instead of figures, so that an error path is never taken for the primitive.
+extern volatile dcos::Status measuredFailure;
+
+/// Records the status of the measured call (a compare and, on failure, a store).
+[[gnu::always_inline]] inline void check(dcos::Status status)
+{
+    if (status != dcos::Status::Ok) {
+        measuredFailure = status;
+    }
+}
 
 /// The object counts every benchmark runs with, smallest first.
 inline constexpr uint32_t objectCounts[] = {8, 4096};
@@ -79,7 +123,7 @@ inline constexpr uint32_t maximumObjectCount = 4096;
 ///
 /// The optional trailing arguments are designated initialisers of
 /// bench::Options and must keep its member order: .restore, .teardown,
-/// .interruptsEnabled.
+/// .interruptsEnabled, .selfTimed.
 #define DCOS_BENCHMARK(identifier, name, setup, measure, cost, ...)                          \
     [[gnu::used, gnu::section("dcos_benchmarks")]] constinit const ::bench::Benchmark identifier \
     {                                                                                        \

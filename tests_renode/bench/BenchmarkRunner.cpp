@@ -16,7 +16,9 @@
 //
 // min and max are time-stamp counter differences less the smallest cost of
 // timing an empty function, i.e. the instructions (under exact counting) the
-// measured call retires beyond a call of an empty function.
+// measured call retires beyond a call of an empty function. For a
+// self-timed benchmark (Options::selfTimed) they are the markStart() to
+// markEnd() interval less the smallest cost of an empty such interval.
 #include "Benchmark.hpp"
 
 #include <arch_x86/Cpu.hpp>
@@ -26,6 +28,11 @@
 #include <stdint.h>
 
 namespace bench {
+
+volatile uint64_t intervalStart = 0;
+volatile uint64_t intervalEnd = 0;
+volatile dcos::Status measuredFailure = dcos::Status::Ok;
+
 namespace {
 
 extern "C" const Benchmark __start_dcos_benchmarks[];
@@ -141,6 +148,26 @@ uint64_t measureOnce(void (*function)(), bool interruptsEnabled)
     return count;
 }
 
+// The empty self-timed interval: what markStart() and markEnd() cost when
+// nothing happens between them.
+[[gnu::noinline]] void emptyInterval()
+{
+    markStart();
+    markEnd();
+}
+
+// One call of a self-timed measure(); the interval it marked, or 0 when it
+// marked none (its end is missing or precedes its start).
+uint64_t measureInterval(void (*function)(), bool interruptsEnabled)
+{
+    intervalStart = 0;
+    intervalEnd = 0;
+    measureOnce(function, interruptsEnabled);
+    const uint64_t start = intervalStart;
+    const uint64_t end = intervalEnd;
+    return start != 0 && end > start ? end - start : 0;
+}
+
 struct Range {
     uint64_t min = UINT64_MAX;
     uint64_t max = 0;
@@ -172,7 +199,8 @@ shell::CommandResult refuse(shell::Shell& shell, const char* reason)
     return shell::CommandResult::Failed;
 }
 
-void runOne(shell::Shell& shell, const Benchmark& benchmark, unsigned repeatCount, uint64_t overhead)
+void runOne(shell::Shell& shell, const Benchmark& benchmark, unsigned repeatCount, uint64_t overhead,
+            uint64_t intervalOverhead)
 {
     for (const uint32_t objects : objectCounts) {
         const dcos::Status status = benchmark.setup(objects);
@@ -185,10 +213,14 @@ void runOne(shell::Shell& shell, const Benchmark& benchmark, unsigned repeatCoun
             continue;
         }
         Range range;
+        measuredFailure = dcos::Status::Ok;
         for (unsigned i = 0; i < warmupCount + repeatCount; ++i) {
-            const uint64_t count = measureOnce(benchmark.measure, benchmark.options.interruptsEnabled);
-            if (i >= warmupCount) {
-                range.add(lessOverhead(count, overhead));
+            const bool selfTimed = benchmark.options.selfTimed;
+            const uint64_t count = selfTimed ? measureInterval(benchmark.measure, benchmark.options.interruptsEnabled)
+                                             : measureOnce(benchmark.measure, benchmark.options.interruptsEnabled);
+            // A self-timed call that marked no interval (0) is left out; see below.
+            if (i >= warmupCount && (!selfTimed || count != 0)) {
+                range.add(lessOverhead(count, selfTimed ? intervalOverhead : overhead));
             }
             if (benchmark.options.restore != nullptr) {
                 benchmark.options.restore();
@@ -196,6 +228,17 @@ void runOne(shell::Shell& shell, const Benchmark& benchmark, unsigned repeatCoun
         }
         if (benchmark.options.teardown != nullptr) {
             benchmark.options.teardown();
+        }
+        if (measuredFailure != dcos::Status::Ok) {
+            shell.print("BENCH %s objects=%lu error=%u measured call failed: %s\r\n", benchmark.name,
+                        static_cast<unsigned long>(objects), static_cast<unsigned>(measuredFailure),
+                        dcos::statusName(measuredFailure));
+            continue;
+        }
+        if (range.min == UINT64_MAX) {
+            shell.print("BENCH %s objects=%lu error=%u no interval was marked\r\n", benchmark.name,
+                        static_cast<unsigned long>(objects), static_cast<unsigned>(dcos::Status::NotFound));
+            continue;
         }
         shell.print("BENCH %s objects=%lu min=%llu max=%llu variable=%u cost=%s\r\n", benchmark.name,
                     static_cast<unsigned long>(objects), static_cast<unsigned long long>(range.min),
@@ -234,13 +277,20 @@ shell::CommandResult run(shell::Shell& shell, const char* pattern, unsigned repe
             overhead.add(count);
         }
     }
+    Range intervalOverhead;
+    for (unsigned i = 0; i < warmupCount + repeatCount; ++i) {
+        const uint64_t count = measureInterval(emptyInterval, false);
+        if (i >= warmupCount) {
+            intervalOverhead.add(count);
+        }
+    }
     shell.print("BENCH overhead min=%llu max=%llu warmup=%u repeat=%u\r\n",
                 static_cast<unsigned long long>(overhead.min), static_cast<unsigned long long>(overhead.max),
                 warmupCount, repeatCount);
 
     for (const Benchmark* benchmark = __start_dcos_benchmarks; benchmark != __stop_dcos_benchmarks; ++benchmark) {
         if (selects(pattern, benchmark->name)) {
-            runOne(shell, *benchmark, repeatCount, overhead.min);
+            runOne(shell, *benchmark, repeatCount, overhead.min, intervalOverhead.min);
         }
     }
     shell.print("BENCH done\r\n");

@@ -16,6 +16,21 @@ inline unsigned leadingZeros64(uint64_t value)
     return 32u + static_cast<unsigned>(__builtin_clz(static_cast<uint32_t>(value)));
 }
 
+// Divides the 64-bit number high:low by d, where high < d, so the quotient
+// fits in 32 bits. On the i486 that is exactly one DIVL (EDX:EAX / r32,
+// Intel SDM Vol. 2, DIV); elsewhere (host tests) the native 64-bit divide
+// gives the same result.
+inline void divideTwoDigits(uint32_t high, uint32_t low, uint32_t d, uint32_t& quotient, uint32_t& remainder)
+{
+#if defined(__i386__)
+    asm("divl %4" : "=a"(quotient), "=d"(remainder) : "a"(low), "d"(high), "rm"(d) : "cc");
+#else
+    const uint64_t n = (uint64_t{high} << 32) | low;
+    quotient = static_cast<uint32_t>(n / d);
+    remainder = static_cast<uint32_t>(n % d);
+#endif
+}
+
 } // namespace
 
 UnsignedQuotient divideUnsigned64(uint64_t dividend, uint64_t divisor)
@@ -31,6 +46,20 @@ UnsignedQuotient divideUnsigned64(uint64_t dividend, uint64_t divisor)
         const uint32_t n = static_cast<uint32_t>(dividend);
         const uint32_t d = static_cast<uint32_t>(divisor);
         return {n / d, n % d};
+    }
+    // A 32-bit divisor (the common case: nanoseconds by a tick period, a
+    // calendar by 86400 s) takes two hardware divides, so the cost does not
+    // depend on the values: long division in base 2^32, where each step
+    // divides a two-digit number whose high digit is below the divisor.
+    if ((divisor >> 32) == 0) {
+        const uint32_t d = static_cast<uint32_t>(divisor);
+        const uint32_t high = static_cast<uint32_t>(dividend >> 32);
+        const uint32_t quotientHigh = high / d;
+        const uint32_t remainderHigh = high % d;
+        uint32_t quotientLow;
+        uint32_t remainder;
+        divideTwoDigits(remainderHigh, static_cast<uint32_t>(dividend), d, quotientLow, remainder);
+        return {(uint64_t{quotientHigh} << 32) | quotientLow, remainder};
     }
 
     // Restoring shift-subtract division, starting at the highest bit where

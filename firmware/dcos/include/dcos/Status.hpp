@@ -34,6 +34,7 @@ enum class Status : uint8_t {
     NotSupported = 18,    ///< The device or object does not implement the request.
     Remote = 19,          ///< The id names an object on another node and no network is up.
     NotOpen = 20,         ///< The device must be opened first (Read, Write, Control, Close).
+    Abandoned = 21,       ///< The task holding the resource ended while the caller waited.
 };
 
 /// Returns a short, stable English name for a status, for logs and the shell.
@@ -60,6 +61,7 @@ constexpr const char* statusName(Status status)
     case Status::Deadlock: return "would deadlock";
     case Status::NotSupported: return "not supported";
     case Status::Remote: return "remote object unreachable";
+    case Status::Abandoned: return "holder ended";
     case Status::NotOpen: return "device not open";
     }
     return "unknown status";

@@ -11,6 +11,7 @@ namespace dcos::internal {
 Task* Scheduler::current_ = nullptr;
 Task* Scheduler::idle_ = nullptr;
 volatile bool Scheduler::dispatchPending_ = false;
+unsigned Scheduler::dispatchHolds_ = 0;
 uint32_t Scheduler::quantumTicks_ = 10;
 uint32_t Scheduler::switchCount_ = 0;
 ReadyBitmap Scheduler::readyBitmap_;
@@ -87,8 +88,15 @@ void Scheduler::requeue(Task& task)
 void Scheduler::requestDispatch()
 {
     dispatchPending_ = true;
-    if (current_ != nullptr && arch_x86::Idt::nestingDepth() == 0) {
+    if (current_ != nullptr && dispatchHolds_ == 0 && arch_x86::Idt::nestingDepth() == 0) {
         asm volatile("int %0" : : "i"(kDispatchTrapVector) : "memory");
+    }
+}
+
+void Scheduler::releaseDispatch()
+{
+    if (--dispatchHolds_ == 0 && dispatchPending_) {
+        requestDispatch();
     }
 }
 

@@ -164,15 +164,62 @@ void reapEndedTasks()
 // Takes a task out of every structure, recovers what it owns and marks it
 // as terminating. The caller frees its stack and slot, now or (for the
 // running task) after the switch away.
+void leaveWaitQueue(Task& task)
+{
+    WaitQueue* queue = task.waitingOn;
+    if (queue != nullptr) {
+        queue->remove(task);
+        task.waitingOn = nullptr;
+        queue->notifyObserver();
+    }
+}
+
+// Runs a task at a new priority: moves it in its ready queue or in the wait
+// queue it is blocked on (whose agent may pass the change on).
+unsigned inheritanceDepth = 0;
+constexpr unsigned kMaximumInheritanceDepth = 8;
+
+void setRunningPriority(Task& task, uint8_t priority)
+{
+    if (task.priority == priority) {
+        return;
+    }
+    const bool queued = static_cast<IntrusiveListNode<ReadyQueueTag>&>(task).isLinked() || task.isQueued();
+    if (queued) {
+        Scheduler::makeUnready(task);
+        task.priority = priority;
+        Scheduler::requeue(task);
+    } else {
+        task.priority = priority;
+    }
+    if (task.waitingOn != nullptr && inheritanceDepth < kMaximumInheritanceDepth) {
+        // A blocked holder's new priority may change what it lends onwards.
+        ++inheritanceDepth;
+        task.waitingOn->reposition(task);
+        task.waitingOn->notifyObserver();
+        --inheritanceDepth;
+    }
+}
+
 void terminate(Task& task)
 {
+    // Recovery may ready tasks more urgent than the running one; none may
+    // run before the dying task is fully taken apart (if it is the running
+    // task, it would never be resumed to finish).
+    Scheduler::holdDispatch();
     task.state = TaskState::Terminating;
+    leaveWaitQueue(task);
     Scheduler::makeUnready(task);
     TimerManager::cancel(task.wakeTimeout);
     TimerManager::cancel(task.deadlineTimeout);
     task.inDeadlineScope = false;
     task.deadlineAtNextBlock = false;
     recoverResourcesOf(task.id);
+    if (&task == &Scheduler::current()) {
+        // Queue it for reaping before any switch away can happen.
+        reapList.pushBack(task);
+    }
+    Scheduler::releaseDispatch();
 }
 
 void reportTermination(Task& task, const ExceptionInfo& info)
@@ -194,9 +241,7 @@ void reportTermination(Task& task, const ExceptionInfo& info)
 // switch away happens at the outermost exit.
 void terminateCurrentFromInterrupt()
 {
-    Task& task = Scheduler::current();
-    terminate(task);
-    reapList.pushBack(task);
+    terminate(Scheduler::current());
     Scheduler::requestDispatch();
 }
 
@@ -308,17 +353,17 @@ Status TaskManager::kill(Task& task)
         }
         exitCurrent();
     }
+    Scheduler::holdDispatch();
     terminate(task);
     releaseTask(task);
+    Scheduler::releaseDispatch();
     return Status::Ok;
 }
 
 void TaskManager::exitCurrent()
 {
     arch_x86::disableInterrupts();
-    Task& task = Scheduler::current();
-    terminate(task);
-    reapList.pushBack(task);
+    terminate(Scheduler::current());
     Scheduler::requestDispatch();
     dcosPanic("a deleted task was resumed");
 }
@@ -367,14 +412,48 @@ Status TaskManager::changePriority(Task& task, uint8_t priority)
     }
     arch_x86::InterruptGuard guard;
     task.basePriority = priority;
-    if (task.state == TaskState::Ready) {
-        Scheduler::makeUnready(task);
-        task.priority = priority;
-        Scheduler::requeue(task);
-    } else {
-        task.priority = priority;
-    }
+    recomputePriority(task);
     return Status::Ok;
+}
+
+void TaskManager::recomputePriority(Task& task)
+{
+    uint8_t priority = task.basePriority;
+    for (InheritanceSource& source : task.heldSources) {
+        if (!source.waiters.isEmpty() && source.waiters.first().priority < priority) {
+            priority = source.waiters.first().priority;
+        }
+    }
+    setRunningPriority(task, priority);
+}
+
+Status TaskManager::blockOn(WaitQueue& queue, uint64_t timeoutNs)
+{
+    Task& task = Scheduler::current();
+    queue.add(task);
+    task.waitingOn = &queue;
+    return blockCurrent(WaitReason::Object, timeoutNs);
+}
+
+Task* TaskManager::wakeFirst(WaitQueue& queue, Status result)
+{
+    if (queue.isEmpty()) {
+        return nullptr;
+    }
+    Task& task = queue.first();
+    queue.remove(task);
+    task.waitingOn = nullptr;
+    wake(task, result);
+    return &task;
+}
+
+void TaskManager::wakeAll(WaitQueue& queue, Status result)
+{
+    // Every waiter is woken before the most urgent of them runs.
+    Scheduler::holdDispatch();
+    while (wakeFirst(queue, result) != nullptr) {
+    }
+    Scheduler::releaseDispatch();
 }
 
 Status TaskManager::blockCurrent(WaitReason reason, uint64_t timeoutNs)
@@ -399,6 +478,8 @@ void TaskManager::wake(Task& task, Status result)
     TimerManager::cancel(task.wakeTimeout);
     task.waitReason = WaitReason::None;
     task.wakeStatus = result;
+    // Leaving by time-out (not through wakeFirst): tell the object's agent.
+    leaveWaitQueue(task);
     if (task.deadlineAtNextBlock) {
         // "Set later": the real-time scope starts as the task is readied.
         task.deadlineAtNextBlock = false;

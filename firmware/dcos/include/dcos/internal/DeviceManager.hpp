@@ -24,6 +24,7 @@
 #include <dcos/ObjectId.hpp>
 #include <dcos/Status.hpp>
 #include <dcos/Visibility.hpp>
+#include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/ObjectTable.hpp>
 
 #include <stddef.h>
@@ -40,9 +41,6 @@ struct DeviceEntry {
     /// Calls into the driver that have started and not yet returned.
     uint16_t callsInProgress = 0;
 };
-
-/// Device slots reserved at build time; AddObjects activates them.
-inline constexpr size_t kDeviceCapacity = 64;
 
 /// The object table type that holds the installed devices.
 using DeviceTable = ObjectTable<DeviceEntry, kDeviceCapacity>;

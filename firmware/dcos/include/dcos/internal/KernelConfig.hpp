@@ -20,6 +20,9 @@
 #ifndef DCOS_CONFIG_TIMERS_ACTIVE
 #define DCOS_CONFIG_TIMERS_ACTIVE 32
 #endif
+#ifndef DCOS_CONFIG_DEVICE_CAPACITY
+#define DCOS_CONFIG_DEVICE_CAPACITY 64
+#endif
 #ifndef DCOS_CONFIG_STACK_ARENA_KIB
 #define DCOS_CONFIG_STACK_ARENA_KIB 1024
 #endif
@@ -27,16 +30,101 @@
 #define DCOS_CONFIG_TIME_WHEEL_SLOTS 257
 #endif
 
+#ifndef DCOS_CONFIG_SEMAPHORE_CAPACITY
+#define DCOS_CONFIG_SEMAPHORE_CAPACITY 256
+#endif
+#ifndef DCOS_CONFIG_SEMAPHORES_ACTIVE
+#define DCOS_CONFIG_SEMAPHORES_ACTIVE 32
+#endif
+
 namespace dcos::internal {
+
+constexpr size_t kSemaphoreCapacity = DCOS_CONFIG_SEMAPHORE_CAPACITY;
+constexpr size_t kSemaphoresActiveAtBoot = DCOS_CONFIG_SEMAPHORES_ACTIVE;
+static_assert(kSemaphoresActiveAtBoot <= kSemaphoreCapacity && kSemaphoresActiveAtBoot % 8 == 0);
 
 constexpr size_t kTaskCapacity = DCOS_CONFIG_TASK_CAPACITY;
 constexpr size_t kTasksActiveAtBoot = DCOS_CONFIG_TASKS_ACTIVE;
 constexpr size_t kTimerCapacity = DCOS_CONFIG_TIMER_CAPACITY;
 constexpr size_t kTimersActiveAtBoot = DCOS_CONFIG_TIMERS_ACTIVE;
+constexpr size_t kDeviceCapacity = DCOS_CONFIG_DEVICE_CAPACITY;
 constexpr size_t kStackArenaBytes = size_t{DCOS_CONFIG_STACK_ARENA_KIB} * 1024;
 constexpr size_t kTimeWheelSlots = DCOS_CONFIG_TIME_WHEEL_SLOTS;
 
 static_assert(kTasksActiveAtBoot <= kTaskCapacity && kTasksActiveAtBoot % 8 == 0);
 static_assert(kTimersActiveAtBoot <= kTimerCapacity && kTimersActiveAtBoot % 8 == 0);
+
+} // namespace dcos::internal
+
+// Message ports and distributed shared memory (seed 7.9, 7.10). A message
+// buffer holds one queued 16-byte message; DCOS_CONFIG_MESSAGE_BUFFERS is the
+// static reserve, of which AddMsgBufs activates more at run time.
+#ifndef DCOS_CONFIG_PORT_CAPACITY
+#define DCOS_CONFIG_PORT_CAPACITY 128
+#endif
+#ifndef DCOS_CONFIG_PORTS_ACTIVE
+#define DCOS_CONFIG_PORTS_ACTIVE 32
+#endif
+#ifndef DCOS_CONFIG_MESSAGE_BUFFERS
+#define DCOS_CONFIG_MESSAGE_BUFFERS 1024
+#endif
+#ifndef DCOS_CONFIG_MESSAGE_BUFFERS_ACTIVE
+#define DCOS_CONFIG_MESSAGE_BUFFERS_ACTIVE 256
+#endif
+#ifndef DCOS_CONFIG_PUBLISHER_CAPACITY
+#define DCOS_CONFIG_PUBLISHER_CAPACITY 128
+#endif
+#ifndef DCOS_CONFIG_PUBLISHERS_ACTIVE
+#define DCOS_CONFIG_PUBLISHERS_ACTIVE 32
+#endif
+#ifndef DCOS_CONFIG_SUBSCRIPTION_CAPACITY
+#define DCOS_CONFIG_SUBSCRIPTION_CAPACITY 256
+#endif
+#ifndef DCOS_CONFIG_SUBSCRIPTIONS_ACTIVE
+#define DCOS_CONFIG_SUBSCRIPTIONS_ACTIVE 64
+#endif
+
+namespace dcos::internal {
+
+constexpr size_t kPortCapacity = DCOS_CONFIG_PORT_CAPACITY;
+constexpr size_t kPortsActiveAtBoot = DCOS_CONFIG_PORTS_ACTIVE;
+constexpr size_t kMessageBufferCapacity = DCOS_CONFIG_MESSAGE_BUFFERS;
+constexpr size_t kMessageBuffersActiveAtBoot = DCOS_CONFIG_MESSAGE_BUFFERS_ACTIVE;
+constexpr size_t kPublisherCapacity = DCOS_CONFIG_PUBLISHER_CAPACITY;
+constexpr size_t kPublishersActiveAtBoot = DCOS_CONFIG_PUBLISHERS_ACTIVE;
+constexpr size_t kSubscriptionCapacity = DCOS_CONFIG_SUBSCRIPTION_CAPACITY;
+constexpr size_t kSubscriptionsActiveAtBoot = DCOS_CONFIG_SUBSCRIPTIONS_ACTIVE;
+
+static_assert(kPortsActiveAtBoot <= kPortCapacity && kPortsActiveAtBoot % 8 == 0);
+static_assert(kMessageBuffersActiveAtBoot <= kMessageBufferCapacity);
+static_assert(kPublishersActiveAtBoot <= kPublisherCapacity && kPublishersActiveAtBoot % 8 == 0);
+static_assert(kSubscriptionsActiveAtBoot <= kSubscriptionCapacity && kSubscriptionsActiveAtBoot % 8 == 0);
+
+} // namespace dcos::internal
+
+// Buffer pools and segmented heaps (seed 7.7, 7.8). The areas come from the
+// application; these are the sizes of the object tables only.
+#ifndef DCOS_CONFIG_POOL_CAPACITY
+#define DCOS_CONFIG_POOL_CAPACITY 64
+#endif
+#ifndef DCOS_CONFIG_POOLS_ACTIVE
+#define DCOS_CONFIG_POOLS_ACTIVE 8
+#endif
+#ifndef DCOS_CONFIG_HEAP_CAPACITY
+#define DCOS_CONFIG_HEAP_CAPACITY 64
+#endif
+#ifndef DCOS_CONFIG_HEAPS_ACTIVE
+#define DCOS_CONFIG_HEAPS_ACTIVE 8
+#endif
+
+namespace dcos::internal {
+
+constexpr size_t kPoolCapacity = DCOS_CONFIG_POOL_CAPACITY;
+constexpr size_t kPoolsActiveAtBoot = DCOS_CONFIG_POOLS_ACTIVE;
+constexpr size_t kHeapCapacity = DCOS_CONFIG_HEAP_CAPACITY;
+constexpr size_t kHeapsActiveAtBoot = DCOS_CONFIG_HEAPS_ACTIVE;
+
+static_assert(kPoolsActiveAtBoot <= kPoolCapacity && kPoolsActiveAtBoot % 8 == 0 && kPoolsActiveAtBoot != 0);
+static_assert(kHeapsActiveAtBoot <= kHeapCapacity && kHeapsActiveAtBoot % 8 == 0 && kHeapsActiveAtBoot != 0);
 
 } // namespace dcos::internal

@@ -54,6 +54,14 @@ public:
     /// dispatch trap), or at the outermost interrupt exit from a handler.
     static void requestDispatch();
 
+    /// Holds task switches requested from task context until the matching
+    /// releaseDispatch(): kernel code that readies several tasks, or that
+    /// ends the running task, finishes its bookkeeping before any of them
+    /// runs. Nests. Call with interrupts disabled.
+    static void holdDispatch() { ++dispatchHolds_; }
+    /// Ends a hold; a switch requested meanwhile happens now.
+    static void releaseDispatch();
+
     /// Moves the running task behind its equals (Yield, end of time slice).
     /// Returns true when another task of the same priority was waiting.
     static bool rotateCurrent();
@@ -81,6 +89,7 @@ private:
     static Task* current_;
     static Task* idle_;
     static volatile bool dispatchPending_;
+    static unsigned dispatchHolds_;
     static uint32_t quantumTicks_;
     static uint32_t switchCount_;
     static ReadyBitmap readyBitmap_;

@@ -11,6 +11,7 @@
 #include <dcos/internal/DeadlineQueue.hpp>
 #include <dcos/internal/IntrusiveList.hpp>
 #include <dcos/internal/TimeoutEntry.hpp>
+#include <dcos/internal/WaitQueue.hpp>
 
 #include <arch_x86/InterruptFrame.hpp>
 
@@ -34,7 +35,18 @@ struct FpuState {
     uint8_t bytes[108];
 };
 
-struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode {
+/// A source of inherited priority: an object whose waiters lend their
+/// priority to the task holding it (a binary semaphore with priority
+/// inheritance, seed 7.11). The holder keeps its sources in a list, so it
+/// runs at the most urgent priority among all their waiters.
+struct InheritanceSourceTag;
+struct InheritanceSource : IntrusiveListNode<InheritanceSourceTag> {
+    explicit InheritanceSource(WaitQueue::Order order) : waiters(order) {}
+    WaitQueue waiters;
+    Task* holder = nullptr;
+};
+
+struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<WaitQueueTag> {
     Task() : wakeTimeout(TimeoutEntry::Kind::TaskWake, this), deadlineTimeout(TimeoutEntry::Kind::DeadlineMiss, this) {}
 
     ObjectId id;
@@ -65,6 +77,11 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode {
     WaitReason waitReason = WaitReason::None;
     Status wakeStatus = Status::Ok;
     TimeoutEntry wakeTimeout;
+    WaitQueue* waitingOn = nullptr; ///< The queue of the object it waits for, if any.
+    uintptr_t waitData = 0;         ///< What the waiter asked for or received (agent-defined).
+
+    // Priority inheritance: the sources this task holds.
+    IntrusiveList<InheritanceSource, InheritanceSourceTag> heldSources;
 
     // Event flags.
     uint32_t events = 0;

@@ -38,6 +38,20 @@ public:
     /// Makes a blocked task ready with the given result. O(1).
     static void wake(Task& task, Status result);
 
+    /// Blocks the running task on an object's wait queue until wakeFirst /
+    /// wakeAll or the time-out. Interrupts disabled, task context. The
+    /// queue's observer is told when the waiter leaves by time-out or kill.
+    static Status blockOn(WaitQueue& queue, uint64_t timeoutNs);
+    /// Wakes the first waiter of a queue with result; returns it, or null. O(1).
+    static Task* wakeFirst(WaitQueue& queue, Status result);
+    /// Wakes every waiter of a queue with result. O(waiters).
+    static void wakeAll(WaitQueue& queue, Status result);
+
+    /// Recomputes the priority a task runs at: its static priority, raised
+    /// to the most urgent waiter of every inheritance source it holds, and
+    /// passes a change on along the chain of holders. O(sources held).
+    static void recomputePriority(Task& task);
+
     static void postEvent(Task& task, uint32_t events);
     static void sendSignal(Task& task, unsigned signal);
     /// Marks an exception for delivery to task when it next runs.

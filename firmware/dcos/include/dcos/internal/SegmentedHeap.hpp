@@ -1,0 +1,168 @@
+// The algorithm of a segmented heap (seed 7.8), free of kernel and hardware.
+//
+// The heap tiles a caller-supplied area with segments. Every segment starts
+// on an 8-byte boundary with an 8-byte header; its size (header included) is
+// a multiple of 8 and at least 16, so it holds at least 8 bytes:
+//
+//     allocated:  | size | A=1 | P | check:16 holder:16 | data ...                          |
+//     free:       | size | A=0 | P=0 | prev link        | next link | ...        | end tag  |
+//
+// The first header word holds the size with two flags in its low bits: A, the
+// segment is allocated, and P, the segment before it is free. An allocated
+// segment's second word is the holder (a 16-bit tag the kernel derives from
+// the task id) and a check value bound to the heap's salt, the segment's
+// position, its first word and its holder. A free segment uses its second
+// word and its first data word for the links of a doubly linked free list,
+// and its last word for a boundary tag: its size scrambled with its end
+// position, so that a segment whose P flag is set finds where its free
+// predecessor starts in O(1) and can check the find.
+//
+// Allocation is first fit (seed 7.8): the free list is walked from its head,
+// in no particular order, and the first segment large enough is used. A
+// larger one is split and the allocation is cut from its end, so the free
+// remainder keeps its place in the list; a remainder under 16 bytes is not
+// split off but given with the allocation. Return merges the segment with a
+// free successor and a free predecessor, so no two free segments are ever
+// adjacent, and costs O(1).
+//
+// Every word is checked before any is written; a failed check (a double
+// return, a pointer that is not a segment's start, an overwritten header,
+// tag or link, a list that loops or loses segments) disables the heap, and
+// every call then fails with Status::Corrupted until the owner deletes it.
+// A header made obsolete by a merge is cleared, so an old pointer to a merged
+// segment is recognised as a double return.
+//
+// The class does no locking; its owner serialises calls.
+#pragma once
+
+#include <dcos/HeapAgent.hpp>
+#include <dcos/Status.hpp>
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos::internal {
+
+/// A first-fit heap of variable-size segments in a caller-supplied contiguous area.
+class SegmentedHeap {
+public:
+    /// The holder tag of segments that belong to the system: any holder may return them.
+    static constexpr uint16_t kSystemHolder = 0xFFFF;
+    /// Bytes of a segment's header.
+    static constexpr size_t kHeaderBytes = HeapAgent::kHeaderBytes;
+    /// Alignment and size granularity of segments.
+    static constexpr size_t kAlignment = HeapAgent::kAlignment;
+    /// Smallest segment, header included: an 8-byte header and 8 bytes of data.
+    static constexpr size_t kSmallestSegment = kHeaderBytes + HeapAgent::kMinimumSegment;
+    /// Largest heap, in bytes.
+    static constexpr size_t kMaximumHeapBytes = size_t{1} << 30;
+
+    /// Creates an unused heap; initialise() puts it in service.
+    constexpr SegmentedHeap() = default;
+
+    /// Makes the area at @p area of @p areaBytes bytes one free segment. O(1).
+    ///
+    /// The start is aligned up and the length down to 8 bytes. @p salt makes
+    /// this heap's check values differ from any other's. Fails with
+    /// InvalidArgument for a null area, fewer than 16 usable bytes or more
+    /// than kMaximumHeapBytes; the heap is then unused.
+    Status initialise(void* area, size_t areaBytes, uint32_t salt);
+
+    /// Allocates a segment for at least @p bytes, first fit, for @p holder. O(free segments).
+    ///
+    /// Fails with InvalidArgument for 0 bytes, NoMemory when no free
+    /// segment is large enough, and Corrupted.
+    Result<void*> allocate(size_t bytes, uint16_t holder);
+
+    /// Returns @p segment on behalf of @p holder and merges it with its free neighbours. O(1).
+    ///
+    /// InvalidArgument for a pointer outside the heap; NotOwner when another
+    /// holder than @p holder or the system holds it; Corrupted (the heap is
+    /// disabled) for a free segment, a pointer that is not a segment's start,
+    /// or bookkeeping that fails its checks.
+    Status release(void* segment, uint16_t holder);
+
+    /// Hands @p segment, held by @p from or by the system, to the holder @p to. O(1).
+    ///
+    /// Fails as release() does.
+    Status transfer(void* segment, uint16_t from, uint16_t to);
+
+    /// Returns every segment @p holder holds; returns how many. O(segments).
+    ///
+    /// When a check fails the heap is disabled and the walk stops.
+    size_t reclaimHeldBy(uint16_t holder);
+
+    /// Usage counters plus the largest free segment, found by walking and
+    /// checking the free list. O(free segments). Fails with Corrupted.
+    Result<HeapStatistics> statistics();
+
+    /// Checks the whole heap: the segments tile the area, every header,
+    /// tag and flag is right, no two free segments are adjacent, and the
+    /// free list holds exactly the free segments, each once, with
+    /// consistent back links. O(segments). Returns Ok or Corrupted (and
+    /// disables the heap). For tests and diagnostics.
+    Status audit();
+
+    /// Number of allocated segments. O(1).
+    size_t allocatedCount() const { return allocatedSegments_; }
+    /// Bytes in free segments, headers included. O(1).
+    size_t freeBytes() const { return freeBytes_; }
+    /// Bytes the heap manages.
+    size_t heapBytes() const { return size_; }
+    /// Whether a check failed; a corrupted heap refuses every call.
+    bool isCorrupted() const { return corrupted_; }
+    /// Whether initialise() succeeded.
+    bool inService() const { return size_ != 0; }
+    /// The first byte of the area given to initialise().
+    uintptr_t areaBegin() const { return areaBegin_; }
+    /// One past the last byte of the area given to initialise().
+    uintptr_t areaEnd() const { return areaEnd_; }
+
+private:
+    static constexpr uint32_t kNone = 0xFFFFFFFFu;
+    static constexpr uint32_t kAllocatedFlag = 1;
+    static constexpr uint32_t kPreviousFreeFlag = 2;
+    static constexpr uint32_t kFlagMask = 7;
+
+    // What a checked allocated header says.
+    struct Allocated {
+        uint32_t size;
+        uint16_t holder;
+        bool previousFree;
+    };
+
+    uint32_t word(uint32_t offset) const;
+    void setWord(uint32_t offset, uint32_t value);
+    uint16_t seal(uint32_t offset, uint32_t first, uint16_t holder) const;
+    uint32_t endTag(uint32_t size, uint32_t end) const;
+    bool isLink(uint32_t link) const;
+    bool checkFree(uint32_t offset, uint32_t& size) const;
+    bool checkAllocated(uint32_t offset, Allocated& header) const;
+    bool checkListNeighbours(uint32_t offset) const;
+    void writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder);
+    void writeFreeSize(uint32_t offset, uint32_t size);
+    void unlink(uint32_t offset);
+    // Finds the offset of an allocated segment for release() and transfer().
+    Result<uint32_t> allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header);
+    // Frees the checked allocated segment at @p offset and merges it; sets
+    // @p freedEnd to the end of the resulting free segment.
+    Status releaseAt(uint32_t offset, const Allocated& header, uint32_t& freedEnd);
+    Status fail();
+
+    uint8_t* base_ = nullptr;
+    uintptr_t areaBegin_ = 0;
+    uintptr_t areaEnd_ = 0;
+    uint32_t size_ = 0;
+    uint32_t head_ = kNone;
+    uint32_t freeBytes_ = 0;
+    uint32_t freeSegments_ = 0;
+    uint32_t allocatedSegments_ = 0;
+    uint32_t lowWater_ = 0;
+    uint32_t allocations_ = 0;
+    uint32_t failedAllocations_ = 0;
+    uint32_t returns_ = 0;
+    uint32_t salt_ = 0;
+    bool corrupted_ = false;
+};
+
+} // namespace dcos::internal

@@ -1,0 +1,45 @@
+#include <dcos/internal/MessageBufferPool.hpp>
+
+namespace dcos::internal {
+
+Status MessageBufferPool::AddMsgBufs(size_t count)
+{
+    if (count == 0) {
+        return Status::InvalidArgument;
+    }
+    if (count > capacity_ - active_) {
+        return Status::NoMemory;
+    }
+    for (size_t i = 0; i < count; ++i) {
+        give(reserve_[active_ + i]);
+    }
+    active_ += count;
+    return Status::Ok;
+}
+
+MessageBuffer* MessageBufferPool::take()
+{
+    MessageBuffer* buffer = freeHead_;
+    if (buffer != nullptr) {
+        freeHead_ = buffer->next;
+        buffer->next = nullptr;
+        --free_;
+    }
+    return buffer;
+}
+
+void MessageBufferPool::give(MessageBuffer& buffer)
+{
+    buffer.next = freeHead_;
+    freeHead_ = &buffer;
+    ++free_;
+}
+
+void MessageBufferPool::giveChain(MessageBuffer& first, MessageBuffer& last, size_t count)
+{
+    last.next = freeHead_;
+    freeHead_ = &first;
+    free_ += count;
+}
+
+} // namespace dcos::internal

@@ -1,0 +1,44 @@
+// The buffer pool memory agent's interface object (seed 7.7): each primitive
+// forwards to the kernel side, internal::BufferPoolManager.
+#include <dcos/BufferPoolAgent.hpp>
+#include <dcos/internal/BufferPoolManager.hpp>
+
+namespace dcos {
+
+using internal::BufferPoolManager;
+
+Result<ObjectId> BufferPoolAgent::Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
+                                         Visibility visibility) const
+{
+    return BufferPoolManager::Create(area, areaBytes, bufferSize, name, visibility);
+}
+
+Status BufferPoolAgent::Delete(ObjectId pool) const { return BufferPoolManager::Delete(pool); }
+
+Result<void*> BufferPoolAgent::Allocate(ObjectId pool) const { return BufferPoolManager::Allocate(pool); }
+
+Status BufferPoolAgent::Return(ObjectId pool, void* buffer) const { return BufferPoolManager::Return(pool, buffer); }
+
+Result<BufferPoolStatistics> BufferPoolAgent::GetStatistics(ObjectId pool) const
+{
+    return BufferPoolManager::GetStatistics(pool);
+}
+
+Result<ObjectId> BufferPoolAgent::NameToObject(const char* name) const
+{
+    return BufferPoolManager::NameToObject(name, Visibility::Local);
+}
+
+Status BufferPoolAgent::AddObjects(size_t count) const { return BufferPoolManager::AddObjects(count); }
+
+Status BufferPoolAgent::XferOwnership(ObjectId pool, ObjectId newOwner) const
+{
+    return BufferPoolManager::XferOwnership(pool, newOwner);
+}
+
+Status BufferPoolAgent::XferOwnership(ObjectId pool, void* buffer, ObjectId newOwner) const
+{
+    return BufferPoolManager::XferOwnership(pool, buffer, newOwner);
+}
+
+} // namespace dcos

@@ -1,0 +1,351 @@
+// The buffer pool memory agent's kernel side (seed 7.7): the pool table,
+// holders, serialisation and resource recovery around internal::BufferPool.
+#include <dcos/internal/BufferPool.hpp>
+#include <dcos/internal/BufferPoolManager.hpp>
+#include <dcos/internal/HeapManager.hpp>
+#include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/ResourceRecovery.hpp>
+#include <dcos/internal/TaskManager.hpp>
+
+#include <arch_x86/Cpu.hpp>
+
+namespace dcos::internal {
+
+namespace {
+
+// Interrupt handlers may allocate and return buffers, so the agent's
+// bookkeeping runs with interrupts disabled.
+using Lock = arch_x86::InterruptGuard;
+
+// A pool object: the algorithm's state plus the area reserved for it. The
+// area is reserved from the start of Create to Delete, including while
+// Create lays out the buffers with interrupts enabled.
+struct PoolObject {
+    BufferPool pool;
+    ObjectId id;
+    uintptr_t reservedBegin = 0;
+    uintptr_t reservedEnd = 0;
+    bool inUse = false;
+};
+
+using PoolTable = ObjectTable<PoolObject*, kPoolCapacity>;
+
+constinit PoolTable poolTable(ObjectType::BufferPool, 0);
+constinit PoolObject pools[kPoolCapacity];
+constinit bool started = false;
+constinit uint32_t poolsCreated = 0;
+
+size_t slotOf(ObjectId id) { return id.index() & (kPoolCapacity - 1); }
+
+// Activates the first slots on first use; call with interrupts disabled.
+void start()
+{
+    if (!started) {
+        (void)poolTable.AddObjects(kPoolsActiveAtBoot); // Cannot fail: checked by KernelConfig.hpp.
+        started = true;
+    }
+    if (poolTable.usedCount() == 0 && poolTable.node() != localNode()) {
+        (void)poolTable.setNode(localNode());
+    }
+}
+
+// The id checks every primitive shares; call with interrupts disabled.
+Result<PoolObject*> lookup(ObjectId id)
+{
+    if (id.isNull()) {
+        return Status::InvalidId;
+    }
+    if (id.type() != ObjectType::BufferPool) {
+        return Status::WrongType;
+    }
+    if (id.node() != localNode()) {
+        return Status::Remote; // Served by the network manager once it exists.
+    }
+    start();
+    const Result<PoolObject**> entry = poolTable.resolve(id);
+    if (!entry.ok()) {
+        return entry.status();
+    }
+    return *entry.value();
+}
+
+// Delete and XferOwnership of the pool need its owner or a super user.
+Status checkOwnerOrSuperUser(ObjectId id)
+{
+    const Status owner = poolTable.checkOwner(id, currentTaskId());
+    return owner == Status::Ok || currentTaskIsSuperUser() ? Status::Ok : owner;
+}
+
+// The holder recorded for buffers the caller allocates: its task, or the
+// system in an interrupt handler (and before the scheduler starts).
+uint16_t callerHolder()
+{
+    const ObjectId task = currentTaskId();
+    return inInterruptContext() || task.isNull() ? BufferPool::kSystemHolder : task.index();
+}
+
+// The holder for a new owner given as a task id; the null id is the system.
+Result<uint16_t> holderFor(ObjectId newOwner)
+{
+    if (newOwner.isNull()) {
+        return BufferPool::kSystemHolder;
+    }
+    const Result<Task*> task = TaskManager::resolve(newOwner);
+    if (!task.ok()) {
+        return task.status(); // The new owner must be a live local task.
+    }
+    return newOwner.index();
+}
+
+void remove(ObjectId id, PoolObject& object)
+{
+    (void)poolTable.Delete(id);
+    object = PoolObject{};
+}
+
+unsigned recoverPools(ObjectId deadTask) { return BufferPoolManager::recoverResourcesOf(deadTask); }
+
+} // namespace
+
+Result<ObjectId> BufferPoolManager::Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
+                                           Visibility visibility)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    const uintptr_t begin = reinterpret_cast<uintptr_t>(area);
+    if (area == nullptr || bufferSize < BufferPool::kMinimumBufferSize || areaBytes > UINTPTR_MAX - begin) {
+        return Status::InvalidArgument;
+    }
+    const uintptr_t end = begin + areaBytes;
+
+    // Reserve the slot and the area.
+    ObjectId id;
+    uint32_t salt;
+    {
+        Lock lock;
+        start();
+        if (overlapsArea(begin, end) || HeapManager::overlapsArea(begin, end)) {
+            return Status::AlreadyExists;
+        }
+        const Result<ObjectId> created = poolTable.Create(currentTaskId(), name, visibility);
+        if (!created.ok()) {
+            return created.status();
+        }
+        id = created.value();
+        PoolObject& object = pools[slotOf(id)];
+        object = PoolObject{};
+        object.id = id;
+        object.reservedBegin = begin;
+        object.reservedEnd = end;
+        object.inUse = true;
+        *poolTable.resolve(id).value() = &object;
+        ++poolsCreated;
+        salt = mixBits(static_cast<uint32_t>(begin) ^ (poolsCreated * 0x9E3779B9u));
+    }
+
+    // Lay out the buffers, O(buffers), with interrupts enabled. Until the
+    // pool is copied in below, the object reads as an empty pool.
+    BufferPool laidOut;
+    const Status layout = laidOut.initialise(area, areaBytes, bufferSize, salt);
+
+    Lock lock;
+    const Result<PoolObject*> object = lookup(id);
+    if (!object.ok()) {
+        return Status::Deleted; // A super user deleted the pool meanwhile.
+    }
+    if (layout != Status::Ok) {
+        remove(id, *object.value());
+        return layout;
+    }
+    object.value()->pool = laidOut;
+    return id;
+}
+
+Status BufferPoolManager::Delete(ObjectId id)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    Lock lock;
+    const Result<PoolObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    const Status owner = checkOwnerOrSuperUser(id);
+    if (owner != Status::Ok) {
+        return owner;
+    }
+    const BufferPool& pool = object.value()->pool;
+    if (!pool.isCorrupted() && pool.allocatedCount() != 0) {
+        return Status::Busy;
+    }
+    remove(id, *object.value());
+    return Status::Ok;
+}
+
+Result<void*> BufferPoolManager::Allocate(ObjectId id)
+{
+    const uint16_t holder = callerHolder();
+    Lock lock;
+    const Result<PoolObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    return object.value()->pool.allocate(holder);
+}
+
+Status BufferPoolManager::Return(ObjectId id, void* buffer)
+{
+    const uint16_t holder = callerHolder();
+    Lock lock;
+    const Result<PoolObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    return object.value()->pool.release(buffer, holder);
+}
+
+Result<BufferPoolStatistics> BufferPoolManager::GetStatistics(ObjectId id)
+{
+    Lock lock;
+    const Result<PoolObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    if (object.value()->pool.isCorrupted()) {
+        return Status::Corrupted;
+    }
+    return object.value()->pool.statistics();
+}
+
+Result<ObjectId> BufferPoolManager::NameToObject(const char* name, Visibility askingScope)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    Lock lock;
+    start();
+    return poolTable.NameToObject(name, askingScope);
+}
+
+Status BufferPoolManager::AddObjects(size_t count)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    if (!currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    Lock lock;
+    start();
+    return poolTable.AddObjects(count);
+}
+
+Status BufferPoolManager::XferOwnership(ObjectId id, ObjectId newOwner)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    Lock lock;
+    const Result<PoolObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    const Status owner = checkOwnerOrSuperUser(id);
+    if (owner != Status::Ok) {
+        return owner;
+    }
+    const Result<uint16_t> newHolder = holderFor(newOwner);
+    if (!newHolder.ok()) {
+        return newHolder.status();
+    }
+    return poolTable.XferOwnership(id, poolTable.ownerOf(id).value(), newOwner);
+}
+
+Status BufferPoolManager::XferOwnership(ObjectId id, void* buffer, ObjectId newOwner)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    const uint16_t holder = callerHolder();
+    Lock lock;
+    const Result<PoolObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    const Result<uint16_t> newHolder = holderFor(newOwner);
+    if (!newHolder.ok()) {
+        return newHolder.status();
+    }
+    return object.value()->pool.transfer(buffer, holder, newHolder.value());
+}
+
+unsigned BufferPoolManager::recoverResourcesOf(ObjectId deadTask)
+{
+    if (deadTask.isNull() || deadTask.type() != ObjectType::Task) {
+        return 0;
+    }
+    // Called by the task agent with interrupts already disabled; the walk
+    // over every buffer is the O(N) cost of recovery.
+    Lock lock;
+    const uint16_t holder = deadTask.index();
+    size_t recovered = 0;
+    for (PoolObject& object : pools) {
+        if (object.inUse && object.pool.inService()) {
+            recovered += object.pool.reclaimHeldBy(holder);
+        }
+    }
+    recovered += poolTable.forEachOwnedBy(deadTask, [](ObjectId id, PoolObject*& object) { remove(id, *object); });
+    return static_cast<unsigned>(recovered);
+}
+
+bool BufferPoolManager::overlapsArea(uintptr_t begin, uintptr_t end)
+{
+    for (const PoolObject& object : pools) {
+        if (object.inUse && begin < object.reservedEnd && object.reservedBegin < end) {
+            return true;
+        }
+    }
+    return false;
+}
+
+bool BufferPoolManager::snapshot(size_t slot, PoolInfo& info)
+{
+    Lock lock;
+    if (slot >= poolTable.activeCount() || !pools[slot].inUse || !pools[slot].pool.inService()) {
+        return false;
+    }
+    const PoolObject& object = pools[slot];
+    info.id = object.id;
+    info.owner = poolTable.ownerOf(object.id).value();
+    info.statistics = object.pool.statistics();
+    info.corrupted = object.pool.isCorrupted();
+    const char* name = poolTable.nameOf(object.id).value();
+    size_t i = 0;
+    for (; i + 1 < sizeof info.name && name[i] != '\0'; ++i) {
+        info.name[i] = name[i];
+    }
+    info.name[i] = '\0';
+    return true;
+}
+
+size_t BufferPoolManager::activeCount()
+{
+    Lock lock;
+    start();
+    return poolTable.activeCount();
+}
+
+size_t BufferPoolManager::usedCount()
+{
+    Lock lock;
+    return poolTable.usedCount();
+}
+
+size_t BufferPoolManager::capacity() { return kPoolCapacity; }
+
+DCOS_RESOURCE_RECOVERY(bufferPoolRecovery, "buffer pool", recoverPools);
+
+} // namespace dcos::internal

@@ -1,0 +1,330 @@
+// The segmented heap memory agent's kernel side (seed 7.8): the heap table,
+// holders, serialisation and resource recovery around internal::SegmentedHeap.
+#include <dcos/internal/BufferPool.hpp>
+#include <dcos/internal/BufferPoolManager.hpp>
+#include <dcos/internal/HeapManager.hpp>
+#include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/ObjectTable.hpp>
+#include <dcos/internal/ResourceRecovery.hpp>
+#include <dcos/internal/SegmentedHeap.hpp>
+#include <dcos/internal/TaskManager.hpp>
+
+#include <arch_x86/Cpu.hpp>
+
+namespace dcos::internal {
+
+namespace {
+
+// Interrupt handlers may allocate and return segments, so the agent's
+// bookkeeping runs with interrupts disabled.
+using Lock = arch_x86::InterruptGuard;
+
+// A heap object: the algorithm's state plus the area it covers.
+struct HeapObject {
+    SegmentedHeap heap;
+    ObjectId id;
+    bool inUse = false;
+};
+
+using HeapTable = ObjectTable<HeapObject*, kHeapCapacity>;
+
+constinit HeapTable heapTable(ObjectType::Heap, 0);
+constinit HeapObject heaps[kHeapCapacity];
+constinit bool started = false;
+constinit uint32_t heapsCreated = 0;
+
+size_t slotOf(ObjectId id) { return id.index() & (kHeapCapacity - 1); }
+
+// Activates the first slots on first use; call with interrupts disabled.
+void start()
+{
+    if (!started) {
+        (void)heapTable.AddObjects(kHeapsActiveAtBoot); // Cannot fail: checked by KernelConfig.hpp.
+        started = true;
+    }
+    if (heapTable.usedCount() == 0 && heapTable.node() != localNode()) {
+        (void)heapTable.setNode(localNode());
+    }
+}
+
+// The id checks every primitive shares; call with interrupts disabled.
+Result<HeapObject*> lookup(ObjectId id)
+{
+    if (id.isNull()) {
+        return Status::InvalidId;
+    }
+    if (id.type() != ObjectType::Heap) {
+        return Status::WrongType;
+    }
+    if (id.node() != localNode()) {
+        return Status::Remote; // Served by the network manager once it exists.
+    }
+    start();
+    const Result<HeapObject**> entry = heapTable.resolve(id);
+    if (!entry.ok()) {
+        return entry.status();
+    }
+    return *entry.value();
+}
+
+// Delete and XferOwnership of the heap need its owner or a super user.
+Status checkOwnerOrSuperUser(ObjectId id)
+{
+    const Status owner = heapTable.checkOwner(id, currentTaskId());
+    return owner == Status::Ok || currentTaskIsSuperUser() ? Status::Ok : owner;
+}
+
+// The holder recorded for segments the caller allocates: its task, or the
+// system in an interrupt handler (and before the scheduler starts).
+uint16_t callerHolder()
+{
+    const ObjectId task = currentTaskId();
+    return inInterruptContext() || task.isNull() ? SegmentedHeap::kSystemHolder : task.index();
+}
+
+// The holder for a new owner given as a task id; the null id is the system.
+Result<uint16_t> holderFor(ObjectId newOwner)
+{
+    if (newOwner.isNull()) {
+        return SegmentedHeap::kSystemHolder;
+    }
+    const Result<Task*> task = TaskManager::resolve(newOwner);
+    if (!task.ok()) {
+        return task.status(); // The new owner must be a live local task.
+    }
+    return newOwner.index();
+}
+
+void remove(ObjectId id, HeapObject& object)
+{
+    (void)heapTable.Delete(id);
+    object = HeapObject{};
+}
+
+unsigned recoverHeaps(ObjectId deadTask) { return HeapManager::recoverResourcesOf(deadTask); }
+
+} // namespace
+
+Result<ObjectId> HeapManager::Create(void* area, size_t areaBytes, const char* name, Visibility visibility)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    const uintptr_t begin = reinterpret_cast<uintptr_t>(area);
+    if (area == nullptr || areaBytes > UINTPTR_MAX - begin) {
+        return Status::InvalidArgument;
+    }
+    const uintptr_t end = begin + areaBytes;
+    // Laying out a heap is O(1), so the whole of Create runs with interrupts disabled.
+    Lock lock;
+    start();
+    if (overlapsArea(begin, end) || BufferPoolManager::overlapsArea(begin, end)) {
+        return Status::AlreadyExists;
+    }
+    const Result<ObjectId> created = heapTable.Create(currentTaskId(), name, visibility);
+    if (!created.ok()) {
+        return created.status();
+    }
+    const ObjectId id = created.value();
+    HeapObject& object = heaps[slotOf(id)];
+    object = HeapObject{};
+    ++heapsCreated;
+    const uint32_t salt = mixBits(static_cast<uint32_t>(begin) ^ (heapsCreated * 0x7F4A7C15u));
+    const Status status = object.heap.initialise(area, areaBytes, salt);
+    if (status != Status::Ok) {
+        (void)heapTable.Delete(id);
+        object = HeapObject{};
+        return status;
+    }
+    object.id = id;
+    object.inUse = true;
+    *heapTable.resolve(id).value() = &object;
+    return id;
+}
+
+Status HeapManager::Delete(ObjectId id)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    Lock lock;
+    const Result<HeapObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    const Status owner = checkOwnerOrSuperUser(id);
+    if (owner != Status::Ok) {
+        return owner;
+    }
+    const SegmentedHeap& heap = object.value()->heap;
+    if (!heap.isCorrupted() && heap.allocatedCount() != 0) {
+        return Status::Busy;
+    }
+    remove(id, *object.value());
+    return Status::Ok;
+}
+
+Result<void*> HeapManager::Allocate(ObjectId id, size_t bytes)
+{
+    const uint16_t holder = callerHolder();
+    Lock lock;
+    const Result<HeapObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    return object.value()->heap.allocate(bytes, holder);
+}
+
+Status HeapManager::Return(ObjectId id, void* segment)
+{
+    const uint16_t holder = callerHolder();
+    Lock lock;
+    const Result<HeapObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    return object.value()->heap.release(segment, holder);
+}
+
+Result<HeapStatistics> HeapManager::GetStatistics(ObjectId id)
+{
+    Lock lock;
+    const Result<HeapObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    return object.value()->heap.statistics();
+}
+
+Result<ObjectId> HeapManager::NameToObject(const char* name, Visibility askingScope)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    Lock lock;
+    start();
+    return heapTable.NameToObject(name, askingScope);
+}
+
+Status HeapManager::AddObjects(size_t count)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    if (!currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    Lock lock;
+    start();
+    return heapTable.AddObjects(count);
+}
+
+Status HeapManager::XferOwnership(ObjectId id, ObjectId newOwner)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    Lock lock;
+    const Result<HeapObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    const Status owner = checkOwnerOrSuperUser(id);
+    if (owner != Status::Ok) {
+        return owner;
+    }
+    const Result<uint16_t> newHolder = holderFor(newOwner);
+    if (!newHolder.ok()) {
+        return newHolder.status();
+    }
+    return heapTable.XferOwnership(id, heapTable.ownerOf(id).value(), newOwner);
+}
+
+Status HeapManager::XferOwnership(ObjectId id, void* segment, ObjectId newOwner)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    const uint16_t holder = callerHolder();
+    Lock lock;
+    const Result<HeapObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    const Result<uint16_t> newHolder = holderFor(newOwner);
+    if (!newHolder.ok()) {
+        return newHolder.status();
+    }
+    return object.value()->heap.transfer(segment, holder, newHolder.value());
+}
+
+unsigned HeapManager::recoverResourcesOf(ObjectId deadTask)
+{
+    if (deadTask.isNull() || deadTask.type() != ObjectType::Task) {
+        return 0;
+    }
+    // Called by the task agent with interrupts already disabled; the walk
+    // over every segment is the O(N) cost of recovery.
+    Lock lock;
+    const uint16_t holder = deadTask.index();
+    size_t recovered = 0;
+    for (HeapObject& object : heaps) {
+        if (object.inUse) {
+            recovered += object.heap.reclaimHeldBy(holder);
+        }
+    }
+    recovered += heapTable.forEachOwnedBy(deadTask, [](ObjectId id, HeapObject*& object) { remove(id, *object); });
+    return static_cast<unsigned>(recovered);
+}
+
+bool HeapManager::overlapsArea(uintptr_t begin, uintptr_t end)
+{
+    for (const HeapObject& object : heaps) {
+        if (object.inUse && begin < object.heap.areaEnd() && object.heap.areaBegin() < end) {
+            return true;
+        }
+    }
+    return false;
+}
+
+bool HeapManager::snapshot(size_t slot, HeapInfo& info)
+{
+    Lock lock;
+    if (slot >= heapTable.activeCount() || !heaps[slot].inUse) {
+        return false;
+    }
+    HeapObject& object = heaps[slot];
+    info.id = object.id;
+    info.owner = heapTable.ownerOf(object.id).value();
+    const Result<HeapStatistics> statistics = object.heap.statistics();
+    info.corrupted = !statistics.ok();
+    info.statistics = statistics.ok() ? statistics.value() : HeapStatistics{};
+    info.statistics.heapBytes = static_cast<uint32_t>(object.heap.heapBytes()); // Known even when corrupted.
+    const char* name = heapTable.nameOf(object.id).value();
+    size_t i = 0;
+    for (; i + 1 < sizeof info.name && name[i] != '\0'; ++i) {
+        info.name[i] = name[i];
+    }
+    info.name[i] = '\0';
+    return true;
+}
+
+size_t HeapManager::activeCount()
+{
+    Lock lock;
+    start();
+    return heapTable.activeCount();
+}
+
+size_t HeapManager::usedCount()
+{
+    Lock lock;
+    return heapTable.usedCount();
+}
+
+size_t HeapManager::capacity() { return kHeapCapacity; }
+
+DCOS_RESOURCE_RECOVERY(heapRecovery, "heap", recoverHeaps);
+
+} // namespace dcos::internal

@@ -1,0 +1,381 @@
+// The semaphore agent (seed 7.11): binary and counting semaphores with
+// optional priority inheritance on binary ones.
+//
+// Priority inheritance: a binary semaphore with inheritance is an
+// InheritanceSource. Its holder keeps every such semaphore it holds in a
+// list, and runs at the most urgent priority among the first waiters of all
+// of them (TaskManager::recomputePriority). Whenever that set of waiters
+// changes (a task starts waiting, times out, is killed or changes priority,
+// the semaphore is released or deleted) the holder is recomputed, so it
+// drops back only as it releases the semaphores that lent it priority.
+#include <dcos/SemaphoreAgent.hpp>
+#include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/ObjectTable.hpp>
+#include <dcos/internal/ResourceRecovery.hpp>
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/TaskManager.hpp>
+
+#include <arch_x86/Cpu.hpp>
+#include <bsp/Board.hpp>
+#include <shell/Shell.hpp>
+
+#include <new>
+
+namespace dcos {
+
+namespace internal {
+
+namespace {
+
+struct Semaphore : InheritanceSource {
+    Semaphore() : InheritanceSource(WaitQueue::Order::Priority) {}
+    ObjectId id;
+    SemaphoreKind kind = SemaphoreKind::Binary;
+    uint32_t count = 0;
+    uint32_t maximum = 1;
+    bool inheritance = false;
+    // InheritanceSource::holder is the holding task of a binary semaphore.
+};
+
+ObjectTable<Semaphore*, kSemaphoreCapacity> table(ObjectType::Semaphore, 0);
+Semaphore semaphores[kSemaphoreCapacity];
+bool tableReady = false;
+
+size_t slotOf(ObjectId id) { return id.index() & (kSemaphoreCapacity - 1); }
+
+void ensureTable()
+{
+    if (!tableReady) {
+        table.setNode(localNode());
+        table.AddObjects(kSemaphoresActiveAtBoot);
+        tableReady = true;
+    }
+}
+
+Result<Semaphore*> resolve(ObjectId id)
+{
+    ensureTable();
+    if (id.isNull()) {
+        return Status::InvalidId;
+    }
+    if (id.type() == ObjectType::Semaphore && id.node() != table.node()) {
+        return Status::Remote;
+    }
+    const Result<Semaphore**> entry = table.resolve(id);
+    if (!entry.ok()) {
+        return entry.status();
+    }
+    return *entry.value();
+}
+
+// A waiter left, or changed priority: the holder's inherited priority follows.
+void onWaitersChanged(WaitQueue&, void* context)
+{
+    Semaphore& semaphore = *static_cast<Semaphore*>(context);
+    if (semaphore.inheritance && semaphore.holder != nullptr) {
+        TaskManager::recomputePriority(*semaphore.holder);
+    }
+}
+
+void takeHold(Semaphore& semaphore, Task& task)
+{
+    semaphore.holder = &task;
+    if (semaphore.inheritance) {
+        task.heldSources.pushBack(semaphore);
+        TaskManager::recomputePriority(task);
+    }
+}
+
+void dropHold(Semaphore& semaphore)
+{
+    Task* holder = semaphore.holder;
+    semaphore.holder = nullptr;
+    if (holder != nullptr && semaphore.inheritance) {
+        holder->heldSources.remove(semaphore);
+        TaskManager::recomputePriority(*holder);
+    }
+}
+
+// Frees a semaphore's slot and wakes its waiters with why.
+void destroy(Semaphore& semaphore, Status why)
+{
+    dropHold(semaphore);
+    semaphore.waiters.setObserver(nullptr, nullptr);
+    TaskManager::wakeAll(semaphore.waiters, why);
+    table.Delete(semaphore.id);
+}
+
+unsigned recoverSemaphores(ObjectId deadTask)
+{
+    arch_x86::InterruptGuard guard;
+    if (!tableReady) {
+        return 0;
+    }
+    unsigned recovered = 0;
+    // Semaphores the dead task held: free them and tell every waiter that
+    // the holder is gone. O(N): task deletion is a configuration service.
+    const Result<Task*> dead = TaskManager::resolve(deadTask);
+    if (dead.ok()) {
+        for (Semaphore& semaphore : semaphores) {
+            if (semaphore.holder == dead.value()) {
+                dropHold(semaphore);
+                semaphore.count = 1;
+                TaskManager::wakeAll(semaphore.waiters, Status::Abandoned);
+                ++recovered;
+            }
+        }
+    }
+    // Semaphores it created.
+    recovered += static_cast<unsigned>(table.forEachOwnedBy(deadTask, [](ObjectId, Semaphore*& semaphore) {
+        destroy(*semaphore, Status::Deleted);
+    }));
+    return recovered;
+}
+
+} // namespace
+
+DCOS_RESOURCE_RECOVERY(semaphoreRecovery, "semaphore", recoverSemaphores);
+
+size_t semaphoreCount()
+{
+    arch_x86::InterruptGuard guard;
+    ensureTable();
+    return table.usedCount();
+}
+
+} // namespace internal
+
+using internal::Scheduler;
+using internal::Semaphore;
+using internal::Task;
+using internal::TaskManager;
+
+Result<ObjectId> SemaphoreAgent::Create(const SemaphoreAttributes& attributes) const
+{
+    const bool binary = attributes.kind == SemaphoreKind::Binary;
+    if ((attributes.kind != SemaphoreKind::Binary && attributes.kind != SemaphoreKind::Counting) ||
+        (binary && attributes.initialCount > 1) || (!binary && attributes.priorityInheritance) ||
+        (!binary && (attributes.maximumCount == 0 || attributes.initialCount > attributes.maximumCount)) ||
+        (attributes.order != WaitOrder::Priority && attributes.order != WaitOrder::Fifo)) {
+        return Status::InvalidArgument;
+    }
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    arch_x86::InterruptGuard guard;
+    internal::ensureTable();
+    const Result<ObjectId> id =
+        internal::table.Create(internal::currentTaskId(), attributes.name, attributes.visibility);
+    if (!id.ok()) {
+        return id.status();
+    }
+    Semaphore& semaphore = internal::semaphores[internal::slotOf(id.value())];
+    semaphore.~Semaphore();
+    new (&semaphore) Semaphore();
+    *internal::table.resolve(id.value()).value() = &semaphore;
+    semaphore.id = id.value();
+    semaphore.kind = attributes.kind;
+    semaphore.count = attributes.initialCount;
+    semaphore.maximum = binary ? 1 : attributes.maximumCount;
+    semaphore.inheritance = attributes.priorityInheritance;
+    semaphore.waiters.setOrder(attributes.order == WaitOrder::Fifo ? internal::WaitQueue::Order::Fifo
+                                                                   : internal::WaitQueue::Order::Priority);
+    semaphore.waiters.setObserver(internal::onWaitersChanged, &semaphore);
+    // A binary semaphore created taken is held by its creator.
+    if (binary && attributes.initialCount == 0 && Scheduler::started()) {
+        internal::takeHold(semaphore, Scheduler::current());
+    }
+    return semaphore.id;
+}
+
+Status SemaphoreAgent::Delete(ObjectId id) const
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> semaphore = internal::resolve(id);
+    if (!semaphore.ok()) {
+        return semaphore.status();
+    }
+    const Status owner = internal::table.checkOwner(id, internal::currentTaskId());
+    if (owner != Status::Ok && !internal::currentTaskIsSuperUser()) {
+        return owner;
+    }
+    internal::destroy(*semaphore.value(), Status::Deleted);
+    return Status::Ok;
+}
+
+Status SemaphoreAgent::Acquire(ObjectId id, uint64_t timeout) const
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> resolved = internal::resolve(id);
+    if (!resolved.ok()) {
+        return resolved.status();
+    }
+    Semaphore& semaphore = *resolved.value();
+    const bool inInterrupt = internal::inInterruptContext();
+    if (semaphore.kind == SemaphoreKind::Binary) {
+        if (semaphore.count == 1) {
+            if (inInterrupt) {
+                return Status::InInterrupt; // A handler cannot hold a semaphore.
+            }
+            semaphore.count = 0;
+            internal::takeHold(semaphore, Scheduler::current());
+            return Status::Ok;
+        }
+        if (!inInterrupt && semaphore.holder == &Scheduler::current()) {
+            return Status::Deadlock;
+        }
+    } else if (semaphore.count > 0) {
+        semaphore.count = semaphore.count - 1;
+        return Status::Ok;
+    }
+    if (timeout == kPoll) {
+        return Status::WouldBlock;
+    }
+    if (inInterrupt) {
+        return Status::InInterrupt;
+    }
+    Task& self = Scheduler::current();
+    // The unit is handed over by Release, so success needs no retry.
+    semaphore.waiters.add(self);
+    self.waitingOn = &semaphore.waiters;
+    if (semaphore.inheritance && semaphore.holder != nullptr) {
+        TaskManager::recomputePriority(*semaphore.holder);
+    }
+    return TaskManager::blockCurrent(internal::WaitReason::Object, timeout);
+}
+
+Status SemaphoreAgent::Release(ObjectId id) const
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> resolved = internal::resolve(id);
+    if (!resolved.ok()) {
+        return resolved.status();
+    }
+    Semaphore& semaphore = *resolved.value();
+    if (semaphore.kind == SemaphoreKind::Binary) {
+        if (internal::inInterruptContext() || semaphore.holder != &Scheduler::current()) {
+            return Status::NotOwner;
+        }
+        Task& self = Scheduler::current();
+        if (semaphore.waiters.isEmpty()) {
+            internal::dropHold(semaphore);
+            semaphore.count = 1;
+            return Status::Ok;
+        }
+        // Hand the semaphore straight to the first waiter, so no other task
+        // can slip in between and the waiter's wait always succeeds. The
+        // waiter is readied before this task drops back from the priority
+        // it inherited: dropping first would let a task of middling
+        // priority run before the waiter (the very inversion inheritance
+        // exists to prevent).
+        if (semaphore.inheritance) {
+            self.heldSources.remove(semaphore);
+        }
+        semaphore.holder = nullptr;
+        Task& next = semaphore.waiters.first();
+        semaphore.waiters.remove(next);
+        next.waitingOn = nullptr;
+        internal::takeHold(semaphore, next);
+        TaskManager::wake(next, Status::Ok);
+        if (semaphore.inheritance) {
+            TaskManager::recomputePriority(self);
+        }
+        return Status::Ok;
+    }
+    if (!semaphore.waiters.isEmpty()) {
+        TaskManager::wakeFirst(semaphore.waiters, Status::Ok);
+        return Status::Ok;
+    }
+    if (semaphore.count == semaphore.maximum) {
+        return Status::InvalidArgument; // The count would exceed its maximum.
+    }
+    semaphore.count = semaphore.count + 1;
+    return Status::Ok;
+}
+
+Result<uint32_t> SemaphoreAgent::GetCount(ObjectId id) const
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> semaphore = internal::resolve(id);
+    if (!semaphore.ok()) {
+        return semaphore.status();
+    }
+    return semaphore.value()->count;
+}
+
+Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id) const
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> semaphore = internal::resolve(id);
+    if (!semaphore.ok()) {
+        return semaphore.status();
+    }
+    return semaphore.value()->holder != nullptr ? semaphore.value()->holder->id : ObjectId::null();
+}
+
+Result<ObjectId> SemaphoreAgent::NameToObject(const char* name) const
+{
+    arch_x86::InterruptGuard guard;
+    internal::ensureTable();
+    return internal::table.NameToObject(name, Visibility::Local);
+}
+
+Status SemaphoreAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> semaphore = internal::resolve(id);
+    if (!semaphore.ok()) {
+        return semaphore.status();
+    }
+    if (!newOwner.isNull() && !TaskManager::resolve(newOwner).ok()) {
+        return Status::InvalidId;
+    }
+    const ObjectId caller = internal::currentTaskId();
+    const ObjectId owner = internal::table.ownerOf(id).value();
+    if (owner != caller && !internal::currentTaskIsSuperUser()) {
+        return Status::NotOwner;
+    }
+    return internal::table.XferOwnership(id, owner, newOwner);
+}
+
+Status SemaphoreAgent::AddObjects(size_t count) const
+{
+    if (!internal::currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    arch_x86::InterruptGuard guard;
+    internal::ensureTable();
+    return internal::table.AddObjects(count);
+}
+
+namespace {
+
+shell::CommandResult listSemaphores(shell::Shell& shell, int argc, char**)
+{
+    if (argc != 1) {
+        return shell::CommandResult::UsageError;
+    }
+    shell.print("id         kind      count  holder     inherit\r\n");
+    for (const Semaphore& s : internal::semaphores) {
+        arch_x86::InterruptGuard guard;
+        if (s.id.isNull() || !internal::table.resolve(s.id).ok()) {
+            continue;
+        }
+        shell.print("%08lx   %-8s %6lu  %08lx   %s\r\n", static_cast<unsigned long>(s.id.raw()),
+                    s.kind == SemaphoreKind::Binary ? "binary" : "counting", static_cast<unsigned long>(s.count),
+                    static_cast<unsigned long>(s.holder != nullptr ? s.holder->id.raw() : 0),
+                    s.inheritance ? "yes" : "no");
+    }
+    shell.print("%lu semaphores\r\n", static_cast<unsigned long>(internal::semaphoreCount()));
+    return shell::CommandResult::Ok;
+}
+
+} // namespace
+
+DCOS_SHELL_COMMAND(semaphoresCommand, "semaphores", "list the semaphores", "semaphores", listSemaphores);
+
+} // namespace dcos

@@ -1,0 +1,484 @@
+// Host tests of the segmented heap algorithm (seed 7.8): header, alignment
+// and minimum size, first fit, merging on both sides, holders, long
+// randomized sequences checked against an independent model of the address
+// space, and detection of corruption.
+#include <dcos/internal/SegmentedHeap.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <random>
+#include <vector>
+
+namespace {
+
+using dcos::HeapAgent;
+using dcos::HeapStatistics;
+using dcos::Status;
+using dcos::internal::SegmentedHeap;
+
+constexpr uint16_t kTaskA = 3;
+constexpr uint16_t kTaskB = 7;
+
+// An 8-byte aligned area with guard bytes on both sides.
+class Area {
+public:
+    explicit Area(size_t bytes) : storage_(bytes + 2 * kGuard + 8, 0xA5)
+    {
+        const uintptr_t raw = reinterpret_cast<uintptr_t>(storage_.data()) + kGuard;
+        offset_ = ((raw + 7) & ~uintptr_t{7}) - reinterpret_cast<uintptr_t>(storage_.data());
+        bytes_ = bytes;
+    }
+    uint8_t* data() { return storage_.data() + offset_; }
+    size_t size() const { return bytes_; }
+    bool guardsIntact() const
+    {
+        for (size_t i = 0; i < storage_.size(); ++i) {
+            if ((i < offset_ || i >= offset_ + bytes_) && storage_[i] != 0xA5) {
+                return false;
+            }
+        }
+        return true;
+    }
+
+private:
+    static constexpr size_t kGuard = 32;
+    std::vector<uint8_t> storage_;
+    size_t offset_ = 0;
+    size_t bytes_ = 0;
+};
+
+HeapStatistics statisticsOf(SegmentedHeap& heap)
+{
+    const dcos::Result<HeapStatistics> statistics = heap.statistics();
+    EXPECT_TRUE(statistics.ok());
+    return statistics.value();
+}
+
+TEST(SegmentedHeapTest, SegmentBytesHasAHeaderAndAnEightByteMinimum)
+{
+    EXPECT_EQ(HeapAgent::SegmentBytes(1), 16u);
+    EXPECT_EQ(HeapAgent::SegmentBytes(8), 16u);
+    EXPECT_EQ(HeapAgent::SegmentBytes(9), 24u);
+    EXPECT_EQ(HeapAgent::SegmentBytes(100), 112u);
+}
+
+TEST(SegmentedHeapTest, AFreshHeapIsOneFreeSegment)
+{
+    Area area(1024);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
+    const HeapStatistics statistics = statisticsOf(heap);
+    EXPECT_EQ(statistics.heapBytes, 1024u);
+    EXPECT_EQ(statistics.freeBytes, 1024u);
+    EXPECT_EQ(statistics.usedBytes, 0u);
+    EXPECT_EQ(statistics.freeSegments, 1u);
+    EXPECT_EQ(statistics.largestFreeSegment, 1016u);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+}
+
+TEST(SegmentedHeapTest, RefusesBadAreas)
+{
+    Area area(64);
+    SegmentedHeap heap;
+    EXPECT_EQ(heap.initialise(nullptr, 64, 1), Status::InvalidArgument);
+    EXPECT_EQ(heap.initialise(area.data(), 15, 1), Status::InvalidArgument);
+    EXPECT_EQ(heap.initialise(area.data() + 1, 22, 1), Status::InvalidArgument); // 15 usable after alignment.
+    EXPECT_FALSE(heap.inService());
+    ASSERT_EQ(heap.initialise(area.data() + 3, 61, 1), Status::Ok); // Aligned to +8, 56 bytes.
+    EXPECT_EQ(heap.heapBytes(), 56u);
+    EXPECT_EQ(heap.initialise(area.data(), SegmentedHeap::kMaximumHeapBytes + 8, 1), Status::InvalidArgument);
+}
+
+TEST(SegmentedHeapTest, SegmentsAreAlignedAndHoldTheRequest)
+{
+    Area area(4096);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
+    for (size_t bytes : {1u, 3u, 8u, 9u, 17u, 100u, 255u}) {
+        const dcos::Result<void*> segment = heap.allocate(bytes, kTaskA);
+        ASSERT_TRUE(segment.ok());
+        EXPECT_EQ(reinterpret_cast<uintptr_t>(segment.value()) % 8, 0u);
+        std::memset(segment.value(), 0x77, bytes);
+    }
+    EXPECT_EQ(heap.audit(), Status::Ok);
+    EXPECT_EQ(heap.allocate(0, kTaskA).status(), Status::InvalidArgument);
+    EXPECT_TRUE(area.guardsIntact());
+}
+
+TEST(SegmentedHeapTest, OneByteCostsSixteenAndATooSmallRemainderIsGivenAway)
+{
+    Area area(64);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
+    ASSERT_TRUE(heap.allocate(1, kTaskA).ok());
+    EXPECT_EQ(statisticsOf(heap).usedBytes, 16u);
+    // 48 free; a 32-byte request (40 with header) leaves 8, too small for a segment.
+    ASSERT_TRUE(heap.allocate(32, kTaskA).ok());
+    const HeapStatistics statistics = statisticsOf(heap);
+    EXPECT_EQ(statistics.usedBytes, 64u);
+    EXPECT_EQ(statistics.freeSegments, 0u);
+    EXPECT_EQ(statistics.largestFreeSegment, 0u);
+    EXPECT_EQ(heap.allocate(1, kTaskA).status(), Status::NoMemory);
+    EXPECT_EQ(heap.allocate(size_t{1} << 40, kTaskA).status(), Status::NoMemory);
+    EXPECT_EQ(statisticsOf(heap).failedAllocations, 2u);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+}
+
+TEST(SegmentedHeapTest, ReturnMergesWithBothNeighbours)
+{
+    Area area(16 * 64);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
+    void* a = heap.allocate(40, kTaskA).value();
+    void* b = heap.allocate(40, kTaskA).value();
+    void* c = heap.allocate(40, kTaskA).value();
+    void* d = heap.allocate(40, kTaskA).value(); // Keeps c away from the big free remainder.
+    EXPECT_EQ(statisticsOf(heap).freeSegments, 1u);
+    EXPECT_EQ(heap.release(a, kTaskA), Status::Ok);
+    EXPECT_EQ(heap.release(c, kTaskA), Status::Ok);
+    EXPECT_EQ(statisticsOf(heap).freeSegments, 3u);
+    EXPECT_EQ(heap.release(b, kTaskA), Status::Ok); // Joins a and c.
+    HeapStatistics statistics = statisticsOf(heap);
+    EXPECT_EQ(statistics.freeSegments, 2u);
+    EXPECT_EQ(statistics.allocatedSegments, 1u);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+    EXPECT_EQ(heap.release(d, kTaskA), Status::Ok); // Joins everything.
+    statistics = statisticsOf(heap);
+    EXPECT_EQ(statistics.freeSegments, 1u);
+    EXPECT_EQ(statistics.largestFreeSegment, area.size() - 8);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+}
+
+TEST(SegmentedHeapTest, FirstFitTakesTheFirstListedSegmentThatIsLargeEnough)
+{
+    Area area(1024);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
+    void* small = heap.allocate(16, kTaskA).value();
+    void* keep1 = heap.allocate(8, kTaskA).value();
+    void* large = heap.allocate(200, kTaskA).value();
+    void* keep2 = heap.allocate(8, kTaskA).value();
+    ASSERT_EQ(heap.release(large, kTaskA), Status::Ok);
+    ASSERT_EQ(heap.release(small, kTaskA), Status::Ok); // The list: small, large, remainder.
+    // 16 bytes fit the first listed segment exactly.
+    EXPECT_EQ(heap.allocate(16, kTaskB).value(), small);
+    // 100 bytes skip nothing suitable: the large one is next, cut from its end.
+    void* cut = heap.allocate(100, kTaskB).value();
+    EXPECT_GT(cut, large);
+    EXPECT_LT(static_cast<uint8_t*>(cut), static_cast<uint8_t*>(large) + 200);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+    (void)keep1;
+    (void)keep2;
+}
+
+TEST(SegmentedHeapTest, OnlyTheHolderOrAnyoneForSystemSegmentsMayReturn)
+{
+    Area area(512);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
+    void* a = heap.allocate(20, kTaskA).value();
+    void* system = heap.allocate(20, SegmentedHeap::kSystemHolder).value();
+    EXPECT_EQ(heap.release(a, kTaskB), Status::NotOwner);
+    EXPECT_EQ(heap.transfer(a, kTaskB, kTaskB), Status::NotOwner);
+    EXPECT_EQ(heap.transfer(a, kTaskA, kTaskB), Status::Ok);
+    EXPECT_EQ(heap.release(a, kTaskA), Status::NotOwner);
+    EXPECT_EQ(heap.release(a, kTaskB), Status::Ok);
+    EXPECT_EQ(heap.release(system, kTaskA), Status::Ok);
+    EXPECT_FALSE(heap.isCorrupted());
+    EXPECT_EQ(heap.audit(), Status::Ok);
+}
+
+// An independent model of the address space: the allocated segments the
+// test knows of, with the bytes each consumed, from which the free gaps
+// follow. Full coalescing means each maximal gap is exactly one free segment.
+struct Model {
+    struct Segment {
+        size_t requested;
+        size_t bytes; // Header included; the request's SegmentBytes, or 8 more when a remainder was too small.
+        uint16_t holder;
+        uint8_t pattern;
+    };
+    std::map<uint8_t*, Segment> allocated; // By data address.
+};
+
+void checkAgainstModel(SegmentedHeap& heap, const Model& model, uint8_t* base, size_t heapBytes)
+{
+    size_t gaps = 0;
+    size_t gapBytes = 0;
+    size_t largestGap = 0;
+    uint8_t* position = base; // End of the previous segment.
+    auto account = [&](uint8_t* nextStart) {
+        ASSERT_GE(nextStart, position) << "segments overlap";
+        const size_t gap = static_cast<size_t>(nextStart - position);
+        if (gap != 0) {
+            ASSERT_GE(gap, 16u) << "a hole too small to be a segment";
+            ++gaps;
+            gapBytes += gap;
+            largestGap = std::max(largestGap, gap);
+        }
+    };
+    for (const auto& [data, segment] : model.allocated) {
+        account(data - 8);
+        for (size_t i = 0; i < segment.requested; ++i) {
+            ASSERT_EQ(data[i], segment.pattern) << "the heap wrote into an allocated segment";
+        }
+        ASSERT_TRUE(segment.bytes == HeapAgent::SegmentBytes(segment.requested)
+                    || segment.bytes == HeapAgent::SegmentBytes(segment.requested) + 8);
+        position = data - 8 + segment.bytes;
+    }
+    account(base + heapBytes);
+    const dcos::Result<HeapStatistics> result = heap.statistics();
+    ASSERT_TRUE(result.ok());
+    const HeapStatistics& statistics = result.value();
+    EXPECT_EQ(statistics.freeSegments, gaps);
+    EXPECT_EQ(statistics.freeBytes, gapBytes);
+    EXPECT_EQ(statistics.usedBytes + statistics.freeBytes, heapBytes);
+    EXPECT_EQ(statistics.allocatedSegments, model.allocated.size());
+    EXPECT_EQ(statistics.largestFreeSegment, largestGap == 0 ? 0 : largestGap - 8);
+}
+
+TEST(SegmentedHeapTest, RandomizedSequencesMatchTheModel)
+{
+    std::mt19937 random(19870615);
+    for (int round = 0; round < 12; ++round) {
+        const size_t heapBytes = 512 + 8 * (random() % 1024);
+        Area area(heapBytes);
+        SegmentedHeap heap;
+        ASSERT_EQ(heap.initialise(area.data(), area.size(), static_cast<uint32_t>(random())), Status::Ok);
+        Model model;
+        uint32_t allocations = 0;
+        uint32_t failed = 0;
+        uint32_t returns = 0;
+        uint32_t lowWater = static_cast<uint32_t>(heapBytes);
+        // Small, medium and occasional large requests, as a real mix would be.
+        const size_t maxRequest = round % 3 == 0 ? 24 : round % 3 == 1 ? 200 : heapBytes / 3;
+        for (int step = 0; step < 6000; ++step) {
+            const uint16_t holder = static_cast<uint16_t>(random() % 4);
+            const unsigned action = random() % 20;
+            if (action < 10) {
+                const size_t bytes = 1 + random() % maxRequest;
+                const HeapStatistics before = heap.statistics().value();
+                const uint32_t largestBefore = before.largestFreeSegment;
+                const dcos::Result<void*> segment = heap.allocate(bytes, holder);
+                // No loss: a request fails exactly when no free segment is large enough.
+                if (HeapAgent::SegmentBytes(bytes) - 8 > largestBefore) {
+                    ASSERT_EQ(segment.status(), Status::NoMemory);
+                    ++failed;
+                } else {
+                    ASSERT_TRUE(segment.ok());
+                    uint8_t* data = static_cast<uint8_t*>(segment.value());
+                    ASSERT_EQ(reinterpret_cast<uintptr_t>(data) % 8, 0u);
+                    ASSERT_GE(data, area.data() + 8);
+                    ASSERT_LE(data + bytes, area.data() + heapBytes);
+                    const uint8_t pattern = static_cast<uint8_t>(random());
+                    std::memset(data, pattern, bytes);
+                    const uint32_t freeAfter = heap.statistics().value().freeBytes;
+                    model.allocated[data] = {bytes, before.freeBytes - freeAfter, holder, pattern};
+                    ++allocations;
+                    lowWater = std::min(lowWater, freeAfter);
+                }
+            } else if (action < 19 && !model.allocated.empty()) {
+                auto it = model.allocated.begin();
+                std::advance(it, static_cast<long>(random() % model.allocated.size()));
+                const uint16_t other = static_cast<uint16_t>((it->second.holder + 1) % 4);
+                ASSERT_EQ(heap.release(it->first, other), Status::NotOwner);
+                if (random() % 4 == 0) {
+                    ASSERT_EQ(heap.transfer(it->first, it->second.holder, other), Status::Ok);
+                    it->second.holder = other;
+                }
+                ASSERT_EQ(heap.release(it->first, it->second.holder), Status::Ok);
+                model.allocated.erase(it);
+                ++returns;
+            } else if (!model.allocated.empty()) {
+                size_t expected = 0;
+                for (auto it = model.allocated.begin(); it != model.allocated.end();) {
+                    if (it->second.holder == holder) {
+                        it = model.allocated.erase(it);
+                        ++expected;
+                    } else {
+                        ++it;
+                    }
+                }
+                ASSERT_EQ(heap.reclaimHeldBy(holder), expected);
+                returns += static_cast<uint32_t>(expected);
+            }
+            checkAgainstModel(heap, model, area.data(), heapBytes);
+            if (HasFatalFailure() || HasNonfatalFailure()) {
+                FAIL() << "round " << round << " step " << step;
+            }
+            if (step % 50 == 0) {
+                ASSERT_EQ(heap.audit(), Status::Ok);
+            }
+        }
+        ASSERT_EQ(heap.audit(), Status::Ok);
+        const HeapStatistics statistics = heap.statistics().value();
+        EXPECT_EQ(statistics.allocations, allocations);
+        EXPECT_EQ(statistics.failedAllocations, failed);
+        EXPECT_EQ(statistics.returns, returns);
+        EXPECT_EQ(statistics.lowWaterFreeBytes, lowWater);
+        // Everything returned: one free segment again, nothing lost.
+        for (const auto& [data, segment] : model.allocated) {
+            ASSERT_EQ(heap.release(data, segment.holder), Status::Ok);
+        }
+        EXPECT_EQ(heap.statistics().value().freeSegments, 1u);
+        EXPECT_EQ(heap.statistics().value().largestFreeSegment, heapBytes - 8);
+        EXPECT_TRUE(area.guardsIntact());
+    }
+}
+
+// A corrupted heap fails every call.
+void expectDisabled(SegmentedHeap& heap, void* someSegment)
+{
+    EXPECT_TRUE(heap.isCorrupted());
+    EXPECT_EQ(heap.allocate(8, kTaskA).status(), Status::Corrupted);
+    EXPECT_EQ(heap.release(someSegment, kTaskA), Status::Corrupted);
+    EXPECT_EQ(heap.transfer(someSegment, kTaskA, kTaskB), Status::Corrupted);
+    EXPECT_EQ(heap.statistics().status(), Status::Corrupted);
+    EXPECT_EQ(heap.audit(), Status::Corrupted);
+    EXPECT_EQ(heap.reclaimHeldBy(kTaskA), 0u);
+}
+
+class SegmentedHeapCorruptionTest : public ::testing::Test {
+protected:
+    void SetUp() override
+    {
+        ASSERT_EQ(heap.initialise(area.data(), area.size(), 0xBEEF), Status::Ok);
+        for (uint8_t*& segment : segments) {
+            segment = static_cast<uint8_t*>(heap.allocate(24, kTaskA).value());
+        }
+        // Segments are cut from the end: segments[0] is highest. Free one in the middle.
+        ASSERT_EQ(heap.release(segments[2], kTaskA), Status::Ok);
+    }
+
+    // The header words of the segment whose data starts at @p data.
+    static uint8_t* headerOf(uint8_t* data) { return data - 8; }
+
+    Area area{1024};
+    SegmentedHeap heap;
+    uint8_t* segments[5] = {};
+};
+
+TEST_F(SegmentedHeapCorruptionTest, DoubleReturnDisablesTheHeap)
+{
+    EXPECT_EQ(heap.release(segments[2], kTaskA), Status::Corrupted);
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, DoubleReturnOfAMergedSegmentIsDetected)
+{
+    // segments[1] sits just above segments[2] (free): it merges into it, and
+    // its header is cleared, so a second return cannot pass for a live one.
+    ASSERT_EQ(heap.release(segments[1], kTaskA), Status::Ok);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+    EXPECT_EQ(heap.release(segments[1], kTaskA), Status::Corrupted);
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, PointersThatAreNotSegmentStartsDisableTheHeap)
+{
+    EXPECT_EQ(heap.release(segments[0] + 8, kTaskA), Status::Corrupted);
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, MisalignedPointerDisablesTheHeap)
+{
+    EXPECT_EQ(heap.release(segments[0] + 1, kTaskA), Status::Corrupted);
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, ForeignPointerIsRefusedAndTheHeapStaysInService)
+{
+    uint8_t elsewhere[32];
+    EXPECT_EQ(heap.release(elsewhere, kTaskA), Status::InvalidArgument);
+    EXPECT_EQ(heap.release(area.data() + area.size(), kTaskA), Status::InvalidArgument);
+    EXPECT_EQ(heap.release(nullptr, kTaskA), Status::InvalidArgument);
+    EXPECT_FALSE(heap.isCorrupted());
+    EXPECT_EQ(heap.release(segments[0], kTaskA), Status::Ok);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, OverrunIntoTheNextHeaderIsDetectedByBothSegments)
+{
+    // segments[4] is lowest; writing past its end hits segments[3]'s header.
+    std::memset(segments[4], 0x11, 24 + 8);
+    EXPECT_EQ(heap.release(segments[4], kTaskA), Status::Corrupted); // Its successor's header fails.
+    expectDisabled(heap, segments[3]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, OverwrittenHolderIsCorruptionNotAnotherOwner)
+{
+    headerOf(segments[0])[4] = static_cast<uint8_t>(kTaskB);
+    EXPECT_EQ(heap.release(segments[0], kTaskB), Status::Corrupted);
+    expectDisabled(heap, segments[1]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, OverwrittenSizeIsDetected)
+{
+    headerOf(segments[0])[1] ^= 0x01; // Size + 256.
+    EXPECT_EQ(heap.release(segments[0], kTaskA), Status::Corrupted);
+    expectDisabled(heap, segments[1]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, WriteAfterReturnIntoTheLinksIsCaughtByAllocate)
+{
+    std::memset(segments[2], 0x00, 8); // The free segment's next link and more.
+    std::memset(headerOf(segments[2]) + 4, 0x00, 4); // Its back link.
+    EXPECT_EQ(heap.allocate(8, kTaskA).status(), Status::Corrupted);
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, OverwrittenBoundaryTagIsCaughtWhenTheSuccessorReturns)
+{
+    std::memset(segments[2] + 16 + 4, 0x33, 4); // Last word of the free 32-byte segment.
+    EXPECT_EQ(heap.release(segments[1], kTaskA), Status::Corrupted); // segments[1] follows it.
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, OverwrittenBoundaryTagIsCaughtByTheStatistics)
+{
+    std::memset(segments[2] + 16 + 4, 0x33, 4);
+    EXPECT_EQ(heap.statistics().status(), Status::Corrupted);
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, FreeListLoopIsCaught)
+{
+    // Point the free segment's next link at itself.
+    const uint32_t self = static_cast<uint32_t>(headerOf(segments[2]) - area.data());
+    std::memcpy(segments[2], &self, 4);
+    EXPECT_EQ(heap.allocate(900, kTaskA).status(), Status::Corrupted); // Fits nowhere: walks the whole list.
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, ClearedPreviousFreeFlagIsCaughtByAudit)
+{
+    headerOf(segments[1])[0] &= static_cast<uint8_t>(~2u); // segments[1] follows the free segment.
+    EXPECT_EQ(heap.audit(), Status::Corrupted);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, RecoveryStopsAtAnOverwrittenHeader)
+{
+    std::memset(headerOf(segments[3]), 0x44, 8);
+    heap.reclaimHeldBy(kTaskA);
+    EXPECT_TRUE(heap.isCorrupted());
+}
+
+TEST(SegmentedHeapSaltTest, HeadersAreBoundToTheirHeap)
+{
+    Area first(256);
+    Area second(256);
+    SegmentedHeap a;
+    SegmentedHeap b;
+    ASSERT_EQ(a.initialise(first.data(), first.size(), 1), Status::Ok);
+    ASSERT_EQ(b.initialise(second.data(), second.size(), 2), Status::Ok);
+    void* inA = a.allocate(40, kTaskA).value();
+    void* inB = b.allocate(40, kTaskA).value();
+    ASSERT_EQ(static_cast<uint8_t*>(inA) - first.data(), static_cast<uint8_t*>(inB) - second.data());
+    std::memcpy(static_cast<uint8_t*>(inB) - 8, static_cast<uint8_t*>(inA) - 8, 8);
+    EXPECT_EQ(b.release(inB, kTaskA), Status::Corrupted);
+}
+
+} // namespace

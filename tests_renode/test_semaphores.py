@@ -1,0 +1,24 @@
+"""The semaphore agent on the emulated 486 board (seed 7.11).
+
+Each case boots the test image under -icount, so the scheduling sequences the
+on-target tests check are exact and repeatable.
+"""
+
+import pytest
+
+from dcoslab.board import EXIT_PASS
+
+SEMAPHORE_TARGET_TESTS = [
+    "semaphores",  # binary and counting, poll, time-out, Deadlock, NotOwner, maximum, id errors
+    "semdelete",   # Delete and holder death wake every waiter with an error
+    "inherit",     # priority inheritance: low/medium/high, a holder of two semaphores, time-out
+]
+
+
+@pytest.mark.parametrize("name", SEMAPHORE_TARGET_TESTS)
+def test_semaphore(boot, isa486, name):
+    emulator = boot(isa486, "test", icount=True)
+    emulator.expect(r"dcos> ")
+    emulator.send(f"test {name} --exit\r")
+    emulator.expect(rf"TEST {name}: (PASS|FAIL)", timeout=120)
+    emulator.expect_exit(EXIT_PASS, timeout=120)
