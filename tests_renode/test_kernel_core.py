@@ -34,6 +34,7 @@ KERNEL_TARGET_TESTS = [
     "intlevel",     # SetInterruptLevel and the legal limit
     "profiling",    # StartProfiling/StopProfiling/GetTimingInfo exclude preemption
     "fpu",          # FPU context per floating-point task
+    "recoverall",   # a dying task gives back a buffer, a segment, a semaphore and a port
 ]
 
 
