@@ -4,25 +4,16 @@ import re
 
 import pytest
 
-from dcoslab.board import EXIT_PASS
+from dcoslab.target import run_target_test
 
 # On-target tests this module runs (see test_kernel_core.test_every_target_test_is_run).
 BOARD_TARGET_TESTS = ["tick", "irqmask"]
 
 
-def run_target_test(boot, board, name, append="", icount=False):
-    emulator = boot(board, "test", append=append, icount=icount)
-    emulator.expect(r"dcos> ")
-    emulator.send(f"test {name} --exit\r")
-    emulator.expect(rf"TEST {name}: (PASS|FAIL)")
-    emulator.expect_exit(EXIT_PASS)
-    return emulator
-
-
 @pytest.mark.parametrize("rate", [None, 19, 100, 250, 2000])
 def test_tick_rate_matches_the_virtual_clock(boot, isa486, rate):
     append = f"tick_hz={rate}" if rate else ""
-    emulator = run_target_test(boot, isa486, "tick", append=append, icount=True)
+    emulator = run_target_test(boot(isa486, "test", append=append, icount=True), "tick")
     configured = rate or 1000
     match = re.search(r"tick rate: (\d+) ticks in 2 s of emulator time; configured (\d+) Hz", emulator.transcript)
     assert match, "the tick test printed no measurement"
@@ -44,5 +35,5 @@ def test_invalid_tick_rate_is_refused_with_a_warning(boot, isa486):
 
 
 def test_masked_irq_does_not_arrive_until_unmasked(boot, isa486):
-    emulator = run_target_test(boot, isa486, "irqmask", icount=True)
+    emulator = run_target_test(boot(isa486, "test", icount=True), "irqmask")
     assert "request pending yes" in emulator.transcript

@@ -12,7 +12,7 @@ import os
 
 import pytest
 
-from dcoslab.board import EXIT_PASS
+from dcoslab.target import run_target_test
 
 KERNEL_TARGET_TESTS = [
     "preempt",      # a task readied in a nested ISR runs at the outermost exit
@@ -40,11 +40,7 @@ KERNEL_TARGET_TESTS = [
 
 @pytest.mark.parametrize("name", KERNEL_TARGET_TESTS)
 def test_kernel(boot, isa486, name):
-    emulator = boot(isa486, "test", icount=True)
-    emulator.expect(r"dcos> ")
-    emulator.send(f"test {name} --exit\r")
-    emulator.expect(rf"TEST {name}: (PASS|FAIL)", timeout=120)
-    emulator.expect_exit(EXIT_PASS, timeout=120)
+    run_target_test(boot(isa486, "test", icount=True), name)
 
 
 def test_every_target_test_is_run(boot, isa486):

@@ -10,7 +10,7 @@ import re
 
 import pytest
 
-from dcoslab.board import EXIT_PASS
+from dcoslab.target import run_target_test
 
 MEMORY_TARGET_TESTS = [
     "pools",        # Create/Delete/Allocate/Return/GetStatistics/NameToObject/XferOwnership, holders, id errors
@@ -25,11 +25,7 @@ MEMORY_TARGET_TESTS = [
 
 @pytest.mark.parametrize("name", MEMORY_TARGET_TESTS)
 def test_memory_agent(boot, isa486, name):
-    emulator = boot(isa486, "test", icount=True)
-    emulator.expect(r"dcos> ")
-    emulator.send(f"test {name} --exit\r")
-    emulator.expect(rf"TEST {name}: (PASS|FAIL)", timeout=120)
-    emulator.expect_exit(EXIT_PASS, timeout=120)
+    run_target_test(boot(isa486, "test", icount=True), name)
 
 
 def test_pools_and_heaps_commands_list_usage_and_corruption(boot, isa486):

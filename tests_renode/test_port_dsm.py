@@ -9,7 +9,7 @@ import re
 
 import pytest
 
-from dcoslab.board import EXIT_PASS
+from dcoslab.target import run_target_test
 
 PORT_DSM_TARGET_TESTS = [
     "portprims",        # every port primitive with its errors: ids, ownership, ISRs, full table
@@ -26,11 +26,7 @@ PORT_DSM_TARGET_TESTS = [
 
 @pytest.mark.parametrize("name", PORT_DSM_TARGET_TESTS)
 def test_port_dsm(boot, isa486, name):
-    emulator = boot(isa486, "test", icount=True)
-    emulator.expect(r"dcos> ")
-    emulator.send(f"test {name} --exit\r")
-    emulator.expect(rf"TEST {name}: (PASS|FAIL)", timeout=120)
-    emulator.expect_exit(EXIT_PASS, timeout=120)
+    run_target_test(boot(isa486, "test", icount=True), name)
 
 
 def test_ports_command_shows_queues_and_free_buffers(boot, isa486):

@@ -6,7 +6,7 @@ on-target tests check are exact and repeatable.
 
 import pytest
 
-from dcoslab.board import EXIT_PASS
+from dcoslab.target import run_target_test
 
 SEMAPHORE_TARGET_TESTS = [
     "semaphores",  # binary and counting, poll, time-out, Deadlock, NotOwner, maximum, id errors
@@ -17,8 +17,4 @@ SEMAPHORE_TARGET_TESTS = [
 
 @pytest.mark.parametrize("name", SEMAPHORE_TARGET_TESTS)
 def test_semaphore(boot, isa486, name):
-    emulator = boot(isa486, "test", icount=True)
-    emulator.expect(r"dcos> ")
-    emulator.send(f"test {name} --exit\r")
-    emulator.expect(rf"TEST {name}: (PASS|FAIL)", timeout=120)
-    emulator.expect_exit(EXIT_PASS, timeout=120)
+    run_target_test(boot(isa486, "test", icount=True), name)

@@ -108,9 +108,9 @@ TEST(ObjectTableTest, ForgedIdsAreRejected)
     const ObjectId good = create(table);
     const uint16_t generationZeroIndex = good.index();
 
-    EXPECT_EQ(table.resolve(ObjectId(kNode + 1, ObjectType::Semaphore, good.index())).status(), Status::InvalidId);
+    EXPECT_EQ(table.resolve(ObjectId(kNode + 1, ObjectType::Semaphore, good.index())).status(), Status::Remote);
+    EXPECT_EQ(table.resolve(ObjectId::null()).status(), Status::InvalidId);
     EXPECT_EQ(table.resolve(ObjectId(kNode, ObjectType::Timer, good.index())).status(), Status::WrongType);
-    EXPECT_EQ(table.resolve(ObjectId::null()).status(), Status::WrongType);
     // Slot 8 is within Capacity but not yet activated by AddObjects.
     EXPECT_EQ(table.resolve(ObjectId(kNode, ObjectType::Semaphore, 8)).status(), Status::InvalidId);
     // A free slot with its current generation was never handed out.

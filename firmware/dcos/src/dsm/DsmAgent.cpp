@@ -88,26 +88,10 @@ void start()
     }
 }
 
-// The checks every id goes through first: InvalidId for null, Remote for an
-// id of this type on another node. The tables give WrongType, InvalidId and
-// StaleId.
-Status checkNode(ObjectId id, ObjectType type, uint16_t node)
-{
-    if (id.isNull()) {
-        return Status::InvalidId;
-    }
-    if (id.type() == type && id.node() != node) {
-        return Status::Remote;
-    }
-    return Status::Ok;
-}
-
 Result<PublisherObject*> resolvePublisher(ObjectId id)
 {
-    const Status node = checkNode(id, ObjectType::DsmPublisher, publisherTable.node());
-    if (node != Status::Ok) {
-        return node;
-    }
+    // The table gives InvalidId, WrongType, Remote and StaleId.
+    start();
     const Result<PublisherObject**> entry = publisherTable.resolve(id);
     if (!entry.ok()) {
         return entry.status();
@@ -120,10 +104,7 @@ Result<PublisherObject*> resolvePublisher(ObjectId id)
 
 Result<SubscriptionObject*> resolveSubscription(ObjectId id)
 {
-    const Status node = checkNode(id, ObjectType::DsmSubscription, subscriptionTable.node());
-    if (node != Status::Ok) {
-        return node;
-    }
+    start();
     return subscriptionTable.resolve(id);
 }
 

@@ -53,15 +53,8 @@ void start()
 // The id checks every primitive shares; call with interrupts disabled.
 Result<PoolObject*> lookup(ObjectId id)
 {
-    if (id.isNull()) {
-        return Status::InvalidId;
-    }
-    if (id.type() != ObjectType::BufferPool) {
-        return Status::WrongType;
-    }
-    if (id.node() != localNode()) {
-        return Status::Remote; // Served by the network manager once it exists.
-    }
+    // The table gives InvalidId, WrongType, Remote (another node's object,
+    // served by the network manager once it exists) and StaleId.
     start();
     const Result<PoolObject**> entry = poolTable.resolve(id);
     if (!entry.ok()) {

@@ -70,12 +70,6 @@ void start()
 // node's port, WrongType and StaleId from the table.
 Result<PortObject*> resolvePort(ObjectId id)
 {
-    if (id.isNull()) {
-        return Status::InvalidId;
-    }
-    if (id.type() == ObjectType::MessagePort && id.node() != portTable.node()) {
-        return Status::Remote;
-    }
     const Result<PortObject**> entry = portTable.resolve(id);
     if (!entry.ok()) {
         return entry.status();

@@ -56,12 +56,6 @@ void ensureTable()
 Result<Semaphore*> resolve(ObjectId id)
 {
     ensureTable();
-    if (id.isNull()) {
-        return Status::InvalidId;
-    }
-    if (id.type() == ObjectType::Semaphore && id.node() != table.node()) {
-        return Status::Remote;
-    }
     const Result<Semaphore**> entry = table.resolve(id);
     if (!entry.ok()) {
         return entry.status();

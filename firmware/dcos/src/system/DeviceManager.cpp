@@ -29,15 +29,9 @@ DeviceManager& deviceManager()
 
 Result<DeviceEntry*> DeviceManager::lookup(ObjectId id)
 {
-    if (id.isNull()) {
-        return Status::InvalidId;
-    }
-    if (id.type() != ObjectType::Device) {
-        return Status::WrongType;
-    }
-    if (id.node() != localNode()) {
-        return Status::Remote;
-    }
+    // The table gives InvalidId, WrongType, Remote and StaleId once it has
+    // taken this node's id.
+    start();
     return table_.resolve(id);
 }
 

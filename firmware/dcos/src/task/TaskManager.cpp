@@ -278,12 +278,6 @@ void TaskManager::initialise(TaskEntry rootEntry)
 
 Result<Task*> TaskManager::resolve(ObjectId id)
 {
-    if (id.isNull()) {
-        return Status::InvalidId;
-    }
-    if (id.type() == ObjectType::Task && id.node() != table.node()) {
-        return Status::Remote;
-    }
     const Result<Task**> entry = table.resolve(id);
     if (!entry.ok()) {
         return entry.status();

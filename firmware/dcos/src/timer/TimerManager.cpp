@@ -95,9 +95,6 @@ void expire(TimeoutEntry& entry)
 
 Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
 {
-    if (id.type() == ObjectType::Timer && id.node() != timerTable.node()) {
-        return Status::Remote;
-    }
     const Result<TimerObject**> entry = timerTable.resolve(id);
     if (!entry.ok()) {
         return entry.status();

@@ -163,8 +163,9 @@ public:
 
     /// Resolves @p id to its object.
     ///
-    /// Fails with WrongType for an id of another type, InvalidId for another
-    /// node, a slot outside the active range or a free slot, and StaleId when
+    /// Fails with InvalidId for the null id, WrongType for an id of another
+    /// type, Remote for an id of this type on another node, InvalidId for a
+    /// slot outside the active range or a free slot, and StaleId when
     /// the generation shows the object was deleted. Cost O(1).
     Result<T*> resolve(ObjectId id)
     {
@@ -305,13 +306,17 @@ private:
     // Every accessor funnels through here so the rejection rules live in one place.
     Result<uint16_t> slotOf(ObjectId id) const
     {
+        if (id.isNull()) {
+            return Status::InvalidId;
+        }
         if (id.type() != type_) {
             return Status::WrongType;
         }
         if (id.node() != node_) {
-            // The agent routes ids of other nodes to the network before it
-            // consults its table, so a foreign node here means a forged id.
-            return Status::InvalidId;
+            // An object of this type on another node: the agents will hand
+            // such ids to the network interfaces manager; until it exists
+            // the object is unreachable.
+            return Status::Remote;
         }
         const uint16_t slot = static_cast<uint16_t>(id.index() & kSlotMask);
         if (slot >= active_) {
