@@ -72,11 +72,13 @@ void onWaitersChanged(WaitQueue&, void* context)
     }
 }
 
+// Every binary semaphore is listed with its holder (see InheritanceSource),
+// so recovery finds what a dead task held without searching the table.
 void takeHold(Semaphore& semaphore, Task& task)
 {
     semaphore.holder = &task;
+    task.heldSources.pushBack(semaphore);
     if (semaphore.inheritance) {
-        task.heldSources.pushBack(semaphore);
         TaskManager::recomputePriority(task);
     }
 }
@@ -85,9 +87,11 @@ void dropHold(Semaphore& semaphore)
 {
     Task* holder = semaphore.holder;
     semaphore.holder = nullptr;
-    if (holder != nullptr && semaphore.inheritance) {
+    if (holder != nullptr) {
         holder->heldSources.remove(semaphore);
-        TaskManager::recomputePriority(*holder);
+        if (semaphore.inheritance) {
+            TaskManager::recomputePriority(*holder);
+        }
     }
 }
 
@@ -108,16 +112,15 @@ unsigned recoverSemaphores(ObjectId deadTask)
     }
     unsigned recovered = 0;
     // Semaphores the dead task held: free them and tell every waiter that
-    // the holder is gone. O(N): task deletion is a configuration service.
+    // the holder is gone. O(semaphores held), from the holder's own list.
     const Result<Task*> dead = TaskManager::resolve(deadTask);
     if (dead.ok()) {
-        for (Semaphore& semaphore : semaphores) {
-            if (semaphore.holder == dead.value()) {
-                dropHold(semaphore);
-                semaphore.count = 1;
-                TaskManager::wakeAll(semaphore.waiters, Status::Abandoned);
-                ++recovered;
-            }
+        while (!dead.value()->heldSources.isEmpty()) {
+            Semaphore& semaphore = static_cast<Semaphore&>(dead.value()->heldSources.front());
+            dropHold(semaphore);
+            semaphore.count = 1;
+            TaskManager::wakeAll(semaphore.waiters, Status::Abandoned);
+            ++recovered;
         }
     }
     // Semaphores it created.
@@ -173,6 +176,7 @@ Result<ObjectId> SemaphoreAgent::Create(const SemaphoreAttributes& attributes) c
     semaphore.count = attributes.initialCount;
     semaphore.maximum = binary ? 1 : attributes.maximumCount;
     semaphore.inheritance = attributes.priorityInheritance;
+    semaphore.lendsPriority = attributes.priorityInheritance;
     semaphore.waiters.setOrder(attributes.order == WaitOrder::Fifo ? internal::WaitQueue::Order::Fifo
                                                                    : internal::WaitQueue::Order::Priority);
     semaphore.waiters.setObserver(internal::onWaitersChanged, &semaphore);
@@ -266,9 +270,7 @@ Status SemaphoreAgent::Release(ObjectId id) const
         // it inherited: dropping first would let a task of middling
         // priority run before the waiter (the very inversion inheritance
         // exists to prevent).
-        if (semaphore.inheritance) {
-            self.heldSources.remove(semaphore);
-        }
+        self.heldSources.remove(semaphore);
         semaphore.holder = nullptr;
         Task& next = semaphore.waiters.first();
         semaphore.waiters.remove(next);

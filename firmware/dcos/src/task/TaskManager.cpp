@@ -414,7 +414,7 @@ void TaskManager::recomputePriority(Task& task)
 {
     uint8_t priority = task.basePriority;
     for (InheritanceSource& source : task.heldSources) {
-        if (!source.waiters.isEmpty() && source.waiters.first().priority < priority) {
+        if (source.lendsPriority && !source.waiters.isEmpty() && source.waiters.first().priority < priority) {
             priority = source.waiters.first().priority;
         }
     }

@@ -157,8 +157,18 @@ uint64_t TimerManager::uptimeNs()
 
 uint64_t TimerManager::preciseUptimeNs()
 {
+    // The tick timer's counter and its interrupt request are read one after
+    // the other, and an emulated or real 8254 may reload the counter a
+    // moment before the request shows: the sum could then step back by up
+    // to a tick. Uptime must never run backwards (intervals are computed by
+    // subtraction), so it holds at the last value instead.
+    static uint64_t lastReported = 0;
     arch_x86::InterruptGuard guard;
-    return incrementNs + bsp::nanosecondsIntoTick();
+    const uint64_t now = incrementNs + bsp::nanosecondsIntoTick();
+    if (now > lastReported) {
+        lastReported = now;
+    }
+    return lastReported;
 }
 
 uint64_t TimerManager::tickAfter(uint64_t ns)
@@ -184,7 +194,7 @@ void TimerManager::cancel(TimeoutEntry& entry)
 uint64_t TimerManager::timeOfDayNs()
 {
     arch_x86::InterruptGuard guard;
-    return baseNs + incrementNs + bsp::nanosecondsIntoTick();
+    return baseNs + preciseUptimeNs();
 }
 
 Result<DateTime> TimerManager::getSystemClock() { return GregorianCalendar::fromNanoseconds(timeOfDayNs()); }
@@ -196,7 +206,7 @@ Status TimerManager::setSystemClock(const DateTime& time)
         return target.status();
     }
     arch_x86::InterruptGuard guard;
-    const uint64_t elapsed = incrementNs + bsp::nanosecondsIntoTick();
+    const uint64_t elapsed = preciseUptimeNs();
     if (target.value() < elapsed) {
         return Status::InvalidArgument; // Before the node was started.
     }

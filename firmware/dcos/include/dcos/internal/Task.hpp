@@ -44,6 +44,10 @@ struct InheritanceSource : IntrusiveListNode<InheritanceSourceTag> {
     explicit InheritanceSource(WaitQueue::Order order) : waiters(order) {}
     WaitQueue waiters;
     Task* holder = nullptr;
+    /// Whether the waiters lend their priority to the holder. A source that
+    /// does not is still listed with its holder, so that the objects a task
+    /// holds are found without searching every table when it dies.
+    bool lendsPriority = false;
 };
 
 struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<WaitQueueTag> {
@@ -80,7 +84,8 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     WaitQueue* waitingOn = nullptr; ///< The queue of the object it waits for, if any.
     uintptr_t waitData = 0;         ///< What the waiter asked for or received (agent-defined).
 
-    // Priority inheritance: the sources this task holds.
+    // The objects this task holds (binary semaphores); those that lend
+    // priority set the priority it runs at.
     IntrusiveList<InheritanceSource, InheritanceSourceTag> heldSources;
 
     // Event flags.
