@@ -21,7 +21,14 @@ FW_BENCH_DEFINES := \
 	-DDCOS_CONFIG_TASK_CAPACITY=4096 \
 	-DDCOS_CONFIG_TIMER_CAPACITY=4096 \
 	-DDCOS_CONFIG_DEVICE_CAPACITY=4096 \
-	-DDCOS_CONFIG_STACK_ARENA_KIB=8256
+	-DDCOS_CONFIG_STACK_ARENA_KIB=8256 \
+	-DDCOS_CONFIG_POOL_CAPACITY=4096 \
+	-DDCOS_CONFIG_HEAP_CAPACITY=4096 \
+	-DDCOS_CONFIG_PORT_CAPACITY=4096 \
+	-DDCOS_CONFIG_MESSAGE_BUFFERS=8192 \
+	-DDCOS_CONFIG_PUBLISHER_CAPACITY=4096 \
+	-DDCOS_CONFIG_SUBSCRIPTION_CAPACITY=4096 \
+	-DDCOS_CONFIG_SEMAPHORE_CAPACITY=4096
 FW_BENCH_CXXFLAGS := $(FW_CXXFLAGS) $(FW_BENCH_DEFINES)
 FW_BENCH_ASFLAGS := $(FW_ASFLAGS) $(FW_BENCH_DEFINES)
 
@@ -38,7 +45,12 @@ FW_BENCH_ORDER := \
 	tests_renode/bench/SchedulerBench.cpp \
 	tests_renode/bench/KernelSwitchBench.cpp \
 	tests_renode/bench/TimerBench.cpp \
-	tests_renode/bench/SystemBench.cpp
+	tests_renode/bench/SystemBench.cpp \
+	tests_renode/bench/BufferPoolBench.cpp \
+	tests_renode/bench/HeapBench.cpp \
+	tests_renode/bench/DsmBench.cpp \
+	tests_renode/bench/PortBench.cpp \
+	tests_renode/bench/SemaphoreBench.cpp
 FW_BENCH_SRCS := $(filter $(wildcard tests_renode/bench/*.cpp),$(FW_BENCH_ORDER)) \
 	$(filter-out $(FW_BENCH_ORDER),$(sort $(wildcard tests_renode/bench/*.cpp))) \
 	$(wildcard tests_renode/thread_metric/*.cpp)
@@ -50,6 +62,7 @@ FW_BENCH_OBJS := $(call fw_bench_objects,$(FW_BENCH_SRCS))
 
 IMAGE_486_BENCH := $(BUILD)/486/dcos486-bench.elf
 BENCH_REPORT := $(BUILD)/bench/kernel.json
+PRIMITIVES_REPORT := $(BUILD)/bench/primitives.json
 THREAD_METRIC_REPORT := $(BUILD)/bench/thread_metric.json
 
 # Built with the other images, so the emulator suite can check the framework.

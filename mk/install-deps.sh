@@ -11,12 +11,21 @@ g++-multilib:gives g++ the 32-bit C++ headers the firmware is compiled against (
 binutils:links the firmware and disassembles it for the i486 instruction check
 make:runs the build
 libgtest-dev:GoogleTest for the host unit tests
-qemu-system-x86:the emulator that runs the ISA 486 board (qemu-system-i386)
-qemu-system-data:option ROMs the emulator loads
+qemu-system-data:option ROMs the emulator loads (multiboot, linuxboot), from the -L path /usr/share/qemu
 seabios:the BIOS image the emulated PC boots through
+dpkg-dev:unpacks Debian's QEMU source (apt-get source qemu) that the emulator with our board models is built from
+meson:configures that QEMU build (the dfsg source carries no meson of its own)
+ninja-build:compiles that QEMU build
+pkg-config:lets QEMU's configure find its libraries
+libglib2.0-dev:GLib, which QEMU is built on
+libpixman-1-dev:pixman, which QEMU's display code needs even without a display
+zlib1g-dev:zlib, which QEMU needs
+libfdt-dev:the device-tree library QEMU links (--enable-fdt=system)
 python3-pytest:runs the emulator regression suite
 python3-pytest-xdist:runs emulator tests side by side
 python3-pexpect:drives the make-run console in its test
+python3-serial:lets the I/O board bring-up tool (host_tools/bringup) talk to a controller's serial console
+python3-matplotlib:draws the bring-up tool's transfer-curve pictures (PNG, Agg backend)
 "
 
 missing=""

@@ -23,12 +23,20 @@ def isa486():
 
 @pytest.fixture
 def boot(request):
-    """boot(board, kind="production", append="", icount=False) -> running Emulator."""
+    """boot(board, kind="production", append="", icount=False, ...) -> running Emulator.
+
+    Optional, per test: device_properties={"isa-mfio": {"no-irq": "on"}} adds
+    or replaces device properties, without_devices=["isa-mfio"] leaves devices
+    out, extra_args=[...] go to the emulator as they are.
+    """
     started = []
     request.node.dcos_emulators = started
 
-    def start(board, kind="production", append="", icount=False):
-        emulator = Emulator(board, board.image(kind), append=append, icount=icount)
+    def start(board, kind="production", append="", icount=False, device_properties=None, without_devices=(),
+              extra_args=()):
+        emulator = Emulator(board, board.image(kind), append=append, icount=icount,
+                            device_properties=device_properties, without_devices=without_devices,
+                            extra_args=extra_args)
         started.append(emulator)
         return emulator.start()
 

@@ -17,6 +17,7 @@ from dcoslab.emulator import Emulator
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "bench"))
 
 from run_benchmarks import LIST_LINE, parse_run  # noqa: E402
+from seed_figures import SEED_FIGURES  # noqa: E402
 
 PROMPT = r"dcos> "
 
@@ -27,7 +28,8 @@ def boot_bench(request, isa486):
     started = request.node.__dict__.setdefault("dcos_emulators", [])
 
     def start(cpu=isa486.benchmark_cpu, icount=True):
-        emulator = Emulator(isa486, isa486.image("benchmark"), icount=icount, cpu=cpu)
+        emulator = Emulator(isa486, isa486.image("benchmark"), icount=icount, cpu=cpu,
+                            memory_mib=isa486.benchmark_memory())
         started.append(emulator)
         emulator.start()
         emulator.expect(PROMPT)
@@ -97,3 +99,57 @@ def test_self_timed_switch_benchmarks_report_exact_flat_counts_with_4096_tasks(b
         assert min_8 > 0, f"{name}: an interval was marked"
         assert min_8 == min_4096, f"{name} must not depend on the number of tasks: {min_8} vs {min_4096}"
     assert results["Kernel.DynamicScheduling"]["cost"] == "log"
+
+
+# Every primitive of the seed's Tables 9.6 to 9.10 that DCOS has, under the
+# seed's names (the seed's GetUsageInfo is GetStatistics), and the extra
+# figures: the waiting forms of the blocking primitives and first fit over
+# a fragmented free list.
+AGENT_BENCHMARKS = {
+    "BufferPool": ("NameToObject", "AddObjects", "XferOwnership", "Create", "Delete", "Allocate", "Return",
+                   "GetUsageInfo"),
+    "Heap": ("NameToObject", "AddObjects", "XferOwnership", "Create", "Delete", "Allocate", "Return", "GetUsageInfo",
+             "AllocateFragmented", "GetUsageInfoFragmented"),
+    "Dsm": ("NameToObject", "AddSubscribers", "AddObjects", "XferOwnership", "Create", "Delete", "Open", "Close",
+            "Read", "Write", "ReadWaiting"),
+    "Port": ("NameToObject", "AddObjects", "XferOwnership", "Create", "Delete", "Send", "Receive", "AddMsgBufs",
+             "ReceiveWaiting"),
+    "Semaphore": ("NameToObject", "AddObjects", "XferOwnership", "Create", "Delete", "Acquire", "Release",
+                  "AcquireWaiting"),
+}
+
+
+def test_every_primitive_of_the_memory_communication_and_synchronisation_agents_is_benchmarked(boot_bench):
+    output = boot_bench().command("bench list")
+    names = {entry["name"] for entry in LIST_LINE.finditer(output)}
+    for agent, primitives in AGENT_BENCHMARKS.items():
+        for primitive in primitives:
+            assert f"{agent}.{primitive}" in names, f"{agent}.{primitive} is missing from 'bench list':\n{output}"
+        seed_names = {name for name in SEED_FIGURES if name.split(".", 1)[0] == agent}
+        assert seed_names <= names, f"seed primitives of {agent} without a benchmark: {sorted(seed_names - names)}"
+
+
+def test_agent_benchmarks_report_exact_counts_for_8_and_4096_objects(boot_bench):
+    # Checks the method, not a speed: every benchmark of the five agents
+    # reports figures for both object counts (AddObjects and AddSubscribers
+    # are refused with 4096 objects: the table is full by definition), and
+    # under exact counting a fixed-cost path run with interrupts disabled
+    # costs the same on every call, so min == max == median.
+    emulator = boot_bench()
+    irq = {entry["name"]: entry["irq"] == "on" for entry in LIST_LINE.finditer(emulator.command("bench list"))}
+    for agent in AGENT_BENCHMARKS:
+        output = emulator.command(f"bench run {agent}", timeout=180)
+        assert output.splitlines()[-1] == "BENCH done", output
+        _, results = parse_run(output)
+        assert set(results) == {f"{agent}.{primitive}" for primitive in AGENT_BENCHMARKS[agent]}, output
+        for name, entry in results.items():
+            for objects in (8, 4096):
+                if objects == 4096 and name.endswith((".AddObjects", ".AddSubscribers")):
+                    assert entry[objects] == "setup failed: object table full", f"{name}: {entry[objects]}"
+                    continue
+                assert isinstance(entry[objects], tuple), f"{name} with {objects} objects: {entry[objects]}"
+                low, high = entry[objects]
+                assert low > 0, f"{name} with {objects} objects: nothing was measured"
+                if entry["cost"] == "constant" and not irq[name]:
+                    assert low == high == entry["median"][objects], (
+                        f"{name} with {objects} objects: an O(1) path must count the same on every call: {entry}")

@@ -166,6 +166,10 @@ void getSystemClock()
 
 void setSystemClock() { check(timerAgent.SetSystemClock(clockSetting)); }
 
+// --- Timer.XferOwnership of the target from the shell to the shell.
+
+void transferOwnership() { check(timerAgent.XferOwnership(target, self())); }
+
 // --- Timer.NameToObject (configuration): the newest timer, "target".
 
 void nameToObject()
@@ -195,6 +199,8 @@ DCOS_BENCHMARK(timerGetSystemClockBench, "Timer.GetSystemClock", populate, getSy
                .teardown = clearAll);
 DCOS_BENCHMARK(timerSetSystemClockBench, "Timer.SetSystemClock", populateWithDayClockAlarms, setSystemClock,
                Cost::Variable, .teardown = clearAll);
+DCOS_BENCHMARK(timerXferOwnershipBench, "Timer.XferOwnership", populate, transferOwnership, Cost::Constant,
+               .teardown = clearAll);
 DCOS_BENCHMARK(timerNameToObjectBench, "Timer.NameToObject", populate, nameToObject, Cost::Variable,
                .teardown = clearAll);
 

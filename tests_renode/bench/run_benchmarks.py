@@ -4,12 +4,25 @@
 Boots the board's bench image on its benchmark CPU model with exact
 instruction counting (-icount shift=0), runs the console command
 `bench run`, parses its BENCH lines (format: tests_renode/bench/BenchmarkRunner.cpp),
-writes a JSON report and prints a table beside the seed's figures.
+prints the seed's Tables 9.2-9.11 for DCOS beside the seed's own figures and
+writes two JSON reports:
 
-The report maps "<Agent>.<Primitive>" to
-    {"instructions_8": n, "instructions_4096": n, "variable": bool, "cost": "constant" | "log" | "variable"}
-where n is the smallest instruction count of one call with that many
-objects (null when setup failed). See docs/performance.md.
+  primitives.json  every benchmark, keyed "<Agent>.<Primitive>":
+      {"instructions_8": n, "instructions_4096": n, "variable": bool,
+       "cost": "constant" | "log" | "variable", "seed_table": "9.x",
+       "seed_microseconds": x | null,
+       "cycles_median_8": n, "cycles_median_4096": n,        (KVM pass only)
+       "cycles_min_8": n, "cycles_max_8": n, "cycles_min_4096": n, "cycles_max_4096": n}
+  kernel.json      the kernel core's subset (Kernel, Task, Scheduler, Timer,
+                   System) with the instruction fields only.
+
+n is the smallest instruction count of one call with that many objects (null
+when setup failed). Where /dev/kvm is usable and the bench image runs under
+KVM, a second pass boots it with -accel kvm, where rdtsc counts real cycles of
+the host CPU, runs every benchmark --kvm-repeat times and reports the median
+(and min and max) of each; otherwise it says plainly that no real cycle
+figures are reported. Real-time figures are reported, never asserted. See
+docs/performance.md.
 """
 
 import argparse
@@ -17,6 +30,7 @@ import json
 import os
 import re
 import sys
+import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))  # tests_renode, for dcoslab
@@ -24,14 +38,14 @@ sys.path.insert(0, HERE)
 
 from dcoslab.board import REPOSITORY, load_board  # noqa: E402
 from dcoslab.emulator import Emulator, EmulatorError  # noqa: E402
-from seed_figures import SEED_PROCESSOR, seed_text  # noqa: E402
+from seed_figures import SEED_FIGURES, SEED_PROCESSOR, SEED_TABLES, seed_text, table_of  # noqa: E402
 
 OBJECT_COUNTS = (8, 4096)
 PROMPT = r"dcos> "
 
 RESULT_LINE = re.compile(
-    r"^BENCH (?P<name>\S+) objects=(?P<objects>\d+) min=(?P<min>\d+) max=(?P<max>\d+) "
-    r"variable=(?P<variable>[01]) cost=(?P<cost>constant|log|variable)\r?$",
+    r"^BENCH (?P<name>\S+) objects=(?P<objects>\d+) min=(?P<min>\d+) max=(?P<max>\d+)"
+    r"(?: median=(?P<median>\d+))? variable=(?P<variable>[01]) cost=(?P<cost>constant|log|variable)\r?$",
     re.MULTILINE,
 )
 ERROR_LINE = re.compile(r"^BENCH (?P<name>\S+) objects=(?P<objects>\d+) error=(?P<code>\d+) (?P<text>.*?)\r?$",
@@ -46,8 +60,16 @@ class BenchmarkError(Exception):
     pass
 
 
+# The agents whose figures go to kernel.json (issue 3: the kernel core).
+KERNEL_AGENTS = ("Kernel", "Task", "Scheduler", "Timer", "System")
+
+
 def parse_run(output):
-    """Parses the output of `bench run` into (overhead, {name: entry})."""
+    """Parses the output of `bench run` into (overhead, {name: entry}).
+
+    entry[objects] is (min, max), or a string when setup or the measured call
+    failed; entry["median"][objects] is the median where the target printed one.
+    """
     overhead = OVERHEAD_LINE.search(output)
     if overhead is None:
         raise BenchmarkError("no 'BENCH overhead' line in the output of 'bench run'")
@@ -55,18 +77,26 @@ def parse_run(output):
     for match in RESULT_LINE.finditer(output):
         entry = results.setdefault(match["name"], {"cost": match["cost"], "variable": match["variable"] == "1"})
         entry[int(match["objects"])] = (int(match["min"]), int(match["max"]))
+        if match["median"] is not None:
+            entry.setdefault("median", {})[int(match["objects"])] = int(match["median"])
     for match in ERROR_LINE.finditer(output):
         entry = results.setdefault(match["name"], {"cost": "?", "variable": False})
         entry[int(match["objects"])] = f"setup failed: {match['text']}"
     return {key: int(value) for key, value in overhead.groupdict().items()}, results
 
 
-def run_on_target(board, image, selection, repeat, timeout):
-    """Boots the bench image and returns the output of `bench run` and the emulator's argv."""
-    emulator = Emulator(board, image, icount=True, cpu=board.benchmark_cpu or None)
+def run_on_target(board, image, selection, repeat, timeout, accel=None, boot_timeout=None):
+    """Boots the bench image and returns the output of `bench run` and the emulator's argv.
+
+    Always on the board's benchmark CPU model (the machine's default model,
+    an i486 for isapc, has no time-stamp counter). Without accel: with exact
+    instruction counting. With accel="kvm": in real time (no -icount).
+    """
+    emulator = Emulator(board, image, icount=not accel, cpu=board.benchmark_cpu or None,
+                        memory_mib=board.benchmark_memory(), accel=accel)
     try:
         emulator.start(timeout=timeout)
-        emulator.expect(PROMPT, timeout=timeout)
+        wait_for_prompt(emulator, boot_timeout or timeout)
         line = "bench run" + (f" {selection}" if selection else "") + (f" --repeat {repeat}" if repeat else "")
         output = emulator.command(line, timeout=timeout)
         if not re.search(r"^BENCH done\r?$", output, re.MULTILINE):
@@ -78,17 +108,88 @@ def run_on_target(board, image, selection, repeat, timeout):
         emulator.close()
 
 
-def report_entry(entry):
-    def smallest(objects):
-        value = entry.get(objects)
-        return value[0] if isinstance(value, tuple) else None
+def wait_for_prompt(emulator, timeout):
+    """Waits for the shell's prompt; gives up at once when KVM reports that it cannot run the guest.
 
+    (QEMU then stops the guest but keeps running, so the console alone would
+    only time out.)
+    """
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            emulator.expect(PROMPT, timeout=min(1.0, max(0.1, deadline - time.monotonic())))
+            return
+        except EmulatorError:
+            if "KVM internal error" in emulator.emulator_messages() or time.monotonic() >= deadline:
+                raise
+
+
+def kvm_unusable_reason():
+    """None when /dev/kvm can be opened for reading and writing, else why not."""
+    try:
+        descriptor = os.open("/dev/kvm", os.O_RDWR)
+    except OSError as error:
+        return f"/dev/kvm: {error.strerror}"
+    os.close(descriptor)
+    return None
+
+
+def emulator_failure_summary(error):
+    """The emulator's own words from an EmulatorError, shortened to its first telling lines."""
+    text = str(error)
+    said = text.split("emulator said:", 1)[1] if "emulator said:" in text else ""
+    lines = [line.strip() for line in said.splitlines()
+             if line.strip() and "waiting for connection" not in line and not line.startswith("extra data")]
+    kvm_lines = [line for line in lines if "KVM" in line or "failure" in line]
+    if kvm_lines:
+        return "; ".join(kvm_lines[:2])
+    return lines[0] if lines else text.splitlines()[0]
+
+
+def run_kvm_pass(board, image, selection, repeat, timeout):
+    """Runs every benchmark under KVM. Returns ({name: entry}, argv, None) or (None, None, reason)."""
+    reason = kvm_unusable_reason()
+    if reason is not None:
+        return None, None, reason
+    try:
+        # A guest that KVM cannot run stops at once; do not wait long for its prompt.
+        output, argv = run_on_target(board, image, selection, repeat, timeout, accel="kvm", boot_timeout=20)
+        _, results = parse_run(output)
+    except (EmulatorError, BenchmarkError) as error:
+        return None, None, ("/dev/kvm opens, but the bench image does not run under -accel kvm: "
+                            + emulator_failure_summary(error))
+    return results, argv, None
+
+
+def smallest(entry, objects):
+    value = entry.get(objects)
+    return value[0] if isinstance(value, tuple) else None
+
+
+def report_entry(entry):
+    """The kernel.json entry of a benchmark: the instruction figures."""
     return {
-        "instructions_8": smallest(8),
-        "instructions_4096": smallest(4096),
+        "instructions_8": smallest(entry, 8),
+        "instructions_4096": smallest(entry, 4096),
         "variable": entry["variable"],
         "cost": entry["cost"],
     }
+
+
+def primitive_entry(name, entry, kvm_entry):
+    """The primitives.json entry: the instruction figures, the seed's, and the KVM cycles when measured."""
+    report = report_entry(entry)
+    figure = SEED_FIGURES.get(name)
+    report["seed_table"] = table_of(name) or None
+    report["seed_microseconds"] = figure.microseconds if figure is not None else None
+    # The KVM fields are always there, null when the KVM pass did not run.
+    for objects in OBJECT_COUNTS:
+        value = kvm_entry.get(objects) if kvm_entry is not None else None
+        measured = isinstance(value, tuple)
+        report[f"cycles_median_{objects}"] = kvm_entry.get("median", {}).get(objects) if measured else None
+        report[f"cycles_min_{objects}"] = value[0] if measured else None
+        report[f"cycles_max_{objects}"] = value[1] if measured else None
+    return report
 
 
 def count_text(value):
@@ -101,11 +202,11 @@ def count_text(value):
 
 
 def order_check(entry):
-    """flat / NOT FLAT for O(1) primitives; the declared order otherwise."""
+    """flat / NOT FLAT for O(1) primitives; O(log n) or variable otherwise."""
     if entry["cost"] == "log":
         return "O(log n)"
     if entry["cost"] == "variable":
-        return "-"
+        return "variable"
     small, large = entry.get(8), entry.get(4096)
     if not isinstance(small, tuple) or not isinstance(large, tuple):
         return "?"
@@ -114,35 +215,97 @@ def order_check(entry):
     return "flat" if small[0] == large[0] else "NOT FLAT"
 
 
-def print_table(results, overhead, cpu):
-    print(f"DCOS kernel benchmarks: bench image on -cpu {cpu}, -icount shift=0 (rdtsc = retired instructions)")
+def cycles_text(kvm_entry):
+    if kvm_entry is None:
+        return "-"
+    medians = kvm_entry.get("median", {})
+    return " / ".join(str(medians[objects]) if isinstance(kvm_entry.get(objects), tuple) and objects in medians
+                      else "-" for objects in OBJECT_COUNTS)
+
+
+def table_rows(results, kvm_results, selection):
+    """[(table, title, rows)] in the seed's order; a row per primitive.
+
+    The seed's primitives come first, in the seed's order (a primitive DCOS
+    does not have, or has not measured, shows "not in DCOS"), then the
+    benchmarks the seed has no row for, by name.
+    """
+    def selected(name):
+        return not selection or name == selection or name.split(".", 1)[0] == selection
+
+    groups = []
+    for table, title, _ in SEED_TABLES:
+        names = [name for name, figure in SEED_FIGURES.items() if figure.table == table and selected(name)]
+        names += sorted(name for name in results if table_of(name) == table and name not in SEED_FIGURES)
+        rows = []
+        for name in names:
+            seed = seed_text(name) or "-"
+            entry = results.get(name)
+            if entry is None:
+                rows.append((name, "-", "-", "not in DCOS", seed, ""))
+                continue
+            kvm = cycles_text(kvm_results.get(name)) if kvm_results is not None else ""
+            rows.append((name, count_text(entry.get(8)), count_text(entry.get(4096)), order_check(entry), seed, kvm))
+        if any(row[3] != "not in DCOS" for row in rows) or not selection:
+            groups.append((table, title, rows))
+    others = sorted(name for name in results if not table_of(name))
+    if others:
+        groups.append(("-", "Not in the seed's tables", [
+            (name, count_text(results[name].get(8)), count_text(results[name].get(4096)),
+             order_check(results[name]), "-",
+             cycles_text(kvm_results.get(name)) if kvm_results is not None else "") for name in others]))
+    return groups
+
+
+def print_table(results, overhead, cpu, kvm_results=None, kvm_repeat=0, selection=""):
+    print(f"DCOS primitives: bench image on -cpu {cpu}, -icount shift=0 (rdtsc = retired instructions)")
     print(f"figures: instructions retired by one call beyond an empty call (timing overhead {overhead['min']} "
           f"subtracted), smallest of {overhead['repeat']} after {overhead['warmup']} warm-up calls; "
           "a..b where the largest differs")
-    print()
-    headers = ("benchmark", "8 objects", "4096 objects", "O(1) check", "variable", "seed (P-150)")
-    rows = []
-    for name in sorted(results):
-        entry = results[name]
-        rows.append((name, count_text(entry.get(8)), count_text(entry.get(4096)), order_check(entry),
-                     "variable" if entry["variable"] else "", seed_text(name) or "-"))
-    widths = [max(len(str(row[i])) for row in rows + [headers]) for i in range(len(headers))]
-    aligns = ("<", ">", ">", "<", "<", "<")
-    for row in [headers] + rows:
-        print("  ".join(f"{cell:{align}{width}}" for cell, align, width in zip(row, aligns, widths)).rstrip())
+    print("flat/variable: flat = O(1) and the same count with 8 and 4096 objects; NOT FLAT = declared O(1) but "
+          "the counts differ; variable = the seed's \"Variable\" (configuration services, first fit, ...)")
+    print(f"seed: microseconds on a {SEED_PROCESSOR}, end to end through the trap interface (seed 9.3.7); "
+          "orientation only, not instruction counts")
+    if kvm_results is not None:
+        print(f"KVM cycles: real time-stamp counter cycles of the host CPU under -accel kvm, median of {kvm_repeat} "
+              "calls, with 8 / with 4096 objects; they vary from run to run")
+    headers = ["primitive", "8 objects", "4096 objects", "flat/variable", "seed (P-150)"]
+    aligns = ["<", ">", ">", "<", "<"]
+    if kvm_results is not None:
+        headers.append("KVM cycles (median 8 / 4096)")
+        aligns.append(">")
+    groups = table_rows(results, kvm_results, selection)
+    all_rows = [row[:len(headers)] for _, _, rows in groups for row in rows]
+    widths = [max(len(str(row[i])) for row in all_rows + [tuple(headers)]) for i in range(len(headers))]
+
+    def line(cells):
+        return "  ".join(f"{cell:{align}{width}}" for cell, align, width in zip(cells, aligns, widths)).rstrip()
+
+    for table, title, rows in groups:
+        print()
+        print(f"Table {table}  {title}" if table != "-" else title)
+        print("  " + line(headers))
+        for row in rows:
+            print("  " + line(row[:len(headers)]))
     print()
     for name in sorted(results):
         for objects in OBJECT_COUNTS:
             if isinstance(results[name].get(objects), str):
                 print(f"{name} with {objects} objects: {results[name][objects]}")
-    not_flat = [row[0] for row in rows if row[3] == "NOT FLAT"]
+    not_flat = [name for name in sorted(results) if order_check(results[name]) == "NOT FLAT"]
     if not_flat:
         print(f"NOT FLAT: {', '.join(not_flat)} declared O(1) but cost differs between 8 and 4096 objects")
-    matched = sum(1 for row in rows if row[5] != "-")
-    print(f"seed figures (Tables 9.2-9.11, microseconds on a {SEED_PROCESSOR}, end to end through the trap "
-          f"interface) shown for {matched} of {len(rows)} benchmarks; they are not instruction counts")
-    print("KVM cycle figures: not reported yet. Only exact instruction counts under QEMU TCG with -icount are "
-          "measured; real-time cycle counts under KVM (medians) are future work.")
+    measured_seed = [name for name in SEED_FIGURES if name in results]
+    print(f"{len(results)} benchmarks; {len(measured_seed)} of the seed's {len(SEED_FIGURES)} primitives measured "
+          f"(the others are not in DCOS yet)")
+
+
+def write_json(path, report):
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w", encoding="utf-8") as handle:
+        json.dump(report, handle, indent=2)
+        handle.write("\n")
+    print(f"wrote {path}")
 
 
 def main():
@@ -150,9 +313,15 @@ def main():
     parser.add_argument("--board", default="isa486")
     parser.add_argument("--image", help="bench image (default: the board's 'benchmark' image)")
     parser.add_argument("--output", default=os.path.join(REPOSITORY, "build", "bench", "kernel.json"),
-                        help="JSON report to write")
+                        help="JSON report of the kernel core's benchmarks to write")
+    parser.add_argument("--primitives", default=os.path.join(REPOSITORY, "build", "bench", "primitives.json"),
+                        help="JSON report of every benchmark to write")
     parser.add_argument("--select", default="", help="one benchmark or one agent, e.g. Timer or Kernel.ResolveId")
     parser.add_argument("--repeat", type=int, default=0, help="measured calls per object count (default: target's)")
+    parser.add_argument("--kvm", choices=("auto", "off"), default="auto",
+                        help="auto: also measure real cycles under KVM where it works; off: never")
+    parser.add_argument("--kvm-repeat", type=int, default=201,
+                        help="measured calls per object count in the KVM pass, whose median is reported")
     parser.add_argument("--timeout", type=float, default=120.0, help="seconds for each wait on the emulator")
     parser.add_argument("--strict", action="store_true", help="exit 1 when an O(1) benchmark is NOT FLAT")
     arguments = parser.parse_args()
@@ -176,14 +345,24 @@ def main():
         print(f"make bench: no figures for every object count from {', '.join(missing)}:\n{output}", file=sys.stderr)
         return 1
 
-    print("emulator: " + " ".join(argv))
-    print_table(results, overhead, board.benchmark_cpu)
+    kvm_results, kvm_argv, kvm_reason = None, None, "disabled with --kvm off"
+    if arguments.kvm == "auto":
+        kvm_results, kvm_argv, kvm_reason = run_kvm_pass(board, image, arguments.select, arguments.kvm_repeat,
+                                                         arguments.timeout)
 
-    os.makedirs(os.path.dirname(os.path.abspath(arguments.output)), exist_ok=True)
-    with open(arguments.output, "w", encoding="utf-8") as handle:
-        json.dump({name: report_entry(results[name]) for name in sorted(results)}, handle, indent=2)
-        handle.write("\n")
-    print(f"wrote {arguments.output}")
+    print("emulator: " + " ".join(argv))
+    if kvm_argv:
+        print("emulator (KVM pass): " + " ".join(kvm_argv))
+    print_table(results, overhead, board.benchmark_cpu, kvm_results, arguments.kvm_repeat, arguments.select)
+    if kvm_results is None:
+        print(f"KVM not available: real cycle figures not reported ({kvm_reason}). "
+              "Every figure above is an exact instruction count under QEMU TCG with -icount.")
+
+    write_json(arguments.output, {name: report_entry(results[name]) for name in sorted(results)
+                                  if name.split(".", 1)[0] in KERNEL_AGENTS})
+    write_json(arguments.primitives, {
+        name: primitive_entry(name, results[name], kvm_results.get(name) if kvm_results is not None else None)
+        for name in sorted(results)})
     if arguments.strict and any(order_check(entry) == "NOT FLAT" for entry in results.values()):
         return 1
     return 0

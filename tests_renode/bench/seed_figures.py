@@ -150,6 +150,35 @@ SEED_FIGURES = {
 }
 
 
+# The seed's timing tables in order: (table, title, benchmark agent prefixes).
+# A benchmark belongs to the table of its agent, whether or not the seed
+# lists its primitive; Table 9.11 also holds the kernel-wide figures.
+SEED_TABLES = (
+    ("9.2", "System Agent Primitives", ("System",)),
+    ("9.3", "Scheduler Agent Primitives", ("Scheduler",)),
+    ("9.4", "Timer Agent Primitives", ("Timer",)),
+    ("9.5", "Task Agent Primitives", ("Task",)),
+    ("9.6", "Buffer Pool Memory Agent Primitives", ("BufferPool",)),
+    ("9.7", "Segmented Heap Memory Agent Primitives", ("Heap",)),
+    ("9.8", "Distributed Shared Memory Agent Primitives", ("Dsm",)),
+    ("9.9", "Message Port Agent Primitives", ("Port",)),
+    ("9.10", "Semaphore Agent Primitives", ("Semaphore",)),
+    ("9.11", "Miscellaneous Timing Data", ("Kernel", "Sei")),
+)
+
+
+def table_of(name):
+    """The seed table a benchmark name belongs to ("9.2" ... "9.11"), or "" for an unknown agent."""
+    figure = SEED_FIGURES.get(name)
+    if figure is not None:
+        return figure.table
+    agent = name.split(".", 1)[0]
+    for table, _, agents in SEED_TABLES:
+        if agent in agents:
+            return table
+    return ""
+
+
 def seed_text(name):
     """The seed figure for a benchmark name as a short string, or "" when the seed lists none."""
     figure = SEED_FIGURES.get(name)

@@ -9,6 +9,8 @@ import json
 import os
 from dataclasses import dataclass, field
 
+from .built_emulator import resolve_emulator
+
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BOARDS_DIRECTORY = os.path.join(REPOSITORY, "tests_renode", "boards")
 
@@ -32,38 +34,76 @@ class Board:
     serial_ports: list = field(default_factory=list)
     images: dict = field(default_factory=dict)
     benchmark_cpu: str = ""
+    # Memory for the bench image only, whose kernel tables are built for 4096
+    # objects of every type (mk/bench.mk); 0: memory_mib. Production and test
+    # images always run with memory_mib, the board's real memory.
+    benchmark_memory_mib: int = 0
+    # Emulator arguments every run of the board takes, e.g. ["-nic", "none"]:
+    # the isapc machine otherwise adds an NE2000 at 0x300, the I/O board's port.
+    emulator_args: list = field(default_factory=list)
 
     def image(self, kind="production"):
         """Absolute path of the board's firmware image of the given kind."""
         return os.path.join(REPOSITORY, self.images[kind])
 
-    def emulator_command(self, image, serial_backends, append="", icount=False, cpu=None):
+    def benchmark_memory(self):
+        """Memory in MiB to boot the bench image with."""
+        return self.benchmark_memory_mib or self.memory_mib
+
+    def device_drivers(self):
+        """The drivers of the board's devices, in order."""
+        return [device["driver"] for device in self.devices]
+
+    def emulator_command(self, image, serial_backends, append="", icount=False, cpu=None, memory_mib=None,
+                         accel=None, device_properties=None, without_devices=(), extra_args=()):
         """The emulator argv for image, with one chardev argument per serial port.
 
         serial_backends maps each name in serial_ports to a QEMU -serial value
         (for example "mon:stdio" or "chardev:console"). cpu replaces the
-        board's CPU model (the bench image runs on benchmark_cpu).
+        board's CPU model (the bench image runs on benchmark_cpu), memory_mib
+        the board's memory (the bench image runs with benchmark_memory()).
+        accel names a QEMU accelerator, e.g. "kvm" (default: QEMU's, TCG);
+        with "kvm" and no cpu the emulator's default CPU model is used.
+
+        Per run, without changing the board file: device_properties maps a
+        device's driver to properties added to or replacing the board's (e.g.
+        {"isa-mfio": {"no-irq": "on"}}); without_devices names drivers to
+        leave out (a board that is absent); extra_args go to the emulator as
+        they are (e.g. the -chardev a device property refers to).
         """
-        command = [self.emulator]
+        drivers = self.device_drivers()
+        for driver in list(device_properties or {}) + list(without_devices):
+            if driver not in drivers:
+                raise ValueError(f"board {self.name} has no device '{driver}'; its devices are: {', '.join(drivers)}")
+        command = [resolve_emulator(self.emulator)]
         for path in self.bios_paths:
             command += ["-L", path]
+        command += ["-M", self.machine]
+        if accel:
+            command += ["-accel", accel]
+        if cpu or not accel:
+            command += ["-cpu", cpu or self.cpu]
         command += [
-            "-M", self.machine,
-            "-cpu", cpu or self.cpu,
-            "-m", str(self.memory_mib),
+            "-m", str(memory_mib or self.memory_mib),
             "-kernel", image,
             "-display", "none",
             "-no-reboot",
             "-monitor", "none",
         ]
+        command += list(self.emulator_args)
         if append:
             command += ["-append", append]
         if icount:
             # rdtsc and all timers follow retired instructions: exact and repeatable.
             command += ["-icount", "shift=0,align=off,sleep=off", "-rtc", "clock=vm"]
         for device in self.devices:
-            properties = "".join(f",{key}={value}" for key, value in device.get("properties", {}).items())
+            if device["driver"] in without_devices:
+                continue
+            merged = dict(device.get("properties", {}))
+            merged.update((device_properties or {}).get(device["driver"], {}))
+            properties = "".join(f",{key}={value}" for key, value in merged.items())
             command += ["-device", device["driver"] + properties]
+        command += list(extra_args)
         for port in self.serial_ports:
             command += ["-serial", serial_backends[port]]
         return command

@@ -24,12 +24,19 @@ class EmulatorError(AssertionError):
 
 
 class Emulator:
-    def __init__(self, board, image, append="", icount=False, cpu=None):
+    def __init__(self, board, image, append="", icount=False, cpu=None, memory_mib=None, accel=None,
+                 device_properties=None, without_devices=(), extra_args=()):
         self.board = board
         self.image = image
         self.append = append
         self.icount = icount
         self.cpu = cpu  # None: the board's own CPU model
+        self.memory_mib = memory_mib  # None: the board's memory
+        self.accel = accel  # None: QEMU's default accelerator (TCG)
+        # Per-run changes to the board's devices (see Board.emulator_command).
+        self.device_properties = device_properties or {}
+        self.without_devices = tuple(without_devices)
+        self.extra_args = tuple(extra_args)
         self._workdir = tempfile.TemporaryDirectory(prefix="dcos-emulator-")
         self._socket_path = os.path.join(self._workdir.name, "console.sock")
         self._stderr_path = os.path.join(self._workdir.name, "emulator.stderr")
@@ -49,7 +56,9 @@ class Emulator:
             raise EmulatorError(f"firmware image {self.image} does not exist; run 'make firmware'")
         backend = f"socket,id=console,path={self._socket_path},server=on,wait=on"
         command = self.board.emulator_command(
-            self.image, {"console": "chardev:console"}, append=self.append, icount=self.icount, cpu=self.cpu
+            self.image, {"console": "chardev:console"}, append=self.append, icount=self.icount, cpu=self.cpu,
+            memory_mib=self.memory_mib, accel=self.accel, device_properties=self.device_properties,
+            without_devices=self.without_devices, extra_args=self.extra_args,
         )
         command[1:1] = ["-chardev", backend]
         self.argv = command

@@ -34,7 +34,8 @@ EXPECTED = [
 
 def run(board_name):
     board = load_board(board_name)
-    emulator = Emulator(board, board.image("benchmark"), icount=True, cpu=board.benchmark_cpu)
+    emulator = Emulator(board, board.image("benchmark"), icount=True, cpu=board.benchmark_cpu,
+                        memory_mib=board.benchmark_memory())
     try:
         emulator.start()
         emulator.expect(r"dcos> ")
