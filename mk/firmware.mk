@@ -12,7 +12,8 @@ FW_INCLUDES := \
 	-Ifirmware/boot/include \
 	-Ifirmware/shell/include \
 	-Ifirmware/dcos/include \
-	-Ifirmware/bsp_486/include
+	-Ifirmware/bsp_486/include \
+	-Idrivers/iobus/include
 
 FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
 FW_CXXFLAGS := -std=c++20 $(FW_ARCH_FLAGS) -O2 -g \
@@ -25,6 +26,7 @@ FW_ASFLAGS := $(FW_ARCH_FLAGS) -MMD -MP $(FW_INCLUDES)
 FW_LDFLAGS := -m elf_i386 -nostdlib -static -T firmware/boot/link.ld
 
 include firmware/dcos/dcos.mk
+include drivers/iobus/iobus.mk
 
 # Sources every image contains.
 FW_SRCS := \
@@ -34,7 +36,9 @@ FW_SRCS := \
 	$(wildcard firmware/shell/src/*.cpp) \
 	$(DCOS_PORTABLE_SRCS) \
 	$(DCOS_TARGET_SRCS) \
-	$(wildcard firmware/bsp_486/src/*.cpp)
+	$(wildcard firmware/bsp_486/src/*.cpp) \
+	$(IOBUS_PORTABLE_SRCS) \
+	$(IOBUS_TARGET_SRCS)
 
 # The on-target test suite, linked only into the test image.
 FW_TARGET_TEST_SRCS := $(wildcard tests_renode/target/*.cpp)

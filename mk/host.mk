@@ -15,9 +15,10 @@ HOST_PORTABLE_SRCS := \
 	$(DCOS_PORTABLE_SRCS) \
 	firmware/bsp_486/src/Pic8259.cpp \
 	firmware/bsp_486/src/Pit8254.cpp \
-	firmware/bsp_486/src/Uart16550.cpp
+	firmware/bsp_486/src/Uart16550.cpp \
+	$(IOBUS_PORTABLE_SRCS)
 
-HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp)
+HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp drivers/*/unit_tests/*.cpp)
 HOST_OBJS := $(patsubst %,$(HOST_BUILD)/%.o,$(HOST_PORTABLE_SRCS) $(HOST_TEST_SRCS))
 HOST_TEST_BINARY := $(HOST_BUILD)/unit_tests
 
