@@ -198,8 +198,9 @@ Status DsmAgent::Delete(ObjectId id) const
     if (!publisher.ok()) {
         return publisher.status();
     }
-    const Status owner = publisherTable.checkOwner(id, internal::currentTaskId());
-    if (owner != Status::Ok && !internal::currentTaskIsSuperUser()) {
+    const Status owner =
+        publisherTable.checkOwnerOrPrivileged(id, internal::currentTaskId(), internal::currentTaskIsSuperUser());
+    if (owner != Status::Ok) {
         return owner;
     }
     internal::destroy(*publisher.value(), id);
@@ -343,11 +344,9 @@ Status DsmAgent::AddSubscribers(size_t count) const
 
 Status DsmAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
 {
-    if (!newOwner.isNull()) {
-        const Result<internal::Task*> task = TaskManager::resolve(newOwner);
-        if (!task.ok()) {
-            return task.status(); // The new owner must be a live local task.
-        }
+    const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
+    if (newOwnerStatus != Status::Ok) {
+        return newOwnerStatus;
     }
     arch_x86::InterruptGuard guard;
     start();

@@ -66,8 +66,7 @@ Result<PoolObject*> lookup(ObjectId id)
 // Delete and XferOwnership of the pool need its owner or a super user.
 Status checkOwnerOrSuperUser(ObjectId id)
 {
-    const Status owner = poolTable.checkOwner(id, currentTaskId());
-    return owner == Status::Ok || currentTaskIsSuperUser() ? Status::Ok : owner;
+    return poolTable.checkOwnerOrPrivileged(id, currentTaskId(), currentTaskIsSuperUser());
 }
 
 // The holder recorded for buffers the caller allocates: its task, or the
@@ -81,14 +80,11 @@ uint16_t callerHolder()
 // The holder for a new owner given as a task id; the null id is the system.
 Result<uint16_t> holderFor(ObjectId newOwner)
 {
-    if (newOwner.isNull()) {
-        return BufferPool::kSystemHolder;
+    const Status status = TaskManager::checkNewOwner(newOwner);
+    if (status != Status::Ok) {
+        return status;
     }
-    const Result<Task*> task = TaskManager::resolve(newOwner);
-    if (!task.ok()) {
-        return task.status(); // The new owner must be a live local task.
-    }
-    return newOwner.index();
+    return newOwner.isNull() ? BufferPool::kSystemHolder : newOwner.index();
 }
 
 void remove(ObjectId id, PoolObject& object)

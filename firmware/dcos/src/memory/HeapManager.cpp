@@ -64,8 +64,7 @@ Result<HeapObject*> lookup(ObjectId id)
 // Delete and XferOwnership of the heap need its owner or a super user.
 Status checkOwnerOrSuperUser(ObjectId id)
 {
-    const Status owner = heapTable.checkOwner(id, currentTaskId());
-    return owner == Status::Ok || currentTaskIsSuperUser() ? Status::Ok : owner;
+    return heapTable.checkOwnerOrPrivileged(id, currentTaskId(), currentTaskIsSuperUser());
 }
 
 // The holder recorded for segments the caller allocates: its task, or the
@@ -79,14 +78,11 @@ uint16_t callerHolder()
 // The holder for a new owner given as a task id; the null id is the system.
 Result<uint16_t> holderFor(ObjectId newOwner)
 {
-    if (newOwner.isNull()) {
-        return SegmentedHeap::kSystemHolder;
+    const Status status = TaskManager::checkNewOwner(newOwner);
+    if (status != Status::Ok) {
+        return status;
     }
-    const Result<Task*> task = TaskManager::resolve(newOwner);
-    if (!task.ok()) {
-        return task.status(); // The new owner must be a live local task.
-    }
-    return newOwner.index();
+    return newOwner.isNull() ? SegmentedHeap::kSystemHolder : newOwner.index();
 }
 
 void remove(ObjectId id, HeapObject& object)

@@ -196,8 +196,9 @@ Status MessagePortAgent::Delete(ObjectId id) const
     if (!port.ok()) {
         return port.status();
     }
-    const Status owner = portTable.checkOwner(id, internal::currentTaskId());
-    if (owner != Status::Ok && !internal::currentTaskIsSuperUser()) {
+    const Status owner =
+        portTable.checkOwnerOrPrivileged(id, internal::currentTaskId(), internal::currentTaskIsSuperUser());
+    if (owner != Status::Ok) {
         return owner;
     }
     internal::destroy(*port.value(), id);
@@ -290,11 +291,9 @@ Status MessagePortAgent::AddObjects(size_t count) const
 
 Status MessagePortAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
 {
-    if (!newOwner.isNull()) {
-        const Result<internal::Task*> task = TaskManager::resolve(newOwner);
-        if (!task.ok()) {
-            return task.status(); // The new owner must be a live local task.
-        }
+    const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
+    if (newOwnerStatus != Status::Ok) {
+        return newOwnerStatus;
     }
     arch_x86::InterruptGuard guard;
     start();

@@ -197,8 +197,9 @@ Status SemaphoreAgent::Delete(ObjectId id) const
     if (!semaphore.ok()) {
         return semaphore.status();
     }
-    const Status owner = internal::table.checkOwner(id, internal::currentTaskId());
-    if (owner != Status::Ok && !internal::currentTaskIsSuperUser()) {
+    const Status owner =
+        internal::table.checkOwnerOrPrivileged(id, internal::currentTaskId(), internal::currentTaskIsSuperUser());
+    if (owner != Status::Ok) {
         return owner;
     }
     internal::destroy(*semaphore.value(), Status::Deleted);
@@ -327,15 +328,16 @@ Status SemaphoreAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
     if (!semaphore.ok()) {
         return semaphore.status();
     }
-    if (!newOwner.isNull() && !TaskManager::resolve(newOwner).ok()) {
-        return Status::InvalidId;
+    const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
+    if (newOwnerStatus != Status::Ok) {
+        return newOwnerStatus;
     }
-    const ObjectId caller = internal::currentTaskId();
-    const ObjectId owner = internal::table.ownerOf(id).value();
-    if (owner != caller && !internal::currentTaskIsSuperUser()) {
-        return Status::NotOwner;
+    const Status allowed = internal::table.checkOwnerOrPrivileged(id, internal::currentTaskId(),
+                                                                   internal::currentTaskIsSuperUser());
+    if (allowed != Status::Ok) {
+        return allowed;
     }
-    return internal::table.XferOwnership(id, owner, newOwner);
+    return internal::table.XferOwnership(id, internal::table.ownerOf(id).value(), newOwner);
 }
 
 Status SemaphoreAgent::AddObjects(size_t count) const

@@ -285,6 +285,11 @@ Result<Task*> TaskManager::resolve(ObjectId id)
     return *entry.value();
 }
 
+Status TaskManager::checkNewOwner(ObjectId newOwner)
+{
+    return newOwner.isNull() ? Status::Ok : resolve(newOwner).status();
+}
+
 Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument)
 {
     if (entry == nullptr || attributes.priority > kLowestPriority || attributes.stackSize < kMinimumStackSize ||

@@ -99,8 +99,8 @@ Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
     if (!entry.ok()) {
         return entry.status();
     }
-    const Status owner = timerTable.checkOwner(id, caller);
-    if (owner != Status::Ok && !currentTaskIsSuperUser()) {
+    const Status owner = timerTable.checkOwnerOrPrivileged(id, caller, currentTaskIsSuperUser());
+    if (owner != Status::Ok) {
         return owner;
     }
     return *entry.value();
@@ -349,11 +349,9 @@ Result<ObjectId> TimerManager::timerNameToObject(const char* name)
 
 Status TimerManager::xferOwnership(ObjectId id, ObjectId caller, ObjectId newOwner)
 {
-    if (!newOwner.isNull()) {
-        const Result<Task*> task = TaskManager::resolve(newOwner);
-        if (!task.ok()) {
-            return task.status(); // The new owner must be a live local task.
-        }
+    const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
+    if (newOwnerStatus != Status::Ok) {
+        return newOwnerStatus;
     }
     arch_x86::InterruptGuard guard;
     const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);

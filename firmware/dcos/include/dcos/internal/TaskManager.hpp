@@ -24,6 +24,10 @@ public:
     /// Resolves a task id (O(1)); remote ids give Status::Remote.
     static Result<Task*> resolve(ObjectId id);
 
+    /// Succeeds when newOwner may receive an object: the null id (the
+    /// system) or a live task of this node; otherwise the id's error.
+    static Status checkNewOwner(ObjectId newOwner);
+
     static Result<ObjectId> create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument);
     static Status kill(Task& task);
     [[noreturn]] static void exitCurrent();
