@@ -5,6 +5,7 @@
 #include <dcos/internal/HeapManager.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/MemoryAreaServices.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/TaskManager.hpp>
 
@@ -67,24 +68,6 @@ Result<PoolObject*> lookup(ObjectId id)
 Status checkOwnerOrSuperUser(ObjectId id)
 {
     return poolTable.checkOwnerOrPrivileged(id, currentTaskId(), currentTaskIsSuperUser());
-}
-
-// The holder recorded for buffers the caller allocates: its task, or the
-// system in an interrupt handler (and before the scheduler starts).
-uint16_t callerHolder()
-{
-    const ObjectId task = currentTaskId();
-    return inInterruptContext() || task.isNull() ? BufferPool::kSystemHolder : task.index();
-}
-
-// The holder for a new owner given as a task id; the null id is the system.
-Result<uint16_t> holderFor(ObjectId newOwner)
-{
-    const Status status = TaskManager::checkNewOwner(newOwner);
-    if (status != Status::Ok) {
-        return status;
-    }
-    return newOwner.isNull() ? BufferPool::kSystemHolder : newOwner.index();
 }
 
 void remove(ObjectId id, PoolObject& object)
@@ -176,7 +159,7 @@ Status BufferPoolManager::Delete(ObjectId id)
 
 Result<void*> BufferPoolManager::Allocate(ObjectId id)
 {
-    const uint16_t holder = callerHolder();
+    const uint16_t holder = memory_area::callerHolder(BufferPool::kSystemHolder);
     Lock lock;
     const Result<PoolObject*> object = lookup(id);
     if (!object.ok()) {
@@ -187,7 +170,7 @@ Result<void*> BufferPoolManager::Allocate(ObjectId id)
 
 Status BufferPoolManager::Return(ObjectId id, void* buffer)
 {
-    const uint16_t holder = callerHolder();
+    const uint16_t holder = memory_area::callerHolder(BufferPool::kSystemHolder);
     Lock lock;
     const Result<PoolObject*> object = lookup(id);
     if (!object.ok()) {
@@ -211,64 +194,21 @@ Result<BufferPoolStatistics> BufferPoolManager::GetStatistics(ObjectId id)
 
 Result<ObjectId> BufferPoolManager::NameToObject(const char* name, Visibility askingScope)
 {
-    if (inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    Lock lock;
-    start();
-    return poolTable.NameToObject(name, askingScope);
+    return memory_area::nameToObject(poolTable, start, name, askingScope);
 }
 
-Status BufferPoolManager::AddObjects(size_t count)
-{
-    if (inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    if (!currentTaskIsSuperUser()) {
-        return Status::NotPermitted;
-    }
-    Lock lock;
-    start();
-    return poolTable.AddObjects(count);
-}
+Status BufferPoolManager::AddObjects(size_t count) { return memory_area::addObjects(poolTable, start, count); }
 
 Status BufferPoolManager::XferOwnership(ObjectId id, ObjectId newOwner)
 {
-    if (inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    Lock lock;
-    const Result<PoolObject*> object = lookup(id);
-    if (!object.ok()) {
-        return object.status();
-    }
-    const Status owner = checkOwnerOrSuperUser(id);
-    if (owner != Status::Ok) {
-        return owner;
-    }
-    const Result<uint16_t> newHolder = holderFor(newOwner);
-    if (!newHolder.ok()) {
-        return newHolder.status();
-    }
-    return poolTable.XferOwnership(id, poolTable.ownerOf(id).value(), newOwner);
+    return memory_area::transferObject(poolTable, lookup, id, newOwner, BufferPool::kSystemHolder);
 }
 
 Status BufferPoolManager::XferOwnership(ObjectId id, void* buffer, ObjectId newOwner)
 {
-    if (inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    const uint16_t holder = callerHolder();
-    Lock lock;
-    const Result<PoolObject*> object = lookup(id);
-    if (!object.ok()) {
-        return object.status();
-    }
-    const Result<uint16_t> newHolder = holderFor(newOwner);
-    if (!newHolder.ok()) {
-        return newHolder.status();
-    }
-    return object.value()->pool.transfer(buffer, holder, newHolder.value());
+    return memory_area::transferMemory(
+        lookup, [](PoolObject* object) -> BufferPool& { return object->pool; }, id, buffer, newOwner,
+        BufferPool::kSystemHolder);
 }
 
 unsigned BufferPoolManager::recoverResourcesOf(ObjectId deadTask)

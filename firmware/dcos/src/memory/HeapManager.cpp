@@ -5,6 +5,7 @@
 #include <dcos/internal/HeapManager.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/MemoryAreaServices.hpp>
 #include <dcos/internal/ObjectTable.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/SegmentedHeap.hpp>
@@ -65,24 +66,6 @@ Result<HeapObject*> lookup(ObjectId id)
 Status checkOwnerOrSuperUser(ObjectId id)
 {
     return heapTable.checkOwnerOrPrivileged(id, currentTaskId(), currentTaskIsSuperUser());
-}
-
-// The holder recorded for segments the caller allocates: its task, or the
-// system in an interrupt handler (and before the scheduler starts).
-uint16_t callerHolder()
-{
-    const ObjectId task = currentTaskId();
-    return inInterruptContext() || task.isNull() ? SegmentedHeap::kSystemHolder : task.index();
-}
-
-// The holder for a new owner given as a task id; the null id is the system.
-Result<uint16_t> holderFor(ObjectId newOwner)
-{
-    const Status status = TaskManager::checkNewOwner(newOwner);
-    if (status != Status::Ok) {
-        return status;
-    }
-    return newOwner.isNull() ? SegmentedHeap::kSystemHolder : newOwner.index();
 }
 
 void remove(ObjectId id, HeapObject& object)
@@ -156,7 +139,7 @@ Status HeapManager::Delete(ObjectId id)
 
 Result<void*> HeapManager::Allocate(ObjectId id, size_t bytes)
 {
-    const uint16_t holder = callerHolder();
+    const uint16_t holder = memory_area::callerHolder(SegmentedHeap::kSystemHolder);
     Lock lock;
     const Result<HeapObject*> object = lookup(id);
     if (!object.ok()) {
@@ -167,7 +150,7 @@ Result<void*> HeapManager::Allocate(ObjectId id, size_t bytes)
 
 Status HeapManager::Return(ObjectId id, void* segment)
 {
-    const uint16_t holder = callerHolder();
+    const uint16_t holder = memory_area::callerHolder(SegmentedHeap::kSystemHolder);
     Lock lock;
     const Result<HeapObject*> object = lookup(id);
     if (!object.ok()) {
@@ -188,64 +171,21 @@ Result<HeapStatistics> HeapManager::GetStatistics(ObjectId id)
 
 Result<ObjectId> HeapManager::NameToObject(const char* name, Visibility askingScope)
 {
-    if (inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    Lock lock;
-    start();
-    return heapTable.NameToObject(name, askingScope);
+    return memory_area::nameToObject(heapTable, start, name, askingScope);
 }
 
-Status HeapManager::AddObjects(size_t count)
-{
-    if (inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    if (!currentTaskIsSuperUser()) {
-        return Status::NotPermitted;
-    }
-    Lock lock;
-    start();
-    return heapTable.AddObjects(count);
-}
+Status HeapManager::AddObjects(size_t count) { return memory_area::addObjects(heapTable, start, count); }
 
 Status HeapManager::XferOwnership(ObjectId id, ObjectId newOwner)
 {
-    if (inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    Lock lock;
-    const Result<HeapObject*> object = lookup(id);
-    if (!object.ok()) {
-        return object.status();
-    }
-    const Status owner = checkOwnerOrSuperUser(id);
-    if (owner != Status::Ok) {
-        return owner;
-    }
-    const Result<uint16_t> newHolder = holderFor(newOwner);
-    if (!newHolder.ok()) {
-        return newHolder.status();
-    }
-    return heapTable.XferOwnership(id, heapTable.ownerOf(id).value(), newOwner);
+    return memory_area::transferObject(heapTable, lookup, id, newOwner, SegmentedHeap::kSystemHolder);
 }
 
 Status HeapManager::XferOwnership(ObjectId id, void* segment, ObjectId newOwner)
 {
-    if (inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    const uint16_t holder = callerHolder();
-    Lock lock;
-    const Result<HeapObject*> object = lookup(id);
-    if (!object.ok()) {
-        return object.status();
-    }
-    const Result<uint16_t> newHolder = holderFor(newOwner);
-    if (!newHolder.ok()) {
-        return newHolder.status();
-    }
-    return object.value()->heap.transfer(segment, holder, newHolder.value());
+    return memory_area::transferMemory(
+        lookup, [](HeapObject* object) -> SegmentedHeap& { return object->heap; }, id, segment, newOwner,
+        SegmentedHeap::kSystemHolder);
 }
 
 unsigned HeapManager::recoverResourcesOf(ObjectId deadTask)

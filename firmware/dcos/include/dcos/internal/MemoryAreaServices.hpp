@@ -1,0 +1,115 @@
+// What the buffer pool and segmented heap agents share (seed 7.7, 7.8).
+//
+// Both agents manage application-supplied memory areas in an object table
+// and record a holder for every buffer or segment handed out; their
+// configuration services and the holder rules are the same, so both call
+// these instead of keeping a copy each. The area type (BufferPool or
+// SegmentedHeap) provides kSystemHolder and transfer(); the agent supplies
+// its table, its lazy start and its id lookup.
+#pragma once
+
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/Visibility.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/TaskManager.hpp>
+
+#include <arch_x86/Cpu.hpp>
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos::internal::memory_area {
+
+/// The holder recorded for memory the caller takes: its task, or the system
+/// (systemHolder) in an interrupt handler and before the scheduler starts.
+inline uint16_t callerHolder(uint16_t systemHolder)
+{
+    const ObjectId task = currentTaskId();
+    return inInterruptContext() || task.isNull() ? systemHolder : task.index();
+}
+
+/// The holder for a new owner given as a task id; the null id is the system.
+inline Result<uint16_t> holderFor(ObjectId newOwner, uint16_t systemHolder)
+{
+    const Status status = TaskManager::checkNewOwner(newOwner);
+    if (status != Status::Ok) {
+        return status;
+    }
+    return newOwner.isNull() ? systemHolder : newOwner.index();
+}
+
+/// NameToObject: refused in interrupt handlers; O(N) in the active slots.
+template <typename Table, typename Start>
+Result<ObjectId> nameToObject(Table& table, Start start, const char* name, Visibility askingScope)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    arch_x86::InterruptGuard guard;
+    start();
+    return table.NameToObject(name, askingScope);
+}
+
+/// AddObjects: a super user's configuration service, not in interrupt handlers.
+template <typename Table, typename Start>
+Status addObjects(Table& table, Start start, size_t count)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    if (!currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    arch_x86::InterruptGuard guard;
+    start();
+    return table.AddObjects(count);
+}
+
+/// XferOwnership of the pool or heap itself: its owner or a super user may
+/// hand it to a live task or to the system.
+template <typename Table, typename Lookup>
+Status transferObject(Table& table, Lookup lookup, ObjectId id, ObjectId newOwner, uint16_t systemHolder)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    arch_x86::InterruptGuard guard;
+    const auto object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    const Status owner = table.checkOwnerOrPrivileged(id, currentTaskId(), currentTaskIsSuperUser());
+    if (owner != Status::Ok) {
+        return owner;
+    }
+    const Result<uint16_t> newHolder = holderFor(newOwner, systemHolder);
+    if (!newHolder.ok()) {
+        return newHolder.status();
+    }
+    return table.XferOwnership(id, table.ownerOf(id).value(), newOwner);
+}
+
+/// XferOwnership of one buffer or segment the caller holds; areaOf gives
+/// the object's BufferPool or SegmentedHeap.
+template <typename Lookup, typename AreaOf>
+Status transferMemory(Lookup lookup, AreaOf areaOf, ObjectId id, void* memory, ObjectId newOwner,
+                      uint16_t systemHolder)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    const uint16_t holder = callerHolder(systemHolder);
+    arch_x86::InterruptGuard guard;
+    const auto object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    const Result<uint16_t> newHolder = holderFor(newOwner, systemHolder);
+    if (!newHolder.ok()) {
+        return newHolder.status();
+    }
+    return areaOf(object.value()).transfer(memory, holder, newHolder.value());
+}
+
+} // namespace dcos::internal::memory_area
