@@ -23,6 +23,7 @@ import pytest
 from dcoslab.board import EXIT_FAIL, EXIT_PASS, REPOSITORY
 from dcoslab.built_emulator import EmulatorNotBuilt, built_emulator_path
 from dcoslab.emulator import EmulatorError
+from dcoslab.logic_analyzer import measure, read_trace
 from dcoslab.target import run_target_test
 
 MFIO_MODEL_TARGET_TESTS = [
@@ -333,3 +334,43 @@ def test_plant_saturation_sets_the_overrange_flag(boot, isa486, plant_stub):
     assert dump["adc"][1] == 0x9000 | 0
     assert dump["adc"][2] == 0x2000 | adc_code(9.99)
     assert dump["adc"][3] == 0x3000 | 0
+
+
+# -- the logic analyzer on DO ----------------------------------------------------------
+
+# What the console writes to DO, in order; the repeated value is no change,
+# so it must give no trace line.
+TRACED_DO_WRITES = [0x0001, 0x0001, 0x8000, 0xA5A5, 0x0000]
+
+
+@pytest.mark.parametrize("wiring", ["loopback", "plant"])
+def test_do_trace_records_every_change_in_emulated_time(boot, isa486, plant_stub, tmp_path, wiring):
+    trace = tmp_path / "do.trace"
+    properties = {"do-trace": "dotrace"}
+    extra_args = ["-chardev", f"file,id=dotrace,path={trace}"]
+    if wiring == "plant":
+        stub = plant_stub(lambda index, fields: input_line([0.0] * 8, 0))
+        properties.update({"wiring": "plant", "plant": "plant"})
+        extra_args += stub.chardev_args()
+    emulator = boot(isa486, "test", icount=True, device_properties={MFIO: properties}, extra_args=extra_args)
+    emulator.expect(r"dcos> ")
+    for value in TRACED_DO_WRITES:
+        assert f"do=0x{value:04x}" in emulator.command(f"iobus write do 0x{value:04x}")
+    # The model writes each line before the guest's OUT instruction completes,
+    # so the trace is complete once the last command has printed its prompt.
+    samples = read_trace(trace)
+    values = [sample.value for sample in samples]
+    times = [sample.time_ns for sample in samples]
+    # The power-on reset states the level, then one line per change, in order.
+    assert values == [0x0000, 0x0001, 0x8000, 0xA5A5, 0x0000], samples
+    assert times[0] == 0
+    assert times == sorted(times), samples
+    assert len(set(times[1:])) == len(times) - 1, "each command runs at a later emulated time"
+    # The analyzer sees bit 0 rise, fall and rise again: one cycle, exactly
+    # the times of the lines.
+    cycle = measure(samples, 0)
+    assert cycle.periods_ns == (times[3] - times[1],)
+    assert cycle.high_times_ns == (times[2] - times[1],)
+    assert "DO trace line" not in emulator.emulator_messages()
+    if wiring == "plant":
+        assert stub.errors == []

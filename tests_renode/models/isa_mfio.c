@@ -13,6 +13,11 @@
  * from a seed, and faults (a stuck DI bit, a dead ADC channel, a missing
  * interrupt) are injected through properties.
  *
+ * A "logic analyzer" on the digital outputs is optional: with the chardev
+ * property do-trace set, every change of DO is written to that chardev as
+ * one "DO <emulated ns> <hex>" line, so a test can measure the waveforms an
+ * application produces in emulated time without asking the firmware.
+ *
  * This file lives in the DCOS repository under tests_renode/models/ and is
  * copied into Debian's QEMU 7.2 source tree by
  * tests_renode/qemu/build_qemu.sh.
@@ -85,6 +90,8 @@ OBJECT_DECLARE_SIMPLE_TYPE(IsaMfioState, ISA_MFIO)
 #define MFIO_PLANT_LINE_MAX 512
 /* How long the model waits for the plant's reply, in host milliseconds. */
 #define MFIO_PLANT_TIMEOUT_MS 1000
+/* The longest DO trace line: "DO ", 20 digits of time, " ", 4 hex, "\n". */
+#define MFIO_DO_TRACE_LINE_MAX 48
 
 struct IsaMfioState {
     ISADevice parent_obj;
@@ -93,6 +100,8 @@ struct IsaMfioState {
     qemu_irq irq;
     QEMUTimer *conversion_timer;
     CharBackend plant;
+    /* The logic analyzer on DO: a chardev (normally a file), or none. */
+    CharBackend do_trace;
 
     /* Properties: the board's switches and jumpers. */
     uint32_t iobase;
@@ -132,6 +141,8 @@ struct IsaMfioState {
     size_t plant_line_length;
     /* Exchanges that got no usable reply; readable as "plant-missed". */
     uint32_t plant_missed;
+    /* DO trace lines the chardev did not take; readable as "do-trace-errors". */
+    uint32_t do_trace_errors;
 };
 
 static const unsigned mfio_gains[4] = { 1, 10, 100, 1000 };
@@ -183,6 +194,51 @@ static uint16_t mfio_digital_in(IsaMfioState *s)
         value = s->stuck_di_value ? (value | bit) : (value & ~bit);
     }
     return value;
+}
+
+/*
+ * The logic analyzer on DO: one line "DO <emulated ns> <DO as 4 hex
+ * digits>" per change of the outputs. The time is the virtual clock, which
+ * under -icount is the exact emulated time of the guest's OUT instruction,
+ * so periods and duty cycles measured from the trace do not depend on how
+ * fast the host runs. Tracing must never stop or slow the board: a line the
+ * chardev does not take (a full disk, a closed pipe) is counted and
+ * dropped, and only the first misses are reported.
+ */
+static void mfio_trace_digital_out(IsaMfioState *s)
+{
+    char line[MFIO_DO_TRACE_LINE_MAX];
+    int length;
+
+    if (!qemu_chr_fe_backend_connected(&s->do_trace)) {
+        return;
+    }
+    length = snprintf(line, sizeof(line), "DO %" PRId64 " %04x\n",
+                      qemu_clock_get_ns(QEMU_CLOCK_VIRTUAL), s->digital_out);
+    if (length <= 0 || length >= (int)sizeof(line) ||
+        qemu_chr_fe_write_all(&s->do_trace, (const uint8_t *)line,
+                              length) != length) {
+        s->do_trace_errors++;
+        if (s->do_trace_errors <= 10 || s->do_trace_errors % 1000 == 0) {
+            warn_report("isa-mfio: could not write a DO trace line (%" PRIu32
+                        " lost so far); the trace has a gap here",
+                        s->do_trace_errors);
+        }
+    }
+}
+
+/*
+ * Every path that can change DO goes through here, so the trace sees each
+ * edge once: a write of the value DO already has is no edge and gives no
+ * line, as on a real analyzer.
+ */
+static void mfio_set_digital_out(IsaMfioState *s, uint16_t value)
+{
+    if (value == s->digital_out) {
+        return;
+    }
+    s->digital_out = value;
+    mfio_trace_digital_out(s);
 }
 
 static void mfio_update_irq(IsaMfioState *s)
@@ -447,7 +503,10 @@ static void mfio_start_conversion(IsaMfioState *s, unsigned channel)
               qemu_clock_get_ns(QEMU_CLOCK_VIRTUAL) + s->conversion_ns);
 }
 
-/* Every register to its reset value; the wiring and the faults stay. */
+/*
+ * Every register to its reset value; the wiring and the faults stay. A DO
+ * that was not 0 falls to 0, which the trace records as an edge.
+ */
 static void mfio_reset_registers(IsaMfioState *s)
 {
     int i;
@@ -458,7 +517,7 @@ static void mfio_reset_registers(IsaMfioState *s)
     s->adc_data = 0;
     s->pending_data = 0;
     s->gain = 0;
-    s->digital_out = 0;
+    mfio_set_digital_out(s, 0);
     for (i = 0; i < MFIO_CHANNELS; i++) {
         s->dac[i] = MFIO_CODE_ZERO;
     }
@@ -531,7 +590,7 @@ static void mfio_write(void *opaque, hwaddr addr, uint64_t value,
         }
         break;
     case MFIO_DO:
-        s->digital_out = value;
+        mfio_set_digital_out(s, value);
         break;
     case MFIO_DAC0 ... MFIO_DAC7:
         s->dac[(addr - MFIO_DAC0) / 2] = value & MFIO_CODE_MAX;
@@ -627,6 +686,8 @@ static void mfio_realize(DeviceState *dev, Error **errp)
                                        mfio_conversion_done, s);
     object_property_add_uint32_ptr(OBJECT(dev), "plant-missed",
                                    &s->plant_missed, OBJ_PROP_FLAG_READ);
+    object_property_add_uint32_ptr(OBJECT(dev), "do-trace-errors",
+                                   &s->do_trace_errors, OBJ_PROP_FLAG_READ);
 }
 
 static void mfio_unrealize(DeviceState *dev)
@@ -642,12 +703,24 @@ static void mfio_reset(DeviceState *dev)
     IsaMfioState *s = ISA_MFIO(dev);
     int i;
 
+    /*
+     * DO is cleared here without an edge, because the line below states the
+     * level anyway: a system reset gives one line, never two.
+     */
+    s->digital_out = 0;
     mfio_reset_registers(s);
     for (i = 0; i < MFIO_CHANNELS; i++) {
         s->plant_volts[i] = 0.0;
     }
     s->plant_digital_in = 0;
     s->plant_line_length = 0;
+    /*
+     * The trace starts from a known level: at power-on, and again after
+     * every system reset, one line states DO whether or not it changed.
+     * Realize writes nothing, because the power-on reset follows it at the
+     * same instant and would repeat the line.
+     */
+    mfio_trace_digital_out(s);
 }
 
 static Property mfio_properties[] = {
@@ -655,6 +728,7 @@ static Property mfio_properties[] = {
     DEFINE_PROP_UINT32("irq", IsaMfioState, irq_line, 5),
     DEFINE_PROP_STRING("wiring", IsaMfioState, wiring),
     DEFINE_PROP_CHR("plant", IsaMfioState, plant),
+    DEFINE_PROP_CHR("do-trace", IsaMfioState, do_trace),
     DEFINE_PROP_STRING("noise-lsb", IsaMfioState, noise_lsb_text),
     DEFINE_PROP_UINT64("noise-seed", IsaMfioState, noise_seed, 1),
     DEFINE_PROP_UINT64("conversion-ns", IsaMfioState, conversion_ns, 20000),
@@ -682,6 +756,8 @@ static void mfio_class_init(ObjectClass *klass, void *data)
         "loopback (DAC n to ADC n, DO to DI, the default) or plant");
     object_class_property_set_description(klass, "plant",
         "socket chardev of the plant simulator, for wiring=plant");
+    object_class_property_set_description(klass, "do-trace",
+        "chardev (normally a file) receiving 'DO <ns> <hex>' per DO change");
     object_class_property_set_description(klass, "noise-lsb",
         "standard deviation of the input noise in LSB (default 0)");
     object_class_property_set_description(klass, "noise-seed",
