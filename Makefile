@@ -2,7 +2,11 @@
 #
 #   make          firmware images and host tools
 #   make run      boot the ISA 486 controller in the emulator, console on this terminal
-#   make test     host unit tests, then the emulator regression suite
+#                 (APP=<dir>: with the application in <dir>)
+#   make test     host unit tests, the emulator regression suite, then the examples
+#   make app APP=<dir>       build an application kept outside the tree
+#   make test-app APP=<dir>  run an application's own emulator tests
+#   make install PREFIX=<path>  install DCOS to build applications against
 #   make bench    benchmarks
 #   make emulator build the emulator with our board models (done by run, test and bench)
 #   make clean    remove build/
@@ -23,6 +27,7 @@ include mk/firmware.mk
 include mk/host.mk
 include mk/bench.mk
 include mk/qemu.mk
+include mk/sdk.mk
 
 all: firmware host-tests
 
@@ -30,8 +35,13 @@ deps:
 	@mk/install-deps.sh
 
 run: deps
+ifeq ($(APP),)
 	@$(MAKE) --no-print-directory firmware
 	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(IMAGE_486)
+else
+	@$(MAKE) --no-print-directory sdk
+	@$(call app_make,$(APP),run)
+endif
 
 # Every suite runs even when an earlier one fails; the summary line counts
 # them all and the exit status says whether anything failed.
@@ -42,6 +52,7 @@ test: deps
 	@status=0; \
 	$(MAKE) --no-print-directory test-host || status=1; \
 	$(MAKE) --no-print-directory test-emulator || status=1; \
+	$(MAKE) --no-print-directory test-examples || status=1; \
 	$(PYTHON) mk/summarize_reports.py $(BUILD)/reports || status=1; \
 	exit $$status
 
@@ -49,7 +60,7 @@ test-host: host-tests
 	@mkdir -p $(BUILD)/reports
 	$(HOST_TEST_BINARY) --gtest_output=xml:$(BUILD)/reports/host-unit-tests.xml
 
-test-emulator: firmware
+test-emulator: firmware sdk
 	@mkdir -p $(BUILD)/reports
 	$(PYTHON) -m pytest -c tests_renode/pytest.ini tests_renode -n $(JOBS) \
 		--junitxml=$(BUILD)/reports/emulator-tests.xml

@@ -7,6 +7,7 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/memory/SegmentedHeap.cpp \
 	firmware/dcos/src/MessageBufferPool.cpp \
 	firmware/dcos/src/MessageQueue.cpp \
+	firmware/dcos/src/application/ConfigurationReport.cpp \
 	$(wildcard firmware/dcos/src/system/DeviceManager.cpp) \
 	$(wildcard firmware/dcos/src/system/DeviceCommands.cpp)
 
@@ -21,4 +22,6 @@ DCOS_TARGET_SRCS := \
 	firmware/dcos/src/system/InterruptManager.cpp \
 	$(wildcard firmware/dcos/src/port/*.cpp) \
 	$(wildcard firmware/dcos/src/dsm/*.cpp) \
-	$(wildcard firmware/dcos/src/semaphore/*.cpp)
+	$(wildcard firmware/dcos/src/semaphore/*.cpp) \
+	firmware/dcos/src/application/ApplicationLoader.cpp \
+	firmware/dcos/src/application/ApplicationCommands.cpp

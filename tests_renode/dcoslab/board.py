@@ -1,4 +1,5 @@
-"""Board definitions: one JSON file per emulated board under tests_renode/boards/.
+"""Board definitions: one JSON file per emulated board under tests_renode/boards/
+(share/dcos/boards/ in an installed DCOS).
 
 The harness and `make run` both build their emulator command line from these
 files, so a board's machine, CPU, memory, devices and serial wiring are stated
@@ -10,9 +11,11 @@ import os
 from dataclasses import dataclass, field
 
 from .built_emulator import resolve_emulator
+from .layout import BOARDS_DIRECTORY, ROOT
 
-REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-BOARDS_DIRECTORY = os.path.join(REPOSITORY, "tests_renode", "boards")
+# The directory board image paths are relative to: the repository, or the
+# prefix of an installed DCOS (see layout.py).
+REPOSITORY = ROOT
 
 # isa-debug-exit turns a guest write of v into the exit status (v << 1) | 1.
 # These are the values the test image writes (tests_renode/target/EmulatorExit.hpp).
@@ -110,7 +113,7 @@ class Board:
 
 
 def load_board(name):
-    """Reads tests_renode/boards/<name>.json."""
+    """Reads <boards directory>/<name>.json."""
     path = os.path.join(BOARDS_DIRECTORY, f"{name}.json")
     try:
         with open(path, encoding="utf-8") as handle:

@@ -5,13 +5,16 @@ A board names its emulator either as a program on PATH or as
 device models (tests_renode/qemu/build_qemu.sh). Its binary lives in
 build/qemu-<key>/, where <key> hashes the build script and the models; the
 script itself says where (--print-path), so the key is computed in one place.
+An installed DCOS carries a copy of it in <prefix>/libexec/dcos/ instead.
 """
 
 import functools
 import os
 import subprocess
 
-REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from . import layout
+
+REPOSITORY = layout.ROOT
 
 BUILD_SCRIPT = os.path.join(REPOSITORY, "tests_renode", "qemu", "build_qemu.sh")
 BUILT_PREFIX = "built:"
@@ -27,6 +30,11 @@ def built_emulator_path(program="qemu-system-i386"):
     """Path of the built program for the current sources; raises if not built."""
     if program not in BUILT_PROGRAMS:
         raise EmulatorNotBuilt(f"'{BUILT_PREFIX}{program}': the build makes only {', '.join(BUILT_PROGRAMS)}")
+    if layout.INSTALLED:
+        candidate = os.path.join(layout.EMULATOR_DIRECTORY, program)
+        if not os.access(candidate, os.X_OK):
+            raise EmulatorNotBuilt(f"this installed DCOS has no {candidate}; reinstall it with 'make install'")
+        return candidate
     try:
         result = subprocess.run([BUILD_SCRIPT, "--print-path"], capture_output=True, text=True, timeout=60, check=True)
     except (OSError, subprocess.SubprocessError) as error:

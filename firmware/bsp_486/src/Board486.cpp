@@ -2,6 +2,8 @@
 // controller node 1): an 8259A pair, an 8254 and a 16550 on COM1, at their
 // PC/AT addresses.
 #include <bsp/Board.hpp>
+
+#include <dcos/ConfigurationRules.hpp>
 #include <bsp/Pic8259.hpp>
 #include <bsp/Pit8254.hpp>
 #include <bsp/Uart16550.hpp>
@@ -89,7 +91,11 @@ arch_x86::InterruptFrame* dispatchInterrupt(arch_x86::InterruptFrame* frame)
 
 const BoardIdentity& identity() { return board; }
 
-void initialise(const boot::BootInfo& bootInfo)
+// Every rate an application may declare (ConfigurationRules.hpp) is one the PIT can make.
+static_assert(Pit8254::minimumRateHz <= dcos::app::kLowestTickRateHz
+              && Pit8254::maximumRateHz >= dcos::app::kHighestTickRateHz);
+
+void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
 {
     char nodeText[8];
     if (boot::findCommandLineOption(bootInfo.commandLine, "node", nodeText, sizeof nodeText)) {
@@ -115,7 +121,12 @@ void initialise(const boot::BootInfo& bootInfo)
     }
     attachInterrupt(consoleLine, consoleInterrupt, nullptr);
 
-    uint32_t rate = defaultTickRateHz;
+    // An application's tick rate is checked when it is compiled; an
+    // impossible one still falls back to the default rather than stop the node.
+    if (tickRateHz < Pit8254::minimumRateHz || tickRateHz > Pit8254::maximumRateHz) {
+        tickRateHz = defaultTickRateHz;
+    }
+    uint32_t rate = tickRateHz;
     char value[12];
     if (boot::findCommandLineOption(bootInfo.commandLine, "tick_hz", value, sizeof value)) {
         // At most five digits, so the accumulation below cannot overflow.
@@ -132,7 +143,7 @@ void initialise(const boot::BootInfo& bootInfo)
             runtime::format(uart, "warning: tick_hz=%s is not a rate from %lu to %lu Hz; using %lu Hz\r\n", value,
                             static_cast<unsigned long>(Pit8254::minimumRateHz),
                             static_cast<unsigned long>(Pit8254::maximumRateHz),
-                            static_cast<unsigned long>(defaultTickRateHz));
+                            static_cast<unsigned long>(tickRateHz));
         }
     }
     pit.start(rate);

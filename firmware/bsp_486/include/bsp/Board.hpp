@@ -36,8 +36,10 @@ constexpr uint32_t consoleBaud = 115200;
 
 /// Brings up the interrupt controller, the console and the tick timer, in
 /// that order, with every interrupt line masked except those attached.
-/// Interrupts stay disabled in the CPU; the kernel enables them.
-void initialise(const boot::BootInfo& bootInfo);
+/// Interrupts stay disabled in the CPU; the kernel enables them. The tick
+/// runs at @p tickRateHz (the linked application's rate, or the default)
+/// unless the command line says tick_hz=.
+void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz = defaultTickRateHz);
 
 /// Called with interrupts disabled for each interrupt on a line.
 using InterruptHandler = void (*)(void* context);

@@ -1,11 +1,12 @@
 // The loader-independent kernel entry.
 //
 // kernelMain brings up the board, the timer agent and the task agent, then
-// starts scheduling. From then on the boot stack is abandoned: the console
-// shell runs as the root task, and the idle task halts the CPU whenever no
+// starts scheduling. From then on the boot stack is abandoned: the root task
+// starts the application linked into the image, if any, then runs the console shell, and the idle task halts the CPU whenever no
 // other task is ready.
 #include <dcos/TaskAgent.hpp>
 #include <dcos/Version.hpp>
+#include <dcos/internal/ApplicationLoader.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/TimerManager.hpp>
@@ -41,6 +42,9 @@ void shellTaskEntry(uintptr_t)
 {
     shellTask = taskAgent.IdOfSelf();
     bsp::setConsoleInputNotifier(onConsoleInput, nullptr);
+    // The application's objects exist, and its more urgent tasks have
+    // started, before the console takes commands.
+    internal::ApplicationLoader::startLinked();
     static shell::Shell shell(bsp::console(), "dcos> ");
     shell.start();
     for (;;) {
@@ -78,7 +82,11 @@ const boot::BootInfo& bootInfo() { return bootInfoCopy; }
     arch_x86::Idt::setExceptionHandler(internal::TaskManager::onCpuException);
     arch_x86::Idt::setTrapHandler(internal::TaskManager::onTrap);
     arch_x86::Idt::setOutermostExitHook(internal::Scheduler::onOutermostExit);
-    bsp::initialise(bootInfo);
+    // The linked application may ask for a finer tick than the board's default.
+    const app::Application* application = internal::ApplicationLoader::linked();
+    const uint32_t tickRateHz = application != nullptr && application->tickRateHz != 0 ? application->tickRateHz
+                                                                                       : bsp::defaultTickRateHz;
+    bsp::initialise(bootInfo, tickRateHz);
     internal::TimerManager::initialise(bsp::tickPeriodNanoseconds());
     if (bsp::attachInterrupt(bsp::systemTickLine, onSystemTick, nullptr) != Status::Ok) {
         dcosPanic("cannot attach the system tick");

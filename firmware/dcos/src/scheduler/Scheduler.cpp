@@ -149,7 +149,8 @@ arch_x86::InterruptFrame* Scheduler::onOutermostExit(arch_x86::InterruptFrame* f
     if (current_ == nullptr) {
         return frame;
     }
-    if (dispatchPending_) {
+    // A hold defers the switch to releaseDispatch(), which requests it again.
+    if (dispatchPending_ && dispatchHolds_ == 0) {
         dispatchPending_ = false;
         Task* next = pickNext();
         if (next != current_) {

@@ -29,8 +29,6 @@ namespace dcos::internal {
 namespace {
 
 constexpr uint32_t kEflagsReservedBit = 1u << 1;
-constexpr size_t kIdleStackSize = 2048;
-constexpr size_t kRootStackSize = 16384;
 // A handler frame is refused when it would leave less than this below it.
 constexpr size_t kHandlerStackReserve = 512;
 
@@ -253,7 +251,7 @@ void TaskManager::initialise(TaskEntry rootEntry)
     table.AddObjects(kTasksActiveAtBoot);
 
     TaskAttributes idle;
-    idle.name = "idle";
+    idle.name = kIdleTaskName;
     idle.priority = kLowestPriority;
     idle.stackSize = kIdleStackSize;
     idle.superUser = true;
@@ -266,7 +264,7 @@ void TaskManager::initialise(TaskEntry rootEntry)
     Scheduler::setIdleTask(idleTask);
 
     TaskAttributes root;
-    root.name = "shell";
+    root.name = kRootTaskName;
     root.priority = 24;
     root.stackSize = kRootStackSize;
     root.superUser = true;

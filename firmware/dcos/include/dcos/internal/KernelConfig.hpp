@@ -52,6 +52,13 @@ constexpr size_t kStackArenaBytes = size_t{DCOS_CONFIG_STACK_ARENA_KIB} * 1024;
 constexpr size_t kTimeWheelSlots = DCOS_CONFIG_TIME_WHEEL_SLOTS;
 
 static_assert(kTasksActiveAtBoot <= kTaskCapacity && kTasksActiveAtBoot % 8 == 0);
+
+// The kernel's own tasks on every node: their names and stacks are part of
+// what an application's configuration is checked against (ConfigurationRules.hpp).
+constexpr const char* kIdleTaskName = "idle";
+constexpr const char* kRootTaskName = "shell";
+constexpr size_t kIdleStackSize = 2048;
+constexpr size_t kRootStackSize = 16384;
 static_assert(kTimersActiveAtBoot <= kTimerCapacity && kTimersActiveAtBoot % 8 == 0);
 
 } // namespace dcos::internal

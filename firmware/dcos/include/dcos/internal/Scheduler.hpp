@@ -54,10 +54,13 @@ public:
     /// dispatch trap), or at the outermost interrupt exit from a handler.
     static void requestDispatch();
 
-    /// Holds task switches requested from task context until the matching
-    /// releaseDispatch(): kernel code that readies several tasks, or that
-    /// ends the running task, finishes its bookkeeping before any of them
-    /// runs. Nests. Call with interrupts disabled.
+    /// Holds every task switch, whether requested from task context or at
+    /// an interrupt's exit, until the matching releaseDispatch(): kernel
+    /// code that readies several tasks, or that ends the running task,
+    /// finishes its bookkeeping before any of them runs. Nests. Interrupts
+    /// may stay enabled meanwhile (the application loader creates tasks and
+    /// prints under a hold); interrupt handlers still run, only the switch
+    /// waits. The holder must not block.
     static void holdDispatch() { ++dispatchHolds_; }
     /// Ends a hold; a switch requested meanwhile happens now.
     static void releaseDispatch();

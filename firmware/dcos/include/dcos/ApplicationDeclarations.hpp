@@ -1,0 +1,117 @@
+// The declarations an application's configuration is made of (seed 8.2).
+//
+// Applications include dcos/Application.hpp, which adds the compile-time
+// checks and DCOS_APPLICATION; the rules (ConfigurationRules.hpp) and the
+// loader need only these types.
+#pragma once
+
+#include <dcos/MessagePortAgent.hpp>
+#include <dcos/ObjectId.hpp>
+#include <dcos/SemaphoreAgent.hpp>
+#include <dcos/TaskAgent.hpp>
+#include <dcos/Visibility.hpp>
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos::app {
+
+/// A task the loader creates (TaskAgent::Create).
+struct TaskDeclaration {
+    const char* name = nullptr;    ///< Required, 1 to 15 characters, unique among tasks.
+    TaskEntry entry = nullptr;     ///< Required.
+    uint8_t priority = 16;         ///< 0 (highest) to 31 (lowest).
+    size_t stackSize = 4096;       ///< At least kMinimumStackSize bytes.
+    uintptr_t argument = 0;        ///< Passed to entry.
+    bool timeSlicing = false;
+    bool floatingPoint = false;    ///< Save and restore the FPU for this task.
+    bool superUser = false;        ///< May use privileged services (AddObjects, devices).
+    Visibility visibility = Visibility::Local;
+    ObjectId* id = nullptr;        ///< Optional: receives the task's id before any task runs.
+};
+
+/// A semaphore the loader creates (SemaphoreAgent::Create).
+struct SemaphoreDeclaration {
+    const char* name = nullptr;
+    SemaphoreKind kind = SemaphoreKind::Binary;
+    uint32_t initialCount = 1;     ///< 0 or 1 for a binary semaphore; at most maximumCount.
+    uint32_t maximumCount = 0xFFFFFFFF;
+    bool priorityInheritance = false; ///< Binary semaphores only.
+    WaitOrder order = WaitOrder::Priority;
+    Visibility visibility = Visibility::Local;
+    const char* owner = nullptr;   ///< A declared task, or null for the system.
+    ObjectId* id = nullptr;
+};
+
+/// A message port the loader creates and hands to its receiver.
+struct MessagePortDeclaration {
+    const char* name = nullptr;
+    const char* receiver = nullptr; ///< Required: the declared task that receives from it.
+    PortOrder order = PortOrder::Priority;
+    Visibility visibility = Visibility::Local;
+    ObjectId* id = nullptr;
+};
+
+/// A distributed shared memory publisher the loader creates and hands to its writer.
+struct PublisherDeclaration {
+    const char* name = nullptr;
+    const char* writer = nullptr;  ///< A declared task, or null for the system (interrupt handlers).
+    Visibility visibility = Visibility::Local;
+    ObjectId* id = nullptr;
+};
+
+/// A buffer pool over an area the application provides (BufferPoolAgent::Create).
+struct BufferPoolDeclaration {
+    const char* name = nullptr;
+    void* area = nullptr;          ///< Required: static storage, e.g. sized with BufferPoolAgent::AreaBytes.
+    size_t areaBytes = 0;
+    size_t bufferSize = 0;         ///< At least BufferPoolAgent::kMinimumBufferSize.
+    Visibility visibility = Visibility::Local;
+    const char* owner = nullptr;   ///< A declared task, or null for the system.
+    ObjectId* id = nullptr;
+};
+
+/// A segmented heap over an area the application provides (HeapAgent::Create).
+struct HeapDeclaration {
+    const char* name = nullptr;
+    void* area = nullptr;          ///< Required: static storage.
+    size_t areaBytes = 0;
+    Visibility visibility = Visibility::Local;
+    const char* owner = nullptr;   ///< A declared task, or null for the system.
+    ObjectId* id = nullptr;
+};
+
+/// A read-only view of a constexpr array of declarations.
+template <class Declaration>
+struct DeclarationList {
+    const Declaration* items = nullptr;
+    size_t count = 0;
+
+    constexpr DeclarationList() = default;
+    template <size_t N>
+    constexpr DeclarationList(const Declaration (&array)[N]) : items(array), count(N)
+    {
+    }
+    constexpr DeclarationList(const Declaration* first, size_t length) : items(first), count(length) {}
+
+    constexpr const Declaration& operator[](size_t index) const { return items[index]; }
+    constexpr const Declaration* begin() const { return items; }
+    constexpr const Declaration* end() const { return items + count; }
+};
+
+/// The whole application. Lists left out are empty.
+struct Application {
+    const char* name = nullptr;    ///< Required, 1 to 31 characters; shown at boot and by 'app'.
+    DeclarationList<TaskDeclaration> tasks;
+    DeclarationList<SemaphoreDeclaration> semaphores;
+    DeclarationList<MessagePortDeclaration> messagePorts;
+    DeclarationList<PublisherDeclaration> publishers;
+    DeclarationList<BufferPoolDeclaration> bufferPools;
+    DeclarationList<HeapDeclaration> heaps;
+    /// The system tick the application needs, in Hz (timer resolution is one
+    /// tick); 0 keeps the board's default. A tick_hz= on the kernel command
+    /// line still wins.
+    uint32_t tickRateHz = 0;
+};
+
+} // namespace dcos::app

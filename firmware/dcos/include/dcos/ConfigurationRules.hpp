@@ -1,0 +1,374 @@
+// The rules an application's configuration (dcos/Application.hpp) must keep.
+//
+// findConfigurationError is one constexpr function for two callers: the
+// compiler, which runs it on every DCOS_APPLICATION and turns a broken rule
+// into a compile-time error naming the object (internal/ConfigurationCheck.hpp),
+// and the application loader, which runs it again at boot on the linked
+// configuration before it creates anything. Rules are checked in declaration
+// order: the application, then tasks, semaphores, ports, publishers, pools
+// and heaps, then the totals; the first broken rule is reported.
+#pragma once
+
+#include <dcos/ApplicationDeclarations.hpp>
+#include <dcos/BufferPoolAgent.hpp>
+#include <dcos/HeapAgent.hpp>
+#include <dcos/internal/KernelConfig.hpp>
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos::app {
+
+/// Which kind of object a configuration error is about.
+enum class ObjectKind : uint8_t {
+    Application,
+    Task,
+    Semaphore,
+    MessagePort,
+    Publisher,
+    BufferPool,
+    Heap,
+};
+
+/// The rule a configuration breaks.
+enum class ConfigurationRule : uint8_t {
+    None,
+    NameMissing,          ///< value: the declaration's index in its list.
+    NameTooLong,          ///< value: its length; limit: the longest allowed.
+    DuplicateName,        ///< Two declarations of one kind share the name.
+    ReservedName,         ///< The kernel's own task already has the name.
+    EntryMissing,
+    PriorityOutOfRange,   ///< value: the priority; limit: kLowestPriority.
+    StackTooSmall,        ///< value: the size; limit: kMinimumStackSize.
+    StacksExceedArena,    ///< value: bytes all stacks need; limit: the arena.
+    TooManyObjects,       ///< value: declared plus the kernel's own; limit: the table.
+    OwnerNotDeclared,     ///< The owner, receiver or writer names no declared task.
+    ReceiverMissing,
+    InitialCountTooLarge, ///< value: initialCount; limit: 1 or maximumCount.
+    InheritanceNeedsBinary,
+    TickRateOutOfRange,   ///< value: the rate; limit: kHighestTickRateHz.
+    AreaMissing,
+    AreaTooSmall,         ///< value: areaBytes; limit: the least that holds one buffer or segment.
+    BufferTooSmall,       ///< value: bufferSize; limit: kMinimumBufferSize.
+    // Rules only the running node can check (application loader).
+    NameInUse,            ///< An object of the node already has the name.
+    CreateFailed,         ///< The agent refused; the loader prints its status.
+};
+
+/// The first broken rule, and about which object.
+struct ConfigurationError {
+    ConfigurationRule rule = ConfigurationRule::None;
+    ObjectKind kind = ObjectKind::Application;
+    const char* object = nullptr; ///< The object's name (null when it has none).
+    size_t value = 0;
+    size_t limit = 0;
+
+    constexpr bool ok() const { return rule == ConfigurationRule::None; }
+};
+
+/// The tick rates every DCOS board can run at, in Hz.
+constexpr uint32_t kLowestTickRateHz = 19;
+constexpr uint32_t kHighestTickRateHz = 10000;
+
+/// Longest application name.
+constexpr size_t kMaximumApplicationName = 31;
+/// Longest object name (every agent's name field holds 15 characters).
+constexpr size_t kMaximumObjectName = 15;
+
+/// Tasks the kernel itself runs on every node (idle and the root shell).
+constexpr const char* kKernelTaskNames[] = {internal::kIdleTaskName, internal::kRootTaskName};
+constexpr size_t kKernelTaskCount = sizeof kKernelTaskNames / sizeof kKernelTaskNames[0];
+/// Stack bytes the kernel's own tasks take from the stack arena.
+constexpr size_t kKernelStackBytes = internal::kIdleStackSize + internal::kRootStackSize;
+
+/// Stack arena bytes a task of @p stackSize takes (the arena's 16-byte rounding).
+constexpr size_t stackArenaBytes(size_t stackSize) { return (stackSize + 15) & ~size_t{15}; }
+
+/// Stable English names, for messages.
+constexpr const char* objectKindName(ObjectKind kind)
+{
+    switch (kind) {
+    case ObjectKind::Application: return "application";
+    case ObjectKind::Task: return "task";
+    case ObjectKind::Semaphore: return "semaphore";
+    case ObjectKind::MessagePort: return "message port";
+    case ObjectKind::Publisher: return "publisher";
+    case ObjectKind::BufferPool: return "buffer pool";
+    case ObjectKind::Heap: return "heap";
+    }
+    return "object";
+}
+
+/// What the rule says, as a phrase that follows the object's name.
+constexpr const char* ruleText(ConfigurationRule rule)
+{
+    switch (rule) {
+    case ConfigurationRule::None: return "is valid";
+    case ConfigurationRule::NameMissing: return "has no name";
+    case ConfigurationRule::NameTooLong: return "has a name that is too long";
+    case ConfigurationRule::DuplicateName: return "is declared twice (names are unique per kind)";
+    case ConfigurationRule::ReservedName: return "has the name of a kernel task";
+    case ConfigurationRule::EntryMissing: return "has no entry function";
+    case ConfigurationRule::PriorityOutOfRange: return "has a priority out of range (0 highest to 31 lowest)";
+    case ConfigurationRule::StackTooSmall: return "has a stack smaller than kMinimumStackSize";
+    case ConfigurationRule::StacksExceedArena: return "does not fit: all stacks together exceed the stack arena";
+    case ConfigurationRule::TooManyObjects: return "is one too many: the table of its kind is full";
+    case ConfigurationRule::OwnerNotDeclared: return "names an owner that is not a declared task";
+    case ConfigurationRule::ReceiverMissing: return "has no receiver task";
+    case ConfigurationRule::InitialCountTooLarge: return "has an initial count above its maximum";
+    case ConfigurationRule::InheritanceNeedsBinary: return "asks for priority inheritance, which only binary semaphores have";
+    case ConfigurationRule::TickRateOutOfRange: return "asks for a tick rate out of range (19 to 10000 Hz, or 0 for the default)";
+    case ConfigurationRule::AreaMissing: return "has no memory area";
+    case ConfigurationRule::AreaTooSmall: return "has an area too small for one buffer or segment";
+    case ConfigurationRule::BufferTooSmall: return "has buffers smaller than kMinimumBufferSize";
+    case ConfigurationRule::NameInUse: return "has a name another object of the node already uses";
+    case ConfigurationRule::CreateFailed: return "was refused by its agent";
+    }
+    return "breaks a configuration rule";
+}
+
+namespace rules {
+
+constexpr size_t length(const char* text)
+{
+    size_t n = 0;
+    while (text[n] != '\0') {
+        ++n;
+    }
+    return n;
+}
+
+constexpr bool sameName(const char* a, const char* b)
+{
+    size_t i = 0;
+    for (; a[i] != '\0' && a[i] == b[i]; ++i) {
+    }
+    return a[i] == b[i];
+}
+
+constexpr ConfigurationError broken(ConfigurationRule rule, ObjectKind kind, const char* object, size_t value = 0,
+                                    size_t limit = 0)
+{
+    return ConfigurationError{rule, kind, object, value, limit};
+}
+
+/// The name rules every declaration keeps: present, short enough, unique in its list.
+template <class Declaration>
+constexpr ConfigurationError checkNames(const DeclarationList<Declaration>& list, ObjectKind kind)
+{
+    for (size_t i = 0; i < list.count; ++i) {
+        const char* name = list[i].name;
+        if (name == nullptr || name[0] == '\0') {
+            return broken(ConfigurationRule::NameMissing, kind, nullptr, i);
+        }
+        if (length(name) > kMaximumObjectName) {
+            return broken(ConfigurationRule::NameTooLong, kind, name, length(name), kMaximumObjectName);
+        }
+        for (size_t j = 0; j < i; ++j) {
+            if (sameName(list[j].name, name)) {
+                return broken(ConfigurationRule::DuplicateName, kind, name);
+            }
+        }
+    }
+    return {};
+}
+
+constexpr bool isDeclaredTask(const Application& application, const char* name)
+{
+    for (const TaskDeclaration& task : application.tasks) {
+        if (sameName(task.name, name)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/// An optional owner (null: the system) must be a declared task.
+constexpr bool ownerIsValid(const Application& application, const char* owner)
+{
+    return owner == nullptr || isDeclaredTask(application, owner);
+}
+
+constexpr ConfigurationError checkTasks(const Application& application)
+{
+    if (ConfigurationError names = checkNames(application.tasks, ObjectKind::Task); !names.ok()) {
+        return names;
+    }
+    for (const TaskDeclaration& task : application.tasks) {
+        for (const char* reserved : kKernelTaskNames) {
+            if (sameName(task.name, reserved)) {
+                return broken(ConfigurationRule::ReservedName, ObjectKind::Task, task.name);
+            }
+        }
+        if (task.entry == nullptr) {
+            return broken(ConfigurationRule::EntryMissing, ObjectKind::Task, task.name);
+        }
+        if (task.priority > kLowestPriority) {
+            return broken(ConfigurationRule::PriorityOutOfRange, ObjectKind::Task, task.name, task.priority,
+                          kLowestPriority);
+        }
+        if (task.stackSize < kMinimumStackSize) {
+            return broken(ConfigurationRule::StackTooSmall, ObjectKind::Task, task.name, task.stackSize,
+                          kMinimumStackSize);
+        }
+    }
+    return {};
+}
+
+constexpr ConfigurationError checkSemaphores(const Application& application)
+{
+    if (ConfigurationError names = checkNames(application.semaphores, ObjectKind::Semaphore); !names.ok()) {
+        return names;
+    }
+    for (const SemaphoreDeclaration& semaphore : application.semaphores) {
+        const bool binary = semaphore.kind == SemaphoreKind::Binary;
+        const size_t most = binary ? 1 : semaphore.maximumCount;
+        if (semaphore.initialCount > most) {
+            return broken(ConfigurationRule::InitialCountTooLarge, ObjectKind::Semaphore, semaphore.name,
+                          semaphore.initialCount, most);
+        }
+        if (semaphore.priorityInheritance && !binary) {
+            return broken(ConfigurationRule::InheritanceNeedsBinary, ObjectKind::Semaphore, semaphore.name);
+        }
+        if (!ownerIsValid(application, semaphore.owner)) {
+            return broken(ConfigurationRule::OwnerNotDeclared, ObjectKind::Semaphore, semaphore.name);
+        }
+    }
+    return {};
+}
+
+constexpr ConfigurationError checkPortsAndPublishers(const Application& application)
+{
+    if (ConfigurationError names = checkNames(application.messagePorts, ObjectKind::MessagePort); !names.ok()) {
+        return names;
+    }
+    for (const MessagePortDeclaration& port : application.messagePorts) {
+        if (port.receiver == nullptr) {
+            return broken(ConfigurationRule::ReceiverMissing, ObjectKind::MessagePort, port.name);
+        }
+        if (!isDeclaredTask(application, port.receiver)) {
+            return broken(ConfigurationRule::OwnerNotDeclared, ObjectKind::MessagePort, port.name);
+        }
+    }
+    if (ConfigurationError names = checkNames(application.publishers, ObjectKind::Publisher); !names.ok()) {
+        return names;
+    }
+    for (const PublisherDeclaration& publisher : application.publishers) {
+        if (!ownerIsValid(application, publisher.writer)) {
+            return broken(ConfigurationRule::OwnerNotDeclared, ObjectKind::Publisher, publisher.name);
+        }
+    }
+    return {};
+}
+
+constexpr ConfigurationError checkMemoryAreas(const Application& application)
+{
+    if (ConfigurationError names = checkNames(application.bufferPools, ObjectKind::BufferPool); !names.ok()) {
+        return names;
+    }
+    for (const BufferPoolDeclaration& pool : application.bufferPools) {
+        if (pool.area == nullptr) {
+            return broken(ConfigurationRule::AreaMissing, ObjectKind::BufferPool, pool.name);
+        }
+        if (pool.bufferSize < BufferPoolAgent::kMinimumBufferSize) {
+            return broken(ConfigurationRule::BufferTooSmall, ObjectKind::BufferPool, pool.name, pool.bufferSize,
+                          BufferPoolAgent::kMinimumBufferSize);
+        }
+        const size_t least = BufferPoolAgent::AreaBytes(pool.bufferSize, 1);
+        if (pool.areaBytes < least) {
+            return broken(ConfigurationRule::AreaTooSmall, ObjectKind::BufferPool, pool.name, pool.areaBytes, least);
+        }
+        if (!ownerIsValid(application, pool.owner)) {
+            return broken(ConfigurationRule::OwnerNotDeclared, ObjectKind::BufferPool, pool.name);
+        }
+    }
+    if (ConfigurationError names = checkNames(application.heaps, ObjectKind::Heap); !names.ok()) {
+        return names;
+    }
+    for (const HeapDeclaration& heap : application.heaps) {
+        if (heap.area == nullptr) {
+            return broken(ConfigurationRule::AreaMissing, ObjectKind::Heap, heap.name);
+        }
+        const size_t least = HeapAgent::SegmentBytes(HeapAgent::kMinimumSegment);
+        if (heap.areaBytes < least) {
+            return broken(ConfigurationRule::AreaTooSmall, ObjectKind::Heap, heap.name, heap.areaBytes, least);
+        }
+        if (!ownerIsValid(application, heap.owner)) {
+            return broken(ConfigurationRule::OwnerNotDeclared, ObjectKind::Heap, heap.name);
+        }
+    }
+    return {};
+}
+
+/// A list longer than its table (less what the kernel uses) names its first object that does not fit.
+template <class Declaration>
+constexpr ConfigurationError checkCount(const DeclarationList<Declaration>& list, ObjectKind kind, size_t capacity,
+                                        size_t kernelUses = 0)
+{
+    if (list.count + kernelUses > capacity) {
+        const size_t firstOver = capacity > kernelUses ? capacity - kernelUses : 0;
+        return broken(ConfigurationRule::TooManyObjects, kind, list[firstOver].name, list.count + kernelUses,
+                      capacity);
+    }
+    return {};
+}
+
+constexpr ConfigurationError checkTotals(const Application& application)
+{
+    using namespace dcos::internal;
+    const ConfigurationError counts[] = {
+        checkCount(application.tasks, ObjectKind::Task, kTaskCapacity, kKernelTaskCount),
+        checkCount(application.semaphores, ObjectKind::Semaphore, kSemaphoreCapacity),
+        checkCount(application.messagePorts, ObjectKind::MessagePort, kPortCapacity),
+        checkCount(application.publishers, ObjectKind::Publisher, kPublisherCapacity),
+        checkCount(application.bufferPools, ObjectKind::BufferPool, kPoolCapacity),
+        checkCount(application.heaps, ObjectKind::Heap, kHeapCapacity),
+    };
+    for (const ConfigurationError& count : counts) {
+        if (!count.ok()) {
+            return count;
+        }
+    }
+    size_t stackBytes = kKernelStackBytes;
+    for (const TaskDeclaration& task : application.tasks) {
+        stackBytes += stackArenaBytes(task.stackSize);
+        if (stackBytes > kStackArenaBytes) {
+            return broken(ConfigurationRule::StacksExceedArena, ObjectKind::Task, task.name, stackBytes,
+                          kStackArenaBytes);
+        }
+    }
+    return {};
+}
+
+} // namespace rules
+
+/// The first rule @p application breaks, or an error with rule None.
+constexpr ConfigurationError findConfigurationError(const Application& application)
+{
+    if (application.name == nullptr || application.name[0] == '\0') {
+        return rules::broken(ConfigurationRule::NameMissing, ObjectKind::Application, nullptr);
+    }
+    const size_t nameLength = rules::length(application.name);
+    if (nameLength > kMaximumApplicationName) {
+        return rules::broken(ConfigurationRule::NameTooLong, ObjectKind::Application, application.name, nameLength,
+                             kMaximumApplicationName);
+    }
+    if (application.tickRateHz != 0
+        && (application.tickRateHz < kLowestTickRateHz || application.tickRateHz > kHighestTickRateHz)) {
+        return rules::broken(ConfigurationRule::TickRateOutOfRange, ObjectKind::Application, application.name,
+                             application.tickRateHz, kHighestTickRateHz);
+    }
+    const ConfigurationError checks[] = {
+        rules::checkTasks(application),       rules::checkSemaphores(application),
+        rules::checkPortsAndPublishers(application), rules::checkMemoryAreas(application),
+        rules::checkTotals(application),
+    };
+    for (const ConfigurationError& check : checks) {
+        if (!check.ok()) {
+            return check;
+        }
+    }
+    return {};
+}
+
+} // namespace dcos::app

@@ -1,0 +1,65 @@
+// The 'app' console command: the linked application, its state and its objects.
+#include <dcos/internal/ApplicationLoader.hpp>
+#include <dcos/internal/ConfigurationReport.hpp>
+
+#include <shell/Shell.hpp>
+
+namespace dcos::internal {
+
+namespace {
+
+template <class Declaration>
+void listObjects(shell::Shell& shell, app::ObjectKind kind, const app::DeclarationList<Declaration>& list,
+                 const char* (*ownerOf)(const Declaration&))
+{
+    for (const Declaration& declaration : list) {
+        const Result<ObjectId> id = ApplicationLoader::find(kind, declaration.name);
+        shell.print("  %-12s %-15s ", app::objectKindName(kind), declaration.name);
+        if (id.ok()) {
+            shell.print("0x%08lx", static_cast<unsigned long>(id.value().raw()));
+        } else {
+            shell.print("%-10s", "(none)");
+        }
+        const char* owner = ownerOf(declaration);
+        shell.print("  %s\r\n", owner != nullptr ? owner : "-");
+    }
+}
+
+shell::CommandResult showApplication(shell::Shell& shell, int argc, char**)
+{
+    if (argc != 1) {
+        return shell::CommandResult::UsageError;
+    }
+    const app::Application* application = ApplicationLoader::linked();
+    if (application == nullptr) {
+        shell.print("no application is linked into this image\r\n");
+        return shell::CommandResult::Ok;
+    }
+    if (ApplicationLoader::state() == ApplicationLoader::State::Rejected) {
+        formatConfigurationError(shell.output(), application->name, ApplicationLoader::lastError());
+        shell.print("\r\n");
+        return shell::CommandResult::Failed;
+    }
+    shell.print("application '%s': running\r\n", application->name);
+    shell.print("  %-12s %-15s %-10s  %s\r\n", "kind", "name", "id", "owner");
+    listObjects<app::TaskDeclaration>(shell, app::ObjectKind::Task, application->tasks,
+                                      [](const app::TaskDeclaration&) -> const char* { return nullptr; });
+    listObjects<app::SemaphoreDeclaration>(shell, app::ObjectKind::Semaphore, application->semaphores,
+                                           [](const app::SemaphoreDeclaration& d) { return d.owner; });
+    listObjects<app::MessagePortDeclaration>(shell, app::ObjectKind::MessagePort, application->messagePorts,
+                                             [](const app::MessagePortDeclaration& d) { return d.receiver; });
+    listObjects<app::PublisherDeclaration>(shell, app::ObjectKind::Publisher, application->publishers,
+                                           [](const app::PublisherDeclaration& d) { return d.writer; });
+    listObjects<app::BufferPoolDeclaration>(shell, app::ObjectKind::BufferPool, application->bufferPools,
+                                            [](const app::BufferPoolDeclaration& d) { return d.owner; });
+    listObjects<app::HeapDeclaration>(shell, app::ObjectKind::Heap, application->heaps,
+                                      [](const app::HeapDeclaration& d) { return d.owner; });
+    return shell::CommandResult::Ok;
+}
+
+} // namespace
+
+DCOS_SHELL_COMMAND(applicationCommand, "app", "show the application, its state and its objects", "app",
+                   showApplication);
+
+} // namespace dcos::internal

@@ -1,0 +1,382 @@
+// The application loader: all of an application's objects, or none of them.
+#include <dcos/internal/ApplicationLoader.hpp>
+
+#include <dcos/BufferPoolAgent.hpp>
+#include <dcos/DsmAgent.hpp>
+#include <dcos/HeapAgent.hpp>
+#include <dcos/MessagePortAgent.hpp>
+#include <dcos/SemaphoreAgent.hpp>
+#include <dcos/TaskAgent.hpp>
+#include <dcos/internal/ConfigurationReport.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/Scheduler.hpp>
+
+#include <bsp/Board.hpp>
+
+// Defined by DCOS_APPLICATION in the application's sources; weak, so an
+// image without an application links and its address is null.
+extern "C" [[gnu::weak]] const dcos::app::Application* const dcosApplication;
+
+namespace dcos::internal {
+
+ApplicationLoader::State ApplicationLoader::state_ = ApplicationLoader::State::None;
+app::ConfigurationError ApplicationLoader::lastError_{};
+
+namespace {
+
+using app::ConfigurationError;
+using app::ConfigurationRule;
+using app::ObjectKind;
+
+// What the loader does with each kind of declaration. Every agent names its
+// objects and hands them over the same way; only Create's arguments differ.
+Result<ObjectId> createObject(const app::SemaphoreDeclaration& declaration)
+{
+    SemaphoreAttributes attributes;
+    attributes.name = declaration.name;
+    attributes.kind = declaration.kind;
+    attributes.initialCount = declaration.initialCount;
+    attributes.maximumCount = declaration.maximumCount;
+    attributes.priorityInheritance = declaration.priorityInheritance;
+    attributes.order = declaration.order;
+    attributes.visibility = declaration.visibility;
+    return semaphoreAgent.Create(attributes);
+}
+
+Result<ObjectId> createObject(const app::MessagePortDeclaration& declaration)
+{
+    return messagePortAgent.Create(declaration.name, declaration.visibility, declaration.order);
+}
+
+Result<ObjectId> createObject(const app::PublisherDeclaration& declaration)
+{
+    return dsmAgent.Create(declaration.name, declaration.visibility);
+}
+
+Result<ObjectId> createObject(const app::BufferPoolDeclaration& declaration)
+{
+    return bufferPoolAgent.Create(declaration.area, declaration.areaBytes, declaration.bufferSize, declaration.name,
+                                  declaration.visibility);
+}
+
+Result<ObjectId> createObject(const app::HeapDeclaration& declaration)
+{
+    return heapAgent.Create(declaration.area, declaration.areaBytes, declaration.name, declaration.visibility);
+}
+
+Result<ObjectId> createObject(const app::TaskDeclaration& declaration)
+{
+    TaskAttributes attributes;
+    attributes.name = declaration.name;
+    attributes.priority = declaration.priority;
+    attributes.stackSize = declaration.stackSize;
+    attributes.timeSlicing = declaration.timeSlicing;
+    attributes.floatingPoint = declaration.floatingPoint;
+    attributes.superUser = declaration.superUser;
+    attributes.visibility = declaration.visibility;
+    return taskAgent.Create(attributes, declaration.entry, declaration.argument);
+}
+
+// The task a declaration names as its owner; null: it stays the system's.
+const char* ownerOf(const app::TaskDeclaration&) { return nullptr; }
+const char* ownerOf(const app::SemaphoreDeclaration& declaration) { return declaration.owner; }
+const char* ownerOf(const app::MessagePortDeclaration& declaration) { return declaration.receiver; }
+const char* ownerOf(const app::PublisherDeclaration& declaration) { return declaration.writer; }
+const char* ownerOf(const app::BufferPoolDeclaration& declaration) { return declaration.owner; }
+const char* ownerOf(const app::HeapDeclaration& declaration) { return declaration.owner; }
+
+struct KindServices {
+    ObjectKind kind;
+    Result<ObjectId> (*nameToObject)(const char* name);
+    Status (*remove)(ObjectId id);
+    Status (*addObjects)(size_t count);
+    Status (*transfer)(ObjectId id, ObjectId newOwner);
+    size_t capacity; ///< The table's size, for the message when it is full.
+};
+
+template <class Declaration>
+struct Kind;
+
+template <>
+struct Kind<app::TaskDeclaration> {
+    static constexpr KindServices services{
+        ObjectKind::Task, [](const char* name) { return taskAgent.NameToObject(name); },
+        [](ObjectId id) { return taskAgent.KillTask(id); }, [](size_t count) { return taskAgent.AddObjects(count); },
+        nullptr, kTaskCapacity};
+};
+template <>
+struct Kind<app::SemaphoreDeclaration> {
+    static constexpr KindServices services{
+        ObjectKind::Semaphore, [](const char* name) { return semaphoreAgent.NameToObject(name); },
+        [](ObjectId id) { return semaphoreAgent.Delete(id); },
+        [](size_t count) { return semaphoreAgent.AddObjects(count); },
+        [](ObjectId id, ObjectId owner) { return semaphoreAgent.XferOwnership(id, owner); }, kSemaphoreCapacity};
+};
+template <>
+struct Kind<app::MessagePortDeclaration> {
+    static constexpr KindServices services{
+        ObjectKind::MessagePort, [](const char* name) { return messagePortAgent.NameToObject(name); },
+        [](ObjectId id) { return messagePortAgent.Delete(id); },
+        [](size_t count) { return messagePortAgent.AddObjects(count); },
+        [](ObjectId id, ObjectId owner) { return messagePortAgent.XferOwnership(id, owner); }, kPortCapacity};
+};
+template <>
+struct Kind<app::PublisherDeclaration> {
+    static constexpr KindServices services{
+        ObjectKind::Publisher, [](const char* name) { return dsmAgent.NameToObject(name); },
+        [](ObjectId id) { return dsmAgent.Delete(id); }, [](size_t count) { return dsmAgent.AddObjects(count); },
+        [](ObjectId id, ObjectId owner) { return dsmAgent.XferOwnership(id, owner); }, kPublisherCapacity};
+};
+template <>
+struct Kind<app::BufferPoolDeclaration> {
+    static constexpr KindServices services{
+        ObjectKind::BufferPool, [](const char* name) { return bufferPoolAgent.NameToObject(name); },
+        [](ObjectId id) { return bufferPoolAgent.Delete(id); },
+        [](size_t count) { return bufferPoolAgent.AddObjects(count); },
+        [](ObjectId id, ObjectId owner) { return bufferPoolAgent.XferOwnership(id, owner); }, kPoolCapacity};
+};
+template <>
+struct Kind<app::HeapDeclaration> {
+    static constexpr KindServices services{
+        ObjectKind::Heap, [](const char* name) { return heapAgent.NameToObject(name); },
+        [](ObjectId id) { return heapAgent.Delete(id); }, [](size_t count) { return heapAgent.AddObjects(count); },
+        [](ObjectId id, ObjectId owner) { return heapAgent.XferOwnership(id, owner); }, kHeapCapacity};
+};
+
+// Slots are activated in groups of eight (ObjectTable::AddObjects).
+constexpr size_t kSlotGroup = 8;
+
+ConfigurationError broken(ConfigurationRule rule, ObjectKind kind, const char* name, size_t value = 0,
+                          size_t limit = 0)
+{
+    return ConfigurationError{rule, kind, name, value, limit};
+}
+
+template <class Declaration>
+ConfigurationError checkNamesUnused(const app::DeclarationList<Declaration>& list)
+{
+    const KindServices& services = Kind<Declaration>::services;
+    for (const Declaration& declaration : list) {
+        if (services.nameToObject(declaration.name).ok()) {
+            return broken(ConfigurationRule::NameInUse, services.kind, declaration.name);
+        }
+    }
+    return {};
+}
+
+// Creates the objects of one list; @p created counts those that exist, for the roll-back.
+template <class Declaration>
+ConfigurationError createAll(const app::DeclarationList<Declaration>& list, size_t& created)
+{
+    const KindServices& services = Kind<Declaration>::services;
+    for (const Declaration& declaration : list) {
+        Result<ObjectId> id = createObject(declaration);
+        if (!id.ok() && id.status() == Status::TableFull) {
+            // The table has room beyond its active slots: activate a group
+            // (a configuration service, which the loader may use as root).
+            const Status added = services.addObjects(kSlotGroup);
+            if (added != Status::Ok) {
+                // value: the table's used slots with this object; limit: its size.
+                return broken(ConfigurationRule::TooManyObjects, services.kind, declaration.name,
+                              services.capacity + 1, services.capacity);
+            }
+            id = createObject(declaration);
+        }
+        if (!id.ok()) {
+            return broken(ConfigurationRule::CreateFailed, services.kind, declaration.name,
+                          static_cast<size_t>(id.status()));
+        }
+        ++created;
+    }
+    return {};
+}
+
+// Hands every object to its declared owner and stores the ids.
+template <class Declaration>
+ConfigurationError handOver(const app::DeclarationList<Declaration>& list)
+{
+    const KindServices& services = Kind<Declaration>::services;
+    for (const Declaration& declaration : list) {
+        const ObjectId id = services.nameToObject(declaration.name).value();
+        if (const char* owner = ownerOf(declaration); owner != nullptr) {
+            const Result<ObjectId> task = taskAgent.NameToObject(owner);
+            const Status transferred = task.ok() ? services.transfer(id, task.value()) : task.status();
+            if (transferred != Status::Ok) {
+                return broken(ConfigurationRule::CreateFailed, services.kind, declaration.name,
+                              static_cast<size_t>(transferred));
+            }
+        }
+        if (declaration.id != nullptr) {
+            *declaration.id = id;
+        }
+    }
+    return {};
+}
+
+// Deletes the first @p count objects of a list, last first. The names were
+// checked unused before any was created, so each name finds the loader's object.
+template <class Declaration>
+unsigned removeFirst(const app::DeclarationList<Declaration>& list, size_t count)
+{
+    const KindServices& services = Kind<Declaration>::services;
+    unsigned removed = 0;
+    for (size_t i = count; i-- > 0;) {
+        const Result<ObjectId> id = services.nameToObject(list[i].name);
+        if (id.ok() && services.remove(id.value()) == Status::Ok) {
+            ++removed;
+        }
+        if (list[i].id != nullptr) {
+            *list[i].id = ObjectId{};
+        }
+    }
+    return removed;
+}
+
+// How far creation got, for the roll-back.
+struct Progress {
+    size_t semaphores = 0;
+    size_t ports = 0;
+    size_t publishers = 0;
+    size_t pools = 0;
+    size_t heaps = 0;
+    size_t tasks = 0;
+};
+
+unsigned rollBack(const app::Application& application, const Progress& progress)
+{
+    // Tasks first: none has run yet, and killing them first means no task
+    // ever sees one of its objects vanish.
+    return removeFirst(application.tasks, progress.tasks) + removeFirst(application.heaps, progress.heaps)
+         + removeFirst(application.bufferPools, progress.pools) + removeFirst(application.publishers, progress.publishers)
+         + removeFirst(application.messagePorts, progress.ports) + removeFirst(application.semaphores, progress.semaphores);
+}
+
+ConfigurationError createEverything(const app::Application& application, Progress& progress)
+{
+    // One step after the other, stopping at the first failure. Tasks come
+    // last, so that every object a task is handed exists.
+    ConfigurationError error = createAll(application.semaphores, progress.semaphores);
+    if (error.ok()) error = createAll(application.messagePorts, progress.ports);
+    if (error.ok()) error = createAll(application.publishers, progress.publishers);
+    if (error.ok()) error = createAll(application.bufferPools, progress.pools);
+    if (error.ok()) error = createAll(application.heaps, progress.heaps);
+    if (error.ok()) error = createAll(application.tasks, progress.tasks);
+    if (error.ok()) error = handOver(application.tasks);
+    if (error.ok()) error = handOver(application.semaphores);
+    if (error.ok()) error = handOver(application.messagePorts);
+    if (error.ok()) error = handOver(application.publishers);
+    if (error.ok()) error = handOver(application.bufferPools);
+    if (error.ok()) error = handOver(application.heaps);
+    return error;
+}
+
+ConfigurationError checkOnNode(const app::Application& application)
+{
+    ConfigurationError error = app::findConfigurationError(application);
+    if (error.ok()) error = checkNamesUnused(application.tasks);
+    if (error.ok()) error = checkNamesUnused(application.semaphores);
+    if (error.ok()) error = checkNamesUnused(application.messagePorts);
+    if (error.ok()) error = checkNamesUnused(application.publishers);
+    if (error.ok()) error = checkNamesUnused(application.bufferPools);
+    if (error.ok()) error = checkNamesUnused(application.heaps);
+    return error;
+}
+
+void printCount(runtime::CharacterSink& console, size_t count, const char* kind, bool& first)
+{
+    if (count == 0) {
+        return;
+    }
+    runtime::format(console, "%s%lu %s%s", first ? "" : ", ", static_cast<unsigned long>(count), kind,
+                    count == 1 ? "" : "s");
+    first = false;
+}
+
+} // namespace
+
+app::ConfigurationError ApplicationLoader::start(const app::Application& application)
+{
+    if (!currentTaskIsSuperUser()) {
+        return broken(ConfigurationRule::CreateFailed, ObjectKind::Application, application.name,
+                      static_cast<size_t>(Status::NotPermitted));
+    }
+    if (ConfigurationError error = checkOnNode(application); !error.ok()) {
+        return error;
+    }
+    // No new task may run before every object exists and every id is
+    // stored: a task would otherwise find its port's id still null.
+    Scheduler::holdDispatch();
+    Progress progress;
+    ConfigurationError error = createEverything(application, progress);
+    if (!error.ok()) {
+        rollBack(application, progress);
+    }
+    Scheduler::releaseDispatch();
+    return error;
+}
+
+unsigned ApplicationLoader::stop(const app::Application& application)
+{
+    Progress all;
+    all.tasks = application.tasks.count;
+    all.semaphores = application.semaphores.count;
+    all.ports = application.messagePorts.count;
+    all.publishers = application.publishers.count;
+    all.pools = application.bufferPools.count;
+    all.heaps = application.heaps.count;
+    Scheduler::holdDispatch();
+    const unsigned removed = rollBack(application, all);
+    Scheduler::releaseDispatch();
+    return removed;
+}
+
+Result<ObjectId> ApplicationLoader::find(app::ObjectKind kind, const char* name)
+{
+    switch (kind) {
+    case ObjectKind::Task: return Kind<app::TaskDeclaration>::services.nameToObject(name);
+    case ObjectKind::Semaphore: return Kind<app::SemaphoreDeclaration>::services.nameToObject(name);
+    case ObjectKind::MessagePort: return Kind<app::MessagePortDeclaration>::services.nameToObject(name);
+    case ObjectKind::Publisher: return Kind<app::PublisherDeclaration>::services.nameToObject(name);
+    case ObjectKind::BufferPool: return Kind<app::BufferPoolDeclaration>::services.nameToObject(name);
+    case ObjectKind::Heap: return Kind<app::HeapDeclaration>::services.nameToObject(name);
+    case ObjectKind::Application: break;
+    }
+    return Status::InvalidArgument;
+}
+
+const app::Application* ApplicationLoader::linked()
+{
+    return &dcosApplication != nullptr ? dcosApplication : nullptr;
+}
+
+void ApplicationLoader::startLinked()
+{
+    const app::Application* application = linked();
+    if (application == nullptr) {
+        return;
+    }
+    runtime::CharacterSink& console = bsp::console();
+    // Held over the report too, so that the line saying the application
+    // started comes before anything its tasks print.
+    Scheduler::holdDispatch();
+    lastError_ = start(*application);
+    if (!lastError_.ok()) {
+        state_ = State::Rejected;
+        formatConfigurationError(console, application->name, lastError_);
+        runtime::format(console, "\r\n");
+    } else {
+        state_ = State::Running;
+        runtime::format(console, "application '%s' started: ", application->name);
+        bool first = true;
+        printCount(console, application->tasks.count, "task", first);
+        printCount(console, application->semaphores.count, "semaphore", first);
+        printCount(console, application->messagePorts.count, "message port", first);
+        printCount(console, application->publishers.count, "publisher", first);
+        printCount(console, application->bufferPools.count, "buffer pool", first);
+        printCount(console, application->heaps.count, "heap", first);
+        runtime::format(console, "%s\r\n", first ? "no objects" : "");
+    }
+    Scheduler::releaseDispatch();
+}
+
+} // namespace dcos::internal

@@ -1,0 +1,121 @@
+# Builds, runs and tests a DCOS application kept in a directory of its own.
+#
+# This file is installed as <prefix>/share/dcos/application.mk. An
+# application's directory holds only its sources (*.cpp, *.S, in any
+# subfolder except build/ and tests/) and, optionally, its emulator tests
+# (tests/test_*.py). Its Makefile needs two lines:
+#
+#     DCOS ?= /opt/dcos
+#     include $(DCOS)/share/dcos/application.mk
+#
+# and then, in that directory:
+#
+#     make          builds build/<name>-486.elf (the default target, "app")
+#     make run      boots it on the emulated ISA 486 board, console on this terminal
+#     make test     runs tests/test_*.py against it in the emulator
+#     make clean    removes build/
+#
+# Without a Makefile: make -f <prefix>/share/dcos/application.mk APP=<dir> [target].
+# In the DCOS source tree, `make app|run|test-app APP=<dir>` does the same
+# through a staged installation in build/sdk.
+#
+# Variables: APP (the application's directory, default: the current one),
+# APP_BUILD (where objects and the image go, default $(APP)/build),
+# APP_CXXFLAGS (extra compiler flags), APP_JUNIT (a JUnit XML report for
+# `test`), V=1 (show commands).
+
+DCOS_SHARE := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
+DCOS_PREFIX := $(abspath $(DCOS_SHARE)/../..)
+include $(DCOS_SHARE)/board-486.mk
+
+APP ?= $(CURDIR)
+APP_DIR := $(abspath $(APP))
+APP_NAME := $(notdir $(APP_DIR))
+APP_BUILD ?= $(APP_DIR)/build
+APP_BUILD_DIR := $(abspath $(APP_BUILD))
+APP_IMAGE := $(APP_BUILD_DIR)/$(APP_NAME)-486.elf
+APP_Q := $(if $(filter 1,$(V)),,@)
+APP_PYTHON := /usr/bin/python3
+
+ifeq ($(wildcard $(APP_DIR)/.),)
+$(error application directory '$(APP)' does not exist)
+endif
+
+APP_SRCS := $(shell cd '$(APP_DIR)' && find . \( -path ./build -o -path ./tests -o -path './$(notdir $(APP_BUILD_DIR))' \) -prune \
+	-o \( -name '*.cpp' -o -name '*.S' \) -type f -print | sed 's|^\./||' | LC_ALL=C sort)
+APP_OBJS := $(patsubst %,$(APP_BUILD_DIR)/obj/%.o,$(APP_SRCS))
+APP_TESTS := $(wildcard $(APP_DIR)/tests/test_*.py)
+
+DCOS_LIBRARY_486 := $(DCOS_PREFIX)/lib/dcos/486/libdcos486.a
+DCOS_LINK_SCRIPT_486 := $(DCOS_PREFIX)/lib/dcos/486/link.ld
+APP_CPPFLAGS := -I$(DCOS_PREFIX)/include -I$(APP_DIR) -MMD -MP
+APP_ALL_CXXFLAGS := $(DCOS_486_CXXFLAGS) $(APP_CPPFLAGS) $(APP_CXXFLAGS)
+
+.PHONY: app run test clean
+.DEFAULT_GOAL := app
+.DELETE_ON_ERROR:
+
+app: $(APP_IMAGE)
+
+# The image: the application's objects, then the whole DCOS library (whole,
+# because shell commands and recovery functions register through linker
+# sections that nothing else references). It must declare its application
+# and, like the kernel, hold no instruction a 486 lacks.
+$(APP_IMAGE): $(APP_OBJS) $(DCOS_LIBRARY_486) $(DCOS_LINK_SCRIPT_486)
+	@if [ -z '$(APP_SRCS)' ]; then echo "error: $(APP_DIR) holds no .cpp or .S source" >&2; exit 1; fi
+	@echo "  LD      $@"
+	$(APP_Q)ld $(DCOS_486_LDFLAGS) -T $(DCOS_LINK_SCRIPT_486) -o $@ $(APP_OBJS) \
+		--whole-archive $(DCOS_LIBRARY_486) --no-whole-archive
+	$(APP_Q)if ! nm $@ | grep -q ' [DdRr] dcosApplication$$'; then \
+		echo "error: no source of $(APP_DIR) declares its application with DCOS_APPLICATION (dcos/Application.hpp)" >&2; \
+		rm -f $@; exit 1; fi
+	$(APP_Q)$(APP_PYTHON) $(DCOS_SHARE)/tools/check_i486.py $@ || { rm -f $@; exit 1; }
+	@echo "application $(APP_NAME): $@"
+
+# Objects depend on the flags and on the DCOS they were compiled against.
+APP_FLAGS_STAMP := $(APP_BUILD_DIR)/flags.stamp
+$(APP_FLAGS_STAMP): FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(APP_ALL_CXXFLAGS) $(DCOS_PREFIX)' > $@.new
+	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+
+$(APP_BUILD_DIR)/obj/%.cpp.o: $(APP_DIR)/%.cpp $(APP_FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $<"
+	$(APP_Q)g++ $(APP_ALL_CXXFLAGS) -c $< -o $@
+
+$(APP_BUILD_DIR)/obj/%.S.o: $(APP_DIR)/%.S $(APP_FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  AS      $<"
+	$(APP_Q)g++ $(DCOS_486_ASFLAGS) $(APP_CPPFLAGS) -c $< -o $@
+
+run: app
+	@$(APP_PYTHON) $(DCOS_SHARE)/python/launch.py --board isa486 --image $(APP_IMAGE)
+
+# The application's own emulator tests, with the lab's fixtures (the
+# `application` fixture boots this image). No tests is not a failure, but it is said.
+test: app
+ifeq ($(APP_TESTS),)
+	@echo "application $(APP_NAME): no tests (add tests/test_*.py to $(APP_DIR))"
+else
+	$(APP_Q)cd '$(APP_DIR)' && PYTHONPATH='$(DCOS_SHARE)/python' PYTHONDONTWRITEBYTECODE=1 \
+		$(APP_PYTHON) -m pytest -c '$(DCOS_SHARE)/pytest.ini' --rootdir '$(APP_DIR)' -p dcoslab.pytest_plugin \
+		--dcos-board isa486 --dcos-image '$(APP_IMAGE)' $(if $(APP_JUNIT),--junitxml='$(APP_JUNIT)') \
+		$(APP_PYTEST_ARGS) tests
+endif
+
+clean:
+	rm -rf '$(APP_BUILD_DIR)'
+
+.PHONY: FORCE
+FORCE:
+
+# A build folder that last built another directory's application (the tree
+# keys build/apps/ by name only) starts afresh: its dependency files name
+# the other directory's sources.
+ifneq ($(shell cat '$(APP_BUILD_DIR)/application-directory' 2>/dev/null),$(APP_DIR))
+$(shell rm -rf '$(APP_BUILD_DIR)/obj' '$(APP_BUILD_DIR)/flags.stamp'; mkdir -p '$(APP_BUILD_DIR)' && \
+	printf '%s\n' '$(APP_DIR)' > '$(APP_BUILD_DIR)/application-directory')
+endif
+
+-include $(shell find '$(APP_BUILD_DIR)/obj' -name '*.d' 2>/dev/null)

@@ -1,0 +1,88 @@
+#!/bin/sh
+# Installs DCOS for building applications outside the source tree.
+#
+#   mk/install-sdk.sh <prefix> <library> <production image> <board flags file> <emulator>
+#
+# Called by 'make install PREFIX=<prefix>' and, for the tree's own 'make app',
+# with the prefix build/sdk. Lays out:
+#
+#   include/                     the firmware's public and internal headers
+#   lib/dcos/486/libdcos486.a    the kernel, board support, shell and drivers
+#   lib/dcos/486/link.ld         the image's memory layout
+#   lib/dcos/486/dcos486.elf     the plain controller image (no application)
+#   share/dcos/application.mk    the application build (see its header)
+#   share/dcos/board-486.mk      the compiler and linker flags of the 486 board
+#   share/dcos/boards/           the emulated boards
+#   share/dcos/python/           the emulator lab (dcoslab) and its launcher
+#   share/dcos/pytest.ini        pytest settings for applications' tests
+#   share/dcos/tools/            the i486 instruction check
+#   libexec/dcos/                the emulator built with the DCOS board models
+#
+# Nothing installed refers back to the source tree, and the paths inside are
+# relative, so the prefix can be moved as a whole. Files are replaced only
+# when their content changes, so a repeated install is quick and keeps times.
+set -eu
+
+[ $# -eq 5 ] || { echo "usage: $0 <prefix> <library> <production image> <board flags file> <emulator>" >&2; exit 2; }
+prefix=$1
+library=$2
+image=$3
+board_flags=$4
+emulator=$5
+
+# Copies a file if it differs, creating directories on the way.
+put() {
+    mkdir -p "$(dirname "$2")"
+    if ! cmp -s "$1" "$2"; then
+        cp "$1" "$2.new"
+        mv "$2.new" "$2"
+    fi
+}
+
+for include_dir in firmware/*/include drivers/*/include; do
+    (cd "$include_dir" && find . -name '*.hpp' -type f) | while read -r header; do
+        put "$include_dir/$header" "$prefix/include/$header"
+    done
+done
+
+put "$library" "$prefix/lib/dcos/486/libdcos486.a"
+put firmware/boot/link.ld "$prefix/lib/dcos/486/link.ld"
+put "$image" "$prefix/lib/dcos/486/dcos486.elf"
+
+put mk/application.mk "$prefix/share/dcos/application.mk"
+put "$board_flags" "$prefix/share/dcos/board-486.mk"
+put host_tools/isa_check/check_i486.py "$prefix/share/dcos/tools/check_i486.py"
+put tests_renode/pytest.ini "$prefix/share/dcos/pytest.ini"
+put tests_renode/launch.py "$prefix/share/dcos/python/launch.py"
+for module in tests_renode/dcoslab/*.py; do
+    put "$module" "$prefix/share/dcos/python/dcoslab/$(basename "$module")"
+done
+
+# The boards, with the plain controller image as their production image.
+mkdir -p "$prefix/share/dcos/boards"
+for board in tests_renode/boards/*.json; do
+    /usr/bin/python3 - "$board" "$prefix/share/dcos/boards/$(basename "$board").new" <<'PYTHON'
+import json, sys
+board = json.load(open(sys.argv[1], encoding="utf-8"))
+board["images"] = {"production": "lib/dcos/486/dcos486.elf"}
+with open(sys.argv[2], "w", encoding="utf-8") as handle:
+    json.dump(board, handle, indent=4)
+    handle.write("\n")
+PYTHON
+    target="$prefix/share/dcos/boards/$(basename "$board")"
+    if cmp -s "$target.new" "$target"; then rm -f "$target.new"; else mv "$target.new" "$target"; fi
+done
+
+# Tells dcoslab it runs from an installation (tests_renode/dcoslab/layout.py).
+layout=$(mktemp)
+printf '{"root": "../../../..", "boards": "share/dcos/boards", "emulator_dir": "libexec/dcos"}\n' > "$layout"
+put "$layout" "$prefix/share/dcos/python/dcoslab/installed_layout.json"
+rm -f "$layout"
+
+# The emulator, stripped of its debug information (about a quarter of the size).
+mkdir -p "$prefix/libexec/dcos"
+stripped=$(mktemp)
+strip -o "$stripped" "$emulator"
+chmod 755 "$stripped"
+put "$stripped" "$prefix/libexec/dcos/qemu-system-i386"
+rm -f "$stripped"

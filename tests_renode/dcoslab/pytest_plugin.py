@@ -1,0 +1,96 @@
+"""The lab's pytest fixtures, for the repository's suite and for applications' own tests.
+
+The repository's tests_renode/conftest.py loads this plugin; an application's
+tests get it from `make test-app` (or its own `make test` against an installed
+DCOS), which runs pytest with `-p dcoslab.pytest_plugin --dcos-image=<image>`.
+
+Fixtures:
+- `boot(board, kind="production", append="", icount=False, ...)` starts a
+  board image and stops it after the test;
+- `isa486`: the ISA 486 board definition;
+- `dcos_board`: the board named by --dcos-board (default isa486);
+- `dcos_image`: the image named by --dcos-image (an application's tests);
+- `application`: a booted emulator running --dcos-image on --dcos-board,
+  with exact emulated time (-icount), at its first shell prompt.
+
+The console transcript of every emulator a test started is attached to the
+report of a failing test, so it is always printed with the failure.
+"""
+
+import os
+
+import pytest
+
+from .board import load_board
+from .emulator import Emulator
+
+
+def pytest_addoption(parser):
+    group = parser.getgroup("dcos", "DCOS emulator lab")
+    group.addoption("--dcos-image", default=None, help="firmware image the `application` fixture boots")
+    group.addoption("--dcos-board", default="isa486", help="board the `application` fixture boots (default isa486)")
+
+
+@pytest.fixture
+def isa486():
+    return load_board("isa486")
+
+
+@pytest.fixture
+def dcos_board(request):
+    return load_board(request.config.getoption("--dcos-board"))
+
+
+@pytest.fixture
+def dcos_image(request):
+    image = request.config.getoption("--dcos-image")
+    if not image:
+        raise pytest.UsageError("this test needs --dcos-image=<firmware image> (make test-app passes it)")
+    if not os.path.exists(image):
+        raise pytest.UsageError(f"--dcos-image {image} does not exist; build the application first")
+    return os.path.abspath(image)
+
+
+@pytest.fixture
+def boot(request):
+    """boot(board, kind="production", append="", icount=False, ...) -> running Emulator.
+
+    kind is an image kind of the board ("production", "test", ...) or the
+    path of an image file. Optional, per test: device_properties={"isa-mfio":
+    {"no-irq": "on"}} adds or replaces device properties, without_devices=
+    ["isa-mfio"] leaves devices out, extra_args=[...] go to the emulator as
+    they are.
+    """
+    started = []
+    request.node.dcos_emulators = started
+
+    def start(board, kind="production", append="", icount=False, device_properties=None, without_devices=(),
+              extra_args=()):
+        image = kind if os.path.sep in kind else board.image(kind)
+        emulator = Emulator(board, image, append=append, icount=icount, device_properties=device_properties,
+                            without_devices=without_devices, extra_args=extra_args)
+        started.append(emulator)
+        return emulator.start()
+
+    yield start
+    for emulator in started:
+        emulator.close()
+
+
+@pytest.fixture
+def application(boot, dcos_board, dcos_image):
+    """The application image booted with exact emulated time, at its first prompt."""
+    emulator = boot(dcos_board, dcos_image, icount=True)
+    emulator.expect(r"dcos> ")
+    return emulator
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    report = outcome.get_result()
+    if report.failed:
+        for index, emulator in enumerate(getattr(item, "dcos_emulators", [])):
+            report.sections.append(
+                (f"console transcript of emulator {index + 1}: {' '.join(getattr(emulator, 'argv', []))}", emulator.transcript)
+            )

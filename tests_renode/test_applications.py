@@ -1,0 +1,334 @@
+"""Applications outside the tree (seed 8.2): built, booted and tested against
+the tree and against an installed DCOS, and every configuration error named.
+
+The application build is mk/application.mk, installed as
+share/dcos/application.mk; `make test` stages an installation in build/sdk,
+which most tests here use directly, so that they never run two top-level
+makes at once. The on-target loader tests live in
+tests_renode/target/ApplicationLoaderTest.cpp.
+"""
+
+import os
+import re
+import shutil
+import subprocess
+import textwrap
+
+import pytest
+
+from dcoslab.board import REPOSITORY
+from dcoslab.target import run_target_test
+
+STAGED_SDK = os.path.join(REPOSITORY, "build", "sdk")
+APPLICATION_MAKEFILE = os.path.join(STAGED_SDK, "share", "dcos", "application.mk")
+COUNTER_EXAMPLE = os.path.join(REPOSITORY, "docs", "examples", "counter")
+# Generous: bounds a hung build or nested test run, it does not measure speed.
+BUILD_TIMEOUT = 600
+
+APPLICATION_TARGET_TESTS = [
+    "appstart",  # every kind of object created, ids stored before any task runs, owners, stop
+    "apprules",  # the compiler's rules checked again at run time: priority, stack, duplicate, reserved name
+    "appfail",   # name in use, full table, no stack memory, overlapping areas: named, and all rolled back
+]
+
+
+@pytest.mark.parametrize("name", APPLICATION_TARGET_TESTS)
+def test_application_loader(boot, isa486, name):
+    run_target_test(boot(isa486, "test", icount=True), name)
+
+
+def test_image_without_an_application_says_so(boot, isa486):
+    emulator = boot(isa486)
+    emulator.expect(r"dcos> ")
+    assert emulator.command("app").strip() == "no application is linked into this image"
+
+
+# --- Building applications with the staged installation ----------------------
+
+HELLO_SOURCE = """\
+#include <dcos/Application.hpp>
+#include <bsp/Board.hpp>
+#include <runtime/Format.hpp>
+
+namespace {{
+dcos::ObjectId greetings;
+
+void greeter(uintptr_t)
+{{
+    dcos::Message message{{}};
+    message.bytes[0] = 7;
+    dcos::messagePortAgent.Send(greetings, message, 0);
+}}
+
+void listener(uintptr_t)
+{{
+    dcos::Message message{{}};
+    if (dcos::messagePortAgent.Receive(greetings, message, dcos::kWaitForever) == dcos::Status::Ok) {{
+        runtime::format(bsp::console(), "listener heard %u\\r\\n", static_cast<unsigned>(message.bytes[0]));
+    }}
+    // Stays, and with it the port it owns: a task that ends takes its objects along.
+    dcos::taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
+}}
+
+constexpr dcos::app::TaskDeclaration tasks[] = {{
+    {{.name = "greeter", .entry = greeter, .priority = {greeter_priority}, .stackSize = {greeter_stack}}},
+    {{.name = "{listener_name}", .entry = listener, .priority = 8}},
+}};
+constexpr dcos::app::MessagePortDeclaration ports[] = {{
+    {{.name = "greetings", .receiver = "listener", .id = &greetings}},
+}};
+}} // namespace
+
+DCOS_APPLICATION(hello, {{.name = "hello", .tasks = tasks, .messagePorts = ports}});
+"""
+
+HELLO_TEST = """\
+import re
+
+
+def test_listener_hears_the_greeter(application):
+    assert "listener heard 7" in application.transcript
+    listing = application.command("app")
+    assert "application 'hello': running" in listing
+    assert re.search(r"message port greetings +0x[0-9a-f]{8}  listener", listing)
+"""
+
+
+def write_hello(directory, greeter_priority=4, greeter_stack=4096, listener_name="listener", with_test=False):
+    os.makedirs(directory, exist_ok=True)
+    with open(os.path.join(directory, "hello.cpp"), "w", encoding="utf-8") as handle:
+        handle.write(HELLO_SOURCE.format(greeter_priority=greeter_priority, greeter_stack=greeter_stack,
+                                         listener_name=listener_name))
+    if with_test:
+        os.makedirs(os.path.join(directory, "tests"), exist_ok=True)
+        with open(os.path.join(directory, "tests", "test_hello.py"), "w", encoding="utf-8") as handle:
+            handle.write(HELLO_TEST)
+    return directory
+
+
+def build_with_staged_sdk(directory, target="app"):
+    """Runs the staged application build; returns the completed process."""
+    return subprocess.run(
+        ["make", "--no-print-directory", "-f", APPLICATION_MAKEFILE, f"APP={directory}", target],
+        capture_output=True, text=True, timeout=BUILD_TIMEOUT,
+    )
+
+
+def expect_build_failure(directory, *phrases):
+    result = build_with_staged_sdk(directory)
+    output = result.stdout + result.stderr
+    assert result.returncode != 0, output
+    for phrase in phrases:
+        assert phrase in output, f"{phrase!r} not in the build's output:\n{output}"
+    return output
+
+
+@pytest.mark.parametrize("change, phrases", [
+    (dict(greeter_priority=40), ['ObjectName{"greeter"}', "PriorityOutOfRange, 40, 31",
+                                 "a task's priority must be 0 (highest) to 31 (lowest)"]),
+    (dict(greeter_stack=1024), ['ObjectName{"greeter"}', "StackTooSmall, 1024, 2048",
+                                "the task's stack is smaller than dcos::kMinimumStackSize"]),
+    (dict(listener_name="greeter"), ['ObjectName{"greeter"}', "DuplicateName",
+                                     "two objects of this kind have this name"]),
+    (dict(listener_name="shell"), ['ObjectName{"shell"}', "ReservedName", "the name of a kernel task"]),
+    (dict(listener_name="talker"), ['ObjectName{"greetings"}', "OwnerNotDeclared",
+                                    "its owner, receiver or writer is not a declared task"]),
+])
+def test_configuration_errors_name_the_object_at_compile_time(tmp_path, change, phrases):
+    application = write_hello(str(tmp_path / "hello"), **change)
+    output = expect_build_failure(application, *phrases)
+    assert "DCOS_APPLICATION: the configuration breaks the rule named above" in output
+    assert not os.path.exists(os.path.join(application, "build", "hello-486.elf"))
+
+
+def test_too_many_tasks_names_the_first_that_does_not_fit(tmp_path):
+    # The task table holds 256 tasks, two of which are the kernel's.
+    directory = tmp_path / "crowd"
+    directory.mkdir()
+    declarations = ",\n".join(f'    {{.name = "worker{i}", .entry = work, .stackSize = 2048}}' for i in range(255))
+    (directory / "crowd.cpp").write_text(textwrap.dedent("""\
+        #include <dcos/Application.hpp>
+        void work(uintptr_t) {}
+        constexpr dcos::app::TaskDeclaration tasks[] = {
+        %s
+        };
+        DCOS_APPLICATION(crowd, {.name = "crowd", .tasks = tasks});
+        """) % declarations)
+    expect_build_failure(str(directory), 'ObjectName{"worker254"}', "TooManyObjects, 257, 256",
+                         "too many objects of this kind")
+
+
+def test_directory_without_an_application_is_refused_clearly(tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    expect_build_failure(str(empty), f"error: {empty} holds no .cpp or .S source")
+
+    undeclared = tmp_path / "undeclared"
+    undeclared.mkdir()
+    (undeclared / "main.cpp").write_text("void unused() {}\n")
+    expect_build_failure(str(undeclared), "declares its application with DCOS_APPLICATION")
+
+    missing = tmp_path / "missing"
+    result = build_with_staged_sdk(str(missing))
+    assert result.returncode != 0
+    assert f"application directory '{missing}' does not exist" in result.stderr
+
+
+def test_configuration_error_only_the_node_finds_is_named_at_boot(tmp_path, boot, isa486):
+    # Two pools over one area pass every compile-time rule; the pool agent
+    # refuses the second at boot. Nothing of the application is created, and
+    # the console still comes up to say why.
+    directory = tmp_path / "overlap"
+    directory.mkdir()
+    (directory / "overlap.cpp").write_text(textwrap.dedent("""\
+        #include <dcos/Application.hpp>
+        #include <dcos/BufferPoolAgent.hpp>
+        alignas(8) static uint8_t area[dcos::BufferPoolAgent::AreaBytes(16, 8)];
+        void work(uintptr_t) {}
+        constexpr dcos::app::TaskDeclaration tasks[] = {{.name = "worker", .entry = work}};
+        constexpr dcos::app::BufferPoolDeclaration pools[] = {
+            {.name = "frames", .area = area, .areaBytes = sizeof area, .bufferSize = 16},
+            {.name = "replies", .area = area, .areaBytes = sizeof area, .bufferSize = 16},
+        };
+        DCOS_APPLICATION(overlap, {.name = "overlap", .tasks = tasks, .bufferPools = pools});
+        """))
+    result = build_with_staged_sdk(str(directory))
+    assert result.returncode == 0, result.stdout + result.stderr
+    emulator = boot(isa486, str(directory / "build" / "overlap-486.elf"))
+    emulator.expect(r"application 'overlap' not started: buffer pool 'replies' was refused by its agent "
+                    r"\(already exists\)")
+    emulator.expect(r"dcos> ")
+    assert "not started" in emulator.command("app")
+    assert "frames" not in emulator.command("pools")
+    assert "worker" not in emulator.command("tasks")
+
+
+def test_application_asks_for_its_tick_rate(tmp_path, boot, isa486):
+    directory = tmp_path / "fasttick"
+    directory.mkdir()
+    (directory / "fasttick.cpp").write_text(textwrap.dedent("""\
+        #include <dcos/Application.hpp>
+        void work(uintptr_t) {}
+        constexpr dcos::app::TaskDeclaration tasks[] = {{.name = "worker", .entry = work}};
+        DCOS_APPLICATION(fasttick, {.name = "fasttick", .tasks = tasks, .tickRateHz = 8000});
+        """))
+    result = build_with_staged_sdk(str(directory))
+    assert result.returncode == 0, result.stdout + result.stderr
+    image = str(directory / "build" / "fasttick-486.elf")
+    emulator = boot(isa486, image)
+    emulator.expect(r"tick 8000 Hz")
+    # The command line still wins.
+    emulator = boot(isa486, image, append="tick_hz=500")
+    emulator.expect(r"tick 500 Hz")
+
+
+# --- Against the tree (make test-app) and against an installed DCOS ----------
+
+def run_make(arguments, cwd=REPOSITORY):
+    result = subprocess.run(["make", "--no-print-directory"] + arguments, cwd=cwd, capture_output=True, text=True,
+                            timeout=BUILD_TIMEOUT)
+    assert result.returncode == 0, f"make {' '.join(arguments)} failed:\n{result.stdout}\n{result.stderr}"
+    return result.stdout + result.stderr
+
+
+def passed_count(output):
+    """The number of tests a nested pytest run reported passed (it exited 0)."""
+    match = re.search(r"(\d+) passed", output)
+    assert match, output
+    return int(match.group(1))
+
+
+def text_files_mentioning(root, needle):
+    found = []
+    for directory, _, files in os.walk(root):
+        for name in files:
+            path = os.path.join(directory, name)
+            try:
+                with open(path, encoding="utf-8") as handle:
+                    if needle in handle.read():
+                        found.append(path)
+            except (UnicodeDecodeError, OSError):
+                continue
+    return found
+
+
+def test_out_of_tree_application_against_the_tree_and_an_installed_dcos(tmp_path):
+    # One test, in order: both steps run top-level makes of this tree,
+    # which must not run side by side.
+    hello = write_hello(str(tmp_path / "hello"), with_test=True)
+    output = run_make(["test-app", f"APP={hello}"])
+    assert passed_count(output) == 1
+    # The tree's build keeps the application's directory clean.
+    assert sorted(os.listdir(hello)) == ["hello.cpp", "tests"]
+
+    prefix = tmp_path / "opt" / "dcos"
+    run_make(["install", f"PREFIX={prefix}"])
+    for installed in ["include/dcos/Application.hpp", "lib/dcos/486/libdcos486.a", "lib/dcos/486/link.ld",
+                      "share/dcos/application.mk", "share/dcos/boards/isa486.json",
+                      "share/dcos/python/dcoslab/pytest_plugin.py", "libexec/dcos/qemu-system-i386"]:
+        assert (prefix / installed).exists(), installed
+    assert text_files_mentioning(str(prefix), REPOSITORY) == [], "the installation refers to the source tree"
+
+    # The counter example, copied out as a user would, built with its own
+    # two-line Makefile against the installation, and its tests run.
+    counter = tmp_path / "counter"
+    shutil.copytree(COUNTER_EXAMPLE, counter, ignore=shutil.ignore_patterns("build", "__pycache__"))
+    output = run_make([f"DCOS={prefix}", "test"], cwd=str(counter))
+    assert passed_count(output) >= 1
+    assert (counter / "build" / "counter-486.elf").exists()
+
+    # The installation can be moved as a whole.
+    moved = tmp_path / "elsewhere" / "dcos"
+    moved.parent.mkdir()
+    shutil.move(str(prefix), str(moved))
+    run_make([f"DCOS={moved}", "clean"], cwd=str(counter))
+    output = run_make([f"DCOS={moved}", "test"], cwd=str(counter))
+    assert passed_count(output) >= 1
+
+
+# --- The guide's own application ----------------------------------------------
+
+GUIDE = os.path.join(REPOSITORY, "docs", "guide", "first-application.md")
+
+
+def guide_files():
+    """The files the guide writes: fenced blocks whose info string says file=<path>."""
+    with open(GUIDE, encoding="utf-8") as handle:
+        text = handle.read()
+    return dict((path, body) for path, body in
+                re.findall(r"^```\w+ file=(\S+)\n(.*?)^```$", text, flags=re.MULTILINE | re.DOTALL))
+
+
+def test_the_guides_application_builds_runs_and_passes_its_tests(tmp_path):
+    files = guide_files()
+    assert sorted(files) == ["Makefile", "tank.cpp", "tests/test_tank.py"]
+    tank = tmp_path / "tank"
+    for path, body in files.items():
+        (tank / path).parent.mkdir(parents=True, exist_ok=True)
+        (tank / path).write_text(body)
+    # Built as the guide says, with its Makefile, against the staged installation.
+    result = subprocess.run(["make", "--no-print-directory", f"DCOS={STAGED_SDK}", "test"], cwd=str(tank),
+                            capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert passed_count(result.stdout) == 2
+
+
+def test_run_boots_the_application_with_its_console_on_a_terminal(tmp_path):
+    # The application build's `run`, as `make run APP=<dir>` calls it, on a pseudo-terminal.
+    import pexpect
+
+    hello = write_hello(str(tmp_path / "hello"))
+    session = pexpect.spawn("make", ["--no-print-directory", "-f", APPLICATION_MAKEFILE, f"APP={hello}", "run"],
+                            timeout=120, encoding="latin-1")
+    try:
+        session.expect(r"application 'hello' started: 2 tasks, 1 message port")
+        session.expect(r"listener heard 7")
+        session.send("app\r")
+        session.expect(r"message port greetings +0x[0-9a-f]{8}  listener")
+        session.expect(r"dcos> ")
+        session.send("\x01x")
+        session.expect(pexpect.EOF)
+    except (pexpect.TIMEOUT, pexpect.EOF) as error:
+        raise AssertionError(f"run session failed: {error}\n----- console -----\n{session.before}") from None
+    finally:
+        session.close(force=True)
