@@ -79,10 +79,14 @@ $(APP_FLAGS_STAMP): FORCE
 	@echo '$(APP_ALL_CXXFLAGS) $(DCOS_PREFIX)' > $@.new
 	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
 
+# A failed compilation's messages end with a one-line summary when they hold
+# a configuration error (the compiler names the object in a template).
 $(APP_BUILD_DIR)/obj/%.cpp.o: $(APP_DIR)/%.cpp $(APP_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $<"
-	$(APP_Q)g++ $(APP_ALL_CXXFLAGS) -c $< -o $@
+	$(APP_Q)g++ $(APP_ALL_CXXFLAGS) -c $< -o $@ 2> $@.messages || { \
+		$(APP_PYTHON) $(DCOS_SHARE)/tools/explain_configuration_error.py $@.messages; rm -f $@.messages; exit 1; }
+	@cat $@.messages >&2; rm -f $@.messages
 
 $(APP_BUILD_DIR)/obj/%.S.o: $(APP_DIR)/%.S $(APP_FLAGS_STAMP)
 	@mkdir -p $(dir $@)

@@ -15,7 +15,7 @@
 #   share/dcos/boards/           the emulated boards
 #   share/dcos/python/           the emulator lab (dcoslab) and its launcher
 #   share/dcos/pytest.ini        pytest settings for applications' tests
-#   share/dcos/tools/            the i486 instruction check
+#   share/dcos/tools/            the i486 instruction check, the configuration error summary
 #   libexec/dcos/                the emulator built with the DCOS board models
 #
 # Nothing installed refers back to the source tree, and the paths inside are
@@ -52,6 +52,7 @@ put "$image" "$prefix/lib/dcos/486/dcos486.elf"
 put mk/application.mk "$prefix/share/dcos/application.mk"
 put "$board_flags" "$prefix/share/dcos/board-486.mk"
 put host_tools/isa_check/check_i486.py "$prefix/share/dcos/tools/check_i486.py"
+put host_tools/app_build/explain_configuration_error.py "$prefix/share/dcos/tools/explain_configuration_error.py"
 put tests_renode/pytest.ini "$prefix/share/dcos/pytest.ini"
 put tests_renode/launch.py "$prefix/share/dcos/python/launch.py"
 for module in tests_renode/dcoslab/*.py; do

@@ -38,7 +38,7 @@ $(QEMU_BINARY):
 	@$(QEMU_BUILD_SCRIPT)
 
 SDK_INPUTS := $(LIBRARY_486) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) mk/install-sdk.sh mk/application.mk \
-	firmware/boot/link.ld host_tools/isa_check/check_i486.py tests_renode/launch.py tests_renode/pytest.ini \
+	firmware/boot/link.ld host_tools/isa_check/check_i486.py host_tools/app_build/explain_configuration_error.py tests_renode/launch.py tests_renode/pytest.ini \
 	$(wildcard tests_renode/dcoslab/*.py tests_renode/boards/*.json) \
 	$(shell find firmware/*/include drivers/*/include -name '*.hpp')
 

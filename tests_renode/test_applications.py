@@ -125,14 +125,18 @@ def expect_build_failure(directory, *phrases):
 
 @pytest.mark.parametrize("change, phrases", [
     (dict(greeter_priority=40), ['ObjectName{"greeter"}', "PriorityOutOfRange, 40, 31",
-                                 "a task's priority must be 0 (highest) to 31 (lowest)"]),
+                                 "configuration error: task 'greeter': a task's priority must be 0 (highest) to 31 "
+                                 "(lowest) (value 40, limit 31)"]),
     (dict(greeter_stack=1024), ['ObjectName{"greeter"}', "StackTooSmall, 1024, 2048",
-                                "the task's stack is smaller than dcos::kMinimumStackSize"]),
+                                "configuration error: task 'greeter': the task's stack is smaller than "
+                                "dcos::kMinimumStackSize (limit) (value 1024, limit 2048)"]),
     (dict(listener_name="greeter"), ['ObjectName{"greeter"}', "DuplicateName",
-                                     "two objects of this kind have this name"]),
-    (dict(listener_name="shell"), ['ObjectName{"shell"}', "ReservedName", "the name of a kernel task"]),
+                                     "configuration error: task 'greeter': two objects of this kind have this name"]),
+    (dict(listener_name="shell"), ['ObjectName{"shell"}', "ReservedName",
+                                   "configuration error: task 'shell': this is the name of a kernel task"]),
     (dict(listener_name="talker"), ['ObjectName{"greetings"}', "OwnerNotDeclared",
-                                    "its owner, receiver or writer is not a declared task"]),
+                                    "configuration error: message port 'greetings': its owner, receiver or writer is "
+                                    "not a declared task"]),
 ])
 def test_configuration_errors_name_the_object_at_compile_time(tmp_path, change, phrases):
     application = write_hello(str(tmp_path / "hello"), **change)
@@ -155,7 +159,15 @@ def test_too_many_tasks_names_the_first_that_does_not_fit(tmp_path):
         DCOS_APPLICATION(crowd, {.name = "crowd", .tasks = tasks});
         """) % declarations)
     expect_build_failure(str(directory), 'ObjectName{"worker254"}', "TooManyObjects, 257, 256",
-                         "too many objects of this kind")
+                         "configuration error: task 'worker254': too many objects of this kind",
+                         "(value 257, limit 256)")
+
+
+def test_an_application_without_tests_says_so(tmp_path):
+    hello = write_hello(str(tmp_path / "hello"))
+    result = build_with_staged_sdk(hello, "test")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert f"application hello: no tests (add tests/test_*.py to {hello})" in result.stdout
 
 
 def test_directory_without_an_application_is_refused_clearly(tmp_path):

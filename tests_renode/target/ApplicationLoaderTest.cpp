@@ -15,6 +15,8 @@
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/StackArena.hpp>
 
+#include <runtime/Text.hpp>
+
 namespace target_test {
 
 namespace {
@@ -40,7 +42,7 @@ bool expectRejected(shell::Shell& shell, const ConfigurationError& error, Config
     shell.print("\r\n");
     bool ok = check(shell, error.rule == rule, "the rule broken");
     ok &= check(shell, error.kind == kind, "the kind of object named");
-    ok &= check(shell, error.object != nullptr && dcos::app::rules::sameName(error.object, object),
+    ok &= check(shell, error.object != nullptr && runtime::textEquals(error.object, object),
                 "the object named");
     return ok;
 }

@@ -5,6 +5,7 @@
 #include <arch_x86/PortIo.hpp>
 #include <boot/Panic.hpp>
 #include <bsp/Board.hpp>
+#include <runtime/Text.hpp>
 
 namespace target_test {
 
@@ -25,28 +26,19 @@ namespace {
 extern "C" const TargetTest __start_dcos_target_tests[];
 extern "C" const TargetTest __stop_dcos_target_tests[];
 
-bool sameText(const char* a, const char* b)
-{
-    while (*a != '\0' && *a == *b) {
-        ++a;
-        ++b;
-    }
-    return *a == *b;
-}
-
 shell::CommandResult runTest(shell::Shell& shell, int argc, char** argv)
 {
-    if (argc < 2 || argc > 3 || (argc == 3 && !sameText(argv[2], "--exit"))) {
+    if (argc < 2 || argc > 3 || (argc == 3 && !runtime::textEquals(argv[2], "--exit"))) {
         return shell::CommandResult::UsageError;
     }
-    if (sameText(argv[1], "list")) {
+    if (runtime::textEquals(argv[1], "list")) {
         for (const TargetTest* test = __start_dcos_target_tests; test != __stop_dcos_target_tests; ++test) {
             shell.print("  %-10s %s\r\n", test->name, test->summary);
         }
         return shell::CommandResult::Ok;
     }
     for (const TargetTest* test = __start_dcos_target_tests; test != __stop_dcos_target_tests; ++test) {
-        if (sameText(test->name, argv[1])) {
+        if (runtime::textEquals(test->name, argv[1])) {
             shell.print("TEST %s: start\r\n", test->name);
             const bool passed = test->run(shell);
             shell.print("TEST %s: %s\r\n", test->name, passed ? "PASS" : "FAIL");

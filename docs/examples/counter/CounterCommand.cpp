@@ -8,6 +8,7 @@
 #include "Counter.hpp"
 
 #include <dcos/TaskAgent.hpp>
+#include <runtime/Text.hpp>
 #include <shell/Shell.hpp>
 #include <shell/ShellCommand.hpp>
 
@@ -16,14 +17,6 @@ namespace counter {
 namespace {
 
 using shell::CommandResult;
-
-bool sameWord(const char* a, const char* b)
-{
-    size_t i = 0;
-    for (; a[i] != '\0' && a[i] == b[i]; ++i) {
-    }
-    return a[i] == b[i];
-}
 
 CommandResult printStatistics(shell::Shell& shell)
 {
@@ -65,10 +58,10 @@ CommandResult counterCommand(shell::Shell& shell, int argc, char** argv)
     if (argc == 1) {
         return printStatistics(shell);
     }
-    if (argc == 2 && sameWord(argv[1], "skip")) {
+    if (argc == 2 && runtime::textEquals(argv[1], "skip")) {
         return requestFault(shell, kSkipRequest, "skip one value");
     }
-    if (argc == 2 && sameWord(argv[1], "repeat")) {
+    if (argc == 2 && runtime::textEquals(argv[1], "repeat")) {
         return requestFault(shell, kRepeatRequest, "publish its last value again");
     }
     return CommandResult::UsageError;

@@ -11,6 +11,7 @@
 
 #include <bsp/Board.hpp>
 #include <dcos/Status.hpp>
+#include <runtime/Text.hpp>
 #include <shell/Shell.hpp>
 #include <shell/ShellCommand.hpp>
 
@@ -19,14 +20,6 @@ namespace freqmul {
 namespace {
 
 using shell::CommandResult;
-
-bool sameWord(const char* a, const char* b)
-{
-    size_t i = 0;
-    for (; a[i] != '\0' && a[i] == b[i]; ++i) {
-    }
-    return a[i] == b[i];
-}
 
 unsigned long asUnsigned(uint32_t value) { return static_cast<unsigned long>(value); }
 
@@ -118,7 +111,7 @@ CommandResult setWaves(shell::Shell& shell, int argc, char** argv)
 
 CommandResult freqmulCommand(shell::Shell& shell, int argc, char** argv)
 {
-    if (argc >= 2 && sameWord(argv[1], "set")) {
+    if (argc >= 2 && runtime::textEquals(argv[1], "set")) {
         return setWaves(shell, argc, argv);
     }
     if (argc != 1) {

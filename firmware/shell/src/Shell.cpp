@@ -1,5 +1,7 @@
 #include <shell/Shell.hpp>
 
+#include <runtime/Text.hpp>
+
 namespace shell {
 
 extern "C" {
@@ -12,23 +14,10 @@ const ShellCommand* CommandTable::begin() { return __start_dcos_shell_commands; 
 
 const ShellCommand* CommandTable::end() { return __stop_dcos_shell_commands; }
 
-namespace {
-
-bool sameText(const char* a, const char* b)
-{
-    while (*a != '\0' && *a == *b) {
-        ++a;
-        ++b;
-    }
-    return *a == *b;
-}
-
-} // namespace
-
 const ShellCommand* CommandTable::find(const char* name)
 {
     for (const ShellCommand* command = begin(); command != end(); ++command) {
-        if (sameText(command->name, name)) {
+        if (runtime::textEquals(command->name, name)) {
             return command;
         }
     }

@@ -13,6 +13,7 @@
 #include <dcos/BufferPoolAgent.hpp>
 #include <dcos/HeapAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <runtime/Text.hpp>
 
 #include <stddef.h>
 #include <stdint.h>
@@ -129,22 +130,8 @@ constexpr const char* ruleText(ConfigurationRule rule)
 
 namespace rules {
 
-constexpr size_t length(const char* text)
-{
-    size_t n = 0;
-    while (text[n] != '\0') {
-        ++n;
-    }
-    return n;
-}
-
-constexpr bool sameName(const char* a, const char* b)
-{
-    size_t i = 0;
-    for (; a[i] != '\0' && a[i] == b[i]; ++i) {
-    }
-    return a[i] == b[i];
-}
+using runtime::textEquals;
+using runtime::textLength;
 
 constexpr ConfigurationError broken(ConfigurationRule rule, ObjectKind kind, const char* object, size_t value = 0,
                                     size_t limit = 0)
@@ -161,11 +148,11 @@ constexpr ConfigurationError checkNames(const DeclarationList<Declaration>& list
         if (name == nullptr || name[0] == '\0') {
             return broken(ConfigurationRule::NameMissing, kind, nullptr, i);
         }
-        if (length(name) > kMaximumObjectName) {
-            return broken(ConfigurationRule::NameTooLong, kind, name, length(name), kMaximumObjectName);
+        if (textLength(name) > kMaximumObjectName) {
+            return broken(ConfigurationRule::NameTooLong, kind, name, textLength(name), kMaximumObjectName);
         }
         for (size_t j = 0; j < i; ++j) {
-            if (sameName(list[j].name, name)) {
+            if (textEquals(list[j].name, name)) {
                 return broken(ConfigurationRule::DuplicateName, kind, name);
             }
         }
@@ -176,7 +163,7 @@ constexpr ConfigurationError checkNames(const DeclarationList<Declaration>& list
 constexpr bool isDeclaredTask(const Application& application, const char* name)
 {
     for (const TaskDeclaration& task : application.tasks) {
-        if (sameName(task.name, name)) {
+        if (textEquals(task.name, name)) {
             return true;
         }
     }
@@ -196,7 +183,7 @@ constexpr ConfigurationError checkTasks(const Application& application)
     }
     for (const TaskDeclaration& task : application.tasks) {
         for (const char* reserved : kKernelTaskNames) {
-            if (sameName(task.name, reserved)) {
+            if (textEquals(task.name, reserved)) {
                 return broken(ConfigurationRule::ReservedName, ObjectKind::Task, task.name);
             }
         }
@@ -348,7 +335,7 @@ constexpr ConfigurationError findConfigurationError(const Application& applicati
     if (application.name == nullptr || application.name[0] == '\0') {
         return rules::broken(ConfigurationRule::NameMissing, ObjectKind::Application, nullptr);
     }
-    const size_t nameLength = rules::length(application.name);
+    const size_t nameLength = rules::textLength(application.name);
     if (nameLength > kMaximumApplicationName) {
         return rules::broken(ConfigurationRule::NameTooLong, ObjectKind::Application, application.name, nameLength,
                              kMaximumApplicationName);

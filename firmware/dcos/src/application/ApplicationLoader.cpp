@@ -94,11 +94,25 @@ struct KindServices {
     size_t capacity; ///< The table's size, for the message when it is full.
 };
 
+// The services of an agent whose objects are named, deleted, added and
+// handed over the same way (all but the task agent).
+template <const auto& agent>
+constexpr KindServices servicesOf(ObjectKind kind, size_t capacity)
+{
+    return KindServices{kind,
+                        [](const char* name) { return agent.NameToObject(name); },
+                        [](ObjectId id) { return agent.Delete(id); },
+                        [](size_t count) { return agent.AddObjects(count); },
+                        [](ObjectId id, ObjectId owner) { return agent.XferOwnership(id, owner); },
+                        capacity};
+}
+
 template <class Declaration>
 struct Kind;
 
 template <>
 struct Kind<app::TaskDeclaration> {
+    // A task is ended with KillTask, and the loader never hands one over.
     static constexpr KindServices services{
         ObjectKind::Task, [](const char* name) { return taskAgent.NameToObject(name); },
         [](ObjectId id) { return taskAgent.KillTask(id); }, [](size_t count) { return taskAgent.AddObjects(count); },
@@ -106,41 +120,23 @@ struct Kind<app::TaskDeclaration> {
 };
 template <>
 struct Kind<app::SemaphoreDeclaration> {
-    static constexpr KindServices services{
-        ObjectKind::Semaphore, [](const char* name) { return semaphoreAgent.NameToObject(name); },
-        [](ObjectId id) { return semaphoreAgent.Delete(id); },
-        [](size_t count) { return semaphoreAgent.AddObjects(count); },
-        [](ObjectId id, ObjectId owner) { return semaphoreAgent.XferOwnership(id, owner); }, kSemaphoreCapacity};
+    static constexpr KindServices services = servicesOf<semaphoreAgent>(ObjectKind::Semaphore, kSemaphoreCapacity);
 };
 template <>
 struct Kind<app::MessagePortDeclaration> {
-    static constexpr KindServices services{
-        ObjectKind::MessagePort, [](const char* name) { return messagePortAgent.NameToObject(name); },
-        [](ObjectId id) { return messagePortAgent.Delete(id); },
-        [](size_t count) { return messagePortAgent.AddObjects(count); },
-        [](ObjectId id, ObjectId owner) { return messagePortAgent.XferOwnership(id, owner); }, kPortCapacity};
+    static constexpr KindServices services = servicesOf<messagePortAgent>(ObjectKind::MessagePort, kPortCapacity);
 };
 template <>
 struct Kind<app::PublisherDeclaration> {
-    static constexpr KindServices services{
-        ObjectKind::Publisher, [](const char* name) { return dsmAgent.NameToObject(name); },
-        [](ObjectId id) { return dsmAgent.Delete(id); }, [](size_t count) { return dsmAgent.AddObjects(count); },
-        [](ObjectId id, ObjectId owner) { return dsmAgent.XferOwnership(id, owner); }, kPublisherCapacity};
+    static constexpr KindServices services = servicesOf<dsmAgent>(ObjectKind::Publisher, kPublisherCapacity);
 };
 template <>
 struct Kind<app::BufferPoolDeclaration> {
-    static constexpr KindServices services{
-        ObjectKind::BufferPool, [](const char* name) { return bufferPoolAgent.NameToObject(name); },
-        [](ObjectId id) { return bufferPoolAgent.Delete(id); },
-        [](size_t count) { return bufferPoolAgent.AddObjects(count); },
-        [](ObjectId id, ObjectId owner) { return bufferPoolAgent.XferOwnership(id, owner); }, kPoolCapacity};
+    static constexpr KindServices services = servicesOf<bufferPoolAgent>(ObjectKind::BufferPool, kPoolCapacity);
 };
 template <>
 struct Kind<app::HeapDeclaration> {
-    static constexpr KindServices services{
-        ObjectKind::Heap, [](const char* name) { return heapAgent.NameToObject(name); },
-        [](ObjectId id) { return heapAgent.Delete(id); }, [](size_t count) { return heapAgent.AddObjects(count); },
-        [](ObjectId id, ObjectId owner) { return heapAgent.XferOwnership(id, owner); }, kHeapCapacity};
+    static constexpr KindServices services = servicesOf<heapAgent>(ObjectKind::Heap, kHeapCapacity);
 };
 
 // Slots are activated in groups of eight (ObjectTable::AddObjects).
