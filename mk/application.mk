@@ -10,7 +10,7 @@
 #
 # and then, in that directory:
 #
-#     make          builds build/<name>-486.elf (the default target, "app")
+#     make          builds build/<name>-<board>.elf (the default target, "app")
 #     make run      boots it on the emulated ISA 486 board, console on this terminal
 #     make test     runs tests/test_*.py against it in the emulator
 #     make clean    removes build/
@@ -20,20 +20,30 @@
 # through a staged installation in build/sdk.
 #
 # Variables: APP (the application's directory, default: the current one),
+# BOARD (the board to build for, default 486; the installed ones are the
+# share/dcos/board-<board>.mk files),
 # APP_BUILD (where objects and the image go, default $(APP)/build),
 # APP_CXXFLAGS (extra compiler flags), APP_JUNIT (a JUnit XML report for
 # `test`), V=1 (show commands).
 
 DCOS_SHARE := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
 DCOS_PREFIX := $(abspath $(DCOS_SHARE)/../..)
-include $(DCOS_SHARE)/board-486.mk
+
+# Each board the installation builds for brings its compiler and linker
+# flags and the name of its emulated board (board-<board>.mk).
+BOARD ?= 486
+DCOS_BOARDS := $(patsubst board-%.mk,%,$(notdir $(wildcard $(DCOS_SHARE)/board-*.mk)))
+ifeq ($(filter $(BOARD),$(DCOS_BOARDS)),)
+$(error BOARD=$(BOARD) is not a board this DCOS builds for; its boards are: $(DCOS_BOARDS))
+endif
+include $(DCOS_SHARE)/board-$(BOARD).mk
 
 APP ?= $(CURDIR)
 APP_DIR := $(abspath $(APP))
 APP_NAME := $(notdir $(APP_DIR))
 APP_BUILD ?= $(APP_DIR)/build
 APP_BUILD_DIR := $(abspath $(APP_BUILD))
-APP_IMAGE := $(APP_BUILD_DIR)/$(APP_NAME)-486.elf
+APP_IMAGE := $(APP_BUILD_DIR)/$(APP_NAME)-$(BOARD).elf
 APP_Q := $(if $(filter 1,$(V)),,@)
 APP_PYTHON := /usr/bin/python3
 
@@ -46,10 +56,10 @@ APP_SRCS := $(shell cd '$(APP_DIR)' && find . \( -path ./build -o -path ./tests 
 APP_OBJS := $(patsubst %,$(APP_BUILD_DIR)/obj/%.o,$(APP_SRCS))
 APP_TESTS := $(wildcard $(APP_DIR)/tests/test_*.py)
 
-DCOS_LIBRARY_486 := $(DCOS_PREFIX)/lib/dcos/486/libdcos486.a
-DCOS_LINK_SCRIPT_486 := $(DCOS_PREFIX)/lib/dcos/486/link.ld
+DCOS_LIBRARY := $(DCOS_PREFIX)/lib/dcos/$(BOARD)/libdcos$(BOARD).a
+DCOS_LINK_SCRIPT := $(DCOS_PREFIX)/lib/dcos/$(BOARD)/link.ld
 APP_CPPFLAGS := -I$(DCOS_PREFIX)/include -I$(APP_DIR) -MMD -MP
-APP_ALL_CXXFLAGS := $(DCOS_486_CXXFLAGS) $(APP_CPPFLAGS) $(APP_CXXFLAGS)
+APP_ALL_CXXFLAGS := $(DCOS_BOARD_CXXFLAGS) $(APP_CPPFLAGS) $(APP_CXXFLAGS)
 
 .PHONY: app run test clean
 .DEFAULT_GOAL := app
@@ -61,15 +71,15 @@ app: $(APP_IMAGE)
 # because shell commands and recovery functions register through linker
 # sections that nothing else references). It must declare its application
 # and, like the kernel, hold no instruction a 486 lacks.
-$(APP_IMAGE): $(APP_OBJS) $(DCOS_LIBRARY_486) $(DCOS_LINK_SCRIPT_486)
+$(APP_IMAGE): $(APP_OBJS) $(DCOS_LIBRARY) $(DCOS_LINK_SCRIPT)
 	@if [ -z '$(APP_SRCS)' ]; then echo "error: $(APP_DIR) holds no .cpp or .S source" >&2; exit 1; fi
 	@echo "  LD      $@"
-	$(APP_Q)ld $(DCOS_486_LDFLAGS) -T $(DCOS_LINK_SCRIPT_486) -o $@ $(APP_OBJS) \
-		--whole-archive $(DCOS_LIBRARY_486) --no-whole-archive
+	$(APP_Q)ld $(DCOS_BOARD_LDFLAGS) -T $(DCOS_LINK_SCRIPT) -o $@ $(APP_OBJS) \
+		--whole-archive $(DCOS_LIBRARY) --no-whole-archive
 	$(APP_Q)if ! nm $@ | grep -q ' [DdRr] dcosApplication$$'; then \
 		echo "error: no source of $(APP_DIR) declares its application with DCOS_APPLICATION (dcos/Application.hpp)" >&2; \
 		rm -f $@; exit 1; fi
-	$(APP_Q)$(APP_PYTHON) $(DCOS_SHARE)/tools/check_i486.py $@ || { rm -f $@; exit 1; }
+	$(APP_Q)$(if $(DCOS_BOARD_INSTRUCTION_CHECK),$(APP_PYTHON) $(DCOS_SHARE)/tools/$(DCOS_BOARD_INSTRUCTION_CHECK) $@ || { rm -f $@; exit 1; })
 	@echo "application $(APP_NAME): $@"
 
 # Objects depend on the flags and on the DCOS they were compiled against.
@@ -91,10 +101,10 @@ $(APP_BUILD_DIR)/obj/%.cpp.o: $(APP_DIR)/%.cpp $(APP_FLAGS_STAMP)
 $(APP_BUILD_DIR)/obj/%.S.o: $(APP_DIR)/%.S $(APP_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  AS      $<"
-	$(APP_Q)g++ $(DCOS_486_ASFLAGS) $(APP_CPPFLAGS) -c $< -o $@
+	$(APP_Q)g++ $(DCOS_BOARD_ASFLAGS) $(APP_CPPFLAGS) -c $< -o $@
 
 run: app
-	@$(APP_PYTHON) $(DCOS_SHARE)/python/launch.py --board isa486 --image $(APP_IMAGE)
+	@$(APP_PYTHON) $(DCOS_SHARE)/python/launch.py --board $(DCOS_BOARD_EMULATED) --image $(APP_IMAGE)
 
 # The application's own emulator tests, with the lab's fixtures (the
 # `application` fixture boots this image). No tests is not a failure, but it is said.
@@ -104,7 +114,7 @@ ifeq ($(APP_TESTS),)
 else
 	$(APP_Q)cd '$(APP_DIR)' && PYTHONPATH='$(DCOS_SHARE)/python' PYTHONDONTWRITEBYTECODE=1 \
 		$(APP_PYTHON) -m pytest -c '$(DCOS_SHARE)/pytest.ini' --rootdir '$(APP_DIR)' -p dcoslab.pytest_plugin \
-		--dcos-board isa486 --dcos-image '$(APP_IMAGE)' $(if $(APP_JUNIT),--junitxml='$(APP_JUNIT)') \
+		--dcos-board $(DCOS_BOARD_EMULATED) --dcos-image '$(APP_IMAGE)' $(if $(APP_JUNIT),--junitxml='$(APP_JUNIT)') \
 		$(APP_PYTEST_ARGS) tests
 endif
 

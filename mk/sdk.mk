@@ -1,7 +1,7 @@
 # Applications outside the tree: the installed DCOS and the targets that use it.
 #
 #   make install PREFIX=<path>   installs DCOS for building applications (mk/install-sdk.sh)
-#   make app APP=<dir>           builds the application in <dir> (image in build/apps/<name>/)
+#   make app APP=<dir> [BOARD=486]  builds the application in <dir> (image in build/apps/<name>/)
 #   make run APP=<dir>           builds it and boots it on the emulated board
 #   make test-app APP=<dir>      builds it and runs its own emulator tests (<dir>/tests/test_*.py)
 #
@@ -29,10 +29,12 @@ $(LIBRARY_486): $(FW_OBJS)
 
 $(BOARD_FLAGS_486): $(FW_FLAGS_STAMP) mk/sdk.mk
 	@mkdir -p $(dir $@)
-	@printf '%s\n' '# How code for the ISA 486 board is compiled and linked (written by make install).' \
-		'DCOS_486_CXXFLAGS := $(FW_CODE_FLAGS) $(FW_WARNING_FLAGS)' \
-		'DCOS_486_ASFLAGS := $(FW_ARCH_FLAGS)' \
-		'DCOS_486_LDFLAGS := $(patsubst -T%,,$(filter-out firmware/boot/link.ld,$(FW_LDFLAGS)))' > $@
+	@printf '%s\n' '# How code for the ISA 486 board is compiled, linked, checked and emulated (written by make install).' \
+		'DCOS_BOARD_CXXFLAGS := $(FW_CODE_FLAGS) $(FW_WARNING_FLAGS)' \
+		'DCOS_BOARD_ASFLAGS := $(FW_ARCH_FLAGS)' \
+		'DCOS_BOARD_LDFLAGS := $(patsubst -T%,,$(filter-out firmware/boot/link.ld,$(FW_LDFLAGS)))' \
+		'DCOS_BOARD_INSTRUCTION_CHECK := check_i486.py' \
+		'DCOS_BOARD_EMULATED := isa486' > $@
 
 $(QEMU_BINARY):
 	@$(QEMU_BUILD_SCRIPT)
@@ -57,7 +59,8 @@ install: deps $(SDK_INPUTS)
 	@echo "DCOS installed in $(PREFIX); build an application with: make -f $(PREFIX)/share/dcos/application.mk APP=<dir>"
 
 # make app|run|test-app APP=<dir>: the application build in build/apps/<name>/.
-app_make = $(MAKE) --no-print-directory -f $(APPLICATION_MAKEFILE) APP='$(1)' \
+# BOARD (default 486) goes through to the application build, which names the boards it has.
+app_make = $(MAKE) --no-print-directory -f $(APPLICATION_MAKEFILE) APP='$(1)' $(if $(BOARD),BOARD='$(BOARD)') \
 	APP_BUILD='$(abspath $(BUILD))/apps/$(notdir $(abspath $(1)))' $(2)
 
 check_app = @if [ -z '$(APP)' ]; then echo "error: say which application: make $@ APP=<dir>" >&2; exit 1; fi

@@ -180,6 +180,12 @@ def test_directory_without_an_application_is_refused_clearly(tmp_path):
     (undeclared / "main.cpp").write_text("void unused() {}\n")
     expect_build_failure(str(undeclared), "declares its application with DCOS_APPLICATION")
 
+    hello = write_hello(str(tmp_path / "hello"))
+    result = subprocess.run(["make", "--no-print-directory", "-f", APPLICATION_MAKEFILE, f"APP={hello}", "BOARD=p5smp"],
+                            capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+    assert result.returncode != 0
+    assert "BOARD=p5smp is not a board this DCOS builds for; its boards are: 486" in result.stderr
+
     missing = tmp_path / "missing"
     result = build_with_staged_sdk(str(missing))
     assert result.returncode != 0
