@@ -221,9 +221,11 @@ unsigned BufferPoolManager::recoverResourcesOf(ObjectId deadTask)
     Lock lock;
     const uint16_t holder = deadTask.index();
     size_t recovered = 0;
-    for (PoolObject& object : pools) {
-        if (object.inUse && object.pool.inService()) {
-            recovered += object.pool.reclaimHeldBy(holder);
+    // Only active slots can hold an object: the walk is O(active slots), not O(capacity).
+    const PoolObject* const activeEnd = pools + poolTable.activeCount();
+    for (PoolObject* object = pools; object != activeEnd; ++object) {
+        if (object->inUse && object->pool.inService()) {
+            recovered += object->pool.reclaimHeldBy(holder);
         }
     }
     recovered += poolTable.forEachOwnedBy(deadTask, [](ObjectId id, PoolObject*& object) { remove(id, *object); });
@@ -232,8 +234,9 @@ unsigned BufferPoolManager::recoverResourcesOf(ObjectId deadTask)
 
 bool BufferPoolManager::overlapsArea(uintptr_t begin, uintptr_t end)
 {
-    for (const PoolObject& object : pools) {
-        if (object.inUse && begin < object.reservedEnd && object.reservedBegin < end) {
+    const PoolObject* const activeEnd = pools + poolTable.activeCount();
+    for (const PoolObject* object = pools; object != activeEnd; ++object) {
+        if (object->inUse && begin < object->reservedEnd && object->reservedBegin < end) {
             return true;
         }
     }

@@ -198,9 +198,11 @@ unsigned HeapManager::recoverResourcesOf(ObjectId deadTask)
     Lock lock;
     const uint16_t holder = deadTask.index();
     size_t recovered = 0;
-    for (HeapObject& object : heaps) {
-        if (object.inUse) {
-            recovered += object.heap.reclaimHeldBy(holder);
+    // Only active slots can hold an object: the walk is O(active slots), not O(capacity).
+    const HeapObject* const activeEnd = heaps + heapTable.activeCount();
+    for (HeapObject* object = heaps; object != activeEnd; ++object) {
+        if (object->inUse) {
+            recovered += object->heap.reclaimHeldBy(holder);
         }
     }
     recovered += heapTable.forEachOwnedBy(deadTask, [](ObjectId id, HeapObject*& object) { remove(id, *object); });
@@ -209,8 +211,9 @@ unsigned HeapManager::recoverResourcesOf(ObjectId deadTask)
 
 bool HeapManager::overlapsArea(uintptr_t begin, uintptr_t end)
 {
-    for (const HeapObject& object : heaps) {
-        if (object.inUse && begin < object.heap.areaEnd() && object.heap.areaBegin() < end) {
+    const HeapObject* const activeEnd = heaps + heapTable.activeCount();
+    for (const HeapObject* object = heaps; object != activeEnd; ++object) {
+        if (object->inUse && begin < object->heap.areaEnd() && object->heap.areaBegin() < end) {
             return true;
         }
     }
