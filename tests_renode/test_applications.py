@@ -146,7 +146,7 @@ def test_configuration_errors_name_the_object_at_compile_time(tmp_path, change, 
 
 
 def test_too_many_tasks_names_the_first_that_does_not_fit(tmp_path):
-    # The task table holds 256 tasks, two of which are the kernel's.
+    # The task table holds 256 tasks, three of which are the kernel's (idle, console, shell).
     directory = tmp_path / "crowd"
     directory.mkdir()
     declarations = ",\n".join(f'    {{.name = "worker{i}", .entry = work, .stackSize = 2048}}' for i in range(255))
@@ -158,9 +158,9 @@ def test_too_many_tasks_names_the_first_that_does_not_fit(tmp_path):
         };
         DCOS_APPLICATION(crowd, {.name = "crowd", .tasks = tasks});
         """) % declarations)
-    expect_build_failure(str(directory), 'ObjectName{"worker254"}', "TooManyObjects, 257, 256",
-                         "configuration error: task 'worker254': too many objects of this kind",
-                         "(value 257, limit 256)")
+    expect_build_failure(str(directory), 'ObjectName{"worker253"}', "TooManyObjects, 258, 256",
+                         "configuration error: task 'worker253': too many objects of this kind",
+                         "(value 258, limit 256)")
 
 
 def test_an_application_without_tests_says_so(tmp_path):

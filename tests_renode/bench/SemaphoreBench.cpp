@@ -1,12 +1,14 @@
 // Benchmarks of the semaphore agent's primitives (seed 7.11, Table 9.10).
 //
-// The object count is the number of semaphores, all created by the shell:
-// binary, free, priority-ordered waiters, no priority inheritance. The
+// The object count is the number of semaphores on the node, the kernel's
+// own included (as for tasks); the rest are created by the shell: binary,
+// free, priority-ordered waiters, no priority inheritance. The
 // measured call acts on the newest, "target". Semaphore.AddObjects is in
 // ConfigurationBench.cpp.
 #include "BenchSupport.hpp"
 
 #include <dcos/SemaphoreAgent.hpp>
+#include <dcos/internal/SemaphoreManager.hpp>
 
 namespace bench {
 namespace {
@@ -19,7 +21,7 @@ using dcos::SemaphoreKind;
 using dcos::Status;
 
 ObjectId semaphores[maximumObjectCount];
-uint32_t semaphoreCount = 0;
+uint32_t createdCount = 0; // Semaphores this file created, oldest first.
 ObjectId target;
 volatile uint32_t lastValue;
 
@@ -45,16 +47,16 @@ Result<ObjectId> createSemaphore(const SemaphoreAttributes& attributes)
     return id;
 }
 
-// Creates semaphores until count exist, the last one "target" with @p last's attributes.
+// Creates semaphores until count exist on the node, the last one "target" with @p last's attributes.
 Status populateWith(uint32_t count, const SemaphoreAttributes& last)
 {
-    while (semaphoreCount < count) {
-        const bool isLast = semaphoreCount + 1 == count;
+    while (dcos::internal::semaphoreCount() < count) {
+        const bool isLast = dcos::internal::semaphoreCount() + 1 == count;
         const Result<ObjectId> id = createSemaphore(isLast ? last : binaryAttributes(nullptr));
         if (!id.ok()) {
             return id.status();
         }
-        semaphores[semaphoreCount++] = id.value();
+        semaphores[createdCount++] = id.value();
         if (isLast) {
             target = id.value();
         }
@@ -67,8 +69,8 @@ Status populate(uint32_t count) { return populateWith(count, binaryAttributes("t
 void clearAll()
 {
     killTasks();
-    while (semaphoreCount > 0) {
-        semaphoreAgent.Delete(semaphores[--semaphoreCount]);
+    while (createdCount > 0) {
+        semaphoreAgent.Delete(semaphores[--createdCount]);
     }
     target = ObjectId::null();
 }
@@ -96,7 +98,7 @@ void recreateTarget()
 {
     const Result<ObjectId> id = createSemaphore(binaryAttributes("target"));
     target = id.ok() ? id.value() : ObjectId::null();
-    semaphores[semaphoreCount - 1] = target;
+    semaphores[createdCount - 1] = target;
 }
 
 // --- Semaphore.Acquire ("available/polling") of the free target, and

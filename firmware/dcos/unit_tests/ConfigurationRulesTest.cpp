@@ -151,7 +151,7 @@ TEST(ConfigurationRulesTest, DuplicateNamesAreFoundPerKind)
 
 TEST(ConfigurationRulesTest, KernelTaskNamesAreReserved)
 {
-    for (const char* reserved : {"idle", "shell"}) {
+    for (const char* reserved : {"idle", "console", "shell"}) {
         Configuration configuration;
         configuration.tasks.push_back({.name = reserved, .entry = entry});
         expectBroken(configuration.check(), ConfigurationRule::ReservedName, ObjectKind::Task, reserved);

@@ -76,11 +76,12 @@ constexpr size_t kMaximumApplicationName = 31;
 /// Longest object name (every agent's name field holds 15 characters).
 constexpr size_t kMaximumObjectName = 15;
 
-/// Tasks the kernel itself runs on every node (idle and the root shell).
-constexpr const char* kKernelTaskNames[] = {internal::kIdleTaskName, internal::kRootTaskName};
+/// Tasks the kernel itself runs on every node (idle, the root task and the console shell).
+constexpr const char* kKernelTaskNames[] = {internal::kIdleTaskName, internal::kRootTaskName,
+                                            internal::kShellTaskName};
 constexpr size_t kKernelTaskCount = sizeof kKernelTaskNames / sizeof kKernelTaskNames[0];
 /// Stack bytes the kernel's own tasks take from the stack arena.
-constexpr size_t kKernelStackBytes = internal::kIdleStackSize + internal::kRootStackSize;
+constexpr size_t kKernelStackBytes = internal::kIdleStackSize + internal::kRootStackSize + internal::kShellStackSize;
 
 /// Stack arena bytes a task of @p stackSize takes (the arena's 16-byte rounding).
 constexpr size_t stackArenaBytes(size_t stackSize) { return (stackSize + 15) & ~size_t{15}; }

@@ -2,8 +2,10 @@
 //
 // kernelMain brings up the board, the timer agent and the task agent, then
 // starts scheduling. From then on the boot stack is abandoned: the root task
-// starts the application linked into the image, if any, then runs the console shell, and the idle task halts the CPU whenever no
-// other task is ready.
+// starts the application linked into the image, if any, then the console
+// shell, which it starts again if it ends; the idle task halts the CPU
+// whenever no other task is ready.
+#include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/Version.hpp>
 #include <dcos/internal/ApplicationLoader.hpp>
@@ -38,20 +40,69 @@ void onConsoleInput(void*) { taskAgent.PostEvent(shellTask, consoleInputEvent); 
 
 void onSystemTick(void*) { internal::TimerManager::onTick(); }
 
-void shellTaskEntry(uintptr_t)
+// The console shell. It holds its life semaphore (the argument) for as long
+// as it runs, so that the root task learns of its end, whatever the cause.
+void shellTaskEntry(uintptr_t lifeSemaphore)
 {
     shellTask = taskAgent.IdOfSelf();
+    semaphoreAgent.Acquire(ObjectId::fromRaw(static_cast<uint32_t>(lifeSemaphore)), kPoll);
     bsp::setConsoleInputNotifier(onConsoleInput, nullptr);
-    // The application's objects exist, and its more urgent tasks have
-    // started, before the console takes commands.
-    internal::ApplicationLoader::startLinked();
-    static shell::Shell shell(bsp::console(), "dcos> ");
+    // A new shell, with an empty line, each time the task starts.
+    shell::Shell shell(bsp::console(), "dcos> ");
     shell.start();
     for (;;) {
         char character;
         while (bsp::consoleRead(character)) {
             shell.feed(character);
         }
+        taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
+    }
+}
+
+Result<ObjectId> startShell(ObjectId lifeSemaphore)
+{
+    TaskAttributes attributes;
+    attributes.name = internal::kShellTaskName;
+    attributes.priority = internal::kShellTaskPriority;
+    attributes.stackSize = internal::kShellStackSize;
+    attributes.superUser = true;
+    return taskAgent.Create(attributes, shellTaskEntry, lifeSemaphore.raw());
+}
+
+// The root task. It starts the application linked into the image, then the
+// console shell, and starts the shell again when it ends (a fatal exception
+// in a command, or KillTask): the console is how an engineer reaches the
+// node, so it must outlive a fault in it. The shell holds a binary
+// semaphore while it lives; when it ends, resource recovery frees the
+// semaphore and wakes this task with Abandoned (seed 7.11).
+void rootTaskEntry(uintptr_t)
+{
+    internal::ApplicationLoader::startLinked();
+    SemaphoreAttributes life;
+    life.name = "shell-life";
+    const Result<ObjectId> lifeSemaphore = semaphoreAgent.Create(life);
+    if (!lifeSemaphore.ok()) {
+        dcosPanic("cannot create the shell's life semaphore: %s", statusName(lifeSemaphore.status()));
+    }
+    for (unsigned started = 0;; ++started) {
+        const Result<ObjectId> shell = startShell(lifeSemaphore.value());
+        if (!shell.ok()) {
+            runtime::format(bsp::console(), "console: cannot start the shell: %s\r\n", statusName(shell.status()));
+            break;
+        }
+        // The shell, more urgent, holds the semaphore by now; this waits for its end.
+        const Status ended = semaphoreAgent.Acquire(lifeSemaphore.value(), kWaitForever);
+        if (ended == Status::Ok) {
+            semaphoreAgent.Release(lifeSemaphore.value());
+        }
+        if (started + 1 >= internal::kShellRestartLimit) {
+            runtime::format(bsp::console(), "console: the shell ended %u times; not starting it again\r\n",
+                            started + 1);
+            break;
+        }
+        runtime::format(bsp::console(), "console: the shell ended; starting it again\r\n");
+    }
+    for (;;) {
         taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
     }
 }
@@ -103,6 +154,6 @@ const boot::BootInfo& bootInfo() { return bootInfoCopy; }
         runtime::format(console, "command line: %s\r\n", bootInfo.commandLine);
     }
 
-    internal::TaskManager::initialise(shellTaskEntry);
+    internal::TaskManager::initialise(rootTaskEntry);
     internal::Scheduler::start();
 }

@@ -8,6 +8,7 @@
 // changes (a task starts waiting, times out, is killed or changes priority,
 // the semaphore is released or deleted) the holder is recomputed, so it
 // drops back only as it releases the semaphores that lent it priority.
+#include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>

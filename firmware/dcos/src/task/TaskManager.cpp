@@ -265,7 +265,7 @@ void TaskManager::initialise(TaskEntry rootEntry)
 
     TaskAttributes root;
     root.name = kRootTaskName;
-    root.priority = 24;
+    root.priority = kRootTaskPriority;
     root.stackSize = kRootStackSize;
     root.superUser = true;
     const Result<ObjectId> rootId = create(root, rootEntry, 0);

@@ -41,7 +41,7 @@ struct ConfigurationRejected {
     static_assert(rule != Rule::NameMissing, "every object needs a name (value: its index in its list)");
     static_assert(rule != Rule::NameTooLong, "the name is too long (value: its length, limit: the longest allowed)");
     static_assert(rule != Rule::DuplicateName, "two objects of this kind have this name; names are unique per kind");
-    static_assert(rule != Rule::ReservedName, "this is the name of a kernel task (idle, shell)");
+    static_assert(rule != Rule::ReservedName, "this is the name of a kernel task (idle, console, shell)");
     static_assert(rule != Rule::EntryMissing, "the task has no entry function");
     static_assert(rule != Rule::PriorityOutOfRange, "a task's priority must be 0 (highest) to 31 (lowest)");
     static_assert(rule != Rule::StackTooSmall, "the task's stack is smaller than dcos::kMinimumStackSize (limit)");

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <stddef.h>
+#include <stdint.h>
 
 #ifndef DCOS_CONFIG_TASK_CAPACITY
 #define DCOS_CONFIG_TASK_CAPACITY 256
@@ -55,10 +56,21 @@ static_assert(kTasksActiveAtBoot <= kTaskCapacity && kTasksActiveAtBoot % 8 == 0
 
 // The kernel's own tasks on every node: their names and stacks are part of
 // what an application's configuration is checked against (ConfigurationRules.hpp).
+// The root task, "console", starts the application and keeps the console
+// shell, "shell", running: it starts the shell again if the shell ends.
 constexpr const char* kIdleTaskName = "idle";
-constexpr const char* kRootTaskName = "shell";
+constexpr const char* kRootTaskName = "console";
+constexpr const char* kShellTaskName = "shell";
 constexpr size_t kIdleStackSize = 2048;
-constexpr size_t kRootStackSize = 16384;
+constexpr size_t kRootStackSize = 4096;
+constexpr size_t kShellStackSize = 16384;
+// The shell is the more urgent of the two, so it runs (and takes its life
+// semaphore) as soon as the root task creates it.
+constexpr uint8_t kShellTaskPriority = 24;
+constexpr uint8_t kRootTaskPriority = 25;
+// How often the root task starts the shell again before it gives up: a
+// shell that ends at once every time would otherwise keep the node busy.
+constexpr unsigned kShellRestartLimit = 8;
 static_assert(kTimersActiveAtBoot <= kTimerCapacity && kTimersActiveAtBoot % 8 == 0);
 
 } // namespace dcos::internal
