@@ -51,8 +51,11 @@ ifeq ($(wildcard $(APP_DIR)/.),)
 $(error application directory '$(APP)' does not exist)
 endif
 
-APP_SRCS := $(shell cd '$(APP_DIR)' && find . \( -path ./build -o -path ./tests -o -path './$(notdir $(APP_BUILD_DIR))' \) -prune \
-	-o \( -name '*.cpp' -o -name '*.S' \) -type f -print | sed 's|^\./||' | LC_ALL=C sort)
+# Sources: every .cpp and .S under the directory except in build/, tests/
+# and the build folder when it lies inside the directory.
+APP_BUILD_INSIDE := $(patsubst $(APP_DIR)/%,./%,$(filter $(APP_DIR)/%,$(APP_BUILD_DIR)))
+APP_SRCS := $(shell cd '$(APP_DIR)' && find . \( -path ./build -o -path ./tests $(if $(APP_BUILD_INSIDE),-o -path '$(APP_BUILD_INSIDE)') \) \
+	-prune -o \( -name '*.cpp' -o -name '*.S' \) -type f -print | sed 's|^\./||' | LC_ALL=C sort)
 APP_OBJS := $(patsubst %,$(APP_BUILD_DIR)/obj/%.o,$(APP_SRCS))
 APP_TESTS := $(wildcard $(APP_DIR)/tests/test_*.py)
 

@@ -19,59 +19,56 @@ void printOwner(shell::Shell& shell, ObjectId owner)
     }
 }
 
-// Each pool is copied under the agent's lock and printed after it, so the
-// slow console never runs with interrupts disabled.
-shell::CommandResult pools(shell::Shell& shell, int argc, char**)
+// Lists every pool or heap of @p Manager: one row per object, its
+// statistics printed by @p printStatistics. Each object is copied under the
+// agent's lock (snapshot) and printed after it, so the slow console never
+// runs with interrupts disabled.
+template <class Manager, class Info, class PrintStatistics>
+shell::CommandResult listAreas(shell::Shell& shell, int argc, const char* header, const char* noun,
+                               PrintStatistics printStatistics)
 {
     if (argc != 1) {
         return shell::CommandResult::UsageError;
     }
-    shell.print("id        name             size   total    free     low   allocs  failed  owner\r\n");
-    const size_t active = BufferPoolManager::activeCount();
+    shell.print("%s\r\n", header);
+    const size_t active = Manager::activeCount();
     for (size_t slot = 0; slot < active; ++slot) {
-        PoolInfo info;
-        if (!BufferPoolManager::snapshot(slot, info)) {
+        Info info;
+        if (!Manager::snapshot(slot, info)) {
             continue;
         }
-        const BufferPoolStatistics& s = info.statistics;
-        shell.print("%08lx  %-15s  %5lu  %6lu  %6lu  %6lu  %7lu  %6lu  ", static_cast<unsigned long>(info.id.raw()),
-                    info.name[0] != '\0' ? info.name : "-", static_cast<unsigned long>(s.bufferSize),
-                    static_cast<unsigned long>(s.totalBuffers), static_cast<unsigned long>(s.freeBuffers),
-                    static_cast<unsigned long>(s.lowWaterMark), static_cast<unsigned long>(s.allocations),
-                    static_cast<unsigned long>(s.failedAllocations));
+        shell.print("%08lx  %-15s  ", static_cast<unsigned long>(info.id.raw()), info.name[0] != '\0' ? info.name : "-");
+        printStatistics(shell, info.statistics);
         printOwner(shell, info.owner);
         shell.print("%s\r\n", info.corrupted ? "  CORRUPTED" : "");
     }
-    shell.print("%lu of %lu pool slots used, %lu reserved\r\n",
-                static_cast<unsigned long>(BufferPoolManager::usedCount()), static_cast<unsigned long>(active),
-                static_cast<unsigned long>(BufferPoolManager::capacity()));
+    shell.print("%lu of %lu %s slots used, %lu reserved\r\n", static_cast<unsigned long>(Manager::usedCount()),
+                static_cast<unsigned long>(active), noun, static_cast<unsigned long>(Manager::capacity()));
     return shell::CommandResult::Ok;
+}
+
+shell::CommandResult pools(shell::Shell& shell, int argc, char**)
+{
+    return listAreas<BufferPoolManager, PoolInfo>(
+        shell, argc, "id        name             size   total    free     low   allocs  failed  owner", "pool",
+        [](shell::Shell& out, const BufferPoolStatistics& s) {
+            out.print("%5lu  %6lu  %6lu  %6lu  %7lu  %6lu  ", static_cast<unsigned long>(s.bufferSize),
+                      static_cast<unsigned long>(s.totalBuffers), static_cast<unsigned long>(s.freeBuffers),
+                      static_cast<unsigned long>(s.lowWaterMark), static_cast<unsigned long>(s.allocations),
+                      static_cast<unsigned long>(s.failedAllocations));
+        });
 }
 
 shell::CommandResult heaps(shell::Shell& shell, int argc, char**)
 {
-    if (argc != 1) {
-        return shell::CommandResult::UsageError;
-    }
-    shell.print("id        name                bytes     free  largest  segs  frags  lowfree  owner\r\n");
-    const size_t active = HeapManager::activeCount();
-    for (size_t slot = 0; slot < active; ++slot) {
-        HeapInfo info;
-        if (!HeapManager::snapshot(slot, info)) {
-            continue;
-        }
-        const HeapStatistics& s = info.statistics;
-        shell.print("%08lx  %-15s  %8lu  %7lu  %7lu  %4lu  %5lu  %7lu  ", static_cast<unsigned long>(info.id.raw()),
-                    info.name[0] != '\0' ? info.name : "-", static_cast<unsigned long>(s.heapBytes),
-                    static_cast<unsigned long>(s.freeBytes), static_cast<unsigned long>(s.largestFreeSegment),
-                    static_cast<unsigned long>(s.allocatedSegments), static_cast<unsigned long>(s.freeSegments),
-                    static_cast<unsigned long>(s.lowWaterFreeBytes));
-        printOwner(shell, info.owner);
-        shell.print("%s\r\n", info.corrupted ? "  CORRUPTED" : "");
-    }
-    shell.print("%lu of %lu heap slots used, %lu reserved\r\n", static_cast<unsigned long>(HeapManager::usedCount()),
-                static_cast<unsigned long>(active), static_cast<unsigned long>(HeapManager::capacity()));
-    return shell::CommandResult::Ok;
+    return listAreas<HeapManager, HeapInfo>(
+        shell, argc, "id        name                bytes     free  largest  segs  frags  lowfree  owner", "heap",
+        [](shell::Shell& out, const HeapStatistics& s) {
+            out.print("%8lu  %7lu  %7lu  %4lu  %5lu  %7lu  ", static_cast<unsigned long>(s.heapBytes),
+                      static_cast<unsigned long>(s.freeBytes), static_cast<unsigned long>(s.largestFreeSegment),
+                      static_cast<unsigned long>(s.allocatedSegments), static_cast<unsigned long>(s.freeSegments),
+                      static_cast<unsigned long>(s.lowWaterFreeBytes));
+        });
 }
 
 } // namespace
