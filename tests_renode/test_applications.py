@@ -350,3 +350,21 @@ def test_run_boots_the_application_with_its_console_on_a_terminal(tmp_path):
         raise AssertionError(f"run session failed: {error}\n----- console -----\n{session.before}") from None
     finally:
         session.close(force=True)
+
+
+def test_sources_in_a_subfolder_named_like_the_application_are_built(tmp_path):
+    # The tree builds into build/apps/<name>; only a build folder inside the
+    # application's directory is left out of its sources.
+    application = tmp_path / "pump"
+    (application / "pump").mkdir(parents=True)
+    (application / "pump" / "main.cpp").write_text(textwrap.dedent("""\
+        #include <dcos/Application.hpp>
+        void run(uintptr_t) {}
+        constexpr dcos::app::TaskDeclaration tasks[] = {{.name = "pump", .entry = run}};
+        DCOS_APPLICATION(pump, {.name = "pump", .tasks = tasks});
+        """))
+    result = subprocess.run(["make", "--no-print-directory", "-f", APPLICATION_MAKEFILE, f"APP={application}",
+                             f"APP_BUILD={tmp_path / 'elsewhere' / 'pump'}"],
+                            capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert (tmp_path / "elsewhere" / "pump" / "pump-486.elf").exists()
