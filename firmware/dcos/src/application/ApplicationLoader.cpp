@@ -107,37 +107,38 @@ constexpr KindServices servicesOf(ObjectKind kind, size_t capacity)
                         capacity};
 }
 
+// A declaration type with no services below is a compile-time error.
 template <class Declaration>
-struct Kind;
+consteval KindServices noServicesFor()
+{
+    static_assert(sizeof(Declaration) == 0, "the loader has no services for this kind of declaration");
+    return {};
+}
 
+// The services of each kind of declaration.
+template <class Declaration>
+constexpr KindServices kindServices = noServicesFor<Declaration>();
+
+// A task is ended with KillTask, and the loader never hands one over.
 template <>
-struct Kind<app::TaskDeclaration> {
-    // A task is ended with KillTask, and the loader never hands one over.
-    static constexpr KindServices services{
-        ObjectKind::Task, [](const char* name) { return taskAgent.NameToObject(name); },
-        [](ObjectId id) { return taskAgent.KillTask(id); }, [](size_t count) { return taskAgent.AddObjects(count); },
-        nullptr, kTaskCapacity};
-};
+constexpr KindServices kindServices<app::TaskDeclaration>{
+    ObjectKind::Task, [](const char* name) { return taskAgent.NameToObject(name); },
+    [](ObjectId id) { return taskAgent.KillTask(id); }, [](size_t count) { return taskAgent.AddObjects(count); },
+    nullptr, kTaskCapacity};
 template <>
-struct Kind<app::SemaphoreDeclaration> {
-    static constexpr KindServices services = servicesOf<semaphoreAgent>(ObjectKind::Semaphore, kSemaphoreCapacity);
-};
+constexpr KindServices kindServices<app::SemaphoreDeclaration> =
+    servicesOf<semaphoreAgent>(ObjectKind::Semaphore, kSemaphoreCapacity);
 template <>
-struct Kind<app::MessagePortDeclaration> {
-    static constexpr KindServices services = servicesOf<messagePortAgent>(ObjectKind::MessagePort, kPortCapacity);
-};
+constexpr KindServices kindServices<app::MessagePortDeclaration> =
+    servicesOf<messagePortAgent>(ObjectKind::MessagePort, kPortCapacity);
 template <>
-struct Kind<app::PublisherDeclaration> {
-    static constexpr KindServices services = servicesOf<dsmAgent>(ObjectKind::Publisher, kPublisherCapacity);
-};
+constexpr KindServices kindServices<app::PublisherDeclaration> =
+    servicesOf<dsmAgent>(ObjectKind::Publisher, kPublisherCapacity);
 template <>
-struct Kind<app::BufferPoolDeclaration> {
-    static constexpr KindServices services = servicesOf<bufferPoolAgent>(ObjectKind::BufferPool, kPoolCapacity);
-};
+constexpr KindServices kindServices<app::BufferPoolDeclaration> =
+    servicesOf<bufferPoolAgent>(ObjectKind::BufferPool, kPoolCapacity);
 template <>
-struct Kind<app::HeapDeclaration> {
-    static constexpr KindServices services = servicesOf<heapAgent>(ObjectKind::Heap, kHeapCapacity);
-};
+constexpr KindServices kindServices<app::HeapDeclaration> = servicesOf<heapAgent>(ObjectKind::Heap, kHeapCapacity);
 
 // Slots are activated in groups of eight (ObjectTable::AddObjects).
 constexpr size_t kSlotGroup = 8;
@@ -151,7 +152,7 @@ ConfigurationError broken(ConfigurationRule rule, ObjectKind kind, const char* n
 template <class Declaration>
 ConfigurationError checkNamesUnused(const app::DeclarationList<Declaration>& list)
 {
-    const KindServices& services = Kind<Declaration>::services;
+    const KindServices& services = kindServices<Declaration>;
     for (const Declaration& declaration : list) {
         if (services.nameToObject(declaration.name).ok()) {
             return broken(ConfigurationRule::NameInUse, services.kind, declaration.name);
@@ -164,7 +165,7 @@ ConfigurationError checkNamesUnused(const app::DeclarationList<Declaration>& lis
 template <class Declaration>
 ConfigurationError createAll(const app::DeclarationList<Declaration>& list, size_t& created)
 {
-    const KindServices& services = Kind<Declaration>::services;
+    const KindServices& services = kindServices<Declaration>;
     for (const Declaration& declaration : list) {
         Result<ObjectId> id = createObject(declaration);
         if (!id.ok() && id.status() == Status::TableFull) {
@@ -191,7 +192,7 @@ ConfigurationError createAll(const app::DeclarationList<Declaration>& list, size
 template <class Declaration>
 ConfigurationError handOver(const app::DeclarationList<Declaration>& list)
 {
-    const KindServices& services = Kind<Declaration>::services;
+    const KindServices& services = kindServices<Declaration>;
     for (const Declaration& declaration : list) {
         const ObjectId id = services.nameToObject(declaration.name).value();
         if (const char* owner = ownerOf(declaration); owner != nullptr) {
@@ -214,7 +215,7 @@ ConfigurationError handOver(const app::DeclarationList<Declaration>& list)
 template <class Declaration>
 unsigned removeFirst(const app::DeclarationList<Declaration>& list, size_t count)
 {
-    const KindServices& services = Kind<Declaration>::services;
+    const KindServices& services = kindServices<Declaration>;
     unsigned removed = 0;
     for (size_t i = count; i-- > 0;) {
         const Result<ObjectId> id = services.nameToObject(list[i].name);
@@ -329,12 +330,12 @@ unsigned ApplicationLoader::stop(const app::Application& application)
 Result<ObjectId> ApplicationLoader::find(app::ObjectKind kind, const char* name)
 {
     switch (kind) {
-    case ObjectKind::Task: return Kind<app::TaskDeclaration>::services.nameToObject(name);
-    case ObjectKind::Semaphore: return Kind<app::SemaphoreDeclaration>::services.nameToObject(name);
-    case ObjectKind::MessagePort: return Kind<app::MessagePortDeclaration>::services.nameToObject(name);
-    case ObjectKind::Publisher: return Kind<app::PublisherDeclaration>::services.nameToObject(name);
-    case ObjectKind::BufferPool: return Kind<app::BufferPoolDeclaration>::services.nameToObject(name);
-    case ObjectKind::Heap: return Kind<app::HeapDeclaration>::services.nameToObject(name);
+    case ObjectKind::Task: return kindServices<app::TaskDeclaration>.nameToObject(name);
+    case ObjectKind::Semaphore: return kindServices<app::SemaphoreDeclaration>.nameToObject(name);
+    case ObjectKind::MessagePort: return kindServices<app::MessagePortDeclaration>.nameToObject(name);
+    case ObjectKind::Publisher: return kindServices<app::PublisherDeclaration>.nameToObject(name);
+    case ObjectKind::BufferPool: return kindServices<app::BufferPoolDeclaration>.nameToObject(name);
+    case ObjectKind::Heap: return kindServices<app::HeapDeclaration>.nameToObject(name);
     case ObjectKind::Application: break;
     }
     return Status::InvalidArgument;
