@@ -30,11 +30,13 @@ image=$3
 board_flags=$4
 emulator=$5
 
-# Copies a file if it differs, creating directories on the way.
+# Copies a file if it differs, creating directories on the way, with mode
+# $3 (default 644: readable by everyone, whatever the source's mode, e.g. a
+# private temporary file).
 put() {
     mkdir -p "$(dirname "$2")"
     if ! cmp -s "$1" "$2"; then
-        cp "$1" "$2.new"
+        install -m "${3:-644}" "$1" "$2.new"
         mv "$2.new" "$2"
     fi
 }
@@ -60,9 +62,9 @@ for module in tests_renode/dcoslab/*.py; do
 done
 
 # The boards, with the plain controller image as their production image.
-mkdir -p "$prefix/share/dcos/boards"
 for board in tests_renode/boards/*.json; do
-    /usr/bin/python3 - "$board" "$prefix/share/dcos/boards/$(basename "$board").new" <<'PYTHON'
+    rewritten=$(mktemp)
+    /usr/bin/python3 - "$board" "$rewritten" <<'PYTHON'
 import json, sys
 board = json.load(open(sys.argv[1], encoding="utf-8"))
 board["images"] = {"production": "lib/dcos/486/dcos486.elf"}
@@ -70,8 +72,8 @@ with open(sys.argv[2], "w", encoding="utf-8") as handle:
     json.dump(board, handle, indent=4)
     handle.write("\n")
 PYTHON
-    target="$prefix/share/dcos/boards/$(basename "$board")"
-    if cmp -s "$target.new" "$target"; then rm -f "$target.new"; else mv "$target.new" "$target"; fi
+    put "$rewritten" "$prefix/share/dcos/boards/$(basename "$board")"
+    rm -f "$rewritten"
 done
 
 # Tells dcoslab it runs from an installation (tests_renode/dcoslab/layout.py).
@@ -84,6 +86,5 @@ rm -f "$layout"
 mkdir -p "$prefix/libexec/dcos"
 stripped=$(mktemp)
 strip -o "$stripped" "$emulator"
-chmod 755 "$stripped"
-put "$stripped" "$prefix/libexec/dcos/qemu-system-i386"
+put "$stripped" "$prefix/libexec/dcos/qemu-system-i386" 755
 rm -f "$stripped"

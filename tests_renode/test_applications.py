@@ -286,6 +286,9 @@ def test_out_of_tree_application_against_the_tree_and_an_installed_dcos(tmp_path
                       "share/dcos/python/dcoslab/pytest_plugin.py", "libexec/dcos/qemu-system-i386"]:
         assert (prefix / installed).exists(), installed
     assert text_files_mentioning(str(prefix), REPOSITORY) == [], "the installation refers to the source tree"
+    unreadable = [os.path.join(directory, name) for directory, _, names in os.walk(prefix) for name in names
+                  if not os.stat(os.path.join(directory, name)).st_mode & 0o004]
+    assert unreadable == [], "installed files other users cannot read"
 
     # The counter example, copied out as a user would, built with its own
     # two-line Makefile against the installation, and its tests run.
