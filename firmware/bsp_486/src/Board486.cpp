@@ -2,8 +2,6 @@
 // controller node 1): an 8259A pair, an 8254 and a 16550 on COM1, at their
 // PC/AT addresses.
 #include <bsp/Board.hpp>
-
-#include <dcos/ConfigurationRules.hpp>
 #include <bsp/Pic8259.hpp>
 #include <bsp/Pit8254.hpp>
 #include <bsp/Uart16550.hpp>
@@ -91,9 +89,7 @@ arch_x86::InterruptFrame* dispatchInterrupt(arch_x86::InterruptFrame* frame)
 
 const BoardIdentity& identity() { return board; }
 
-// Every rate an application may declare (ConfigurationRules.hpp) is one the PIT can make.
-static_assert(Pit8254::minimumRateHz <= dcos::app::kLowestTickRateHz
-              && Pit8254::maximumRateHz >= dcos::app::kHighestTickRateHz);
+static_assert(Pit8254::minimumRateHz == minimumTickRateHz && Pit8254::maximumRateHz == maximumTickRateHz);
 
 void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
 {
@@ -123,7 +119,7 @@ void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
 
     // An application's tick rate is checked when it is compiled; an
     // impossible one still falls back to the default rather than stop the node.
-    if (tickRateHz < Pit8254::minimumRateHz || tickRateHz > Pit8254::maximumRateHz) {
+    if (tickRateHz < minimumTickRateHz || tickRateHz > maximumTickRateHz) {
         tickRateHz = defaultTickRateHz;
     }
     uint32_t rate = tickRateHz;

@@ -31,6 +31,9 @@ constexpr unsigned consoleLine = 4;
 
 /// The default system tick rate; "tick_hz=N" on the command line changes it.
 constexpr uint32_t defaultTickRateHz = 1000;
+/// The tick rates the board's timer makes, in Hz (the 8254's limits).
+constexpr uint32_t minimumTickRateHz = 19;
+constexpr uint32_t maximumTickRateHz = 10000;
 /// The console's line settings: 115200 baud, 8 data bits, no parity, 1 stop bit.
 constexpr uint32_t consoleBaud = 115200;
 

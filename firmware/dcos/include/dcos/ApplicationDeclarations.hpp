@@ -81,6 +81,16 @@ struct HeapDeclaration {
     ObjectId* id = nullptr;
 };
 
+/// The declared task an object is handed to: its owner, a port's receiver,
+/// a publisher's writer. Null: the object stays the system's. (The loader
+/// never hands a task over.)
+constexpr const char* ownerOf(const TaskDeclaration&) { return nullptr; }
+constexpr const char* ownerOf(const SemaphoreDeclaration& declaration) { return declaration.owner; }
+constexpr const char* ownerOf(const MessagePortDeclaration& declaration) { return declaration.receiver; }
+constexpr const char* ownerOf(const PublisherDeclaration& declaration) { return declaration.writer; }
+constexpr const char* ownerOf(const BufferPoolDeclaration& declaration) { return declaration.owner; }
+constexpr const char* ownerOf(const HeapDeclaration& declaration) { return declaration.owner; }
+
 /// A read-only view of a constexpr array of declarations.
 template <class Declaration>
 struct DeclarationList {

@@ -304,18 +304,14 @@ constexpr ConfigurationError checkCount(const DeclarationList<Declaration>& list
 constexpr ConfigurationError checkTotals(const Application& application)
 {
     using namespace dcos::internal;
-    const ConfigurationError counts[] = {
-        checkCount(application.tasks, ObjectKind::Task, kTaskCapacity, kKernelTaskCount),
-        checkCount(application.semaphores, ObjectKind::Semaphore, kSemaphoreCapacity),
-        checkCount(application.messagePorts, ObjectKind::MessagePort, kPortCapacity),
-        checkCount(application.publishers, ObjectKind::Publisher, kPublisherCapacity),
-        checkCount(application.bufferPools, ObjectKind::BufferPool, kPoolCapacity),
-        checkCount(application.heaps, ObjectKind::Heap, kHeapCapacity),
-    };
-    for (const ConfigurationError& count : counts) {
-        if (!count.ok()) {
-            return count;
-        }
+    ConfigurationError error = checkCount(application.tasks, ObjectKind::Task, kTaskCapacity, kKernelTaskCount);
+    if (error.ok()) error = checkCount(application.semaphores, ObjectKind::Semaphore, kSemaphoreCapacity);
+    if (error.ok()) error = checkCount(application.messagePorts, ObjectKind::MessagePort, kPortCapacity);
+    if (error.ok()) error = checkCount(application.publishers, ObjectKind::Publisher, kPublisherCapacity);
+    if (error.ok()) error = checkCount(application.bufferPools, ObjectKind::BufferPool, kPoolCapacity);
+    if (error.ok()) error = checkCount(application.heaps, ObjectKind::Heap, kHeapCapacity);
+    if (!error.ok()) {
+        return error;
     }
     size_t stackBytes = kKernelStackBytes;
     for (const TaskDeclaration& task : application.tasks) {
@@ -346,17 +342,13 @@ constexpr ConfigurationError findConfigurationError(const Application& applicati
         return rules::broken(ConfigurationRule::TickRateOutOfRange, ObjectKind::Application, application.name,
                              application.tickRateHz, kHighestTickRateHz);
     }
-    const ConfigurationError checks[] = {
-        rules::checkTasks(application),       rules::checkSemaphores(application),
-        rules::checkPortsAndPublishers(application), rules::checkMemoryAreas(application),
-        rules::checkTotals(application),
-    };
-    for (const ConfigurationError& check : checks) {
-        if (!check.ok()) {
-            return check;
-        }
-    }
-    return {};
+    // One group after the other, stopping at the first broken rule.
+    ConfigurationError error = rules::checkTasks(application);
+    if (error.ok()) error = rules::checkSemaphores(application);
+    if (error.ok()) error = rules::checkPortsAndPublishers(application);
+    if (error.ok()) error = rules::checkMemoryAreas(application);
+    if (error.ok()) error = rules::checkTotals(application);
+    return error;
 }
 
 } // namespace dcos::app

@@ -9,8 +9,7 @@ namespace dcos::internal {
 namespace {
 
 template <class Declaration>
-void listObjects(shell::Shell& shell, app::ObjectKind kind, const app::DeclarationList<Declaration>& list,
-                 const char* (*ownerOf)(const Declaration&))
+void listObjects(shell::Shell& shell, app::ObjectKind kind, const app::DeclarationList<Declaration>& list)
 {
     for (const Declaration& declaration : list) {
         const Result<ObjectId> id = ApplicationLoader::find(kind, declaration.name);
@@ -20,7 +19,7 @@ void listObjects(shell::Shell& shell, app::ObjectKind kind, const app::Declarati
         } else {
             shell.print("%-10s", "(none)");
         }
-        const char* owner = ownerOf(declaration);
+        const char* owner = app::ownerOf(declaration);
         shell.print("  %s\r\n", owner != nullptr ? owner : "-");
     }
 }
@@ -42,18 +41,12 @@ shell::CommandResult showApplication(shell::Shell& shell, int argc, char**)
     }
     shell.print("application '%s': running\r\n", application->name);
     shell.print("  %-12s %-15s %-10s  %s\r\n", "kind", "name", "id", "owner");
-    listObjects<app::TaskDeclaration>(shell, app::ObjectKind::Task, application->tasks,
-                                      [](const app::TaskDeclaration&) -> const char* { return nullptr; });
-    listObjects<app::SemaphoreDeclaration>(shell, app::ObjectKind::Semaphore, application->semaphores,
-                                           [](const app::SemaphoreDeclaration& d) { return d.owner; });
-    listObjects<app::MessagePortDeclaration>(shell, app::ObjectKind::MessagePort, application->messagePorts,
-                                             [](const app::MessagePortDeclaration& d) { return d.receiver; });
-    listObjects<app::PublisherDeclaration>(shell, app::ObjectKind::Publisher, application->publishers,
-                                           [](const app::PublisherDeclaration& d) { return d.writer; });
-    listObjects<app::BufferPoolDeclaration>(shell, app::ObjectKind::BufferPool, application->bufferPools,
-                                            [](const app::BufferPoolDeclaration& d) { return d.owner; });
-    listObjects<app::HeapDeclaration>(shell, app::ObjectKind::Heap, application->heaps,
-                                      [](const app::HeapDeclaration& d) { return d.owner; });
+    listObjects(shell, app::ObjectKind::Task, application->tasks);
+    listObjects(shell, app::ObjectKind::Semaphore, application->semaphores);
+    listObjects(shell, app::ObjectKind::MessagePort, application->messagePorts);
+    listObjects(shell, app::ObjectKind::Publisher, application->publishers);
+    listObjects(shell, app::ObjectKind::BufferPool, application->bufferPools);
+    listObjects(shell, app::ObjectKind::Heap, application->heaps);
     return shell::CommandResult::Ok;
 }
 

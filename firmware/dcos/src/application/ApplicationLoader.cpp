@@ -27,6 +27,7 @@ namespace {
 using app::ConfigurationError;
 using app::ConfigurationRule;
 using app::ObjectKind;
+using app::rules::broken;
 
 // What the loader does with each kind of declaration. Every agent names its
 // objects and hands them over the same way; only Create's arguments differ.
@@ -76,14 +77,6 @@ Result<ObjectId> createObject(const app::TaskDeclaration& declaration)
     attributes.visibility = declaration.visibility;
     return taskAgent.Create(attributes, declaration.entry, declaration.argument);
 }
-
-// The task a declaration names as its owner; null: it stays the system's.
-const char* ownerOf(const app::TaskDeclaration&) { return nullptr; }
-const char* ownerOf(const app::SemaphoreDeclaration& declaration) { return declaration.owner; }
-const char* ownerOf(const app::MessagePortDeclaration& declaration) { return declaration.receiver; }
-const char* ownerOf(const app::PublisherDeclaration& declaration) { return declaration.writer; }
-const char* ownerOf(const app::BufferPoolDeclaration& declaration) { return declaration.owner; }
-const char* ownerOf(const app::HeapDeclaration& declaration) { return declaration.owner; }
 
 struct KindServices {
     ObjectKind kind;
@@ -143,11 +136,6 @@ constexpr KindServices kindServices<app::HeapDeclaration> = servicesOf<heapAgent
 // Slots are activated in groups of eight (ObjectTable::AddObjects).
 constexpr size_t kSlotGroup = 8;
 
-ConfigurationError broken(ConfigurationRule rule, ObjectKind kind, const char* name, size_t value = 0,
-                          size_t limit = 0)
-{
-    return ConfigurationError{rule, kind, name, value, limit};
-}
 
 template <class Declaration>
 ConfigurationError checkNamesUnused(const app::DeclarationList<Declaration>& list)
@@ -195,7 +183,7 @@ ConfigurationError handOver(const app::DeclarationList<Declaration>& list)
     const KindServices& services = kindServices<Declaration>;
     for (const Declaration& declaration : list) {
         const ObjectId id = services.nameToObject(declaration.name).value();
-        if (const char* owner = ownerOf(declaration); owner != nullptr) {
+        if (const char* owner = app::ownerOf(declaration); owner != nullptr) {
             const Result<ObjectId> task = taskAgent.NameToObject(owner);
             const Status transferred = task.ok() ? services.transfer(id, task.value()) : task.status();
             if (transferred != Status::Ok) {

@@ -102,10 +102,14 @@ void rootTaskEntry(uintptr_t)
         }
         runtime::format(bsp::console(), "console: the shell ended; starting it again\r\n");
     }
+    // Nothing is left to do: wait for an event nobody posts to this task.
     for (;;) {
         taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
     }
 }
+
+// Every tick rate an application may declare (ConfigurationRules.hpp) is one the board makes.
+static_assert(bsp::minimumTickRateHz <= app::kLowestTickRateHz && bsp::maximumTickRateHz >= app::kHighestTickRateHz);
 
 // CR0.NE (Intel SDM Vol. 3, 2.5): report x87 errors as #MF (vector 16) to
 // the task that caused them, rather than through the PC's IRQ 13 path.
