@@ -106,6 +106,16 @@ Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
     return *entry.value();
 }
 
+// What every Set...Alarm does first: the timer's previous alarm, if any, is
+// cancelled, and the new one's kind and notification are recorded; the
+// caller then schedules it.
+void replaceAlarm(TimerObject& timer, AlarmKind kind, const AlarmNotification& n)
+{
+    wheel.cancel(timer.entry);
+    timer.kind = kind;
+    timer.notification = n;
+}
+
 Status validNotification(const AlarmNotification& n)
 {
     if (n.kind == AlarmNotification::Kind::Signal) {
@@ -272,9 +282,7 @@ Status TimerManager::setWatchDogAlarm(ObjectId id, ObjectId caller, uint64_t int
         return timer.status();
     }
     TimerObject& t = *timer.value();
-    wheel.cancel(t.entry);
-    t.kind = AlarmKind::WatchDog;
-    t.notification = n;
+    replaceAlarm(t, AlarmKind::WatchDog, n);
     wheel.insert(t.entry, tickAfter(intervalNs));
     return Status::Ok;
 }
@@ -294,9 +302,7 @@ Status TimerManager::setDayClockAlarm(ObjectId id, ObjectId caller, const DateTi
         return timer.status();
     }
     TimerObject& t = *timer.value();
-    wheel.cancel(t.entry);
-    t.kind = AlarmKind::DayClock;
-    t.notification = n;
+    replaceAlarm(t, AlarmKind::DayClock, n);
     t.dayClockNs = target.value();
     const uint64_t now = baseNs + incrementNs;
     // A time already past goes off at the next tick.
@@ -315,9 +321,7 @@ Status TimerManager::setPeriodicAlarm(ObjectId id, ObjectId caller, uint64_t per
         return timer.status();
     }
     TimerObject& t = *timer.value();
-    wheel.cancel(t.entry);
-    t.kind = AlarmKind::Periodic;
-    t.notification = n;
+    replaceAlarm(t, AlarmKind::Periodic, n);
     t.periodNs = periodNs;
     // The schedule starts from the current tick's time, the base of every
     // interval measured in ticks.
