@@ -3,6 +3,8 @@
 // model, and detection of every kind of corruption the seed names.
 #include <dcos/internal/BufferPool.hpp>
 
+#include "GuardedArea.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,34 +23,10 @@ using dcos::internal::BufferPool;
 constexpr uint16_t kTaskA = 3;
 constexpr uint16_t kTaskB = 7;
 
-// An 8-byte aligned area with guard bytes on both sides, so that a pool
-// writing outside its area is caught.
-class Area {
+// The pool tests start from a zeroed area.
+class Area : public dcos_test::GuardedArea {
 public:
-    explicit Area(size_t bytes) : storage_(bytes + 2 * kGuard + 8, 0xA5)
-    {
-        const uintptr_t raw = reinterpret_cast<uintptr_t>(storage_.data()) + kGuard;
-        offset_ = ((raw + 7) & ~uintptr_t{7}) - reinterpret_cast<uintptr_t>(storage_.data());
-        bytes_ = bytes;
-        std::fill(storage_.begin() + static_cast<long>(offset_), storage_.begin() + static_cast<long>(offset_ + bytes), 0);
-    }
-    uint8_t* data() { return storage_.data() + offset_; }
-    size_t size() const { return bytes_; }
-    bool guardsIntact() const
-    {
-        for (size_t i = 0; i < storage_.size(); ++i) {
-            if ((i < offset_ || i >= offset_ + bytes_) && storage_[i] != 0xA5) {
-                return false;
-            }
-        }
-        return true;
-    }
-
-private:
-    static constexpr size_t kGuard = 32;
-    std::vector<uint8_t> storage_;
-    size_t offset_ = 0;
-    size_t bytes_ = 0;
+    explicit Area(size_t bytes) : GuardedArea(bytes, 0) {}
 };
 
 TEST(BufferPoolTest, AreaBytesHoldsExactlyTheRequestedCount)

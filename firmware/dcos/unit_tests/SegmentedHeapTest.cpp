@@ -4,6 +4,8 @@
 // space, and detection of corruption.
 #include <dcos/internal/SegmentedHeap.hpp>
 
+#include "GuardedArea.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,33 +24,7 @@ using dcos::internal::SegmentedHeap;
 constexpr uint16_t kTaskA = 3;
 constexpr uint16_t kTaskB = 7;
 
-// An 8-byte aligned area with guard bytes on both sides.
-class Area {
-public:
-    explicit Area(size_t bytes) : storage_(bytes + 2 * kGuard + 8, 0xA5)
-    {
-        const uintptr_t raw = reinterpret_cast<uintptr_t>(storage_.data()) + kGuard;
-        offset_ = ((raw + 7) & ~uintptr_t{7}) - reinterpret_cast<uintptr_t>(storage_.data());
-        bytes_ = bytes;
-    }
-    uint8_t* data() { return storage_.data() + offset_; }
-    size_t size() const { return bytes_; }
-    bool guardsIntact() const
-    {
-        for (size_t i = 0; i < storage_.size(); ++i) {
-            if ((i < offset_ || i >= offset_ + bytes_) && storage_[i] != 0xA5) {
-                return false;
-            }
-        }
-        return true;
-    }
-
-private:
-    static constexpr size_t kGuard = 32;
-    std::vector<uint8_t> storage_;
-    size_t offset_ = 0;
-    size_t bytes_ = 0;
-};
+using Area = dcos_test::GuardedArea;
 
 HeapStatistics statisticsOf(SegmentedHeap& heap)
 {
