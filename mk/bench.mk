@@ -8,7 +8,8 @@
 #
 # Every benchmark runs once with 8 and once with 4096 objects of its type,
 # so the bench image is compiled with kernel tables of 4096 slots (the 12-bit
-# index limit) and a stack arena for 4096 tasks of kMinimumStackSize (2 KiB)
+# index limit) and a stack arena for 4096 tasks of kMinimumStackSize (2 KiB,
+# which takes a 4 KiB page and a 4 KiB guard page)
 # besides the shell's 16 KiB. The kernel's table sizes are compile-time
 # constants (dcos/internal/KernelConfig.hpp), so every firmware source is
 # compiled a second time with them into $(FW_BENCH_BUILD); the production
@@ -21,7 +22,7 @@ FW_BENCH_DEFINES := \
 	-DDCOS_CONFIG_TASK_CAPACITY=4096 \
 	-DDCOS_CONFIG_TIMER_CAPACITY=4096 \
 	-DDCOS_CONFIG_DEVICE_CAPACITY=4096 \
-	-DDCOS_CONFIG_STACK_ARENA_KIB=8256 \
+	-DDCOS_CONFIG_STACK_ARENA_KIB=33024 \
 	-DDCOS_CONFIG_POOL_CAPACITY=4096 \
 	-DDCOS_CONFIG_HEAP_CAPACITY=4096 \
 	-DDCOS_CONFIG_PORT_CAPACITY=4096 \

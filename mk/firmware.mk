@@ -20,7 +20,7 @@ FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
 # alike (mk/sdk.mk hands these to applications through the installed DCOS).
 FW_CODE_FLAGS := -std=c++20 $(FW_ARCH_FLAGS) -O2 -g \
 	-ffreestanding -fno-pic -fno-pie -fno-exceptions -fno-rtti -fno-threadsafe-statics \
-	-fno-stack-protector -fno-asynchronous-unwind-tables -fno-unwind-tables \
+	-fno-stack-protector -fstack-clash-protection -fno-asynchronous-unwind-tables -fno-unwind-tables \
 	-fno-omit-frame-pointer -fno-tree-loop-distribute-patterns -mgeneral-regs-only \
 	-fno-isolate-erroneous-paths-dereference -fno-isolate-erroneous-paths-attribute
 FW_WARNING_FLAGS := -Wall -Wextra -Wno-missing-field-initializers

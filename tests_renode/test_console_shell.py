@@ -57,8 +57,12 @@ def test_mem_shows_the_memory_map(boot, isa486):
     assert re.search(r"memory +6\d\d KiB conventional, 15\d\d\d KiB extended", output)
     image = re.search(r"image +([0-9a-f]{8})-([0-9a-f]{8})", output)
     assert image and int(image.group(1), 16) == 0x100000
+    # The page tables follow the image; free memory follows them, to the end.
+    paging = re.search(r"paging +([0-9a-f]{8})-([0-9a-f]{8})", output)
+    assert paging and paging.group(1) == image.group(2)
     free = re.search(r"free +([0-9a-f]{8})-([0-9a-f]{8})", output)
-    assert free and free.group(1) == image.group(2)
+    assert free and free.group(1) == paging.group(2) and int(free.group(1), 16) % 4096 == 0
+    assert int(free.group(2), 16) == 0x1000000
 
 
 def test_bad_arguments_print_the_usage_line(boot, isa486):

@@ -263,13 +263,14 @@ bool fullTableRollsBack(shell::Shell& shell)
 
 bool stackArenaExhausted(shell::Shell& shell)
 {
-    // A task of the node holds all but 10 KiB of the stack arena; the
-    // configuration's three 4 KiB stacks pass the rules but not the node.
+    // A task of the node holds all but 20 KiB of the stack arena: room for
+    // two of the configuration's 4 KiB stacks with their guard pages (8 KiB
+    // each), not three, which pass the rules but not the node.
     const size_t free = dcos::internal::StackArena::largestFreeBlock();
     dcos::TaskAttributes hog;
     hog.name = "ldhog";
     hog.priority = 30;
-    hog.stackSize = free - 10 * 1024;
+    hog.stackSize = free - dcos::internal::StackArena::kPageSize - 20 * 1024;
     const Result<ObjectId> hogTask = taskAgent.Create(hog, idle, 0);
     bool ok = check(shell, hogTask.ok(), "the hog task takes the arena");
     const size_t stackBytesBefore = dcos::internal::StackArena::freeBytes();

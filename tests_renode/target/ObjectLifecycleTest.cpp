@@ -144,7 +144,7 @@ bool fullTable(shell::Shell& shell)
     attributes.stackSize = 100;
     ok = checkStatus(shell, taskAgent.Create(attributes, waitForeverEntry, 0).status(), Status::InvalidArgument,
                      "a stack below the minimum") && ok;
-    attributes.stackSize = 1024 * 1024;
+    attributes.stackSize = dcos::internal::StackArena::largestFreeBlock(); // No room left for its guard page.
     ok = checkStatus(shell, taskAgent.Create(attributes, waitForeverEntry, 0).status(), Status::NoMemory,
                      "a stack larger than the free arena") && ok;
     return ok;

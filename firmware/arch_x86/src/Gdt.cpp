@@ -19,11 +19,19 @@ constexpr uint8_t typeExecuteRead = 0x0A;
 constexpr uint8_t typeReadWrite = 0x02;
 // Flags nibble: G (4 KiB granularity) and D/B (32-bit segment).
 constexpr uint8_t flagsGranularity4k32Bit = 0xC;
+// System descriptor type of an available 32-bit TSS (SDM Vol. 3, 3.5,
+// Table 3-2); the processor turns it into busy (0xB) while the task runs.
+constexpr uint8_t typeTss32Available = 0x9;
 
-alignas(8) constinit const uint64_t table[] = {
+// Writable: the processor sets the busy bit of a TSS descriptor on LTR and
+// on every task switch into it (SDM Vol. 3, 7.2.2).
+alignas(8) constinit uint64_t table[] = {
     0, // The null descriptor.
     descriptor(0, 0xFFFFF, accessPresent | accessCodeOrData | typeExecuteRead, flagsGranularity4k32Bit),
     descriptor(0, 0xFFFFF, accessPresent | accessCodeOrData | typeReadWrite, flagsGranularity4k32Bit),
+    0, // Gdt::mainTss, filled by setTaskStateSegment().
+    0, // Gdt::pageFaultTss
+    0, // Gdt::doubleFaultTss
 };
 
 struct [[gnu::packed]] TablePointer {
@@ -32,6 +40,11 @@ struct [[gnu::packed]] TablePointer {
 };
 
 } // namespace
+
+void Gdt::setTaskStateSegment(uint16_t selector, uint32_t base, uint32_t limit)
+{
+    table[selector >> 3] = descriptor(base, limit, accessPresent | typeTss32Available, 0);
+}
 
 void Gdt::install()
 {

@@ -56,6 +56,12 @@ void Idt::install()
     asm volatile("lidt %0" : : "m"(pointer) : "memory");
 }
 
+void Idt::setGate(unsigned vector, uint16_t selector, uint32_t offset, uint8_t typeAttributes)
+{
+    gates[vector & 0xFF] = Gate{static_cast<uint16_t>(offset & 0xFFFF), selector, 0, typeAttributes,
+                                static_cast<uint16_t>(offset >> 16)};
+}
+
 void Idt::setExceptionHandler(Handler handler) { exceptionHandler = handler; }
 
 void Idt::setInterruptHandler(Handler handler) { interruptHandler = handler; }

@@ -2,6 +2,7 @@
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/CpuException.hpp>
+#include <arch_x86/FaultTasks.hpp>
 
 #include <stdarg.h>
 
@@ -89,9 +90,13 @@ extern "C" [[noreturn]] void dcosPanicWithFrame(const arch_x86::InterruptFrame* 
                         isException ? arch_x86::exceptionMnemonic(vector) : "IRQ",
                         isException ? arch_x86::exceptionName(vector) : "interrupt",
                         static_cast<unsigned long>(frame->errorCode));
+        // A frame a fault task built was copied off the faulting stack, so
+        // the stack pointer is the one the fault task recorded.
+        const bool faultFrame = arch_x86::FaultTasks::isFaultFrame(frame);
+        const uint32_t esp = faultFrame ? arch_x86::FaultTasks::lastFault().stackPointer : frame->interruptedEsp();
         runtime::format(out, "EIP=%08lx CS=%04lx EFLAGS=%08lx ESP=%08lx\r\n", static_cast<unsigned long>(frame->eip),
                         static_cast<unsigned long>(frame->cs), static_cast<unsigned long>(frame->eflags),
-                        static_cast<unsigned long>(frame->interruptedEsp()));
+                        static_cast<unsigned long>(esp));
         runtime::format(out, "EAX=%08lx EBX=%08lx ECX=%08lx EDX=%08lx\r\n", static_cast<unsigned long>(frame->eax),
                         static_cast<unsigned long>(frame->ebx), static_cast<unsigned long>(frame->ecx),
                         static_cast<unsigned long>(frame->edx));

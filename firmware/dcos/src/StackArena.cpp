@@ -2,24 +2,26 @@
 #include <dcos/internal/StackArena.hpp>
 
 #include <arch_x86/Cpu.hpp>
+#include <arch_x86/Paging.hpp>
 
 namespace dcos::internal {
 
 namespace {
 
 // A free block records its size and the next free block in its first bytes.
+// Free blocks are present memory: a guard page is made present again before
+// its block joins the free list.
 struct FreeBlock {
     size_t size;
     FreeBlock* next;
 };
 
-alignas(StackArena::kAlignment) uint8_t arena[kStackArenaBytes];
+static_assert(kStackArenaBytes % StackArena::kPageSize == 0, "the stack arena is whole pages");
+static_assert(StackArena::kPageSize == arch_x86::Paging::kPageSize);
+
+alignas(StackArena::kPageSize) uint8_t arena[kStackArenaBytes];
 FreeBlock* freeList = nullptr;
 bool initialised = false;
-
-static_assert(sizeof(FreeBlock) <= StackArena::kAlignment, "every remainder must hold a free block header");
-
-size_t roundUp(size_t size) { return (size + StackArena::kAlignment - 1) & ~(StackArena::kAlignment - 1); }
 
 void initialiseOnce()
 {
@@ -31,22 +33,17 @@ void initialiseOnce()
     }
 }
 
-} // namespace
-
-Result<uint8_t*> StackArena::allocate(size_t size)
+uint8_t* takeBlock(size_t size)
 {
-    arch_x86::InterruptGuard guard;
-    initialiseOnce();
-    size = roundUp(size < sizeof(FreeBlock) ? sizeof(FreeBlock) : size);
     FreeBlock** link = &freeList;
     for (FreeBlock* block = freeList; block != nullptr; link = &block->next, block = block->next) {
         if (block->size < size) {
             continue;
         }
         // Take the block's top end, so the free block keeps its place in the
-        // list. Sizes are multiples of the alignment, which a free block's
-        // header fits in, so any remainder can stay a free block: a block
-        // is never handed out larger than asked, which release() relies on.
+        // list. Sizes are whole pages, so any remainder can stay a free
+        // block: a block is never handed out larger than asked, which
+        // release() relies on.
         if (block->size > size) {
             block->size -= size;
             return reinterpret_cast<uint8_t*>(block) + block->size;
@@ -54,15 +51,35 @@ Result<uint8_t*> StackArena::allocate(size_t size)
         *link = block->next;
         return reinterpret_cast<uint8_t*>(block);
     }
-    return Status::NoMemory;
+    return nullptr;
 }
 
-void StackArena::release(uint8_t* memory, size_t size)
+} // namespace
+
+Result<uint8_t*> StackArena::allocate(size_t size)
+{
+    if (size == 0 || size > kStackArenaBytes) {
+        return Status::NoMemory;
+    }
+    arch_x86::InterruptGuard guard;
+    initialiseOnce();
+    uint8_t* block = takeBlock(blockSize(size));
+    if (block == nullptr) {
+        return Status::NoMemory;
+    }
+    arch_x86::Paging::setPresent(reinterpret_cast<uintptr_t>(block), false);
+    return block + kPageSize;
+}
+
+void StackArena::release(uint8_t* stack, size_t size)
 {
     arch_x86::InterruptGuard guard;
-    size = roundUp(size < sizeof(FreeBlock) ? sizeof(FreeBlock) : size);
+    uint8_t* memory = stack - kPageSize;
+    // The guard page becomes ordinary free memory again; the free list's
+    // header is written into it just below.
+    arch_x86::Paging::setPresent(reinterpret_cast<uintptr_t>(memory), true);
     auto* block = reinterpret_cast<FreeBlock*>(memory);
-    block->size = size;
+    block->size = blockSize(size);
     // Find the neighbours in address order.
     FreeBlock* previous = nullptr;
     FreeBlock* next = freeList;
@@ -86,6 +103,12 @@ void StackArena::release(uint8_t* memory, size_t size)
         previous->size += block->size;
         previous->next = block->next;
     }
+}
+
+bool StackArena::isGuardOf(const uint8_t* stack, uintptr_t address)
+{
+    const uintptr_t base = reinterpret_cast<uintptr_t>(stack);
+    return stack != nullptr && address < base && address >= base - kPageSize;
 }
 
 size_t StackArena::freeBytes()

@@ -186,7 +186,9 @@ TEST(ConfigurationRulesTest, StacksThatExceedTheArenaNameTheTaskThatOverflows)
     Configuration configuration;
     const size_t room = dcos::internal::kStackArenaBytes - dcos::app::kKernelStackBytes;
     configuration.tasks.clear();
-    configuration.tasks.push_back({.name = "big", .entry = entry, .stackSize = room - 4096});
+    // Every stack takes whole pages and a guard page: "big" takes room less
+    // two pages, "fits" one page and its guard, which fills the arena.
+    configuration.tasks.push_back({.name = "big", .entry = entry, .stackSize = room - 3 * 4096});
     configuration.tasks.push_back({.name = "fits", .entry = entry, .stackSize = 4096});
     EXPECT_TRUE(configuration.check().ok());
     configuration.tasks.push_back({.name = "overflow", .entry = entry, .stackSize = 2048});

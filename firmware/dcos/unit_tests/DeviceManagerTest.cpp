@@ -342,16 +342,14 @@ TEST_F(DeviceManagerTest, DeletedIdsTurnStaleEvenAfterTheSlotIsReused)
     expectEveryPrimitiveRefuses(old, Status::StaleId);
     EXPECT_EQ(manager.NameToObject("adc0", Visibility::Local).status(), Status::NotFound);
 
-    // Reinstall the same driver until it lands in the old slot again.
+    // Fill every active slot, so the old one is taken again: freed slots are
+    // reused last, so the last device created lands in it.
     std::vector<FakeDevice> others(DeviceManager::kInitialDevices);
     ObjectId reused;
-    for (size_t i = 0; i < others.size() && reused.isNull(); ++i) {
-        const ObjectId id = create(others[i]);
-        if ((id.index() & (DeviceManager::kCapacity - 1)) == (old.index() & (DeviceManager::kCapacity - 1))) {
-            reused = id;
-        }
+    for (FakeDevice& other : others) {
+        reused = create(other);
+        ASSERT_FALSE(reused.isNull());
     }
-    ASSERT_FALSE(reused.isNull());
     EXPECT_NE(reused, old);
     expectEveryPrimitiveRefuses(old, Status::StaleId);
     EXPECT_EQ(manager.Probe(reused), Status::Ok);
@@ -367,13 +365,15 @@ TEST_F(DeviceManagerTest, ForgedIdsAreRefused)
     expectEveryPrimitiveRefuses(ObjectId::null(), Status::InvalidId);
     expectEveryPrimitiveRefuses(ObjectId(kNode, ObjectType::Semaphore, id.index()), Status::WrongType);
     expectEveryPrimitiveRefuses(ObjectId(kNode, ObjectType::Task, id.index()), Status::WrongType);
-    // A slot beyond the eight active ones.
+    // Indices the table never handed out.
     expectEveryPrimitiveRefuses(ObjectId(kNode, ObjectType::Device, 20), Status::InvalidId);
-    // An active slot that holds no device (the first Create took slot 0).
-    expectEveryPrimitiveRefuses(ObjectId(kNode, ObjectType::Device, (id.index() + 1) % 8), Status::InvalidId);
-    // The right slot with a generation that was never issued.
-    const uint16_t wrongGeneration = static_cast<uint16_t>(id.index() ^ (1u << DeviceTable::kSlotBits));
-    expectEveryPrimitiveRefuses(ObjectId(kNode, ObjectType::Device, wrongGeneration), Status::StaleId);
+    expectEveryPrimitiveRefuses(ObjectId(kNode, ObjectType::Device, static_cast<uint16_t>(id.index() + 1)),
+                                Status::InvalidId);
+    // An index handed out before, whose device was deleted.
+    FakeDevice other;
+    const ObjectId gone = create(other);
+    ASSERT_EQ(manager.Delete(gone), Status::Ok);
+    expectEveryPrimitiveRefuses(gone, Status::StaleId);
     // None of this touched the real device.
     EXPECT_EQ(device.probes + device.opens + device.closes + device.reads + device.writes + device.controls, 0);
     EXPECT_EQ(manager.Probe(id), Status::Ok);

@@ -35,12 +35,10 @@ ObjectId create(SmallTable& table, const char* name = nullptr, ObjectId owner = 
 
 } // namespace
 
-TEST(ObjectTableTest, GenerationBitsFollowCapacity)
+TEST(ObjectTableTest, EveryTableHandsOutAllTwelveBitIndices)
 {
-    EXPECT_EQ((ObjectTable<Semaphore, 8>::kSlotBits), 3u);
-    EXPECT_EQ((ObjectTable<Semaphore, 8>::kGenerationBits), 9u);
-    EXPECT_EQ((ObjectTable<Semaphore, 256>::kGenerationBits), 4u);
-    EXPECT_EQ((ObjectTable<Semaphore, 4096>::kGenerationBits), 0u);
+    EXPECT_EQ((ObjectTable<Semaphore, 8>::kIndexCount), 4096u);
+    EXPECT_EQ((ObjectTable<Semaphore, 4096>::kIndexCount), 4096u);
 }
 
 TEST(ObjectTableTest, StartsWithoutActiveSlots)
@@ -137,7 +135,7 @@ TEST(ObjectTableTest, DeletedIdIsStaleEvenAfterTheSlotIsReused)
     // The only free slot is the deleted one, so the next Create must reuse it.
     const auto reused = table.Create(kTaskB, nullptr, Visibility::Local);
     ASSERT_TRUE(reused.ok());
-    EXPECT_EQ(reused.value().index() & 7u, ids[3].index() & 7u);
+    EXPECT_EQ(table.slotNumber(reused.value()), table.slotNumber(ids[3]));
     EXPECT_NE(reused.value(), ids[3]);
     EXPECT_EQ(table.resolve(ids[3]).status(), Status::StaleId);
     ASSERT_TRUE(table.resolve(reused.value()).ok());
@@ -150,43 +148,100 @@ TEST(ObjectTableTest, FreedSlotsAreReusedInFifoOrder)
     ASSERT_EQ(table.AddObjects(8), Status::Ok);
     const ObjectId first = create(table);
     ASSERT_EQ(table.Delete(first), Status::Ok);
+    const size_t firstSlot = table.slotNumber(first);
     // Seven never-used slots are queued ahead of the freed one.
     for (int i = 0; i < 7; ++i) {
-        EXPECT_NE(create(table).index() & 15u, first.index() & 15u);
+        EXPECT_NE(table.slotNumber(create(table)), firstSlot);
     }
-    EXPECT_EQ(create(table).index() & 15u, first.index() & 15u);
+    EXPECT_EQ(table.slotNumber(create(table)), firstSlot);
 }
 
-TEST(ObjectTableTest, GenerationWrapsWithinItsBits)
+// The defect this guards against: with a slot's generation in the index
+// bits its capacity leaves free, a semaphore id came back after 496
+// create/delete cycles (31 free slots of a 256-slot table, 4 generation
+// bits). Every index is now handed out before a freed one comes back.
+template <size_t Capacity, size_t Active>
+void expectStaleIdLastsAsLongAsTwelveBitsAllow()
 {
-    ObjectTable<Semaphore, 8> table(ObjectType::Semaphore, kNode);
-    ASSERT_EQ(table.AddObjects(8), Status::Ok);
-    // Keep seven slots busy so every create/delete cycles the same slot.
-    for (int i = 0; i < 7; ++i) {
-        ASSERT_TRUE(table.Create(kTaskA, nullptr, Visibility::Local).ok());
-    }
+    static ObjectTable<Semaphore, Capacity> table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(Active), Status::Ok);
+    // One long-lived object, as the shell's life semaphore is on a node.
+    const ObjectId resident = table.Create(kTaskA, nullptr, Visibility::Local).value();
     const ObjectId original = table.Create(kTaskA, nullptr, Visibility::Local).value();
     ObjectId current = original;
-    for (unsigned cycle = 1; cycle < (1u << 9); ++cycle) {
+    const size_t bound = ObjectTable<Semaphore, Capacity>::kIndexCount - table.usedCount();
+    size_t cycle = 1;
+    for (; cycle <= bound; ++cycle) {
         ASSERT_EQ(table.Delete(current), Status::Ok);
         current = table.Create(kTaskA, nullptr, Visibility::Local).value();
         ASSERT_NE(current, original) << "cycle " << cycle;
-        ASSERT_EQ(table.resolve(original).status(), Status::StaleId);
+        ASSERT_EQ(table.resolve(original).status(), Status::StaleId) << "cycle " << cycle;
+        ASSERT_TRUE(table.resolve(resident).ok());
     }
+    // 4096 indices, two live: the original's index is the oldest free one
+    // only after every other index was handed out once more.
+    EXPECT_EQ(cycle - 1, 4094u);
     ASSERT_EQ(table.Delete(current), Status::Ok);
     current = table.Create(kTaskA, nullptr, Visibility::Local).value();
-    EXPECT_EQ(current, original) << "after 2^9 reuses the 9-bit generation wraps";
+    EXPECT_EQ(current, original) << "the index comes back after 4096 - 1 other Creates at the earliest";
 }
 
-TEST(ObjectTableTest, FullSizeTableHasNoGenerationButDetectsFreeSlots)
+TEST(ObjectTableTest, AStaleIdLastsAsLongAsTwelveBitsAllowInASmallTable)
+{
+    expectStaleIdLastsAsLongAsTwelveBitsAllow<8, 8>();
+}
+
+TEST(ObjectTableTest, AStaleIdLastsAsLongAsTwelveBitsAllowWithFewSlotsActive)
+{
+    // The semaphore table of the production image: 256 slots, 32 active.
+    expectStaleIdLastsAsLongAsTwelveBitsAllow<256, 32>();
+}
+
+TEST(ObjectTableTest, AStaleIdLastsAsLongAsTwelveBitsAllowInAFullSizeTable)
+{
+    expectStaleIdLastsAsLongAsTwelveBitsAllow<4096, 4096>();
+}
+
+TEST(ObjectTableTest, FullSizeTableDetectsDeletedAndForgedIds)
 {
     static ObjectTable<Semaphore, 4096> table(ObjectType::Semaphore, kNode);
     ASSERT_EQ(table.AddObjects(4096), Status::Ok);
     EXPECT_EQ(table.AddObjects(8), Status::TableFull);
     const ObjectId id = table.Create(kTaskA, nullptr, Visibility::Local).value();
     ASSERT_EQ(table.Delete(id), Status::Ok);
-    EXPECT_EQ(table.resolve(id).status(), Status::InvalidId);
+    EXPECT_EQ(table.resolve(id).status(), Status::StaleId);
     EXPECT_EQ(table.resolve(ObjectId(kNode, ObjectType::Semaphore, 4095)).status(), Status::InvalidId);
+}
+
+TEST(ObjectTableTest, EveryLiveObjectHasItsOwnIndexWhenTheTableIsFull)
+{
+    static ObjectTable<Semaphore, 4096> table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(4096), Status::Ok);
+    std::set<uint32_t> ids;
+    std::vector<ObjectId> live;
+    for (int round = 0; round < 3; ++round) {
+        while (table.freeCount() != 0) {
+            const ObjectId id = table.Create(kTaskA, nullptr, Visibility::Local).value();
+            live.push_back(id);
+        }
+        EXPECT_EQ(table.Create(kTaskA, nullptr, Visibility::Local).status(), Status::TableFull);
+        std::set<uint32_t> distinct;
+        for (const ObjectId id : live) {
+            ASSERT_TRUE(table.resolve(id).ok());
+            distinct.insert(id.raw());
+        }
+        EXPECT_EQ(distinct.size(), live.size());
+        // Free every other object and go round again.
+        std::vector<ObjectId> kept;
+        for (size_t i = 0; i < live.size(); ++i) {
+            if (i % 2 == 0) {
+                ASSERT_EQ(table.Delete(live[i]), Status::Ok);
+            } else {
+                kept.push_back(live[i]);
+            }
+        }
+        live = kept;
+    }
 }
 
 TEST(ObjectTableTest, CreateValidatesArguments)

@@ -1,6 +1,8 @@
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/StackArena.hpp>
 
+#include <arch_x86/Paging.hpp>
+
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -9,7 +11,10 @@
 
 namespace {
 
+using arch_x86::Paging;
 using dcos::internal::StackArena;
+
+constexpr size_t kPage = StackArena::kPageSize;
 
 // The arena is one static area, so every test leaves it as it found it.
 class StackArenaTest : public ::testing::Test {
@@ -23,63 +28,86 @@ protected:
     size_t initialFree_ = 0;
 };
 
-TEST_F(StackArenaTest, BlocksAreAlignedAndRounded)
+TEST_F(StackArenaTest, StacksAreWholePagesAboveAGuardPage)
 {
     const auto a = StackArena::allocate(100);
     ASSERT_TRUE(a.ok());
-    EXPECT_EQ(reinterpret_cast<uintptr_t>(a.value()) % StackArena::kAlignment, 0u);
-    EXPECT_EQ(StackArena::freeBytes(), initialFree_ - 112);
+    const uintptr_t base = reinterpret_cast<uintptr_t>(a.value());
+    EXPECT_EQ(base % kPage, 0u);
+    EXPECT_EQ(StackArena::usableSize(100), kPage);
+    EXPECT_EQ(StackArena::freeBytes(), initialFree_ - 2 * kPage) << "one page of stack and one guard page";
+    EXPECT_FALSE(Paging::isPresent(base - 1)) << "the page below the stack is its guard";
+    EXPECT_FALSE(Paging::isPresent(base - kPage));
+    EXPECT_TRUE(Paging::isPresent(base));
+    EXPECT_TRUE(StackArena::isGuardOf(a.value(), base - 4));
+    EXPECT_FALSE(StackArena::isGuardOf(a.value(), base));
+    EXPECT_FALSE(StackArena::isGuardOf(a.value(), base - kPage - 1));
     StackArena::release(a.value(), 100);
+    EXPECT_TRUE(Paging::isPresent(base - 1)) << "a released guard is free memory again";
+}
+
+TEST_F(StackArenaTest, SizesRoundToPagesWithoutWrapping)
+{
+    EXPECT_EQ(StackArena::usableSize(1), kPage);
+    EXPECT_EQ(StackArena::usableSize(kPage), kPage);
+    EXPECT_EQ(StackArena::usableSize(kPage + 1), 2 * kPage);
+    EXPECT_EQ(StackArena::blockSize(2048), 2 * kPage);
+    EXPECT_EQ(StackArena::blockSize(SIZE_MAX), SIZE_MAX) << "saturates instead of wrapping to a small block";
+    EXPECT_EQ(StackArena::allocate(SIZE_MAX).status(), dcos::Status::NoMemory);
+    EXPECT_EQ(StackArena::allocate(0).status(), dcos::Status::NoMemory);
 }
 
 TEST_F(StackArenaTest, TooLargeARequestIsRefused)
 {
-    EXPECT_EQ(StackArena::allocate(initialFree_ + 16).status(), dcos::Status::NoMemory);
-    const auto all = StackArena::allocate(initialFree_);
-    ASSERT_TRUE(all.ok());
+    const size_t all = initialFree_ - kPage; // Everything but the guard.
+    EXPECT_EQ(StackArena::allocate(all + 1).status(), dcos::Status::NoMemory);
+    const auto block = StackArena::allocate(all);
+    ASSERT_TRUE(block.ok());
     EXPECT_EQ(StackArena::allocate(16).status(), dcos::Status::NoMemory);
-    StackArena::release(all.value(), initialFree_);
+    StackArena::release(block.value(), all);
 }
 
 TEST_F(StackArenaTest, RandomUseNeverOverlapsAndCoalescesFully)
 {
     std::mt19937 random(2026);
-    std::map<uintptr_t, size_t> live; // start -> rounded size
+    std::map<uintptr_t, size_t> live; // block start (the guard) -> requested size
     for (int step = 0; step < 20000; ++step) {
         if (live.empty() || random() % 3 != 0) {
-            const size_t size = 2048 + (random() % 64) * 16 + random() % 16;
-            const auto block = StackArena::allocate(size);
-            if (!block.ok()) {
-                EXPECT_EQ(block.status(), dcos::Status::NoMemory);
-                EXPECT_LT(StackArena::largestFreeBlock(), size);
+            const size_t size = 2048 + (random() % 64) * 256 + random() % 16;
+            const auto stack = StackArena::allocate(size);
+            if (!stack.ok()) {
+                EXPECT_EQ(stack.status(), dcos::Status::NoMemory);
+                EXPECT_LT(StackArena::largestFreeBlock(), StackArena::blockSize(size));
                 continue;
             }
-            const uintptr_t start = reinterpret_cast<uintptr_t>(block.value());
-            const size_t rounded = (size + 15) & ~size_t{15};
-            // No overlap with any live block.
+            const uintptr_t start = reinterpret_cast<uintptr_t>(stack.value()) - kPage;
+            const size_t taken = StackArena::blockSize(size);
+            ASSERT_FALSE(Paging::isPresent(start));
+            // No overlap with any live block, guards included.
             const auto after = live.lower_bound(start);
             if (after != live.end()) {
-                ASSERT_LE(start + rounded, after->first);
+                ASSERT_LE(start + taken, after->first);
             }
             if (after != live.begin()) {
                 const auto before = std::prev(after);
-                ASSERT_LE(before->first + before->second, start);
+                ASSERT_LE(before->first + StackArena::blockSize(before->second), start);
             }
-            live[start] = rounded;
+            live[start] = size;
         } else {
             auto victim = live.begin();
             std::advance(victim, random() % live.size());
-            StackArena::release(reinterpret_cast<uint8_t*>(victim->first), victim->second);
+            StackArena::release(reinterpret_cast<uint8_t*>(victim->first + kPage), victim->second);
+            ASSERT_TRUE(Paging::isPresent(victim->first));
             live.erase(victim);
         }
         size_t used = 0;
         for (const auto& block : live) {
-            used += block.second;
+            used += StackArena::blockSize(block.second);
         }
         ASSERT_EQ(StackArena::freeBytes() + used, initialFree_) << "no byte lost at step " << step;
     }
     for (const auto& block : live) {
-        StackArena::release(reinterpret_cast<uint8_t*>(block.first), block.second);
+        StackArena::release(reinterpret_cast<uint8_t*>(block.first + kPage), block.second);
     }
 }
 

@@ -20,6 +20,10 @@ public:
     /// loads the table. Until handlers are set, every vector panics.
     static void install();
 
+    /// Replaces one gate: selector, offset and type/attribute byte as in
+    /// SDM Vol. 3, 6.11 (FaultTasks.hpp turns #PF and #DF into task gates).
+    static void setGate(unsigned vector, uint16_t selector, uint32_t offset, uint8_t typeAttributes);
+
     /// Sets the handler for the CPU exception vectors 0-31.
     static void setExceptionHandler(Handler handler);
 

@@ -13,6 +13,7 @@
 #include <dcos/BufferPoolAgent.hpp>
 #include <dcos/HeapAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/StackArena.hpp>
 #include <runtime/Text.hpp>
 
 #include <stddef.h>
@@ -80,11 +81,13 @@ constexpr size_t kMaximumObjectName = 15;
 constexpr const char* kKernelTaskNames[] = {internal::kIdleTaskName, internal::kRootTaskName,
                                             internal::kShellTaskName};
 constexpr size_t kKernelTaskCount = sizeof kKernelTaskNames / sizeof kKernelTaskNames[0];
-/// Stack bytes the kernel's own tasks take from the stack arena.
-constexpr size_t kKernelStackBytes = internal::kIdleStackSize + internal::kRootStackSize + internal::kShellStackSize;
+/// Stack arena bytes a task of @p stackSize takes: whole pages and a guard page.
+constexpr size_t stackArenaBytes(size_t stackSize) { return internal::StackArena::blockSize(stackSize); }
 
-/// Stack arena bytes a task of @p stackSize takes (the arena's 16-byte rounding).
-constexpr size_t stackArenaBytes(size_t stackSize) { return (stackSize + 15) & ~size_t{15}; }
+/// Stack bytes the kernel's own tasks take from the stack arena.
+constexpr size_t kKernelStackBytes = stackArenaBytes(internal::kIdleStackSize) +
+                                     stackArenaBytes(internal::kRootStackSize) +
+                                     stackArenaBytes(internal::kShellStackSize);
 
 /// Stable English names, for messages.
 constexpr const char* objectKindName(ObjectKind kind)

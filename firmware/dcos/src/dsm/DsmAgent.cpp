@@ -72,7 +72,7 @@ PublisherObject publishers[kPublisherCapacity];
 ObjectTable<SubscriptionObject, kSubscriptionCapacity> subscriptionTable(ObjectType::DsmSubscription, 0);
 bool started = false;
 
-size_t publisherSlotOf(ObjectId id) { return id.index() & (kPublisherCapacity - 1); }
+size_t publisherSlotOf(ObjectId id) { return publisherTable.slotNumber(id); }
 
 // Activates the boot-time slots and takes the board's node id on the first
 // call to the agent. Interrupts are disabled by the caller.

@@ -14,6 +14,8 @@
 #include <dcos/internal/TimerManager.hpp>
 
 #include <arch_x86/Cpu.hpp>
+#include <arch_x86/FaultTasks.hpp>
+#include <arch_x86/Paging.hpp>
 #include <arch_x86/Idt.hpp>
 #include <boot/BootInfo.hpp>
 #include <boot/Panic.hpp>
@@ -31,6 +33,8 @@ namespace {
 
 // The kernel's memory facts, kept for the 'mem' command.
 boot::BootInfo bootInfoCopy;
+// The first byte after the image and the page tables.
+uintptr_t firstFreeAddress = 0;
 
 // The shell task sleeps on this event until the console has input.
 constexpr uint32_t consoleInputEvent = 1u << 0;
@@ -123,9 +127,30 @@ void enableNativeFpuErrors()
     asm volatile("fninit");
 }
 
+// The end of the memory the loader reported: extended memory starts at 1 MiB.
+constexpr uintptr_t kExtendedMemoryStart = 0x100000;
+
+// Paging catches null pointers and stack overflows (Paging.hpp); the fault
+// tasks report them with a stack of their own (FaultTasks.hpp). Both come
+// before anything can fault in a task.
+void enableMemoryProtection(const boot::BootInfo& info)
+{
+    const boot::ImageLayout image = boot::imageLayout();
+    uintptr_t memoryEnd = kExtendedMemoryStart + uintptr_t{info.upperMemoryKib} * 1024u;
+    if (info.upperMemoryKib == 0 || memoryEnd < image.end) {
+        // A loader that says nothing of memory: map what the image needs
+        // and the page tables' own room (1 MiB covers them up to 1 GiB).
+        memoryEnd = arch_x86::Paging::roundUpToPage(image.end) + 0x100000;
+    }
+    firstFreeAddress = arch_x86::Paging::enable(memoryEnd, image.end);
+    arch_x86::FaultTasks::install();
+}
+
 } // namespace
 
 const boot::BootInfo& bootInfo() { return bootInfoCopy; }
+
+uintptr_t firstFreeMemory() { return firstFreeAddress; }
 
 } // namespace dcos
 
@@ -133,6 +158,7 @@ const boot::BootInfo& bootInfo() { return bootInfoCopy; }
 {
     using namespace dcos;
     bootInfoCopy = bootInfo;
+    enableMemoryProtection(bootInfo);
     enableNativeFpuErrors();
     arch_x86::Idt::setExceptionHandler(internal::TaskManager::onCpuException);
     arch_x86::Idt::setTrapHandler(internal::TaskManager::onTrap);

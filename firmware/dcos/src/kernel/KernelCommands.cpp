@@ -15,6 +15,7 @@
 namespace dcos {
 
 const boot::BootInfo& bootInfo();
+uintptr_t firstFreeMemory();
 
 namespace {
 
@@ -67,9 +68,13 @@ shell::CommandResult mem(shell::Shell& shell, int argc, char**)
     shell.print("  stack %08lx-%08lx %6lu KiB\r\n", static_cast<unsigned long>(image.bootStackBottom),
                 static_cast<unsigned long>(image.bootStackTop),
                 static_cast<unsigned long>((image.bootStackTop - image.bootStackBottom) / 1024u));
-    if (memoryEnd > image.end) {
-        shell.print("free    %08lx-%08lx %6lu KiB\r\n", static_cast<unsigned long>(image.end),
-                    static_cast<unsigned long>(memoryEnd), static_cast<unsigned long>((memoryEnd - image.end) / 1024u));
+    const uintptr_t freeStart = firstFreeMemory();
+    shell.print("paging  %08lx-%08lx %6lu KiB (page tables; page 0 and stack guards not present)\r\n",
+                static_cast<unsigned long>(image.end), static_cast<unsigned long>(freeStart),
+                static_cast<unsigned long>((freeStart - image.end) / 1024u));
+    if (memoryEnd > freeStart) {
+        shell.print("free    %08lx-%08lx %6lu KiB\r\n", static_cast<unsigned long>(freeStart),
+                    static_cast<unsigned long>(memoryEnd), static_cast<unsigned long>((memoryEnd - freeStart) / 1024u));
     } else {
         shell.print("free    none: the image does not fit the reported memory\r\n");
     }
@@ -95,12 +100,13 @@ shell::CommandResult tasks(shell::Shell& shell, int argc, char**)
     if (argc != 1) {
         return shell::CommandResult::UsageError;
     }
-    shell.print("id         name             prio state      stack  flags\r\n");
+    shell.print("id         name             prio state      stack   used  flags\r\n");
     internal::TaskManager::forEachTask([&shell](internal::Task& task) {
         const Result<TaskState> state = taskAgent.GetState(task.id);
-        shell.print("%08lx   %-16s %4u %-10s %6lu %s%s%s%s\r\n", static_cast<unsigned long>(task.id.raw()),
+        shell.print("%08lx   %-16s %4u %-10s %6lu %6lu  %s%s%s%s\r\n", static_cast<unsigned long>(task.id.raw()),
                     internal::TaskManager::nameOf(task.id), task.basePriority,
                     state.ok() ? stateName(state.value()) : "?", static_cast<unsigned long>(task.stackSize),
+                    static_cast<unsigned long>(internal::TaskManager::stackHighWater(task)),
                     task.superUser ? "S" : "-", task.timeSlicing ? "T" : "-", task.floatingPoint ? "F" : "-",
                     task.inDeadlineScope ? "D" : "-");
     });

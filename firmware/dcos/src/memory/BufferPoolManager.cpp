@@ -37,7 +37,7 @@ constinit PoolObject pools[kPoolCapacity];
 constinit bool started = false;
 constinit uint32_t poolsCreated = 0;
 
-size_t slotOf(ObjectId id) { return id.index() & (kPoolCapacity - 1); }
+size_t slotOf(ObjectId id) { return poolTable.slotNumber(id); }
 
 // Activates the first slots on first use; call with interrupts disabled.
 void start()

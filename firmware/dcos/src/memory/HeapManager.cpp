@@ -35,7 +35,7 @@ constinit HeapObject heaps[kHeapCapacity];
 constinit bool started = false;
 constinit uint32_t heapsCreated = 0;
 
-size_t slotOf(ObjectId id) { return id.index() & (kHeapCapacity - 1); }
+size_t slotOf(ObjectId id) { return heapTable.slotNumber(id); }
 
 // Activates the first slots on first use; call with interrupts disabled.
 void start()

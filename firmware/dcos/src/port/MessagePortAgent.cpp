@@ -49,7 +49,7 @@ MessageBuffer bufferReserve[kMessageBufferCapacity];
 MessageBufferPool bufferPool(bufferReserve, kMessageBufferCapacity);
 bool started = false;
 
-size_t portSlotOf(ObjectId id) { return id.index() & (kPortCapacity - 1); }
+size_t portSlotOf(ObjectId id) { return portTable.slotNumber(id); }
 
 // Activates the boot-time slots and buffers, and takes the board's node id,
 // on the first call to the agent (the board knows its node only once it is

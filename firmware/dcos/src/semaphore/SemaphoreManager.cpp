@@ -43,7 +43,7 @@ ObjectTable<Semaphore*, kSemaphoreCapacity> table(ObjectType::Semaphore, 0);
 Semaphore semaphores[kSemaphoreCapacity];
 bool tableReady = false;
 
-size_t slotOf(ObjectId id) { return id.index() & (kSemaphoreCapacity - 1); }
+size_t slotOf(ObjectId id) { return table.slotNumber(id); }
 
 void ensureTable()
 {

@@ -27,6 +27,18 @@ Status checkControl(const Task& target)
     return Status::NotPermitted;
 }
 
+// The kernel's own tasks (idle, and the root task that keeps the console
+// alive) share their process with the application the root task starts, so
+// the process rule alone would let any application task end the console.
+// Only a super user may kill or suspend them.
+Status checkLifeControl(const Task& target)
+{
+    if (target.kernelTask && !Scheduler::current().superUser) {
+        return Status::NotPermitted;
+    }
+    return checkControl(target);
+}
+
 } // namespace
 
 Result<ObjectId> TaskAgent::Create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument) const
@@ -51,7 +63,7 @@ Status TaskAgent::KillTask(ObjectId id) const
     if (!task.ok()) {
         return task.status();
     }
-    const Status allowed = checkControl(*task.value());
+    const Status allowed = checkLifeControl(*task.value());
     return allowed != Status::Ok ? allowed : TaskManager::kill(*task.value());
 }
 
@@ -61,7 +73,7 @@ Status TaskAgent::Suspend(ObjectId id) const
     if (!task.ok()) {
         return task.status();
     }
-    const Status allowed = checkControl(*task.value());
+    const Status allowed = checkLifeControl(*task.value());
     return allowed != Status::Ok ? allowed : TaskManager::suspend(*task.value());
 }
 

@@ -10,8 +10,10 @@
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/CpuException.hpp>
+#include <arch_x86/FaultTasks.hpp>
 #include <arch_x86/Gdt.hpp>
 #include <arch_x86/Idt.hpp>
+#include <arch_x86/Paging.hpp>
 #include <boot/Panic.hpp>
 #include <bsp/Board.hpp>
 
@@ -29,6 +31,9 @@ namespace dcos::internal {
 namespace {
 
 constexpr uint32_t kEflagsReservedBit = 1u << 1;
+// Every stack is filled with this at creation, so the console can tell how
+// deep it has been used (its high-water mark).
+constexpr uint32_t kStackPaint = 0xDC05DC05u;
 // A handler frame is refused when it would leave less than this below it.
 constexpr size_t kHandlerStackReserve = 512;
 
@@ -38,7 +43,7 @@ Task tasks[kTaskCapacity];
 // another task runs (the dying task's own stack is in use until then).
 IntrusiveList<Task, ReadyQueueTag> reapList;
 
-size_t slotOf(ObjectId id) { return id.index() & (kTaskCapacity - 1); }
+size_t slotOf(ObjectId id) { return table.slotNumber(id); }
 
 bool inInterrupt() { return arch_x86::Idt::nestingDepth() > 0; }
 
@@ -51,6 +56,21 @@ arch_x86::InterruptFrame* initialFrame(uint8_t* stackTop, void (*entry)())
     frame->eflags = arch_x86::eflagsInterruptEnable | kEflagsReservedBit;
     frame->eip = static_cast<uint32_t>(reinterpret_cast<uintptr_t>(entry));
     return frame;
+}
+
+void paintStack(uint8_t* base, size_t bytes)
+{
+    auto* word = reinterpret_cast<uint32_t*>(base);
+    size_t count = bytes / sizeof(uint32_t);
+#if defined(DCOS_HOST_BUILD)
+    for (size_t i = 0; i < count; ++i) {
+        word[i] = kStackPaint;
+    }
+#else
+    // One string store: creation is a configuration-class service, but it
+    // need not cost more than the stack it fills.
+    asm volatile("cld; rep stosl" : "+D"(word), "+c"(count) : "a"(kStackPaint) : "memory");
+#endif
 }
 
 // The FPU state FNINIT leaves, in FSAVE's 32-bit layout: control word 0x037F
@@ -235,6 +255,39 @@ void reportTermination(Task& task, const ExceptionInfo& info)
     }
 }
 
+// Says what a page fault the fault task caught means, in the words an
+// engineer looks for: a stack overflow (the task's own guard page), a null
+// pointer, another stack's guard, or an address nothing is mapped at.
+void explainPageFault(const Task& task, const arch_x86::FaultRecord& fault)
+{
+    runtime::CharacterSink& out = bsp::console();
+    const char* access = (fault.errorCode & arch_x86::pageFaultWrite) != 0 ? "write" : "read";
+    const uintptr_t address = fault.address;
+    if (StackArena::isGuardOf(task.stackBase, address)) {
+        runtime::format(out, "  stack overflow: the stack of %lu bytes at %08lx-%08lx ran into its guard page (%s at "
+                             "%08lx, ESP=%08lx)\r\n",
+                        static_cast<unsigned long>(task.stackSize),
+                        static_cast<unsigned long>(reinterpret_cast<uintptr_t>(task.stackBase)),
+                        static_cast<unsigned long>(reinterpret_cast<uintptr_t>(task.stackBase) + task.stackSize),
+                        access, static_cast<unsigned long>(address), static_cast<unsigned long>(fault.stackPointer));
+        return;
+    }
+    if (address < arch_x86::Paging::kPageSize) {
+        runtime::format(out, "  null pointer: %s at %08lx\r\n", access, static_cast<unsigned long>(address));
+        return;
+    }
+    for (size_t i = 0; i < kTaskCapacity; ++i) {
+        const Task& other = tasks[i];
+        if (other.state != TaskState::NonExistent && StackArena::isGuardOf(other.stackBase, address)) {
+            runtime::format(out, "  %s at %08lx, in the guard page below the stack of task %s (0x%08lx)\r\n", access,
+                            static_cast<unsigned long>(address), TaskManager::nameOf(other.id),
+                            static_cast<unsigned long>(other.id.raw()));
+            return;
+        }
+    }
+    runtime::format(out, "  %s at %08lx, where no memory is mapped\r\n", access, static_cast<unsigned long>(address));
+}
+
 // Ends the running task from interrupt context (exception or trap); the
 // switch away happens at the outermost exit.
 void terminateCurrentFromInterrupt()
@@ -260,6 +313,7 @@ void TaskManager::initialise(TaskEntry rootEntry)
         dcosPanic("cannot create the idle task: %s", statusName(idleId.status()));
     }
     Task& idleTask = tasks[slotOf(idleId.value())];
+    idleTask.kernelTask = true;
     Scheduler::makeUnready(idleTask);
     Scheduler::setIdleTask(idleTask);
 
@@ -272,6 +326,7 @@ void TaskManager::initialise(TaskEntry rootEntry)
     if (!rootId.ok()) {
         dcosPanic("cannot create the root task: %s", statusName(rootId.status()));
     }
+    tasks[slotOf(rootId.value())].kernelTask = true;
 }
 
 Result<Task*> TaskManager::resolve(ObjectId id)
@@ -304,7 +359,8 @@ Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry
     if (!id.ok()) {
         return id.status();
     }
-    const Result<uint8_t*> stack = StackArena::allocate(attributes.stackSize);
+    const size_t stackSize = StackArena::usableSize(attributes.stackSize);
+    const Result<uint8_t*> stack = StackArena::allocate(stackSize);
     if (!stack.ok()) {
         table.Delete(id.value());
         return stack.status();
@@ -324,7 +380,8 @@ Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry
     task.superUser = attributes.superUser;
     task.process = attributes.newProcess || !started ? task.id : Scheduler::current().process;
     task.stackBase = stack.value();
-    task.stackSize = attributes.stackSize;
+    task.stackSize = stackSize;
+    paintStack(task.stackBase, task.stackSize - sizeof(arch_x86::InterruptFrame));
     task.entry = entry;
     task.argument = argument;
     task.sliceTicksLeft = Scheduler::quantumTicks();
@@ -613,6 +670,21 @@ arch_x86::InterruptFrame* TaskManager::onCpuException(arch_x86::InterruptFrame* 
         dcosPanicWithFrame(frame, "CPU exception in kernel context");
     }
     Task& task = Scheduler::current();
+    if (arch_x86::FaultTasks::isFaultFrame(frame)) {
+        // A page fault: its frame was rebuilt on the recovery stack, because
+        // the task's own stack may be the very thing that failed. Inside a
+        // kernel critical section (interrupts off, or dispatch held) the
+        // kernel's lists may be half updated, so only a halt is safe.
+        if ((frame->eflags & arch_x86::eflagsInterruptEnable) == 0 || Scheduler::dispatchHeld()) {
+            dcosPanicWithFrame(frame, "page fault in a kernel critical section");
+        }
+        const ExceptionInfo info{ExceptionClass::Fatal, static_cast<uint8_t>(frame->vector), frame->errorCode,
+                                 frame->eip, nullptr};
+        reportTermination(task, info);
+        explainPageFault(task, arch_x86::FaultTasks::lastFault());
+        terminateCurrentFromInterrupt();
+        return frame;
+    }
     ExceptionInfo info{classify(frame->vector), static_cast<uint8_t>(frame->vector), frame->errorCode, frame->eip,
                        nullptr};
     if (info.exceptionClass == ExceptionClass::Fatal || task.exceptionHandler == nullptr || task.inExceptionHandler) {
@@ -679,6 +751,17 @@ arch_x86::InterruptFrame* TaskManager::onTrap(arch_x86::InterruptFrame* frame)
     default:
         dcosPanicWithFrame(frame, "unknown software trap");
     }
+}
+
+size_t TaskManager::stackHighWater(const Task& task)
+{
+    const auto* word = reinterpret_cast<const uint32_t*>(task.stackBase);
+    const size_t words = task.stackSize / sizeof(uint32_t);
+    size_t untouched = 0;
+    while (untouched < words && word[untouched] == kStackPaint) {
+        ++untouched;
+    }
+    return task.stackSize - untouched * sizeof(uint32_t);
 }
 
 size_t TaskManager::taskCount() { return table.usedCount(); }

@@ -37,7 +37,7 @@ uint64_t baseNs = 0;               // Time of day, in ns since 1970, when the ti
 ObjectTable<TimerObject*, kTimerCapacity> timerTable(ObjectType::Timer, 0);
 TimerObject timers[kTimerCapacity];
 
-size_t timerSlotOf(ObjectId id) { return id.index() & (kTimerCapacity - 1); }
+size_t timerSlotOf(ObjectId id) { return timerTable.slotNumber(id); }
 
 // The first tick whose time (uptime) is at or after ns.
 uint64_t firstTickAtOrAfter(uint64_t ns)

@@ -128,7 +128,7 @@ public:
     size_t usedCount() const;
 
 private:
-    static constexpr size_t slotOf(ObjectId id) { return id.index() & (kCapacity - 1); }
+    size_t slotOf(ObjectId id) const { return table_.slotNumber(id); }
 
     // Applies the id checks common to every primitive; call with interrupts disabled.
     Result<DeviceEntry*> lookup(ObjectId id);

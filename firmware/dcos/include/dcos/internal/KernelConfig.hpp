@@ -24,8 +24,11 @@
 #ifndef DCOS_CONFIG_DEVICE_CAPACITY
 #define DCOS_CONFIG_DEVICE_CAPACITY 64
 #endif
+// Every stack takes whole pages plus a guard page (StackArena.hpp): this
+// arena gives every slot of the task table a stack of kMinimumStackSize
+// (8 KiB each with its guard) besides the kernel's own tasks.
 #ifndef DCOS_CONFIG_STACK_ARENA_KIB
-#define DCOS_CONFIG_STACK_ARENA_KIB 1024
+#define DCOS_CONFIG_STACK_ARENA_KIB 2112
 #endif
 #ifndef DCOS_CONFIG_TIME_WHEEL_SLOTS
 #define DCOS_CONFIG_TIME_WHEEL_SLOTS 257

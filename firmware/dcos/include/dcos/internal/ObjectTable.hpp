@@ -8,14 +8,17 @@
 // configuration services (AddObjects, NameToObject, enumeration by owner)
 // cost O(N), which the seed accepts for configuration-class services.
 //
-// Stale id detection: the 12-bit index field of an ObjectId is split into a
-// slot number in its low log2(Capacity) bits and a per-slot generation in the
-// remaining high bits. Deleting an object bumps the generation of its slot,
-// so an id kept after the delete no longer matches, even when the slot has
-// since been reused. With Capacity 4096 the slot number needs all 12 bits and
-// no generation is left: only the "slot is free" check remains, so an id to a
-// deleted and reused slot then resolves to the new object. Tables that must
-// detect stale ids therefore stay below 4096 slots.
+// Stale id detection: the 12-bit index field of an ObjectId is not a slot
+// number. Every table hands out all 4096 index values, each naming at most
+// one live object, and maps an index to its slot in O(1). A deleted object's
+// index joins the back of a FIFO of free indices, and Create takes the index
+// freed longest ago (indices never issued come first), so an id kept after
+// its object was deleted answers StaleId until at least 4096 - N further
+// Creates in that table, N being the objects alive in it: as late as 12 bits
+// allow, whatever the table's capacity or how many of its slots are active.
+// Slots themselves are reused least recently freed first as well. The cost
+// is two arrays of 4096 entries per table (12 KiB for a table of at most 256
+// slots, 16 KiB above), and Create and Delete stay O(1).
 //
 // The table does no locking; the owning agent serialises access to it.
 #pragma once
@@ -27,6 +30,7 @@
 #include <bit>
 #include <stddef.h>
 #include <stdint.h>
+#include <type_traits>
 
 namespace dcos::internal {
 
@@ -42,7 +46,7 @@ namespace dcos::internal {
 template <typename T, size_t Capacity>
 class ObjectTable {
     static_assert(Capacity >= 8 && Capacity <= 4096, "a table holds 8 to 4096 objects (12-bit index)");
-    static_assert(std::has_single_bit(Capacity), "Capacity must be a power of two to split slot and generation bits");
+    static_assert(std::has_single_bit(Capacity), "Capacity is a power of two, as the kernel configuration sizes it");
     static_assert(Capacity % 8 == 0, "objects are added in groups of eight");
 
 public:
@@ -52,10 +56,8 @@ public:
     static constexpr size_t kNameCapacity = 16;
     /// Longest name accepted by Create.
     static constexpr size_t kMaxNameLength = kNameCapacity - 1;
-    /// Low bits of the index field that select the slot.
-    static constexpr unsigned kSlotBits = static_cast<unsigned>(std::countr_zero(Capacity));
-    /// High bits of the index field that carry the slot generation; 0 when Capacity is 4096.
-    static constexpr unsigned kGenerationBits = ObjectId::kIndexBits - kSlotBits;
+    /// Index values a table hands out: every value the 12-bit field holds.
+    static constexpr size_t kIndexCount = size_t{1} << ObjectId::kIndexBits;
 
     /// Creates an empty table for objects of @p type on node @p node.
     ///
@@ -131,6 +133,8 @@ public:
         }
         const uint16_t slot = popFree();
         Entry& entry = entries_[slot];
+        entry.index = takeIndex();
+        indexSlot_[entry.index] = static_cast<SlotNumber>(slot);
         entry.used = true;
         entry.owner = owner;
         entry.visibility = visibility;
@@ -141,8 +145,8 @@ public:
 
     /// Deletes the object named by @p id and frees its slot.
     ///
-    /// The object is reset to T{} and the slot generation advances, so every
-    /// copy of @p id turns stale. Ownership is checked by the agent before,
+    /// The object is reset to T{} and its index goes to the back of the free
+    /// indices, so every copy of @p id turns stale for 4096 - N Creates. Ownership is checked by the agent before,
     /// because some primitives (KillTask by a super user) bypass it. Cost O(1).
     Status Delete(ObjectId id)
     {
@@ -155,7 +159,7 @@ public:
         entry.used = false;
         entry.owner = ObjectId::null();
         entry.name[0] = '\0';
-        entry.generation = static_cast<uint16_t>((entry.generation + 1) & kGenerationMask);
+        giveBackIndex(entry.index);
         --used_;
         pushFree(slot.value());
         return Status::Ok;
@@ -164,9 +168,9 @@ public:
     /// Resolves @p id to its object.
     ///
     /// Fails with InvalidId for the null id, WrongType for an id of another
-    /// type, Remote for an id of this type on another node, InvalidId for a
-    /// slot outside the active range or a free slot, and StaleId when
-    /// the generation shows the object was deleted. Cost O(1).
+    /// type, Remote for an id of this type on another node, InvalidId for an
+    /// index this table never handed out, and StaleId for one whose object
+    /// was deleted. Cost O(1).
     Result<T*> resolve(ObjectId id)
     {
         const Result<uint16_t> slot = slotOf(id);
@@ -175,6 +179,10 @@ public:
         }
         return &entries_[slot.value()].object;
     }
+
+    /// The slot an id that Create returned occupies, for agents that keep
+    /// their objects in an array beside the table. Cost O(1).
+    size_t slotNumber(ObjectId id) const { return indexSlot_[id.index() & ObjectId::kMaxIndex]; }
 
     /// Returns the task that owns @p id (null for system objects). Cost O(1).
     Result<ObjectId> ownerOf(ObjectId id) const
@@ -293,23 +301,39 @@ public:
 
 private:
     static constexpr uint16_t kNoSlot = 0xFFFF;
-    static constexpr uint16_t kSlotMask = static_cast<uint16_t>(Capacity - 1);
-    static constexpr uint16_t kGenerationMask = static_cast<uint16_t>((1u << kGenerationBits) - 1);
+    // The smallest type that numbers every slot.
+    using SlotNumber = std::conditional_t<(Capacity <= 256), uint8_t, uint16_t>;
 
     struct Entry {
         T object{};
         ObjectId owner{};
-        uint16_t generation = 0;
+        uint16_t index = 0; ///< The id's index field while the slot is used.
         uint16_t nextFree = kNoSlot;
         bool used = false;
         Visibility visibility = Visibility::Local;
         char name[kNameCapacity] = {};
     };
 
-    ObjectId idOf(uint16_t slot) const
+    ObjectId idOf(uint16_t slot) const { return ObjectId(node_, type_, entries_[slot].index); }
+
+    // The index freed longest ago; indices never handed out count as freed
+    // before any other. There is always one: at most Capacity objects live,
+    // and Capacity <= 4096.
+    uint16_t takeIndex()
     {
-        const uint16_t index = static_cast<uint16_t>((entries_[slot].generation << kSlotBits) | slot);
-        return ObjectId(node_, type_, index);
+        if (freshIndices_ < kIndexCount) {
+            return static_cast<uint16_t>(freshIndices_++);
+        }
+        const uint16_t index = freedIndices_[freedHead_];
+        freedHead_ = (freedHead_ + 1) % kIndexCount;
+        --freedCount_;
+        return index;
+    }
+
+    void giveBackIndex(uint16_t index)
+    {
+        freedIndices_[(freedHead_ + freedCount_) % kIndexCount] = index;
+        ++freedCount_;
     }
 
     // Every accessor funnels through here so the rejection rules live in one place.
@@ -327,22 +351,19 @@ private:
             // the object is unreachable.
             return Status::Remote;
         }
-        const uint16_t slot = static_cast<uint16_t>(id.index() & kSlotMask);
-        if (slot >= active_) {
-            return Status::InvalidId;
+        if (id.index() >= freshIndices_) {
+            return Status::InvalidId; // Never handed out: forged.
         }
+        const uint16_t slot = indexSlot_[id.index()];
         const Entry& entry = entries_[slot];
-        if ((id.index() >> kSlotBits) != entry.generation) {
-            return Status::StaleId;
-        }
-        if (!entry.used) {
-            return Status::InvalidId;
+        if (!entry.used || entry.index != id.index()) {
+            return Status::StaleId; // Handed out once; its object is gone.
         }
         return slot;
     }
 
-    // Freed slots join the tail so that a slot is reused as late as possible,
-    // which keeps a stale id detectable for as many generations as possible.
+    // Freed slots join the tail so that the slot freed longest ago is reused
+    // first, which spreads wear of the slots' storage evenly.
     void pushFree(uint16_t slot)
     {
         entries_[slot].nextFree = kNoSlot;
@@ -402,6 +423,14 @@ private:
     }
 
     Entry entries_[Capacity] = {};
+    // Index -> slot, for every index handed out (the slot it last named).
+    SlotNumber indexSlot_[kIndexCount] = {};
+    // Freed indices, oldest first: a ring of freedCount_ entries at freedHead_.
+    uint16_t freedIndices_[kIndexCount] = {};
+    size_t freedHead_ = 0;
+    size_t freedCount_ = 0;
+    // Indices [freshIndices_, 4096) were never handed out.
+    size_t freshIndices_ = 0;
     ObjectType type_;
     uint16_t node_;
     size_t active_ = 0;

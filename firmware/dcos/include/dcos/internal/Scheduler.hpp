@@ -64,6 +64,8 @@ public:
     static void holdDispatch() { ++dispatchHolds_; }
     /// Ends a hold; a switch requested meanwhile happens now.
     static void releaseDispatch();
+    /// Whether a dispatch hold is taken: the kernel is inside a critical section.
+    static bool dispatchHeld() { return dispatchHolds_ != 0; }
 
     /// Moves the running task behind its equals (Yield, end of time slice).
     /// Returns true when another task of the same priority was waiting.

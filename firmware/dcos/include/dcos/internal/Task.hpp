@@ -64,12 +64,13 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     bool floatingPoint = false;
     bool superUser = false;
     bool idle = false;          ///< The idle task: never queued, runs when nothing else can.
+    bool kernelTask = false;    ///< idle or the root (console): only a super user may kill or suspend it.
     ObjectId process;           ///< The process the task belongs to.
 
     // Execution context.
     arch_x86::InterruptFrame* savedFrame = nullptr;
-    uint8_t* stackBase = nullptr;
-    size_t stackSize = 0;
+    uint8_t* stackBase = nullptr; ///< Lowest byte; the guard page lies below it.
+    size_t stackSize = 0;         ///< Usable bytes: the size asked for, rounded to whole pages.
     TaskEntry entry = nullptr;
     uintptr_t argument = 0;
     FpuState fpu{};

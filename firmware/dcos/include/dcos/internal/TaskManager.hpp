@@ -76,6 +76,11 @@ public:
     template <typename Visitor>
     static void forEachTask(Visitor&& visit);
 
+    /// The deepest the task's stack has been used, in bytes, found by
+    /// scanning for the pattern its stack was filled with at creation.
+    /// O(stack size): for the console, not for real-time paths.
+    static size_t stackHighWater(const Task& task);
+
     static size_t taskCount();
     static Status addObjects(size_t count);
     static Result<ObjectId> nameToObject(const char* name);
