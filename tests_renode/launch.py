@@ -6,12 +6,14 @@ Leave the emulator with Ctrl-A X; Ctrl-A H lists the emulator's other keys.
 
 import argparse
 import os
+import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from dcoslab.board import load_board  # noqa: E402
 from dcoslab.built_emulator import EmulatorNotBuilt  # noqa: E402
+from dcoslab.symbolize import explain  # noqa: E402
 
 
 def device_property(text):
@@ -55,7 +57,42 @@ def main():
         return
     print(f"Booting the {board.name} board: {board.description}.", flush=True)
     print("Console on this terminal; Ctrl-A X leaves the emulator.", flush=True)
-    os.execvp(command[0], command)
+    sys.exit(relay_console(command, image))
+
+
+def relay_console(command, image):
+    """Runs the emulator with its console passed through to this terminal.
+
+    The emulator reads the keyboard itself (it puts the terminal in raw
+    mode); its output comes through here, so that below every report that
+    names code by address (a panic, a task's fault, a back trace) the
+    function and source line of each address appear as well. Returns the
+    emulator's exit status.
+    """
+    process = subprocess.Popen(command, stdout=subprocess.PIPE)
+    out = sys.stdout.buffer
+    line = bytearray()
+    try:
+        while True:
+            chunk = os.read(process.stdout.fileno(), 4096)
+            if not chunk:
+                break
+            out.write(chunk)
+            out.flush()
+            line.extend(chunk)
+            while b"\n" in line:
+                complete, _, rest = line.partition(b"\n")
+                line = bytearray(rest)
+                text = complete.decode("latin-1")
+                if "EIP=" in text or "back trace:" in text:
+                    code = explain(text, image)
+                    if code:
+                        # The terminal is raw while the emulator runs: end lines with CR LF.
+                        out.write(code.replace("\n", "\r\n").encode("latin-1"))
+                        out.flush()
+    except KeyboardInterrupt:
+        process.terminate()
+    return process.wait()
 
 
 if __name__ == "__main__":

@@ -34,3 +34,25 @@ def test_unknown_board_is_refused_with_the_list():
     session.close()
     assert "unknown board 'vax'; the boards are: isa486" in session.before
     assert session.exitstatus != 0
+
+
+def test_launcher_names_the_code_a_fault_report_points_at():
+    """A task's fault report on the console is followed by its function and line."""
+    image = os.path.join(REPOSITORY, "build", "486", "dcos486-test.elf")
+    session = pexpect.spawn(sys.executable, [LAUNCHER, "--board", "isa486", "--image", image], timeout=60,
+                            encoding="latin-1")
+    try:
+        session.expect(r"dcos> ")
+        session.send("test nullwrite\r")
+        session.expect(r"task nullwrite \(0x[0-9a-f]{8}\) terminated: fatal exception, vector 14 .* at EIP=([0-9a-f]{8})")
+        eip = session.match.group(1)
+        session.expect(rf"{eip} is \(anonymous namespace\)::nullWrite\(unsigned int\) at "
+                       r"tests_renode/target/MemoryProtectionTest\.cpp:\d+")
+        session.expect(r"TEST nullwrite: PASS")
+        session.expect(r"dcos> ")
+        session.send("\x01x")
+        session.expect(pexpect.EOF)
+    except (pexpect.TIMEOUT, pexpect.EOF) as error:
+        raise AssertionError(f"launcher session failed: {error}\n----- console -----\n{session.before}") from None
+    finally:
+        session.close(force=True)

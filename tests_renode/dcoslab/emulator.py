@@ -14,6 +14,7 @@ import threading
 import time
 
 from .board import EXIT_PANIC, EXIT_FAIL, EXIT_PASS
+from .symbolize import explain
 
 # Generous limits: these bound a hung emulator, they do not measure speed.
 DEFAULT_TIMEOUT = 60.0
@@ -129,8 +130,11 @@ class Emulator:
             return ""
 
     def _failure(self, what):
+        transcript = self.transcript
+        code = explain(transcript, self.image)
         return EmulatorError(
-            f"{what}\n----- console transcript -----\n{self.transcript}\n----- end of transcript -----\n"
+            f"{what}\n----- console transcript -----\n{transcript}\n----- end of transcript -----\n"
+            + (f"----- code addresses in the transcript ({self.image}) -----\n{code}" if code else "")
             + (f"emulator said: {self.emulator_messages()}" if self.emulator_messages() else "")
         )
 

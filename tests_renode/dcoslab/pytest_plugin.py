@@ -23,6 +23,7 @@ import pytest
 
 from .board import load_board
 from .emulator import Emulator
+from .symbolize import explain
 
 
 def pytest_addoption(parser):
@@ -94,3 +95,6 @@ def pytest_runtest_makereport(item, call):
             report.sections.append(
                 (f"console transcript of emulator {index + 1}: {' '.join(getattr(emulator, 'argv', []))}", emulator.transcript)
             )
+            code = explain(emulator.transcript, getattr(emulator, "image", None))
+            if code:
+                report.sections.append((f"code addresses in the transcript of emulator {index + 1}", code))
