@@ -14,6 +14,7 @@ import pytest
 MEMORY_PROTECTION_TARGET_TESTS = [
     "overflowlocal",  # a 6,000-byte local in a 2 KiB stack
     "overflowdeep",   # unbounded recursion, well past the stack area
+    "overflowirq",    # an interrupt's frame pushed into the guard page; the tick goes on
     "nullwrite",      # a write through a null pointer
     "nullread",       # a read at a small offset from a null pointer
     "kerneltasks",    # idle and console cannot be killed or suspended by an ordinary task
@@ -30,6 +31,9 @@ REPORTS = {
                       rf"\((read|write) at {HEX}, ESP={HEX}\)"],
     "overflowdeep": [rf"task recursion \({ID}\) terminated: fatal exception, vector 14",
                      rf"  stack overflow: the stack of 8192 bytes at {HEX}-{HEX} ran into its guard page"],
+    "overflowirq": [rf"task irqoverflow \({ID}\) terminated: fatal exception, vector 14",
+                    rf"  stack overflow: the stack of 4096 bytes at {HEX}-{HEX} ran into its guard page "
+                    rf"\(write at {HEX}"],
     "nullwrite": [rf"task nullwrite \({ID}\) terminated: fatal exception, vector 14",
                   r"  null pointer: write at 00000000"],
     "nullread": [rf"task nullread \({ID}\) terminated: fatal exception, vector 14",

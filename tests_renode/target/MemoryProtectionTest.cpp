@@ -9,6 +9,8 @@
 
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/TimerManager.hpp>
 #include <dcos/internal/StackArena.hpp>
 #include <dcos/internal/TaskManager.hpp>
 
@@ -85,6 +87,20 @@ void nullRead(uintptr_t)
     faulterSurvived = true;
 }
 
+// Leaves 8 bytes of stack and waits for the tick: the processor's push of
+// the interrupt frame runs into the guard page, after the interrupt
+// controller has put the tick in service. Without delivering the tick after
+// all, the controller would hold back IRQ 0 and every less urgent line.
+void overflowOnInterrupt(uintptr_t)
+{
+    const uintptr_t base = reinterpret_cast<uintptr_t>(dcos::internal::Scheduler::current().stackBase);
+    asm volatile("movl %0, %%esp\n"
+                 "1: jmp 1b"
+                 :
+                 : "r"(base + 8)
+                 : "memory");
+}
+
 dcos::ObjectId createTask(const char* name, uint8_t priority, size_t stackSize, dcos::TaskEntry entry)
 {
     dcos::TaskAttributes attributes;
@@ -139,6 +155,16 @@ bool largeLocalOverflow(shell::Shell& shell)
 bool recursionOverflow(shell::Shell& shell)
 {
     return faultStaysInItsTask(shell, "recursion", 8192, deepRecursion);
+}
+
+bool interruptOverflow(shell::Shell& shell)
+{
+    const uint64_t ticksBefore = dcos::internal::TimerManager::ticks();
+    bool ok = faultStaysInItsTask(shell, "irqoverflow", 4096, overflowOnInterrupt);
+    const uint64_t ticksAfter = dcos::internal::TimerManager::ticks();
+    shell.print("%lu ticks while the tests ran\r\n", static_cast<unsigned long>(ticksAfter - ticksBefore));
+    ok &= check(shell, ticksAfter - ticksBefore >= 30, "the tick went on after the fault");
+    return ok;
 }
 
 bool nullWriteFaults(shell::Shell& shell) { return faultStaysInItsTask(shell, "nullwrite", 4096, nullWrite); }
@@ -216,6 +242,9 @@ DCOS_TARGET_TEST(largeLocalOverflowTest, "overflowlocal",
                  largeLocalOverflow);
 DCOS_TARGET_TEST(recursionOverflowTest, "overflowdeep",
                  "unbounded recursion runs into the guard page; only that task ends", recursionOverflow);
+DCOS_TARGET_TEST(interruptOverflowTest, "overflowirq",
+                 "an interrupt frame pushed into the guard page: only that task ends, the tick goes on",
+                 interruptOverflow);
 DCOS_TARGET_TEST(nullWriteTest, "nullwrite", "a write through a null pointer faults; only that task ends",
                  nullWriteFaults);
 DCOS_TARGET_TEST(nullReadTest, "nullread", "a read near a null pointer faults; only that task ends",

@@ -68,6 +68,8 @@ void Idt::setInterruptHandler(Handler handler) { interruptHandler = handler; }
 
 void Idt::setTrapHandler(Handler handler) { trapHandler = handler; }
 
+InterruptFrame* Idt::dispatchInterrupt(InterruptFrame* frame) { return interruptHandler(frame); }
+
 void Idt::setOutermostExitHook(Handler hook) { outermostExitHook = hook; }
 
 unsigned Idt::nestingDepth() { return depth; }

@@ -190,6 +190,25 @@ bool isInterruptRequested(unsigned line)
     return line < interruptLineCount && (pic.readRequestRegister() & (1u << line)) != 0;
 }
 
+bool interruptCutShort(unsigned& line)
+{
+    arch_x86::InterruptGuard guard;
+    const uint16_t inService = pic.readInServiceRegister();
+    const uint8_t master = static_cast<uint8_t>(inService & ~(1u << Pic8259::cascadeLine));
+    const uint8_t slave = static_cast<uint8_t>(inService >> 8);
+    // With no handler running at most one line is in service: a slave line
+    // shows on the master's cascade input as well.
+    if (slave != 0) {
+        line = 8 + static_cast<unsigned>(__builtin_ctz(slave));
+        return true;
+    }
+    if (master != 0) {
+        line = static_cast<unsigned>(__builtin_ctz(master));
+        return true;
+    }
+    return false;
+}
+
 uint32_t unexpectedInterruptCount(unsigned line) { return line < interruptLineCount ? unexpected[line] : 0; }
 
 uint32_t spuriousInterruptCount() { return spurious; }

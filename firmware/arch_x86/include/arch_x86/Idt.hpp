@@ -35,6 +35,10 @@ public:
     static constexpr unsigned firstTrapVector = 0x30;
     static constexpr unsigned lastTrapVector = 0x3F;
 
+    /// Runs the interrupt handler for frame's vector, as its arrival would
+    /// (for an interrupt whose delivery a fault cut short).
+    static InterruptFrame* dispatchInterrupt(InterruptFrame* frame);
+
     /// Sets the handler for the kernel trap vectors.
     static void setTrapHandler(Handler handler);
 

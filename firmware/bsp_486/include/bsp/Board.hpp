@@ -61,6 +61,14 @@ bool isInterruptMasked(unsigned line);
 /// True when the interrupt controller holds a request on line (IRR).
 bool isInterruptRequested(unsigned line);
 
+/// Finds the interrupt whose delivery a fault cut short: called with no
+/// handler running, a line the interrupt controller still has in service
+/// was acknowledged by the processor, whose push of the interrupt frame then
+/// faulted (a task's stack ran into its guard page just then). Sets line to
+/// it and returns true, so the kernel can deliver it after all; without that
+/// the controller would hold back this line and every less urgent one for good.
+bool interruptCutShort(unsigned& line);
+
 /// Interrupts that arrived on a line with no handler (and were masked).
 uint32_t unexpectedInterruptCount(unsigned line);
 

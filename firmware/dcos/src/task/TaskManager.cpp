@@ -683,6 +683,16 @@ arch_x86::InterruptFrame* TaskManager::onCpuException(arch_x86::InterruptFrame* 
         reportTermination(task, info);
         explainPageFault(task, arch_x86::FaultTasks::lastFault());
         terminateCurrentFromInterrupt();
+        // The fault may have hit while the processor pushed an interrupt's
+        // frame onto the task's stack: deliver that interrupt now, on the
+        // recovery stack, or its line would stay in service for good.
+        unsigned line = 0;
+        if (bsp::interruptCutShort(line)) {
+            arch_x86::InterruptFrame delivery = *frame;
+            delivery.vector = arch_x86::firstIrqVector + line;
+            delivery.errorCode = 0;
+            (void)arch_x86::Idt::dispatchInterrupt(&delivery);
+        }
         return frame;
     }
     ExceptionInfo info{classify(frame->vector), static_cast<uint8_t>(frame->vector), frame->errorCode, frame->eip,
