@@ -29,8 +29,16 @@ class TimerAgent {
 public:
     /// The time of day in the Gregorian calendar.
     Result<DateTime> GetSystemClock() const;
+    /// The last year SetSystemClock accepts. The clock counts nanoseconds
+    /// since 1970 in 64 bits, which end in July 2554; stopping at the end
+    /// of 2399 leaves the clock more than 150 years to run from any time it
+    /// is set to.
+    static constexpr uint16_t kLastClockYear = 2399;
+
     /// Sets the time of day (privileged). Only the clock's base changes, so
-    /// intervals already running are not disturbed.
+    /// intervals already running are not disturbed; day-clock alarms and
+    /// SleepTill move with the clock. InvalidArgument for a time before the
+    /// node started or after kLastClockYear.
     Status SetSystemClock(const DateTime& time) const;
     /// Nanoseconds since the system tick started (monotonic).
     uint64_t Uptime() const;

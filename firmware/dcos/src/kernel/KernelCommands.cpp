@@ -162,6 +162,11 @@ shell::CommandResult date(shell::Shell& shell, int argc, char** argv)
         if (!parseDateTime(argv[1], argv[2], time)) {
             return shell::CommandResult::UsageError;
         }
+        if (GregorianCalendar::validate(time) != Status::Ok || time.year > TimerAgent::kLastClockYear) {
+            shell.print("error: %s %s is not a date and time from 1970-01-01 00:00:00 to %u-12-31 23:59:59\r\n",
+                        argv[1], argv[2], static_cast<unsigned>(TimerAgent::kLastClockYear));
+            return shell::CommandResult::Failed;
+        }
         const Status status = timerAgent.SetSystemClock(time);
         if (status != Status::Ok) {
             shell.print("error: cannot set the clock: %s\r\n", statusName(status));

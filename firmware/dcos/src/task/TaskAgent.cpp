@@ -1,5 +1,6 @@
 // The task agent's interface object: argument checks and id resolution in
 // front of TaskManager. Every method is what a ring-3 trap will call later.
+#include <dcos/GregorianCalendar.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/Scheduler.hpp>
@@ -112,11 +113,18 @@ Status TaskAgent::SleepFor(uint64_t nanoseconds) const
 
 Status TaskAgent::SleepTill(const DateTime& time) const
 {
-    const Result<uint64_t> interval = internal::TimerManager::nanosecondsUntil(time);
-    if (!interval.ok()) {
-        return interval.status();
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
     }
-    return SleepFor(interval.value());
+    // A time of day, not an interval: SetSystemClock moves the wake-up with
+    // the clock, as it moves day-clock alarms.
+    const Result<uint64_t> target = GregorianCalendar::toNanoseconds(time);
+    if (!target.ok()) {
+        return target.status();
+    }
+    arch_x86::InterruptGuard guard;
+    const Status status = TaskManager::blockCurrentTillTimeOfDay(target.value());
+    return status == Status::Timeout ? Status::Ok : status;
 }
 
 Status TaskAgent::PostEvent(ObjectId id, uint32_t events) const

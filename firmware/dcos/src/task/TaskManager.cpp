@@ -524,6 +524,21 @@ Status TaskManager::blockCurrent(WaitReason reason, uint64_t timeoutNs)
     return task.wakeStatus;
 }
 
+Status TaskManager::blockCurrentTillTimeOfDay(uint64_t timeOfDayNs)
+{
+    Task& task = Scheduler::current();
+    task.state = TaskState::Blocked;
+    task.waitReason = WaitReason::Sleep;
+    task.wakeStatus = Status::Ok;
+    task.sleepsTillTimeOfDay = true;
+    task.wakeTimeOfDayNs = timeOfDayNs;
+    Scheduler::makeUnready(task);
+    TimerManager::arm(task.wakeTimeout, TimerManager::tickAtTimeOfDay(timeOfDayNs));
+    Scheduler::requestDispatch();
+    task.sleepsTillTimeOfDay = false;
+    return task.wakeStatus;
+}
+
 void TaskManager::wake(Task& task, Status result)
 {
     if (task.state != TaskState::Blocked) {
@@ -531,6 +546,7 @@ void TaskManager::wake(Task& task, Status result)
     }
     TimerManager::cancel(task.wakeTimeout);
     task.waitReason = WaitReason::None;
+    task.sleepsTillTimeOfDay = false;
     task.wakeStatus = result;
     // Leaving by time-out (not through wakeFirst): tell the object's agent.
     leaveWaitQueue(task);

@@ -40,11 +40,19 @@ TimerObject timers[kTimerCapacity];
 size_t timerSlotOf(ObjectId id) { return timerTable.slotNumber(id); }
 
 // The first tick whose time (uptime) is at or after ns.
+// The first tick whose start is at or after ns of uptime: a time-out armed
+// for it fires no earlier than ns, and less than a tick later. Rounded up
+// without forming ns + period, which would wrap for ns near 2^64.
 uint64_t firstTickAtOrAfter(uint64_t ns)
 {
     const uint64_t period = TimerManager::tickPeriodNs();
-    return (ns + period - 1) / period;
+    const uint64_t ticks = ns / period;
+    return ns % period != 0 ? ticks + 1 : ticks;
 }
+
+// a + b, held at the largest value instead of wrapping: a time-out within
+// a tick of 2^64 ns is a very long wait, never one that expires at once.
+uint64_t saturatingAdd(uint64_t a, uint64_t b) { return b > UINT64_MAX - a ? UINT64_MAX : a + b; }
 
 void notifyOwner(TimerObject& timer)
 {
@@ -91,6 +99,14 @@ void expire(TimeoutEntry& entry)
         break;
     }
     }
+}
+
+// The tick at which a time of day is reached with the clock as now set; a
+// time already past is due at once (the current tick, which the wheel fires
+// at the next). Interrupts disabled.
+uint64_t dayClockTick(uint64_t timeOfDayNs)
+{
+    return timeOfDayNs > baseNs ? firstTickAtOrAfter(timeOfDayNs - baseNs) : tickCount;
 }
 
 Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
@@ -184,9 +200,25 @@ uint64_t TimerManager::preciseUptimeNs()
 
 uint64_t TimerManager::tickAfter(uint64_t ns)
 {
-    const uint64_t wholeTicks = (ns + tickPeriodNs_ - 1) / tickPeriodNs_;
+    // Measured from the precise time now, not from the start of the current
+    // tick: counting whole ticks from the tick's start needs one tick more
+    // for the part already gone, and a tick of the 8254 (999,847 ns at
+    // 1 kHz) rounds 1 ms up to two, so waits ran up to two ticks long.
+    return firstTickAtOrAfter(saturatingAdd(preciseUptimeNs(), ns));
+}
+
+uint64_t TimerManager::tickAtUptime(uint64_t uptimeNs) { return firstTickAtOrAfter(uptimeNs); }
+
+uint64_t TimerManager::tickAtTimeOfDay(uint64_t timeOfDayNs)
+{
     arch_x86::InterruptGuard guard;
-    return tickCount + wholeTicks + 1;
+    return dayClockTick(timeOfDayNs);
+}
+
+Result<uint64_t> TimerManager::uptimeAtTimeOfDay(uint64_t timeOfDayNs)
+{
+    arch_x86::InterruptGuard guard;
+    return timeOfDayNs > baseNs ? Result<uint64_t>(timeOfDayNs - baseNs) : Result<uint64_t>(uint64_t{0});
 }
 
 void TimerManager::arm(TimeoutEntry& entry, uint64_t dueTick)
@@ -212,6 +244,9 @@ Result<DateTime> TimerManager::getSystemClock() { return GregorianCalendar::from
 
 Status TimerManager::setSystemClock(const DateTime& time)
 {
+    if (time.year > TimerAgent::kLastClockYear) {
+        return Status::InvalidArgument; // The clock could not carry it for long.
+    }
     const Result<uint64_t> target = GregorianCalendar::toNanoseconds(time);
     if (!target.ok()) {
         return target.status();
@@ -222,17 +257,21 @@ Status TimerManager::setSystemClock(const DateTime& time)
         return Status::InvalidArgument; // Before the node was started.
     }
     baseNs = target.value() - elapsed;
-    // Day-clock alarms are times of day: move them with the clock. This is
-    // a configuration service, so the O(N) walk is acceptable.
+    // Day-clock alarms and SleepTill are times of day: move them with the
+    // clock. This is a configuration service, so the O(N) walks are
+    // acceptable.
     for (TimerObject& timer : timers) {
         if (timer.kind == AlarmKind::DayClock) {
             wheel.cancel(timer.entry);
-            const uint64_t due = timer.dayClockNs > baseNs + incrementNs
-                                     ? tickAfter(timer.dayClockNs - baseNs - incrementNs) - 1
-                                     : tickCount;
-            wheel.insert(timer.entry, due);
+            wheel.insert(timer.entry, dayClockTick(timer.dayClockNs));
         }
     }
+    TaskManager::forEachTask([](Task& task) {
+        if (task.sleepsTillTimeOfDay && static_cast<TimeWheelNode<>&>(task.wakeTimeout).isLinked()) {
+            wheel.cancel(task.wakeTimeout);
+            wheel.insert(task.wakeTimeout, dayClockTick(task.wakeTimeOfDayNs));
+        }
+    });
     return Status::Ok;
 }
 
@@ -305,9 +344,7 @@ Status TimerManager::setDayClockAlarm(ObjectId id, ObjectId caller, const DateTi
     TimerObject& t = *timer.value();
     replaceAlarm(t, AlarmKind::DayClock, n);
     t.dayClockNs = target.value();
-    const uint64_t now = baseNs + incrementNs;
-    // A time already past goes off at the next tick.
-    wheel.insert(t.entry, target.value() > now ? tickAfter(target.value() - now) - 1 : tickCount);
+    wheel.insert(t.entry, dayClockTick(t.dayClockNs));
     return Status::Ok;
 }
 

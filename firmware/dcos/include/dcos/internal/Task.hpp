@@ -84,6 +84,9 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     TimeoutEntry wakeTimeout;
     WaitQueue* waitingOn = nullptr; ///< The queue of the object it waits for, if any.
     uintptr_t waitData = 0;         ///< What the waiter asked for or received (agent-defined).
+    /// SleepTill: the wake time-out is a time of day, which moves with the clock.
+    bool sleepsTillTimeOfDay = false;
+    uint64_t wakeTimeOfDayNs = 0;
 
     // The objects this task holds (binary semaphores); those that lend
     // priority set the priority it runs at.

@@ -39,6 +39,10 @@ public:
     /// for none). Returns the status wake() gave, or Timeout. Must be called
     /// with interrupts disabled, from task context.
     static Status blockCurrent(WaitReason reason, uint64_t timeoutNs);
+    /// Blocks the running task until the clock reads a time of day (SleepTill);
+    /// a change of the clock moves the wake-up with it. Returns Timeout when
+    /// the time came. Interrupts disabled, task context.
+    static Status blockCurrentTillTimeOfDay(uint64_t timeOfDayNs);
     /// Makes a blocked task ready with the given result. O(1).
     static void wake(Task& task, Status result);
 

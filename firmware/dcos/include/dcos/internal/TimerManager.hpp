@@ -36,10 +36,19 @@ public:
     /// Nanoseconds since the tick started, refined within the tick by the board.
     static uint64_t preciseUptimeNs();
 
-    /// The absolute tick at which an interval of ns from now has fully
-    /// passed: rounded up, and one tick more, because the current tick is
-    /// already partly over.
+    /// The first tick at or after ns from now, measured from the precise
+    /// time (preciseUptimeNs): a time-out armed for it expires no earlier
+    /// than ns and less than one tick later. An ns so large that the sum
+    /// passes 2^64 is held there, a wait that never ends, not one that
+    /// expires at once.
     static uint64_t tickAfter(uint64_t ns);
+    /// The first tick at or after an uptime.
+    static uint64_t tickAtUptime(uint64_t uptimeNs);
+    /// The tick at which a time of day is reached with the clock as set
+    /// now; a time already past is due at the next tick.
+    static uint64_t tickAtTimeOfDay(uint64_t timeOfDayNs);
+    /// The uptime at which a time of day is reached with the clock as set now (0 if past).
+    static Result<uint64_t> uptimeAtTimeOfDay(uint64_t timeOfDayNs);
     /// Arms entry for the absolute tick dueTick.
     static void arm(TimeoutEntry& entry, uint64_t dueTick);
     static void cancel(TimeoutEntry& entry);
