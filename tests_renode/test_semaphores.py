@@ -12,6 +12,8 @@ SEMAPHORE_TARGET_TESTS = [
     "semaphores",  # binary and counting, poll, time-out, Deadlock, NotOwner, maximum, id errors
     "semdelete",   # Delete and holder death wake every waiter with an error
     "inherit",     # priority inheritance: low/medium/high, a holder of two semaphores, time-out
+    "inheritfifo",     # a FIFO queue lends its most urgent waiter's priority, not its oldest's
+    "inheritdeadline", # a deadline waiter's urgency reaches a static-priority holder
 ]
 
 

@@ -32,13 +32,23 @@ bool Scheduler::isMoreUrgent(const Task& a, const Task& b)
     if (a.idle) {
         return false;
     }
-    if (a.inDeadlineScope != b.inDeadlineScope) {
-        return a.inDeadlineScope; // Deadline-driven tasks come first (seed 7.4.1).
+    if (a.schedulesByDeadline() != b.schedulesByDeadline()) {
+        return a.schedulesByDeadline(); // Deadline-driven tasks come first (seed 7.4.1).
     }
-    if (a.inDeadlineScope) {
+    if (a.schedulesByDeadline()) {
         return a.deadlineKey().precedes(b.deadlineKey());
     }
     return a.priority < b.priority;
+}
+
+DeadlineKey Scheduler::urgencyKey(const Task& task)
+{
+    if (!task.inDeadlineScope) {
+        return task.inheritedDeadline;
+    }
+    const DeadlineKey own = DeadlineKey::make(task.priority, task.deadlineNs - task.deadlinePeriodNs,
+                                              task.deadlinePeriodNs, task.executionPeriodNs);
+    return task.inheritsDeadline && task.inheritedDeadline.precedes(own) ? task.inheritedDeadline : own;
 }
 
 void Scheduler::makeReady(Task& task)
@@ -46,10 +56,8 @@ void Scheduler::makeReady(Task& task)
     if (task.idle) {
         return;
     }
-    if (task.inDeadlineScope) {
-        const DeadlineKey key = DeadlineKey::make(task.priority, task.deadlineNs - task.deadlinePeriodNs,
-                                                  task.deadlinePeriodNs, task.executionPeriodNs);
-        deadlineQueue_.insert(task, key);
+    if (task.schedulesByDeadline()) {
+        deadlineQueue_.insert(task, urgencyKey(task));
     } else {
         readyQueues_[task.priority].pushBack(task);
         readyBitmap_.set(task.priority);
@@ -103,7 +111,7 @@ void Scheduler::releaseDispatch()
 bool Scheduler::rotateCurrent()
 {
     Task& task = *current_;
-    if (task.idle || task.inDeadlineScope || !static_cast<IntrusiveListNode<ReadyQueueTag>&>(task).isLinked()) {
+    if (task.idle || task.schedulesByDeadline() || !static_cast<IntrusiveListNode<ReadyQueueTag>&>(task).isLinked()) {
         return false;
     }
     auto& queue = readyQueues_[task.priority];

@@ -197,18 +197,26 @@ void leaveWaitQueue(Task& task)
 unsigned inheritanceDepth = 0;
 constexpr unsigned kMaximumInheritanceDepth = 8;
 
-void setRunningPriority(Task& task, uint8_t priority)
+bool sameKey(const DeadlineKey& a, const DeadlineKey& b)
 {
-    if (task.priority == priority) {
+    return a.encoded() == b.encoded() && a.deadline() == b.deadline();
+}
+
+void setRunningUrgency(Task& task, uint8_t priority, bool inheritsDeadline, const DeadlineKey& inheritedDeadline)
+{
+    if (task.priority == priority && task.inheritsDeadline == inheritsDeadline &&
+        (!inheritsDeadline || sameKey(task.inheritedDeadline, inheritedDeadline))) {
         return;
     }
     const bool queued = static_cast<IntrusiveListNode<ReadyQueueTag>&>(task).isLinked() || task.isQueued();
     if (queued) {
         Scheduler::makeUnready(task);
-        task.priority = priority;
+    }
+    task.priority = priority;
+    task.inheritsDeadline = inheritsDeadline;
+    task.inheritedDeadline = inheritsDeadline ? inheritedDeadline : DeadlineKey{};
+    if (queued) {
         Scheduler::requeue(task);
-    } else {
-        task.priority = priority;
     }
     if (task.waitingOn != nullptr && inheritanceDepth < kMaximumInheritanceDepth) {
         // A blocked holder's new priority may change what it lends onwards.
@@ -231,6 +239,7 @@ void terminate(Task& task)
     TimerManager::cancel(task.wakeTimeout);
     TimerManager::cancel(task.deadlineTimeout);
     task.inDeadlineScope = false;
+    task.inheritsDeadline = false;
     task.deadlineAtNextBlock = false;
     recoverResourcesOf(task.id);
     if (&task == &Scheduler::current()) {
@@ -473,12 +482,33 @@ Status TaskManager::changePriority(Task& task, uint8_t priority)
 void TaskManager::recomputePriority(Task& task)
 {
     uint8_t priority = task.basePriority;
+    bool inheritsDeadline = false;
+    DeadlineKey inheritedDeadline{};
     for (InheritanceSource& source : task.heldSources) {
-        if (source.lendsPriority && !source.waiters.isEmpty() && source.waiters.first().priority < priority) {
-            priority = source.waiters.first().priority;
+        WaitQueue& waiters = source.waiters;
+        if (!source.lendsPriority || waiters.isEmpty()) {
+            continue;
+        }
+        if (waiters.order() == WaitQueue::Order::Priority && waiters.deadlineWaiters() == 0) {
+            // The queue's first waiter is its most urgent: O(1).
+            priority = waiters.first().priority < priority ? waiters.first().priority : priority;
+            continue;
+        }
+        // A FIFO queue's first waiter is its oldest, and a deadline waiter
+        // may be more urgent than its static priority says: the holder must
+        // run with the most urgent waiter's urgency, so look at them all.
+        for (Task& waiter : waiters) {
+            priority = waiter.priority < priority ? waiter.priority : priority;
+            if (waiter.schedulesByDeadline()) {
+                const DeadlineKey key = Scheduler::urgencyKey(waiter);
+                if (!inheritsDeadline || key.precedes(inheritedDeadline)) {
+                    inheritsDeadline = true;
+                    inheritedDeadline = key;
+                }
+            }
         }
     }
-    setRunningPriority(task, priority);
+    setRunningUrgency(task, priority, inheritsDeadline, inheritedDeadline);
 }
 
 Status TaskManager::blockOn(WaitQueue& queue, uint64_t timeoutNs)

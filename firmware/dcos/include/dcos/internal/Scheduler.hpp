@@ -49,6 +49,9 @@ public:
 
     /// True when a is to run before b.
     static bool isMoreUrgent(const Task& a, const Task& b);
+    /// The key a deadline-scheduled task is ordered by: its own scope's,
+    /// or the one a waiter lends it when that is more urgent.
+    static DeadlineKey urgencyKey(const Task& task);
 
     /// Asks for a task switch: at once from task context (through the
     /// dispatch trap), or at the outermost interrupt exit from a handler.

@@ -8,6 +8,7 @@
 #include <dcos/ObjectId.hpp>
 #include <dcos/Status.hpp>
 #include <dcos/TaskAgent.hpp>
+#include <dcos/internal/DeadlineKey.hpp>
 #include <dcos/internal/DeadlineQueue.hpp>
 #include <dcos/internal/IntrusiveList.hpp>
 #include <dcos/internal/TimeoutEntry.hpp>
@@ -121,6 +122,14 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
 
     // Deadline scope (seed 7.4.1).
     bool inDeadlineScope = false;
+    /// A deadline lent by a waiter in a deadline scope, through a semaphore
+    /// with priority inheritance this task holds (seed 7.11): the task is
+    /// scheduled with that urgency, though its own scope (and its timing
+    /// exceptions) stay as they are.
+    bool inheritsDeadline = false;
+    DeadlineKey inheritedDeadline{};
+    /// Set while queued on a WaitQueue as a deadline-scheduled waiter.
+    bool queuedWithDeadline = false;
     bool deadlineAtNextBlock = false;
     uint64_t executionPeriodNs = 0;
     uint64_t deadlinePeriodNs = 0;
@@ -138,6 +147,10 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     uint64_t profileMinimumNs = 0;
     uint64_t profileMaximumNs = 0;
     uint64_t profileTotalNs = 0;
+
+    /// Whether the scheduler orders this task by a deadline: its own scope,
+    /// or one a waiter lends it.
+    bool schedulesByDeadline() const { return inDeadlineScope || inheritsDeadline; }
 };
 
 } // namespace dcos::internal

@@ -36,6 +36,12 @@ public:
     WaitQueue& operator=(const WaitQueue&) = delete;
 
     bool isEmpty() const { return list_.isEmpty(); }
+    /// Waiters scheduled by a deadline; while there are none, the first
+    /// waiter of a priority-ordered queue is its most urgent.
+    unsigned deadlineWaiters() const { return deadlineWaiters_; }
+    /// The waiters in queue order, for finding the most urgent in a FIFO queue.
+    auto begin() { return list_.begin(); }
+    auto end() { return list_.end(); }
     /// The waiter that wakeFirst() would wake; only when not empty.
     Task& first() const { return list_.front(); }
     Order order() const { return order_; }
@@ -62,6 +68,7 @@ public:
 private:
     WaitList<Task, WaitQueueTag> list_;
     Order order_;
+    unsigned deadlineWaiters_ = 0;
     WaitQueueObserver observer_ = nullptr;
     void* observerContext_ = nullptr;
 };
