@@ -15,6 +15,7 @@ HOST_PORTABLE_SRCS := \
 	$(DCOS_PORTABLE_SRCS) \
 	firmware/bsp_486/src/Pic8259.cpp \
 	firmware/bsp_486/src/Pit8254.cpp \
+	firmware/bsp_486/src/Rtc146818.cpp \
 	firmware/bsp_486/src/Uart16550.cpp \
 	$(IOBUS_PORTABLE_SRCS)
 

@@ -29,3 +29,16 @@ def test_date_refuses_a_time_the_clock_cannot_carry(boot, isa486):
     assert "2399-12-31 23:59:59" in accepted
     later = emulator.command("date")
     assert "2399-12-31" in later or "2400-01-01" in later, later
+
+
+def test_the_time_of_day_comes_from_the_real_time_clock_at_boot(boot, isa486):
+    emulator = boot(isa486, icount=True, extra_args=["-rtc", "base=2031-05-06T07:08:09"])
+    emulator.expect(r"time of day 2031-05-06 07:08:09 from the real-time clock")
+    emulator.expect(r"dcos> ")
+    assert "2031-05-06 07:08:" in emulator.command("date")
+
+
+def test_the_clock_reads_the_hosts_date_without_a_base(boot, isa486):
+    emulator = boot(isa486)
+    match = emulator.expect(r"time of day (\d{4})-\d\d-\d\d \d\d:\d\d:\d\d from the real-time clock")
+    assert int(match.group(1)) >= 2024

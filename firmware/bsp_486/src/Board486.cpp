@@ -3,6 +3,7 @@
 // PC/AT addresses.
 #include <bsp/Board.hpp>
 #include <bsp/Pic8259.hpp>
+#include <bsp/Rtc146818.hpp>
 #include <bsp/Pit8254.hpp>
 #include <bsp/Uart16550.hpp>
 
@@ -21,6 +22,9 @@ constexpr uint16_t pitPort = 0x40;
 constexpr uint16_t com1Port = 0x3F8;
 
 Pic8259 pic(arch_x86::IoWindow::ports(masterPicPort, 2), arch_x86::IoWindow::ports(slavePicPort, 2));
+// The PC/AT's CMOS real-time clock: index port 0x70, data port 0x71.
+constexpr uint16_t rtcPort = 0x70;
+const Rtc146818 rtc(arch_x86::IoWindow::ports(rtcPort, 2));
 Pit8254 pit(arch_x86::IoWindow::ports(pitPort, 4));
 Uart16550 uart(arch_x86::IoWindow::ports(com1Port, 8));
 
@@ -189,6 +193,8 @@ bool isInterruptRequested(unsigned line)
     arch_x86::InterruptGuard guard;
     return line < interruptLineCount && (pic.readRequestRegister() & (1u << line)) != 0;
 }
+
+dcos::Result<dcos::DateTime> readRealTimeClock() { return rtc.read(); }
 
 bool interruptCutShort(unsigned& line)
 {

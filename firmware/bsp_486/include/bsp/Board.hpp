@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include <boot/BootInfo.hpp>
+#include <dcos/DateTime.hpp>
 #include <dcos/Status.hpp>
 #include <runtime/Format.hpp>
 
@@ -68,6 +69,10 @@ bool isInterruptRequested(unsigned line);
 /// it and returns true, so the kernel can deliver it after all; without that
 /// the controller would hold back this line and every less urgent one for good.
 bool interruptCutShort(unsigned& line);
+
+/// Reads the board's battery-backed real-time clock, so the time of day is
+/// right from power-on. Corrupted when the clock was never set.
+dcos::Result<dcos::DateTime> readRealTimeClock();
 
 /// Interrupts that arrived on a line with no handler (and were masked).
 uint32_t unexpectedInterruptCount(unsigned line);

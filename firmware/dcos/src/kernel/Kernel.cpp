@@ -127,6 +127,23 @@ void enableNativeFpuErrors()
     asm volatile("fninit");
 }
 
+// The time of day comes from the board's real-time clock, so that it is
+// right from power-on; a clock never set leaves the system clock at 1970
+// with a warning instead of a wrong date taken as true.
+void setClockFromTheBoard(runtime::CharacterSink& console)
+{
+    const Result<DateTime> time = bsp::readRealTimeClock();
+    const Status set = time.ok() ? internal::TimerManager::setSystemClock(time.value()) : time.status();
+    if (set != Status::Ok) {
+        runtime::format(console, "warning: real-time clock not read (%s); the time of day starts at 1970\r\n",
+                        statusName(set));
+        return;
+    }
+    const DateTime& t = time.value();
+    runtime::format(console, "time of day %04u-%02u-%02u %02u:%02u:%02u from the real-time clock\r\n", t.year,
+                    t.month, t.day, t.hour, t.minute, t.second);
+}
+
 // The end of the memory the loader reported: extended memory starts at 1 MiB.
 constexpr uintptr_t kExtendedMemoryStart = 0x100000;
 
@@ -183,6 +200,7 @@ uintptr_t firstFreeMemory() { return firstFreeAddress; }
     if (bootInfo.commandLine[0] != '\0') {
         runtime::format(console, "command line: %s\r\n", bootInfo.commandLine);
     }
+    setClockFromTheBoard(console);
 
     internal::TaskManager::initialise(rootTaskEntry);
     internal::Scheduler::start();
