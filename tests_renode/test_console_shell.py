@@ -115,3 +115,22 @@ def test_output_longer_than_the_transmit_ring_arrives_intact(boot, isa486):
         emulator.expect(re.escape(f"{line:04d}:{body}\r\n"), timeout=60)
     emulator.expect(r"TEST txflood: PASS")
     emulator.expect_exit(EXIT_PASS)
+
+
+def test_arrow_keys_recall_and_edit_lines_instead_of_running_as_commands(boot, isa486):
+    emulator = boot(isa486)
+    emulator.expect(PROMPT)
+    emulator.command("version")
+    # Up recalls "version"; Enter runs it again (its echo is the redrawn line).
+    emulator.send("\x1b[A\r")
+    emulator.expect(r"version\r\nDCOS \d+\.\d+\.\d+", timeout=10)
+    emulator.expect(PROMPT)
+    # Left twice, Delete, Right, "e": "uptiem" becomes "uptime".
+    emulator.send("uptiem\x1b[D\x1b[D\x1b[3~\x1b[Ce\r")
+    emulator.expect(r"up \d+ d \d\d:\d\d:\d\d", timeout=10)
+    emulator.expect(PROMPT)
+    # A function key, Home/End and a modified arrow do nothing at all: the
+    # line stays empty and Enter shows just another prompt.
+    emulator.send("\x1b[15~\x1b[H\x1b[F\x1b[1;5D\x1bOP\r")
+    emulator.expect(PROMPT, timeout=10)
+    assert "unknown command" not in emulator.transcript
