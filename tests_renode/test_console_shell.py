@@ -134,3 +134,42 @@ def test_arrow_keys_recall_and_edit_lines_instead_of_running_as_commands(boot, i
     emulator.send("\x1b[15~\x1b[H\x1b[F\x1b[1;5D\x1bOP\r")
     emulator.expect(PROMPT, timeout=10)
     assert "unknown command" not in emulator.transcript
+
+
+# Every listing writes an object id as 0x and eight hex digits; a bare
+# eight-digit word in one of them is an id written the old way.
+OBJECT_ID = re.compile(r"\b0x[0-9a-f]{8}\b")
+BARE_WORD = re.compile(r"(?<![x0-9a-f])[0-9a-f]{8}\b")
+LISTINGS = ("tasks", "semaphores", "ports", "pools", "heaps", "devices")
+
+
+def test_listings_write_ids_one_way_and_name_their_objects(boot, isa486):
+    emulator = boot(isa486)
+    emulator.expect(PROMPT)
+    assert "present" in emulator.command("iobus probe")  # installs the device mfio0
+    outputs = {listing: emulator.command(listing) for listing in LISTINGS}
+    for listing, output in outputs.items():
+        header = output.splitlines()[0]
+        assert header.startswith("id  "), (listing, output)
+        for row in output.splitlines()[1:]:
+            assert not BARE_WORD.search(OBJECT_ID.sub("", row)), (listing, row)
+    # Names where the agents keep them: the kernel's tasks, the shell's life semaphore, the device.
+    assert re.search(r"^0x[0-9a-f]{8} +shell +\d+ ", outputs["tasks"], re.MULTILINE), outputs["tasks"]
+    assert re.search(r"^0x[0-9a-f]{8} +shell-life +binary +0 +0x[0-9a-f]{8} +priority +", outputs["semaphores"],
+                     re.MULTILINE), outputs["semaphores"]
+    assert re.search(r"^0x[0-9a-f]{8}  mfio0 +0  system +regional", outputs["devices"], re.MULTILINE), \
+        outputs["devices"]
+    # The id of the shell in 'tasks' is the holder of its life semaphore in 'semaphores'.
+    shell_id = re.search(r"^(0x[0-9a-f]{8}) +shell ", outputs["tasks"], re.MULTILINE).group(1)
+    assert re.search(rf"shell-life +binary +0 +{shell_id} ", outputs["semaphores"]), outputs["semaphores"]
+
+
+def test_help_explains_the_columns_and_flags_of_listings(boot, isa486):
+    emulator = boot(isa486)
+    emulator.expect(PROMPT)
+    tasks = emulator.command("help tasks")
+    assert "usage: tasks" in tasks
+    assert "flags: S super-user, T time slicing, F floating point, D deadline scheduling" in tasks
+    assert "used: its high-water mark" in tasks
+    for listing in LISTINGS:
+        assert "id: the object id, 0x and eight hex digits" in emulator.command(f"help {listing}"), listing

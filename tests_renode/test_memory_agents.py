@@ -37,9 +37,9 @@ def test_pools_and_heaps_commands_list_usage_and_corruption(boot, isa486):
     assert re.search(r"0 of 8 heap slots used, 64 reserved", heaps), heaps
     # The corruption tests list their disabled pool and heap before deleting them.
     emulator.send("test poolcorrupt\r")
-    emulator.expect(r"[0-9a-f]{8}  bad-pool +32 +8 +\d+ +\d+ +\d+ +\d+  [0-9a-f]{8}  CORRUPTED")
+    emulator.expect(r"0x[0-9a-f]{8}  bad-pool +32 +8 +\d+ +\d+ +\d+ +\d+  0x[0-9a-f]{8}  CORRUPTED")
     emulator.expect(r"TEST poolcorrupt: PASS")
     emulator.expect(r"dcos> ")
     emulator.send("test heapcorrupt\r")
-    emulator.expect(r"[0-9a-f]{8}  bad-heap +4096 +\d+ +\d+ +\d+ +\d+ +\d+  [0-9a-f]{8}  CORRUPTED")
+    emulator.expect(r"0x[0-9a-f]{8}  bad-heap +4096 +\d+ +\d+ +\d+ +\d+ +\d+  0x[0-9a-f]{8}  CORRUPTED")
     emulator.expect(r"TEST heapcorrupt: PASS")

@@ -33,7 +33,7 @@ def test_ports_command_shows_queues_and_free_buffers(boot, isa486):
     emulator = boot(isa486)
     emulator.expect(r"dcos> ")
     output = emulator.command("ports")
-    assert "id        name             order     queued  levels    receiver  owner" in output
+    assert "id          name             order     queued  levels    receiver  owner" in output
     match = re.search(r"(\d+) of (\d+) port slots used; message buffers: (\d+) free of (\d+) active, (\d+) reserved",
                       output)
     assert match, output

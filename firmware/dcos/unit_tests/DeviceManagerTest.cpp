@@ -846,12 +846,12 @@ TEST_F(DeviceSystemAgentTest, DevicesCommandListsIdNameOpenCountAndOwner)
     char line[] = "devices";
     EXPECT_EQ(shell.execute(line), shell::CommandResult::Ok);
     char namedRow[80];
-    std::snprintf(namedRow, sizeof namedRow, "%08x  adc0                2  %08x  global\r\n", namedId.raw(),
+    std::snprintf(namedRow, sizeof namedRow, "0x%08x  adc0                2  0x%08x  global\r\n", namedId.raw(),
                   kSuperUser.raw());
     char unnamedRow[80];
-    std::snprintf(unnamedRow, sizeof unnamedRow, "%08x  -                   0  system    local\r\n", unnamedId.raw());
+    std::snprintf(unnamedRow, sizeof unnamedRow, "0x%08x  -                   0  system      local\r\n", unnamedId.raw());
     // Rows come in slot order, which depends on the slots earlier tests freed.
-    const std::string header = "id        name             open  owner     visibility\r\n";
+    const std::string header = "id          name             open  owner       visibility\r\n";
     const std::string footer = "2 of 8 device slots used, 64 reserved\r\n";
     const bool namedFirst = (namedId.index() & (DeviceManager::kCapacity - 1))
                             < (unnamedId.index() & (DeviceManager::kCapacity - 1));

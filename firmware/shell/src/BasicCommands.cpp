@@ -26,6 +26,9 @@ CommandResult help(Shell& shell, int argc, char** argv)
             return CommandResult::Failed;
         }
         shell.print("%s - %s\r\nusage: %s\r\n", command->name, command->summary, command->usage);
+        if (command->details != nullptr) {
+            shell.print("%s\r\n", command->details);
+        }
         return CommandResult::Ok;
     }
     // List alphabetically. The table is in link order and small, so a

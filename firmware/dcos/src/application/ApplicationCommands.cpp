@@ -1,6 +1,7 @@
 // The 'app' console command: the linked application, its state and its objects.
 #include <dcos/internal/ApplicationLoader.hpp>
 #include <dcos/internal/ConfigurationReport.hpp>
+#include <dcos/internal/IdText.hpp>
 
 #include <shell/Shell.hpp>
 
@@ -15,7 +16,7 @@ void listObjects(shell::Shell& shell, app::ObjectKind kind, const app::Declarati
         const Result<ObjectId> id = ApplicationLoader::find(kind, declaration.name);
         shell.print("  %-12s %-15s ", app::objectKindName(kind), declaration.name);
         if (id.ok()) {
-            shell.print("0x%08lx", static_cast<unsigned long>(id.value().raw()));
+            shell.print("%s", internal::IdText(id.value()).c_str());
         } else {
             shell.print("%-10s", "(none)");
         }

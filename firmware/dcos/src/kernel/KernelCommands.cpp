@@ -11,6 +11,7 @@
 #include <dcos/internal/StackArena.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/TimerManager.hpp>
+#include <dcos/internal/IdText.hpp>
 
 namespace dcos {
 
@@ -100,10 +101,10 @@ shell::CommandResult tasks(shell::Shell& shell, int argc, char**)
     if (argc != 1) {
         return shell::CommandResult::UsageError;
     }
-    shell.print("id         name             prio state      stack   used  flags\r\n");
+    shell.print("id           name             prio state      stack   used  flags\r\n");
     internal::TaskManager::forEachTask([&shell](internal::Task& task) {
         const Result<TaskState> state = taskAgent.GetState(task.id);
-        shell.print("%08lx   %-16s %4u %-10s %6lu %6lu  %s%s%s%s\r\n", static_cast<unsigned long>(task.id.raw()),
+        shell.print("%-10s   %-16s %4u %-10s %6lu %6lu  %s%s%s%s\r\n", internal::IdText(task.id).c_str(),
                     internal::TaskManager::nameOf(task.id), task.basePriority,
                     state.ok() ? stateName(state.value()) : "?", static_cast<unsigned long>(task.stackSize),
                     static_cast<unsigned long>(internal::TaskManager::stackHighWater(task)),
@@ -183,7 +184,12 @@ shell::CommandResult date(shell::Shell& shell, int argc, char** argv)
 
 } // namespace
 
-DCOS_SHELL_COMMAND(tasksCommand, "tasks", "list the tasks and their states", "tasks", tasks);
+DCOS_SHELL_COMMAND_DETAILED(tasksCommand, "tasks", "list the tasks and their states", "tasks",
+                            "  id: the object id, 0x and eight hex digits in every listing and report\r\n"
+                            "  prio: the base priority, 0 (most urgent) to 31; inheritance may lend a task more\r\n"
+                            "  stack: the stack size in bytes; used: its high-water mark, the most bytes it has held\r\n"
+                            "  flags: S super-user, T time slicing, F floating point, D deadline scheduling, - not set",
+                            tasks);
 DCOS_SHELL_COMMAND(dateCommand, "date", "show or set the time of day", "date [YYYY-MM-DD HH:MM:SS]", date);
 DCOS_SHELL_COMMAND(versionCommand, "version", "show the DCOS release, board and build", "version", version);
 DCOS_SHELL_COMMAND(uptimeCommand, "uptime", "show the time since the system tick started", "uptime", uptime);

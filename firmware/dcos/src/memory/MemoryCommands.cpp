@@ -2,6 +2,7 @@
 // pool and segmented heap with its usage (seed 7.7, 7.8, 8.3).
 #include <dcos/internal/BufferPoolManager.hpp>
 #include <dcos/internal/HeapManager.hpp>
+#include <dcos/internal/IdText.hpp>
 
 #include <shell/Shell.hpp>
 #include <shell/ShellCommand.hpp>
@@ -12,11 +13,7 @@ namespace {
 
 void printOwner(shell::Shell& shell, ObjectId owner)
 {
-    if (owner.isNull()) {
-        shell.print("system  ");
-    } else {
-        shell.print("%08lx", static_cast<unsigned long>(owner.raw()));
-    }
+    shell.print("%-10s", owner.isNull() ? "system" : internal::IdText(owner).c_str());
 }
 
 // Lists every pool or heap of @p Manager: one row per object, its
@@ -37,7 +34,7 @@ shell::CommandResult listAreas(shell::Shell& shell, int argc, const char* header
         if (!Manager::snapshot(slot, info)) {
             continue;
         }
-        shell.print("%08lx  %-15s  ", static_cast<unsigned long>(info.id.raw()), info.name[0] != '\0' ? info.name : "-");
+        shell.print("%-10s  %-15s  ", internal::IdText(info.id).c_str(), info.name[0] != '\0' ? info.name : "-");
         printStatistics(shell, info.statistics);
         printOwner(shell, info.owner);
         shell.print("%s\r\n", info.corrupted ? "  CORRUPTED" : "");
@@ -50,7 +47,7 @@ shell::CommandResult listAreas(shell::Shell& shell, int argc, const char* header
 shell::CommandResult pools(shell::Shell& shell, int argc, char**)
 {
     return listAreas<BufferPoolManager, PoolInfo>(
-        shell, argc, "id        name             size   total    free     low   allocs  failed  owner", "pool",
+        shell, argc, "id          name             size   total    free     low   allocs  failed  owner", "pool",
         [](shell::Shell& out, const BufferPoolStatistics& s) {
             out.print("%5lu  %6lu  %6lu  %6lu  %7lu  %6lu  ", static_cast<unsigned long>(s.bufferSize),
                       static_cast<unsigned long>(s.totalBuffers), static_cast<unsigned long>(s.freeBuffers),
@@ -62,7 +59,7 @@ shell::CommandResult pools(shell::Shell& shell, int argc, char**)
 shell::CommandResult heaps(shell::Shell& shell, int argc, char**)
 {
     return listAreas<HeapManager, HeapInfo>(
-        shell, argc, "id        name                bytes     free  largest  segs  frags  lowfree  owner", "heap",
+        shell, argc, "id          name                bytes     free  largest  segs  frags  lowfree  owner", "heap",
         [](shell::Shell& out, const HeapStatistics& s) {
             out.print("%8lu  %7lu  %7lu  %4lu  %5lu  %7lu  ", static_cast<unsigned long>(s.heapBytes),
                       static_cast<unsigned long>(s.freeBytes), static_cast<unsigned long>(s.largestFreeSegment),
@@ -73,7 +70,17 @@ shell::CommandResult heaps(shell::Shell& shell, int argc, char**)
 
 } // namespace
 
-DCOS_SHELL_COMMAND(poolsCommand, "pools", "list the buffer pools and their usage", "pools", pools);
-DCOS_SHELL_COMMAND(heapsCommand, "heaps", "list the segmented heaps and their usage", "heaps", heaps);
+DCOS_SHELL_COMMAND_DETAILED(poolsCommand, "pools", "list the buffer pools and their usage", "pools",
+                            "  id: the object id, 0x and eight hex digits in every listing and report; name: - when unnamed\r\n"
+                            "  size: bytes per buffer; total, free: buffers; low: the fewest free there have been\r\n"
+                            "  allocs: successful Allocate calls; failed: Allocate calls that found the pool empty\r\n"
+                            "  owner: the owning task, or system; CORRUPTED: a check failed and the pool is disabled",
+                            pools);
+DCOS_SHELL_COMMAND_DETAILED(heapsCommand, "heaps", "list the segmented heaps and their usage", "heaps",
+                            "  id: the object id, 0x and eight hex digits in every listing and report; name: - when unnamed\r\n"
+                            "  bytes, free: bytes managed and free (headers included); largest: the largest request that fits now\r\n"
+                            "  segs: allocated segments; frags: free segments; lowfree: the fewest free bytes there have been\r\n"
+                            "  owner: the owning task, or system; CORRUPTED: a check failed and the heap is disabled",
+                            heaps);
 
 } // namespace dcos::internal

@@ -16,8 +16,10 @@
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/IdText.hpp>
 
 #include <arch_x86/Cpu.hpp>
+#include <boot/Panic.hpp>
 #include <bsp/Board.hpp>
 #include <shell/Shell.hpp>
 
@@ -48,8 +50,10 @@ size_t slotOf(ObjectId id) { return table.slotNumber(id); }
 void ensureTable()
 {
     if (!tableReady) {
-        table.setNode(localNode());
-        table.AddObjects(kSemaphoresActiveAtBoot);
+        if (table.setNode(localNode()) != Status::Ok || table.AddObjects(kSemaphoresActiveAtBoot) != Status::Ok) {
+            dcosPanic("cannot set up the semaphore table (node %u, %lu semaphores)",
+                      static_cast<unsigned>(localNode()), static_cast<unsigned long>(kSemaphoresActiveAtBoot));
+        }
         tableReady = true;
     }
 }
@@ -102,7 +106,7 @@ void destroy(Semaphore& semaphore, Status why)
     dropHold(semaphore);
     semaphore.waiters.setObserver(nullptr, nullptr);
     TaskManager::wakeAll(semaphore.waiters, why);
-    table.Delete(semaphore.id);
+    (void)table.Delete(semaphore.id); // Cannot fail: the callers resolved the id under the same lock.
 }
 
 unsigned recoverSemaphores(ObjectId deadTask)
@@ -358,15 +362,18 @@ shell::CommandResult listSemaphores(shell::Shell& shell, int argc, char**)
     if (argc != 1) {
         return shell::CommandResult::UsageError;
     }
-    shell.print("id         kind      count  holder     inherit\r\n");
+    shell.print("id           name             kind      count  holder       order     inherit\r\n");
     for (const Semaphore& s : internal::semaphores) {
         arch_x86::InterruptGuard guard;
         if (s.id.isNull() || !internal::table.resolve(s.id).ok()) {
             continue;
         }
-        shell.print("%08lx   %-8s %6lu  %08lx   %s\r\n", static_cast<unsigned long>(s.id.raw()),
+        const Result<const char*> name = internal::table.nameOf(s.id);
+        shell.print("%-10s   %-16s %-8s %6lu  %-10s   %-8s  %s\r\n", internal::IdText(s.id).c_str(),
+                    name.ok() && name.value()[0] != '\0' ? name.value() : "-",
                     s.kind == SemaphoreKind::Binary ? "binary" : "counting", static_cast<unsigned long>(s.count),
-                    static_cast<unsigned long>(s.holder != nullptr ? s.holder->id.raw() : 0),
+                    internal::IdText(s.holder != nullptr ? s.holder->id : ObjectId::null()).c_str(),
+                    s.waiters.order() == internal::WaitQueue::Order::Fifo ? "fifo" : "priority",
                     s.inheritance ? "yes" : "no");
     }
     shell.print("%lu semaphores\r\n", static_cast<unsigned long>(internal::semaphoreCount()));
@@ -375,6 +382,11 @@ shell::CommandResult listSemaphores(shell::Shell& shell, int argc, char**)
 
 } // namespace
 
-DCOS_SHELL_COMMAND(semaphoresCommand, "semaphores", "list the semaphores", "semaphores", listSemaphores);
+DCOS_SHELL_COMMAND_DETAILED(semaphoresCommand, "semaphores", "list the semaphores", "semaphores",
+                            "  id: the object id, 0x and eight hex digits in every listing and report; name: - when unnamed\r\n"
+                            "  kind: binary or counting; count: units available now\r\n"
+                            "  holder: the task holding a binary semaphore, - when free\r\n"
+                            "  order: how waiters queue, fifo or priority; inherit: priority inheritance on",
+                            listSemaphores);
 
 } // namespace dcos

@@ -28,6 +28,9 @@ struct ShellCommand {
     const char* usage;
     /// Runs the command; argv[0] is the command name.
     CommandResult (*run)(Shell& shell, int argc, char** argv);
+    /// What 'help <command>' adds after the usage line: what the columns
+    /// and flags of a listing mean. nullptr when the summary says it all.
+    const char* details = nullptr;
 };
 
 /// The commands linked into this image, in link order.
@@ -43,6 +46,16 @@ public:
 } // namespace shell
 
 /// Defines a console command. Use once per command at namespace scope.
-#define DCOS_SHELL_COMMAND(identifier, name, summary, usage, function)                         \
-    [[gnu::used, gnu::section("dcos_shell_commands")]] constinit const ::shell::ShellCommand \
-        identifier{name, summary, usage, function}
+#define DCOS_SHELL_COMMAND(identifier, name, summary, usage, function) \
+    DCOS_SHELL_COMMAND_DETAILED(identifier, name, summary, usage, nullptr, function)
+
+/// Defines a console command whose 'help' also explains its output: details
+/// is printed after the usage line, one explanation per line ("\r\n" apart).
+///
+/// The section is read as one array, so every entry must sit exactly
+/// sizeof(ShellCommand) after the previous one: the explicit alignment stops
+/// the compiler from aligning larger objects further (GCC gives objects of
+/// 32 bytes or more 32-byte alignment on x86-64), which would leave gaps.
+#define DCOS_SHELL_COMMAND_DETAILED(identifier, name, summary, usage, details, function)        \
+    [[gnu::used, gnu::section("dcos_shell_commands"), gnu::aligned(alignof(::shell::ShellCommand))]] \
+    constinit const ::shell::ShellCommand identifier{name, summary, usage, function, details}
