@@ -40,6 +40,16 @@ def test_iobus_driver(boot, isa486, name):
     run_target_test(boot(isa486, "test", icount=True, **BOOT_OPTIONS.get(name, {})), name)
 
 
+def test_iobus_tests_pass_again_in_the_same_boot(boot, isa486):
+    """A board installed again starts its counters afresh, so a test run twice passes twice."""
+    emulator = boot(isa486, "test", icount=True)
+    for name in ("iobusoverrange", "iobusirq", "iobusoverrange"):
+        emulator.expect(r"dcos> ")
+        emulator.send(f"test {name}\r")
+        verdict = emulator.expect(rf"TEST {name}: (PASS|FAIL)").group(1)
+        assert verdict == b"PASS", f"{name} failed when run again:\n{emulator.transcript}"
+
+
 BRINGUP_LINE = re.compile(r"^BRINGUP .*$", re.MULTILINE)
 ADC_LINE = re.compile(
     r"^BRINGUP ADC channel=(\d) gain=(\d+) offset_lsb=(-?\d+\.\d\d) gain_error_pct=(-?\d+\.\d\d) "
@@ -130,9 +140,30 @@ def test_iobus_console_commands(boot, isa486):
     assert re.search(r"mfio0 +0x300-0x33f +5", resources), resources
     assert re.search(r"com1 +0x3f8-0x3ff +4", resources), resources
     assert "error: IRQ 4 wanted by mfio0 is held by com1" in emulator.command("iobus probe 0x300 4")
-    for bad in ("iobus", "iobus read", "iobus read 18", "iobus write ai0 1", "iobus write ao0 4096",
-                "iobus gain 0 20", "iobus gain ao0 10", "iobus probe 0x301", "iobus frobnicate"):
-        assert "usage: iobus probe [base] [irq] | read <channel>" in emulator.command(bad), bad
+    # A bad argument is named with what would have been right, instead of
+    # the usage of every subcommand.
+    assert "usage: iobus probe [base] [irq] | read <channel>" in emulator.command("iobus")
+    for bad, error in (
+            ("iobus read", "error: read takes one channel\r\nusage: iobus read <channel>"),
+            ("iobus read 18", "error: unknown channel '18': the channels are ai0-ai7, ao0-ao7, di and do, or 0-17"),
+            ("iobus read ai9", "error: unknown channel 'ai9'"),
+            ("iobus write ai0 1", "error: ai0 is an input; write takes an analog output ao0-ao7 or do"),
+            ("iobus write di 1", "error: di is an input"),
+            ("iobus write ao0 4096", "error: value '4096' is out of range for ao0: 0 to 4095 (0xfff)"),
+            ("iobus write do 0x10000", "error: value '0x10000' is out of range for do: 0 to 65535 (0xffff)"),
+            ("iobus write ao0 volts", "error: value 'volts' is out of range for ao0"),
+            ("iobus gain 0 20", "error: gain '20' is not one of 1, 10, 100 and 1000"),
+            ("iobus gain ao0 10", "error: ao0 has no gain; the programmable gain is on the analog inputs ai0-ai7"),
+            ("iobus probe 0x301", "error: base '0x301' is not an even port from 0x000 to 0xffc0\r\n"
+                                  "usage: iobus probe [base] [irq]"),
+            ("iobus probe 0x300 16", "error: irq '16' is not an interrupt line from 0 to 15"),
+            ("iobus bringup 0x300 5 7", "error: too many arguments"),
+            ("iobus stats now", "error: stats takes no arguments"),
+            ("iobus frobnicate", "error: unknown subcommand 'frobnicate': the subcommands are probe read write "
+                                 "gain bringup resources stats")):
+        answer = emulator.command(bad)
+        assert error in answer, (bad, answer)
+        assert "| read <channel>" not in answer, (bad, answer)
 
 
 def test_iobus_without_a_board(boot, isa486):

@@ -62,26 +62,65 @@ bool parseChannel(const char* text, uint32_t& number)
     return true;
 }
 
-// Parses the optional [base] [irq] at argv[first] and argv[first + 1].
-bool parseLocation(int argc, char** argv, int first, uint16_t& base, uint8_t& irq)
+// Writes a channel number the way the console names it: ai3, ao0, di, do.
+void printChannelName(shell::Shell& shell, uint32_t number)
+{
+    if (number < channel::kAnalogOutput0) {
+        shell.print("ai%lu", static_cast<unsigned long>(number - channel::kAnalogInput0));
+    } else if (number < channel::kDigitalInputs) {
+        shell.print("ao%lu", static_cast<unsigned long>(number - channel::kAnalogOutput0));
+    } else {
+        shell.print(number == channel::kDigitalInputs ? "di" : "do");
+    }
+}
+
+// Parses a channel argument; prints what was wrong with it and returns false.
+bool parseChannelArgument(shell::Shell& shell, const char* text, uint32_t& number)
+{
+    if (parseChannel(text, number)) {
+        return true;
+    }
+    shell.print("error: unknown channel '%s': the channels are ai0-ai7, ao0-ao7, di and do, or 0-%lu\r\n", text,
+                static_cast<unsigned long>(channel::kCount - 1));
+    return false;
+}
+
+// The subcommand's own usage line, printed after an error in its arguments
+// instead of the usage of every subcommand.
+CommandResult subcommandUsage(shell::Shell& shell, const char* usage)
+{
+    shell.print("usage: iobus %s\r\n", usage);
+    return CommandResult::Failed;
+}
+
+// Parses the optional [base] [irq] at argv[first] and argv[first + 1]; prints
+// what was wrong and returns false.
+bool parseLocation(shell::Shell& shell, int argc, char** argv, int first, uint16_t& base, uint8_t& irq)
 {
     base = consoleBoard.base();
     irq = consoleBoard.irq();
+    if (argc > first + 2) {
+        shell.print("error: too many arguments: give at most a base port and an interrupt line\r\n");
+        return false;
+    }
     unsigned long value = 0;
     if (argc > first) {
-        if (!shell::Shell::parseUnsigned(argv[first], value) || value > 0xFFFF - mfio::kWindowSize + 1 ||
-            (value & 1u) != 0) {
+        constexpr unsigned long kHighestBase = 0xFFFFu - mfio::kWindowSize + 1u;
+        if (!shell::Shell::parseUnsigned(argv[first], value) || value > kHighestBase || (value & 1u) != 0) {
+            shell.print("error: base '%s' is not an even port from 0x000 to 0x%04lx\r\n", argv[first], kHighestBase);
             return false;
         }
         base = static_cast<uint16_t>(value);
     }
     if (argc > first + 1) {
         if (!shell::Shell::parseUnsigned(argv[first + 1], value) || value >= IsaResourceManager::kLineCount) {
+            shell.print("error: irq '%s' is not an interrupt line from 0 to %lu\r\n", argv[first + 1],
+                        static_cast<unsigned long>(IsaResourceManager::kLineCount - 1));
             return false;
         }
         irq = static_cast<uint8_t>(value);
     }
-    return argc <= first + 2;
+    return true;
 }
 
 // Makes the console's board sit at base and irq and be installed. Prints
@@ -144,8 +183,8 @@ CommandResult probe(shell::Shell& shell, int argc, char** argv)
 {
     uint16_t base;
     uint8_t irq;
-    if (!parseLocation(argc, argv, 2, base, irq)) {
-        return CommandResult::UsageError;
+    if (!parseLocation(shell, argc, argv, 2, base, irq)) {
+        return subcommandUsage(shell, "probe [base] [irq]");
     }
     if (!installAt(shell, base, irq)) {
         return CommandResult::Failed;
@@ -186,8 +225,12 @@ void printReading(shell::Shell& shell, uint32_t number, uint16_t word)
 CommandResult read(shell::Shell& shell, int argc, char** argv)
 {
     uint32_t number;
-    if (argc != 3 || !parseChannel(argv[2], number)) {
-        return CommandResult::UsageError;
+    if (argc != 3) {
+        shell.print("error: read takes one channel\r\n");
+        return subcommandUsage(shell, "read <channel>");
+    }
+    if (!parseChannelArgument(shell, argv[2], number)) {
+        return CommandResult::Failed;
     }
     if (!installAt(shell, consoleBoard.base(), consoleBoard.irq()) || !openBoard(shell)) {
         return CommandResult::Failed;
@@ -208,10 +251,25 @@ CommandResult write(shell::Shell& shell, int argc, char** argv)
 {
     uint32_t number;
     unsigned long value = 0;
-    if (argc != 4 || !parseChannel(argv[2], number) || !shell::Shell::parseUnsigned(argv[3], value) ||
-        number < channel::kAnalogOutput0 || number == channel::kDigitalInputs ||
-        value > (number == channel::kDigitalOutputs ? 0xFFFFu : mfio::kCodeMaximum)) {
-        return CommandResult::UsageError;
+    if (argc != 4) {
+        shell.print("error: write takes a channel and a value\r\n");
+        return subcommandUsage(shell, "write <channel> <value>");
+    }
+    if (!parseChannelArgument(shell, argv[2], number)) {
+        return CommandResult::Failed;
+    }
+    if (number < channel::kAnalogOutput0 || number == channel::kDigitalInputs) {
+        shell.print("error: ");
+        printChannelName(shell, number);
+        shell.print(" is an input; write takes an analog output ao0-ao7 or do\r\n");
+        return CommandResult::Failed;
+    }
+    const unsigned long largest = number == channel::kDigitalOutputs ? 0xFFFFu : mfio::kCodeMaximum;
+    if (!shell::Shell::parseUnsigned(argv[3], value) || value > largest) {
+        shell.print("error: value '%s' is out of range for ", argv[3]);
+        printChannelName(shell, number);
+        shell.print(": 0 to %lu (0x%lx)\r\n", largest, largest);
+        return CommandResult::Failed;
     }
     if (!installAt(shell, consoleBoard.base(), consoleBoard.irq()) || !openBoard(shell)) {
         return CommandResult::Failed;
@@ -231,9 +289,22 @@ CommandResult gain(shell::Shell& shell, int argc, char** argv)
 {
     uint32_t number;
     unsigned long factor = 0;
-    if (argc != 4 || !parseChannel(argv[2], number) || number >= channel::kAnalogOutput0 ||
-        !shell::Shell::parseUnsigned(argv[3], factor) || !AnalogScaling::fromFactor(factor).ok()) {
-        return CommandResult::UsageError;
+    if (argc != 4) {
+        shell.print("error: gain takes an analog input and a factor\r\n");
+        return subcommandUsage(shell, "gain <channel> <1|10|100|1000>");
+    }
+    if (!parseChannelArgument(shell, argv[2], number)) {
+        return CommandResult::Failed;
+    }
+    if (number >= channel::kAnalogOutput0) {
+        shell.print("error: ");
+        printChannelName(shell, number);
+        shell.print(" has no gain; the programmable gain is on the analog inputs ai0-ai7\r\n");
+        return CommandResult::Failed;
+    }
+    if (!shell::Shell::parseUnsigned(argv[3], factor) || !AnalogScaling::fromFactor(factor).ok()) {
+        shell.print("error: gain '%s' is not one of 1, 10, 100 and 1000\r\n", argv[3]);
+        return CommandResult::Failed;
     }
     if (!installAt(shell, consoleBoard.base(), consoleBoard.irq()) || !openBoard(shell)) {
         return CommandResult::Failed;
@@ -252,8 +323,8 @@ CommandResult bringup(shell::Shell& shell, int argc, char** argv)
 {
     uint16_t base;
     uint8_t irq;
-    if (!parseLocation(argc, argv, 2, base, irq)) {
-        return CommandResult::UsageError;
+    if (!parseLocation(shell, argc, argv, 2, base, irq)) {
+        return subcommandUsage(shell, "bringup [base] [irq]");
     }
     shell.print("BRINGUP BEGIN base=0x%03x irq=%u\r\n", base, irq);
     if (!installAt(shell, base, irq)) {
@@ -277,7 +348,8 @@ CommandResult bringup(shell::Shell& shell, int argc, char** argv)
 CommandResult resources(shell::Shell& shell, int argc, char**)
 {
     if (argc != 2) {
-        return CommandResult::UsageError;
+        shell.print("error: resources takes no arguments\r\n");
+        return subcommandUsage(shell, "resources");
     }
     IsaResourceManager& manager = isaResources();
     shell.print("claimant         ports        irq\r\n");
@@ -301,7 +373,8 @@ CommandResult resources(shell::Shell& shell, int argc, char**)
 CommandResult statistics(shell::Shell& shell, int argc, char**)
 {
     if (argc != 2) {
-        return CommandResult::UsageError;
+        shell.print("error: stats takes no arguments\r\n");
+        return subcommandUsage(shell, "stats");
     }
     if (!consoleBoard.installed()) {
         shell.print("mfio0 is not installed\r\n");
@@ -358,7 +431,12 @@ CommandResult iobus(shell::Shell& shell, int argc, char** argv)
             return subcommand.run(shell, argc, argv);
         }
     }
-    return CommandResult::UsageError;
+    shell.print("error: unknown subcommand '%s': the subcommands are", argv[1]);
+    for (const Subcommand& subcommand : kSubcommands) {
+        shell.print(" %s", subcommand.name);
+    }
+    shell.print("\r\n");
+    return CommandResult::Failed;
 }
 
 } // namespace

@@ -84,6 +84,9 @@ Result<dcos::ObjectId> MfioBoard::install(const char* name, dcos::Visibility vis
         return created.status();
     }
     boardInitialised_ = false;
+    // The counters describe this installation: a board object installed
+    // again (the console's, a test's) does not carry an earlier one's.
+    statistics_ = BoardStatistics{};
     return created;
 }
 

@@ -204,6 +204,30 @@ TEST_F(MfioBoardTest, InterruptDrivenConversion)
     EXPECT_EQ(s.lastInterruptNs - s.lastStartNs, 25000u);
 }
 
+TEST_F(MfioBoardTest, StatisticsCountFromTheInstall)
+{
+    // The same board object uninstalled and installed again (as the console
+    // and the on-target tests do) starts counting afresh: a test that
+    // expects four overranges must see four however often it runs.
+    for (int installation = 0; installation < 2; ++installation) {
+        const ObjectId id = installAndOpen();
+        const auto before = statistics(id);
+        EXPECT_EQ(before.conversions, 0u) << "installation " << installation;
+        EXPECT_EQ(before.overranges, 0u) << "installation " << installation;
+        EXPECT_EQ(before.interrupts, 0u) << "installation " << installation;
+        iobus_fake::onReceiveEvent([this](uint32_t events, uint64_t) -> Result<uint32_t> {
+            completeConversion(6, 0x0123, true);
+            iobus_fake::raise(5);
+            return events;
+        });
+        ASSERT_TRUE(iobus::readAnalogInput(id, 6).ok());
+        EXPECT_EQ(statistics(id).overranges, 1u) << "installation " << installation;
+        while (systemAgent.Close(id) == Status::Ok) {
+        }
+        ASSERT_EQ(board.uninstall(), Status::Ok);
+    }
+}
+
 TEST_F(MfioBoardTest, AnInterruptWithNothingWaitingIsCountedAsSpurious)
 {
     const ObjectId id = installAndOpen();

@@ -77,7 +77,7 @@ struct BoardInfo {
     uint16_t revision; ///< `REVISION` as last read.
 };
 
-/// Counters of the driver (kGetStatistics).
+/// Counters of the driver (kGetStatistics), from the board's install on.
 struct BoardStatistics {
     uint32_t conversions;        ///< Results delivered to Read.
     uint32_t interrupts;         ///< Calls of the interrupt service routine.
