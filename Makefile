@@ -2,7 +2,8 @@
 #
 #   make          firmware images and host tools
 #   make run      boot the ISA 486 controller in the emulator, console on this terminal
-#                 (APP=<dir>: with the application in <dir>)
+#                 (APP=<dir>: with the application in <dir>; ARGS="...": launcher options,
+#                 e.g. ARGS="--set isa-mfio.noise-lsb=0.5 --append node=3 --append tick_hz=100")
 #   make test     host unit tests, the emulator regression suite, then the examples
 #   make app APP=<dir>       build an application kept outside the tree
 #   make test-app APP=<dir>  run an application's own emulator tests
@@ -37,7 +38,7 @@ deps:
 run: deps
 ifeq ($(APP),)
 	@$(MAKE) --no-print-directory firmware
-	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(IMAGE_486)
+	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(IMAGE_486) $(ARGS)
 else
 	@$(MAKE) --no-print-directory sdk
 	@$(call app_make,$(APP),run)

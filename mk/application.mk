@@ -12,6 +12,7 @@
 #
 #     make          builds build/<name>-<board>.elf (the default target, "app")
 #     make run      boots it on the emulated ISA 486 board, console on this terminal
+#                   (ARGS="..." passes launcher options: --append node=3, --set isa-mfio.noise-lsb=0.5)
 #     make test     runs tests/test_*.py against it in the emulator
 #     make clean    removes build/
 #
@@ -86,11 +87,14 @@ $(APP_IMAGE): $(APP_OBJS) $(DCOS_LIBRARY) $(DCOS_LINK_SCRIPT)
 	@echo "application $(APP_NAME): $@"
 
 # Objects depend on the flags and on the DCOS they were compiled against.
+# The stamp is rewritten only when the text changes, through a temporary file
+# named after the shell's process id, so that two builds at once never race
+# on one temporary name.
 APP_FLAGS_STAMP := $(APP_BUILD_DIR)/flags.stamp
 $(APP_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(APP_ALL_CXXFLAGS) $(DCOS_PREFIX)' > $@.new
-	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+	@new='$@.new.'$$$$; echo '$(APP_ALL_CXXFLAGS) $(DCOS_PREFIX)' > "$$new" && \
+		{ cmp -s "$$new" '$@' && rm -f "$$new" || mv -f "$$new" '$@'; }
 
 # A failed compilation's messages end with a one-line summary when they hold
 # a configuration error (the compiler names the object in a template).
@@ -107,7 +111,7 @@ $(APP_BUILD_DIR)/obj/%.S.o: $(APP_DIR)/%.S $(APP_FLAGS_STAMP)
 	$(APP_Q)g++ $(DCOS_BOARD_ASFLAGS) $(APP_CPPFLAGS) -c $< -o $@
 
 run: app
-	@$(APP_PYTHON) $(DCOS_SHARE)/python/launch.py --board $(DCOS_BOARD_EMULATED) --image $(APP_IMAGE)
+	@$(APP_PYTHON) $(DCOS_SHARE)/python/launch.py --board $(DCOS_BOARD_EMULATED) --image $(APP_IMAGE) $(ARGS)
 
 # The application's own emulator tests, with the lab's fixtures (the
 # `application` fixture boots this image). No tests is not a failure, but it is said.

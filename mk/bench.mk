@@ -77,8 +77,7 @@ $(IMAGE_486_BENCH): $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS) firmware/boot/link.
 FW_BENCH_FLAGS_STAMP := $(FW_BENCH_BUILD)/flags.stamp
 $(FW_BENCH_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(FW_BENCH_CXXFLAGS) $(FW_BENCH_ASFLAGS)' > $@.new
-	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+	@echo '$(FW_BENCH_CXXFLAGS) $(FW_BENCH_ASFLAGS)' | $(update_if_changed)
 
 $(FW_BENCH_BUILD)/%.cpp.o: %.cpp $(FW_BENCH_FLAGS_STAMP)
 	@mkdir -p $(dir $@)

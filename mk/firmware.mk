@@ -23,7 +23,9 @@ FW_CODE_FLAGS := -std=c++20 $(FW_ARCH_FLAGS) -O2 -g \
 	-fno-stack-protector -fstack-clash-protection -fno-asynchronous-unwind-tables -fno-unwind-tables \
 	-fno-omit-frame-pointer -fno-tree-loop-distribute-patterns -mgeneral-regs-only \
 	-fno-isolate-erroneous-paths-dereference -fno-isolate-erroneous-paths-attribute
-FW_WARNING_FLAGS := -Wall -Wextra -Wno-missing-field-initializers
+# An ignored Status or Result is an error in applications too, whose build
+# does not otherwise stop at warnings (dcos/Status.hpp says why).
+FW_WARNING_FLAGS := -Wall -Wextra -Wno-missing-field-initializers -Werror=unused-result
 FW_CXXFLAGS := $(FW_CODE_FLAGS) $(FW_WARNING_FLAGS) -Werror -MMD -MP $(FW_INCLUDES)
 FW_ASFLAGS := $(FW_ARCH_FLAGS) -MMD -MP $(FW_INCLUDES)
 FW_LDFLAGS := -m elf_i386 -nostdlib -static -T firmware/boot/link.ld
@@ -65,13 +67,18 @@ $(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) firmware/boot/link.ld
 	@echo "  LD      $@"
 	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS)
 
+# Replaces the target by the text piped into it, only when the text changed,
+# so that what depends on the target is rebuilt only then. The temporary file
+# is named after the shell's process id: two builds at once each rename their
+# own file, and a rename is atomic, so neither can find the other's file gone.
+update_if_changed = { new='$@.new.'$$$$; cat > "$$new" && { cmp -s "$$new" '$@' && rm -f "$$new" || mv -f "$$new" '$@'; }; }
+
 # Objects depend on the flags they were compiled with: a change of flags
 # rebuilds everything instead of linking stale objects.
 FW_FLAGS_STAMP := $(FW_BUILD)/flags.stamp
 $(FW_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(FW_CXXFLAGS) $(FW_ASFLAGS)' > $@.new
-	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+	@echo '$(FW_CXXFLAGS) $(FW_ASFLAGS)' | $(update_if_changed)
 
 $(FW_BUILD)/%.cpp.o: %.cpp $(FW_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
@@ -88,8 +95,7 @@ $(FW_BUILD)/%.S.o: %.S $(FW_FLAGS_STAMP)
 FW_REVISION := $(shell git describe --always --dirty 2>/dev/null || echo unknown)
 $(FW_BUILD)/generated/BuildRevision.cpp: FORCE
 	@mkdir -p $(dir $@)
-	@printf 'namespace dcos { const char* buildRevisionText = "%s"; }\n' "$(FW_REVISION)" > $@.new
-	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+	@printf 'namespace dcos { const char* buildRevisionText = "%s"; }\n' "$(FW_REVISION)" | $(update_if_changed)
 
 $(FW_BUILD)/generated/BuildRevision.cpp.o: $(FW_BUILD)/generated/BuildRevision.cpp
 	@echo "  CXX     $@"

@@ -33,8 +33,7 @@ $(HOST_TEST_BINARY): $(HOST_OBJS)
 HOST_FLAGS_STAMP := $(HOST_BUILD)/flags.stamp
 $(HOST_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(HOST_CXXFLAGS)' > $@.new
-	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+	@echo '$(HOST_CXXFLAGS)' | $(update_if_changed)
 
 $(HOST_BUILD)/%.cpp.o: %.cpp $(HOST_FLAGS_STAMP)
 	@mkdir -p $(dir $@)

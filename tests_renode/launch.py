@@ -29,7 +29,9 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--board", default="isa486", help="board definition in tests_renode/boards/")
     parser.add_argument("--image", help="firmware image (default: the board's production image)")
-    parser.add_argument("--append", default="", help="kernel command line, e.g. tick_hz=100")
+    parser.add_argument("--append", action="append", default=[], metavar="OPTION",
+                        help="add to the kernel command line (repeatable): node=N sets the node id (1-65534, "
+                             "default 1), tick_hz=N the system tick rate (19-10000 Hz, default 1000)")
     parser.add_argument("--set", type=device_property, action="append", default=[], metavar="DRIVER.PROPERTY=VALUE",
                         help="set a device property for this run, e.g. isa-mfio.stuck-di-bit=3 (repeatable)")
     parser.add_argument("--without", action="append", default=[], metavar="DRIVER",
@@ -47,7 +49,7 @@ def main():
     if not os.path.exists(image):
         sys.exit(f"error: firmware image {image} does not exist; run 'make firmware'")
     try:
-        command = board.emulator_command(image, {"console": "mon:stdio"}, append=arguments.append,
+        command = board.emulator_command(image, {"console": "mon:stdio"}, append=" ".join(arguments.append),
                                          device_properties=properties, without_devices=arguments.without,
                                          extra_args=arguments.emulator_arg)
     except (EmulatorNotBuilt, ValueError) as error:

@@ -56,3 +56,26 @@ def test_launcher_names_the_code_a_fault_report_points_at():
         raise AssertionError(f"launcher session failed: {error}\n----- console -----\n{session.before}") from None
     finally:
         session.close(force=True)
+
+
+def test_make_run_passes_board_and_kernel_options():
+    """`make run ARGS=...` hands launcher options through: a model property and two kernel options."""
+    arguments = "--set isa-mfio.stuck-di-bit=3 --append node=3 --append tick_hz=100"
+    session = pexpect.spawn("make", ["--no-print-directory", "-C", REPOSITORY, "run", f"ARGS={arguments}"],
+                            timeout=300, encoding="latin-1")
+    try:
+        session.expect(r"node 3, \d+ KiB memory, tick 100 Hz")
+        session.expect(r"dcos> ")
+        # The stuck bit shows through the I/O board's loopback: DO bit 3 set, DI bit 3 stays 0.
+        session.send("iobus write do 0x000f\r")
+        session.expect(r"do=0x000f")
+        session.expect(r"dcos> ")
+        session.send("iobus read di\r")
+        session.expect(r"di=0x0007")
+        session.expect(r"dcos> ")
+        session.send("\x01x")
+        session.expect(pexpect.EOF)
+    except (pexpect.TIMEOUT, pexpect.EOF) as error:
+        raise AssertionError(f"make run session failed: {error}\n----- console -----\n{session.before}") from None
+    finally:
+        session.close(force=True)
