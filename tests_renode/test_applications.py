@@ -57,7 +57,9 @@ void greeter(uintptr_t)
 {{
     dcos::Message message{{}};
     message.bytes[0] = 7;
-    dcos::messagePortAgent.Send(greetings, message, 0);
+    if (dcos::messagePortAgent.Send(greetings, message, 0) != dcos::Status::Ok) {{
+        runtime::format(bsp::console(), "greeter: not sent\\r\\n");
+    }}
 }}
 
 void listener(uintptr_t)
@@ -67,7 +69,8 @@ void listener(uintptr_t)
         runtime::format(bsp::console(), "listener heard %u\\r\\n", static_cast<unsigned>(message.bytes[0]));
     }}
     // Stays, and with it the port it owns: a task that ends takes its objects along.
-    dcos::taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
+    // No one posts the event, so the wait's answer does not matter.
+    (void)dcos::taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
 }}
 
 constexpr dcos::app::TaskDeclaration tasks[] = {{
@@ -130,6 +133,9 @@ def expect_build_failure(directory, *phrases):
     (dict(greeter_stack=1024), ['ObjectName{"greeter"}', "StackTooSmall, 1024, 2048",
                                 "configuration error: task 'greeter': the task's stack is smaller than "
                                 "dcos::kMinimumStackSize (limit) (value 1024, limit 2048)"]),
+    (dict(greeter_stack="SIZE_MAX"), ['ObjectName{"greeter"}', "StacksExceedArena",
+                                      "configuration error: task 'greeter': the stacks up to this task need more "
+                                      "than the stack arena (DCOS_CONFIG_STACK_ARENA_KIB) (value 4294967295"]),
     (dict(listener_name="greeter"), ['ObjectName{"greeter"}', "DuplicateName",
                                      "configuration error: task 'greeter': two objects of this kind have this name"]),
     (dict(listener_name="shell"), ['ObjectName{"shell"}', "ReservedName",
@@ -143,6 +149,20 @@ def test_configuration_errors_name_the_object_at_compile_time(tmp_path, change, 
     output = expect_build_failure(application, *phrases)
     assert "DCOS_APPLICATION: the configuration breaks the rule named above" in output
     assert not os.path.exists(os.path.join(application, "build", "hello-486.elf"))
+
+
+def test_an_unchecked_status_does_not_compile(tmp_path):
+    """Status and Result are [[nodiscard]], and an application build refuses a dropped one."""
+    application = write_hello(str(tmp_path / "hello"))
+    source = os.path.join(application, "hello.cpp")
+    with open(source, encoding="utf-8") as handle:
+        text = handle.read()
+    checked = "if (dcos::messagePortAgent.Send(greetings, message, 0) != dcos::Status::Ok) {"
+    assert checked in text
+    with open(source, "w", encoding="utf-8") as handle:
+        handle.write(text.replace(checked, "dcos::messagePortAgent.Send(greetings, message, 0);\n    {"))
+    expect_build_failure(application, "hello.cpp", "ignoring returned value of type", "nodiscard",
+                         "-Werror=unused-result")
 
 
 def test_too_many_tasks_names_the_first_that_does_not_fit(tmp_path):

@@ -17,7 +17,7 @@ uint32_t spawnedCount = 0;
 void blockForever(uintptr_t)
 {
     for (;;) {
-        dcos::taskAgent.ReceiveEvent(kNeverPostedEvent, dcos::EventWait::All, dcos::kWaitForever);
+        (void)dcos::taskAgent.ReceiveEvent(kNeverPostedEvent, dcos::EventWait::All, dcos::kWaitForever);
     }
 }
 
@@ -71,7 +71,7 @@ void killTasks()
     while (spawnedCount > 0) {
         const dcos::ObjectId id = spawned[--spawnedCount];
         if (!id.isNull()) {
-            dcos::taskAgent.KillTask(id);
+            (void)dcos::taskAgent.KillTask(id);
         }
     }
 }

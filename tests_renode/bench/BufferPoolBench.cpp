@@ -61,11 +61,11 @@ Status populate(uint32_t count)
 void clearAll()
 {
     if (buffer != nullptr) {
-        bufferPoolAgent.Return(target, buffer);
+        (void)bufferPoolAgent.Return(target, buffer);
         buffer = nullptr;
     }
     while (poolCount > 0) {
-        bufferPoolAgent.Delete(pools[--poolCount]);
+        (void)bufferPoolAgent.Delete(pools[--poolCount]);
     }
     target = ObjectId::null();
 }
@@ -86,7 +86,7 @@ void createPool()
     created = id.ok() ? id.value() : ObjectId::null();
 }
 
-void deleteCreated() { bufferPoolAgent.Delete(created); }
+void deleteCreated() { (void)bufferPoolAgent.Delete(created); }
 
 // --- BufferPool.Delete of the target (no buffer allocated); re-created unmeasured.
 
@@ -116,7 +116,7 @@ void returnBuffer()
 
 void returnAllocated()
 {
-    bufferPoolAgent.Return(target, buffer);
+    (void)bufferPoolAgent.Return(target, buffer);
     buffer = nullptr;
 }
 

@@ -74,7 +74,7 @@ Status timersWithRoom(uint32_t count)
 void deleteTimers()
 {
     while (timerCount > 0) {
-        dcos::timerAgent.Delete(timers[--timerCount]);
+        (void)dcos::timerAgent.Delete(timers[--timerCount]);
     }
 }
 
@@ -113,7 +113,7 @@ Status devicesWithRoom(uint32_t count)
 void deleteDevices()
 {
     while (deviceCount > 0) {
-        dcos::systemAgent.Delete(devices[--deviceCount]);
+        (void)dcos::systemAgent.Delete(devices[--deviceCount]);
     }
 }
 
@@ -166,7 +166,7 @@ Status poolsWithRoom(uint32_t count)
 void deletePools()
 {
     while (poolCount > 0) {
-        dcos::bufferPoolAgent.Delete(pools[--poolCount]);
+        (void)dcos::bufferPoolAgent.Delete(pools[--poolCount]);
     }
 }
 
@@ -188,7 +188,7 @@ Status heapsWithRoom(uint32_t count)
 void deleteHeaps()
 {
     while (heapCount > 0) {
-        dcos::heapAgent.Delete(heaps[--heapCount]);
+        (void)dcos::heapAgent.Delete(heaps[--heapCount]);
     }
 }
 
@@ -209,7 +209,7 @@ Status portsWithRoom(uint32_t count)
 void deletePorts()
 {
     while (portCount > 0) {
-        dcos::messagePortAgent.Delete(ports[--portCount]);
+        (void)dcos::messagePortAgent.Delete(ports[--portCount]);
     }
 }
 
@@ -230,7 +230,7 @@ Status semaphoresWithRoom(uint32_t count)
 void deleteSemaphores()
 {
     while (semaphoreCount > 0) {
-        dcos::semaphoreAgent.Delete(semaphores[--semaphoreCount]);
+        (void)dcos::semaphoreAgent.Delete(semaphores[--semaphoreCount]);
     }
 }
 
@@ -264,10 +264,10 @@ Status subscriptionsWithRoom(uint32_t count)
 void deleteDsmObjects()
 {
     while (subscriptionCount > 0) {
-        dcos::dsmAgent.Close(subscriptions[--subscriptionCount]);
+        (void)dcos::dsmAgent.Close(subscriptions[--subscriptionCount]);
     }
     while (publisherCount > 0) {
-        dcos::dsmAgent.Delete(publishers[--publisherCount]);
+        (void)dcos::dsmAgent.Delete(publishers[--publisherCount]);
     }
 }
 

@@ -92,10 +92,10 @@ void clearAll()
 {
     killTasks(); // Recovery deletes a publisher handed to a partner; its Delete below then fails harmlessly.
     while (subscriptionCount > 0) {
-        dsmAgent.Close(subscriptions[--subscriptionCount]);
+        (void)dsmAgent.Close(subscriptions[--subscriptionCount]);
     }
     while (publisherCount > 0) {
-        dsmAgent.Delete(publishers[--publisherCount]);
+        (void)dsmAgent.Delete(publishers[--publisherCount]);
     }
     target = ObjectId::null();
     targetSubscription = ObjectId::null();
@@ -115,7 +115,7 @@ void createOnePublisher()
     created = id.ok() ? id.value() : ObjectId::null();
 }
 
-void deleteCreated() { dsmAgent.Delete(created); }
+void deleteCreated() { (void)dsmAgent.Delete(created); }
 
 // --- Dsm.Delete of the target, with no subscription to it and no reader
 // waiting; re-created unmeasured.
@@ -140,7 +140,7 @@ void openToTarget()
     created = id.ok() ? id.value() : ObjectId::null();
 }
 
-void closeCreated() { dsmAgent.Close(created); }
+void closeCreated() { (void)dsmAgent.Close(created); }
 
 // --- Dsm.Close of the subscription to the target; re-opened unmeasured.
 
@@ -182,7 +182,7 @@ void markThenWrite(uintptr_t)
 {
     for (;;) {
         markEnd();
-        dsmAgent.Write(target, page);
+        (void)dsmAgent.Write(target, page);
     }
 }
 

@@ -78,7 +78,7 @@ void returnSegments()
 {
     for (void*& segment : segments) {
         if (segment != nullptr) {
-            heapAgent.Return(target, segment);
+            (void)heapAgent.Return(target, segment);
             segment = nullptr;
         }
     }
@@ -88,7 +88,7 @@ void clearAll()
 {
     returnSegments();
     while (heapCount > 0) {
-        heapAgent.Delete(heaps[--heapCount]);
+        (void)heapAgent.Delete(heaps[--heapCount]);
     }
     target = ObjectId::null();
 }
@@ -108,7 +108,7 @@ void createHeap()
     created = id.ok() ? id.value() : ObjectId::null();
 }
 
-void deleteCreated() { heapAgent.Delete(created); }
+void deleteCreated() { (void)heapAgent.Delete(created); }
 
 // --- Heap.Delete of the target (nothing allocated); re-created unmeasured.
 
@@ -133,7 +133,7 @@ void allocate()
 
 void returnFirst()
 {
-    heapAgent.Return(target, segments[0]);
+    (void)heapAgent.Return(target, segments[0]);
     segments[0] = nullptr;
 }
 
@@ -149,8 +149,8 @@ void buildMergeShape()
         const Result<void*> allocated = heapAgent.Allocate(target, kRequest);
         segment = allocated.ok() ? allocated.value() : nullptr;
     }
-    heapAgent.Return(target, segments[2]);
-    heapAgent.Return(target, segments[0]);
+    (void)heapAgent.Return(target, segments[2]);
+    (void)heapAgent.Return(target, segments[0]);
     segments[2] = nullptr;
     segments[0] = nullptr;
 }
@@ -243,17 +243,17 @@ Status populateFragmented(uint32_t freeSegments)
 void clearFragmented()
 {
     if (segments[0] != nullptr) {
-        heapAgent.Return(fragmentedHeap, segments[0]);
+        (void)heapAgent.Return(fragmentedHeap, segments[0]);
         segments[0] = nullptr;
     }
     for (uint32_t i = 0; i < fragmentCount; ++i) {
         if (fragmentSegments[i] != nullptr) {
-            heapAgent.Return(fragmentedHeap, fragmentSegments[i]);
+            (void)heapAgent.Return(fragmentedHeap, fragmentSegments[i]);
             fragmentSegments[i] = nullptr;
         }
     }
     fragmentCount = 0;
-    heapAgent.Delete(fragmentedHeap);
+    (void)heapAgent.Delete(fragmentedHeap);
     fragmentedHeap = ObjectId::null();
 }
 
@@ -266,7 +266,7 @@ void allocateFragmented()
 
 void returnFragmented()
 {
-    heapAgent.Return(fragmentedHeap, segments[0]);
+    (void)heapAgent.Return(fragmentedHeap, segments[0]);
     segments[0] = nullptr;
 }
 

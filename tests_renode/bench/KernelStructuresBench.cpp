@@ -43,7 +43,7 @@ TableObject* volatile resolvedObject;
 void clearTable()
 {
     for (uint32_t i = 0; i < tableIdCount; ++i) {
-        table.Delete(tableIds[i]);
+        (void)table.Delete(tableIds[i]);
     }
     tableIdCount = 0;
 }
@@ -114,10 +114,10 @@ uint64_t measuredDueTick = 0;
 void clearWheel()
 {
     for (uint32_t i = 0; i < pendingTimerCount; ++i) {
-        wheel.cancel(pendingTimers[i]);
+        (void)wheel.cancel(pendingTimers[i]);
     }
     pendingTimerCount = 0;
-    wheel.cancel(measuredTimer);
+    (void)wheel.cancel(measuredTimer);
 }
 
 // Arms one time-out per object, due on consecutive ticks after firstDue.
@@ -156,8 +156,8 @@ Status armTimersForEarliest(uint32_t timers)
 
 void timeWheelInsertCancel()
 {
-    wheel.insert(measuredTimer, measuredDueTick);
-    wheel.cancel(measuredTimer);
+    (void)wheel.insert(measuredTimer, measuredDueTick);
+    (void)wheel.cancel(measuredTimer);
 }
 
 // --- Scheduler.DeadlineQueueInsertPop: a deadline task more urgent than all
@@ -201,7 +201,7 @@ Status fillDeadlineQueue(uint32_t tasks)
 
 void deadlineQueueInsertPop()
 {
-    deadlineQueue.insert(urgentTask, urgentKey);
+    (void)deadlineQueue.insert(urgentTask, urgentKey);
     dispatchedTask = deadlineQueue.pop();
 }
 

@@ -41,14 +41,14 @@ void markStartThenYield(uintptr_t)
 {
     for (;;) {
         markStart();
-        schedulerAgent.Yield();
+        (void)schedulerAgent.Yield();
     }
 }
 
 void yieldThenMarkEnd(uintptr_t)
 {
     for (;;) {
-        schedulerAgent.Yield();
+        (void)schedulerAgent.Yield();
         markEnd();
     }
 }
@@ -69,7 +69,7 @@ Status spawnYieldingPair(uint32_t tasks, bool floatingPoint)
 Status populateForSwitch(uint32_t tasks) { return spawnYieldingPair(tasks, false); }
 Status populateForFloatingPointSwitch(uint32_t tasks) { return spawnYieldingPair(tasks, true); }
 
-void yieldToPartners() { schedulerAgent.Yield(); }
+void yieldToPartners() { (void)schedulerAgent.Yield(); }
 
 // --- Kernel.InterruptLatency: a routine installed with InstallISR on the
 // spare line 5 whose first action reads the time-stamp counter; a software
@@ -95,7 +95,7 @@ void raiseSpareLine()
 
 void removeRoutineAndClear()
 {
-    dcos::systemAgent.RemoveISR(kSpareLine);
+    (void)dcos::systemAgent.RemoveISR(kSpareLine);
     clearAll();
 }
 
@@ -113,7 +113,7 @@ ObjectId urgentTask;
 void waitThenMarkEnd(uintptr_t)
 {
     for (;;) {
-        taskAgent.ReceiveEvent(kWakeEvent, dcos::EventWait::Any, dcos::kWaitForever);
+        (void)taskAgent.ReceiveEvent(kWakeEvent, dcos::EventWait::Any, dcos::kWaitForever);
         markEnd();
     }
 }
@@ -131,7 +131,7 @@ Status populateForStaticScheduling(uint32_t tasks)
 void wakeUrgentTask()
 {
     markStart();
-    taskAgent.PostEvent(urgentTask, kWakeEvent);
+    (void)taskAgent.PostEvent(urgentTask, kWakeEvent);
 }
 
 // --- Kernel.DynamicScheduling: as StaticScheduling, but every task is in a
@@ -145,15 +145,15 @@ constexpr uint32_t kEnterScopeEvent = 1u << 4;
 
 void enterScopeThenMarkEnd(uintptr_t)
 {
-    schedulerAgent.SetDeadline(dcos::DeadlineStart::AtNextBlock, kMillisecond, kHour);
+    (void)schedulerAgent.SetDeadline(dcos::DeadlineStart::AtNextBlock, kMillisecond, kHour);
     waitThenMarkEnd(0);
 }
 
 // Its deadline period differs per filler, so the heap holds distinct keys.
 void enterScopeThenBlock(uintptr_t index)
 {
-    schedulerAgent.SetDeadline(dcos::DeadlineStart::AtNextBlock, kMillisecond, kHour + index * kMillisecond);
-    taskAgent.ReceiveEvent(kEnterScopeEvent, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)schedulerAgent.SetDeadline(dcos::DeadlineStart::AtNextBlock, kMillisecond, kHour + index * kMillisecond);
+    (void)taskAgent.ReceiveEvent(kEnterScopeEvent, dcos::EventWait::Any, dcos::kWaitForever);
     blockForever(0);
 }
 
@@ -176,14 +176,14 @@ Status populateForDynamicScheduling(uint32_t tasks)
             return filler.status();
         }
         deadlineFillers[deadlineFillerCount++] = filler.value();
-        taskAgent.ChangePriority(filler.value(), kReadyFillerPriority);
+        (void)taskAgent.ChangePriority(filler.value(), kReadyFillerPriority);
     }
     const Status scope = schedulerAgent.SetDeadline(dcos::DeadlineStart::Now, kMillisecond, kHour);
     if (scope != Status::Ok) {
         return scope;
     }
     for (uint32_t i = 0; i < deadlineFillerCount; ++i) {
-        taskAgent.PostEvent(deadlineFillers[i], kEnterScopeEvent);
+        (void)taskAgent.PostEvent(deadlineFillers[i], kEnterScopeEvent);
     }
     return Status::Ok;
 }
@@ -194,7 +194,7 @@ void leaveScopeAndClear()
 {
     clearAll();
     deadlineFillerCount = 0;
-    schedulerAgent.ClearDeadline();
+    (void)schedulerAgent.ClearDeadline();
 }
 
 } // namespace

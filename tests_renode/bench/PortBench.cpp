@@ -83,7 +83,7 @@ void clearAll()
     killTasks();
     // Delete discards the queued messages; their buffers go back to the free area.
     while (portCount > 0) {
-        messagePortAgent.Delete(ports[--portCount]);
+        (void)messagePortAgent.Delete(ports[--portCount]);
     }
     target = ObjectId::null();
     partner = ObjectId::null();
@@ -102,7 +102,7 @@ void createOnePort()
     created = id.ok() ? id.value() : ObjectId::null();
 }
 
-void deleteCreated() { messagePortAgent.Delete(created); }
+void deleteCreated() { (void)messagePortAgent.Delete(created); }
 
 // --- Port.Delete of the empty target; re-created unmeasured.
 
@@ -120,7 +120,7 @@ void recreateTarget()
 
 void send() { check(messagePortAgent.Send(target, message, kMeasuredLevel)); }
 
-void receiveQueued() { messagePortAgent.Receive(target, received, dcos::kPoll); }
+void receiveQueued() { (void)messagePortAgent.Receive(target, received, dcos::kPoll); }
 
 // --- Port.Receive ("available/polling"): the target holds one message.
 
@@ -132,7 +132,7 @@ Status populateWithMessage(uint32_t count)
 
 void receiveAvailable() { check(messagePortAgent.Receive(target, received, dcos::kPoll)); }
 
-void sendAgain() { messagePortAgent.Send(target, message, kMeasuredLevel); }
+void sendAgain() { (void)messagePortAgent.Send(target, message, kMeasuredLevel); }
 
 // --- Port.ReceiveWaiting: the target is empty, so the shell blocks in
 // Receive. Self-timed from the call to the first instruction of the partner
@@ -143,7 +143,7 @@ void markThenSend(uintptr_t)
 {
     for (;;) {
         markEnd();
-        messagePortAgent.Send(target, message, kMeasuredLevel);
+        (void)messagePortAgent.Send(target, message, kMeasuredLevel);
     }
 }
 
@@ -161,7 +161,7 @@ Status populateWithSendingPartner(uint32_t count)
 void receiveBlocking()
 {
     markStart();
-    messagePortAgent.Receive(target, received, dcos::kWaitForever);
+    (void)messagePortAgent.Receive(target, received, dcos::kWaitForever);
 }
 
 // --- Port.AddMsgBufs (configuration, variable): eight more buffers of the

@@ -53,7 +53,7 @@ Status populateInScope(uint32_t tasks)
 
 void leaveScopeAndClear()
 {
-    schedulerAgent.ClearDeadline();
+    (void)schedulerAgent.ClearDeadline();
     clearAll();
 }
 

@@ -70,7 +70,7 @@ void clearAll()
 {
     killTasks();
     while (createdCount > 0) {
-        semaphoreAgent.Delete(semaphores[--createdCount]);
+        (void)semaphoreAgent.Delete(semaphores[--createdCount]);
     }
     target = ObjectId::null();
 }
@@ -88,7 +88,7 @@ void createOneSemaphore()
     created = id.ok() ? id.value() : ObjectId::null();
 }
 
-void deleteCreated() { semaphoreAgent.Delete(created); }
+void deleteCreated() { (void)semaphoreAgent.Delete(created); }
 
 // --- Semaphore.Delete of the free target (no waiter); re-created unmeasured.
 
@@ -106,8 +106,8 @@ void recreateTarget()
 
 void acquire() { check(semaphoreAgent.Acquire(target, dcos::kPoll)); }
 void release() { check(semaphoreAgent.Release(target)); }
-void acquireAgain() { semaphoreAgent.Acquire(target, dcos::kPoll); }
-void releaseAgain() { semaphoreAgent.Release(target); }
+void acquireAgain() { (void)semaphoreAgent.Acquire(target, dcos::kPoll); }
+void releaseAgain() { (void)semaphoreAgent.Release(target); }
 
 Status populateHeld(uint32_t count)
 {
@@ -126,7 +126,7 @@ void markThenRelease(uintptr_t)
 {
     for (;;) {
         markEnd();
-        semaphoreAgent.Release(target);
+        (void)semaphoreAgent.Release(target);
     }
 }
 
@@ -146,7 +146,7 @@ Status populateWithReleasingPartner(uint32_t count)
 void acquireBlocking()
 {
     markStart();
-    semaphoreAgent.Acquire(target, dcos::kWaitForever);
+    (void)semaphoreAgent.Acquire(target, dcos::kWaitForever);
 }
 
 // --- Semaphore.XferOwnership of the target from the shell to the shell.

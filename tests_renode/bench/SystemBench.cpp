@@ -71,11 +71,11 @@ Status populate(uint32_t count)
 void clearAll()
 {
     if (targetOpen) {
-        systemAgent.Close(target);
+        (void)systemAgent.Close(target);
         targetOpen = false;
     }
     while (deviceCount > 0) {
-        systemAgent.Delete(devices[--deviceCount]);
+        (void)systemAgent.Delete(devices[--deviceCount]);
     }
     target = ObjectId::null();
 }
@@ -93,7 +93,7 @@ void createDevice()
     created = id.ok() ? id.value() : ObjectId::null();
 }
 
-void deleteCreated() { systemAgent.Delete(created); }
+void deleteCreated() { (void)systemAgent.Delete(created); }
 
 void deleteTarget() { check(systemAgent.Delete(target)); }
 
@@ -158,7 +158,7 @@ constexpr unsigned kSpareLine = 10;
 void emptyRoutine(void*) {}
 
 void installIsr() { check(systemAgent.InstallISR(kSpareLine, emptyRoutine, nullptr)); }
-void removeIsr() { systemAgent.RemoveISR(kSpareLine); }
+void removeIsr() { (void)systemAgent.RemoveISR(kSpareLine); }
 
 void setInterruptLevel()
 {
@@ -167,7 +167,7 @@ void setInterruptLevel()
     lastValue = level.ok() ? level.value() : 0;
 }
 
-void clearInterruptLevel() { systemAgent.SetInterruptLevel(0xFF); }
+void clearInterruptLevel() { (void)systemAgent.SetInterruptLevel(0xFF); }
 
 void setLegalLimit() { check(systemAgent.SetInterruptLevel(31, 1)); }
 

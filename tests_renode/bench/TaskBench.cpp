@@ -31,7 +31,7 @@ void clearAll()
 {
     killTasks();
     // Leave no event of ours pending for the shell (bit 0 is the console's).
-    taskAgent.ReceiveEvent(kSelfEvent, dcos::EventWait::Any, dcos::kPoll);
+    (void)taskAgent.ReceiveEvent(kSelfEvent, dcos::EventWait::Any, dcos::kPoll);
     target = ObjectId::null();
     partner = ObjectId::null();
 }
@@ -60,7 +60,7 @@ void createTask()
 
 void killCreated()
 {
-    taskAgent.KillTask(created);
+    (void)taskAgent.KillTask(created);
     created = ObjectId::null();
 }
 
@@ -72,9 +72,9 @@ constexpr uint32_t kVictimEvent = 1u << 0;
 
 void deleteWhenWoken(uintptr_t)
 {
-    taskAgent.ReceiveEvent(kVictimEvent, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(kVictimEvent, dcos::EventWait::Any, dcos::kWaitForever);
     markStart();
-    taskAgent.Delete();
+    (void)taskAgent.Delete();
 }
 
 Status spawnDeletingVictim()
@@ -92,14 +92,14 @@ Status populateWithDeletingVictim(uint32_t tasks)
 
 void wakeVictimToDelete()
 {
-    taskAgent.PostEvent(partner, kVictimEvent);
+    (void)taskAgent.PostEvent(partner, kVictimEvent);
     markEnd();
 }
 
 void replaceDeletedVictim()
 {
     forgetTask(partner);
-    spawnDeletingVictim();
+    (void)spawnDeletingVictim();
 }
 
 // --- Task.KillTask: one blocked task killed by the shell; a new one takes its place.
@@ -122,7 +122,7 @@ void killVictim() { check(taskAgent.KillTask(partner)); }
 void replaceKilledVictim()
 {
     forgetTask(partner);
-    spawnBlockedVictim();
+    (void)spawnBlockedVictim();
 }
 
 // --- Task.Suspend and Task.Resume of the blocked target.
@@ -139,7 +139,7 @@ Status populateSuspended(uint32_t tasks)
 // --- Task.ChangePriority of the blocked target, and back (unmeasured).
 
 void raiseTargetPriority() { check(taskAgent.ChangePriority(target, kBlockedFillerPriority - 1)); }
-void restoreTargetPriority() { taskAgent.ChangePriority(target, kBlockedFillerPriority); }
+void restoreTargetPriority() { (void)taskAgent.ChangePriority(target, kBlockedFillerPriority); }
 
 // --- Task.SleepFor and Task.SleepTill ("overhead only" in the seed):
 // self-timed from the shell's call to the first instruction of the task
@@ -152,7 +152,7 @@ void markThenWait(uintptr_t)
 {
     for (;;) {
         markEnd();
-        taskAgent.ReceiveEvent(kPartnerEvent, dcos::EventWait::Any, dcos::kWaitForever);
+        (void)taskAgent.ReceiveEvent(kPartnerEvent, dcos::EventWait::Any, dcos::kWaitForever);
     }
 }
 
@@ -166,12 +166,12 @@ Status populateWithWaitingPartner(uint32_t tasks)
     return populate(tasks);
 }
 
-void readyPartner() { taskAgent.PostEvent(partner, kPartnerEvent); }
+void readyPartner() { (void)taskAgent.PostEvent(partner, kPartnerEvent); }
 
 void sleepForOneMillisecond()
 {
     markStart();
-    taskAgent.SleepFor(kMillisecond);
+    (void)taskAgent.SleepFor(kMillisecond);
 }
 
 dcos::DateTime wakeTime;
@@ -196,7 +196,7 @@ void readyPartnerAndChooseWakeTime()
 void sleepTill()
 {
     markStart();
-    taskAgent.SleepTill(wakeTime);
+    (void)taskAgent.SleepTill(wakeTime);
 }
 
 // --- Task.PostEvent to the blocked target, an event it does not wait for
@@ -220,7 +220,7 @@ void receiveAvailableEvent()
     lastValue = events.ok() ? events.value() : 0;
 }
 
-void postOwnEvent() { taskAgent.PostEvent(self(), kSelfEvent); }
+void postOwnEvent() { (void)taskAgent.PostEvent(self(), kSelfEvent); }
 
 // --- Task.ReceiveEvent: the event is not there, so the shell blocks.
 // Self-timed from the call to the first instruction of the partner (below
@@ -230,7 +230,7 @@ void markThenPostToShell(uintptr_t shell)
 {
     for (;;) {
         markEnd();
-        taskAgent.PostEvent(ObjectId::fromRaw(static_cast<uint32_t>(shell)), kSelfEvent);
+        (void)taskAgent.PostEvent(ObjectId::fromRaw(static_cast<uint32_t>(shell)), kSelfEvent);
     }
 }
 
@@ -248,7 +248,7 @@ Status populateWithPostingPartner(uint32_t tasks)
 void receiveEventBlocking()
 {
     markStart();
-    taskAgent.ReceiveEvent(kSelfEvent, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(kSelfEvent, dcos::EventWait::Any, dcos::kWaitForever);
 }
 
 // --- Task.SendSignal to the blocked target (held pending: it has no handler).
@@ -265,9 +265,9 @@ void setSignalHandler() { check(taskAgent.SetSignalHandler(ignoreSignal)); }
 
 void clearHandlers()
 {
-    taskAgent.SetSignalHandler(nullptr);
-    taskAgent.SetExceptionHandler(nullptr);
-    taskAgent.SetSignalMask(0);
+    (void)taskAgent.SetSignalHandler(nullptr);
+    (void)taskAgent.SetExceptionHandler(nullptr);
+    (void)taskAgent.SetSignalMask(0);
     clearAll();
 }
 

@@ -95,7 +95,7 @@ Status populate(uint32_t count) { return populateArmed(count, Armed::WatchDog); 
 void clearAll()
 {
     while (timerCount > 0) {
-        timerAgent.Delete(timers[--timerCount]);
+        (void)timerAgent.Delete(timers[--timerCount]);
     }
     target = ObjectId::null();
 }
@@ -113,7 +113,7 @@ void createOneTimer()
     created = id.ok() ? id.value() : ObjectId::null();
 }
 
-void deleteCreated() { timerAgent.Delete(created); }
+void deleteCreated() { (void)timerAgent.Delete(created); }
 
 void deleteTarget() { check(timerAgent.Delete(target)); }
 

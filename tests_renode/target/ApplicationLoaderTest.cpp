@@ -101,16 +101,16 @@ void controller(uintptr_t)
     dcos::DsmPage page{};
     writeStatus = dcos::dsmAgent.Write(levelPublisher, page).status();
     finished();
-    taskAgent.ReceiveEvent(1u << 3, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1u << 3, dcos::EventWait::Any, dcos::kWaitForever);
 }
 
 void operatorEntry(uintptr_t)
 {
     Message message{};
     message.bytes[0] = 42;
-    messagePortAgent.Send(commandsPort, message, 0);
+    (void)messagePortAgent.Send(commandsPort, message, 0);
     finished();
-    taskAgent.ReceiveEvent(1u << 3, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1u << 3, dcos::EventWait::Any, dcos::kWaitForever);
 }
 
 constexpr dcos::app::TaskDeclaration wholeTasks[] = {
@@ -172,7 +172,7 @@ bool startAndStop(shell::Shell& shell)
 
 // --- Rules the compiler checks, checked again at run time --------------------
 
-void idle(uintptr_t) { taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever); }
+void idle(uintptr_t) { (void)taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever); }
 
 bool rulesAtRunTime(shell::Shell& shell)
 {
@@ -238,7 +238,7 @@ bool fullTableRollsBack(shell::Shell& shell)
     }
     bool ok = check(shell, made == dcos::internal::kPortCapacity, "the port table fills up");
     for (size_t i = 0; i < 3; ++i) {
-        messagePortAgent.Delete(filler[--made]);
+        (void)messagePortAgent.Delete(filler[--made]);
     }
     const size_t stackBytesBefore = dcos::internal::StackArena::freeBytes();
     dcos::app::TaskDeclaration tasks[] = {{.name = "ldfirst", .entry = idle}};
@@ -256,7 +256,7 @@ bool fullTableRollsBack(shell::Shell& shell)
     ok &= nothingLeft(shell, application);
     ok &= check(shell, dcos::internal::StackArena::freeBytes() == stackBytesBefore, "no stack was taken");
     while (made > 0) {
-        messagePortAgent.Delete(filler[--made]);
+        (void)messagePortAgent.Delete(filler[--made]);
     }
     return ok;
 }

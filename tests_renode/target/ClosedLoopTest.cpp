@@ -65,7 +65,7 @@ void controllerEntry(uintptr_t)
         ok = ok && iobus::writeWord(boardId, iobus::channel::kAnalogOutput0, dacCode(output)) == Status::Ok;
     }
     if (timer.ok()) {
-        dcos::timerAgent.Delete(timer.value());
+        (void)dcos::timerAgent.Delete(timer.value());
     }
     loopOk = ok;
     finished();
@@ -81,7 +81,7 @@ bool closedLoop(shell::Shell& shell)
     }
     boardId = id.value();
     ok = checkStatus(shell, dcos::systemAgent.Open(boardId), Status::Ok, "open the board") && ok;
-    iobus::writeWord(boardId, iobus::channel::kAnalogOutput0, dacCode(0));
+    (void)iobus::writeWord(boardId, iobus::channel::kAnalogOutput0, dacCode(0));
     ok = ok && check(shell, !spawn("controller", 8, controllerEntry).isNull(), "start the controller task");
     ok = ok && waitForDone(shell, 1, 10000000000ull);
     ok = check(shell, loopOk, "every period read and wrote the board") && ok;
@@ -105,7 +105,7 @@ bool closedLoop(shell::Shell& shell)
     ok = check(shell, worst <= kBandMicrovolts, "the plant stays within the band in the last second") && ok;
     while (dcos::systemAgent.Close(boardId) == Status::Ok) {
     }
-    loopBoard.uninstall();
+    (void)loopBoard.uninstall();
     return ok;
 }
 

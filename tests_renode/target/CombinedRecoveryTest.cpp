@@ -45,7 +45,7 @@ void holdingEntry(uintptr_t endsItself)
     holding = buffer && segment && held && queued;
     finished();
     if (endsItself == 0) {
-        taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
+        (void)taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
     }
 }
 
@@ -69,7 +69,7 @@ bool combinedRecovery(shell::Shell& shell)
         if (endsItself == 0) {
             ok = checkStatus(shell, taskAgent.KillTask(task), Status::Ok, "KillTask") && ok;
         } else {
-            taskAgent.SleepFor(2000000); // It has ended; let the reaper run.
+            (void)taskAgent.SleepFor(2000000); // It has ended; let the reaper run.
         }
         const uint32_t poolNow = bufferPoolAgent.GetStatistics(pool).value().freeBuffers;
         const uint32_t heapNow = heapAgent.GetStatistics(heap).value().freeBytes;

@@ -100,16 +100,16 @@ bool interruptLevels(shell::Shell& shell)
     // The tick keeps running at the most urgent level.
     granted = systemAgent.SetInterruptLevel(1);
     const uint64_t before = dcos::timerAgent.Uptime();
-    taskAgent.SleepFor(5000000);
+    (void)taskAgent.SleepFor(5000000);
     ok = check(shell, dcos::timerAgent.Uptime() - before >= 5000000, "the tick is never held off") && ok;
     // The legal limit lowers a request that is too urgent for the priority.
     const uint8_t priority = taskAgent.GetPriority(taskAgent.IdOfSelf()).value();
     ok = checkStatus(shell, systemAgent.SetInterruptLevel(priority, 10), Status::Ok, "set the legal limit") && ok;
     granted = systemAgent.SetInterruptLevel(2);
     ok = check(shell, granted.ok() && granted.value() == 10, "a request above the legal limit gets the limit") && ok;
-    systemAgent.SetInterruptLevel(priority, 1);
+    (void)systemAgent.SetInterruptLevel(priority, 1);
     ok = checkStatus(shell, systemAgent.SetInterruptLevel(0).status(), Status::InvalidArgument, "level 0") && ok;
-    systemAgent.SetInterruptLevel(0xFF);
+    (void)systemAgent.SetInterruptLevel(0xFF);
     ok = check(shell, interruptMask() == open, "level 0xFF holds off nothing") && ok;
     return ok;
 }

@@ -19,7 +19,7 @@ void finished()
         arch_x86::InterruptGuard guard;
         doneCount = doneCount + 1;
     }
-    dcos::taskAgent.PostEvent(testTask(), kDoneEvent);
+    (void)dcos::taskAgent.PostEvent(testTask(), kDoneEvent);
 }
 
 void Trace::clear()
@@ -56,7 +56,7 @@ bool Trace::expect(shell::Shell& shell, const char* expected)
 HoldScheduling::HoldScheduling() : held_(true)
 {
     savedPriority_ = dcos::taskAgent.GetPriority(testTask()).value();
-    dcos::taskAgent.ChangePriority(testTask(), 0);
+    (void)dcos::taskAgent.ChangePriority(testTask(), 0);
 }
 
 HoldScheduling::~HoldScheduling() { release(); }
@@ -65,7 +65,7 @@ void HoldScheduling::release()
 {
     if (held_) {
         held_ = false;
-        dcos::taskAgent.ChangePriority(testTask(), savedPriority_);
+        (void)dcos::taskAgent.ChangePriority(testTask(), savedPriority_);
     }
 }
 

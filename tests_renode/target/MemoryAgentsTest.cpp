@@ -274,7 +274,7 @@ bool heaps(shell::Shell& shell)
                      Status::AlreadyExists, "an area of a pool") && ok;
     ok = checkStatus(shell, bufferPoolAgent.Create(heapArea, 64, 8, nullptr, Visibility::Local).status(),
                      Status::AlreadyExists, "a pool in a heap's area") && ok;
-    bufferPoolAgent.Delete(pool);
+    (void)bufferPoolAgent.Delete(pool);
 
     // Sizes, alignment, the 8-byte header and minimum.
     ok = checkStatus(shell, heapAgent.Allocate(heap, 0).status(), Status::InvalidArgument, "Allocate(0)") && ok;
@@ -381,7 +381,7 @@ bool tables(shell::Shell& shell)
     for (size_t i = 0; i < count; ++i) {
         ok = checkStatus(shell, bufferPoolAgent.Delete(created[i]), Status::Ok, "Delete a pool") && ok;
     }
-    bufferPoolAgent.Delete(more.value());
+    (void)bufferPoolAgent.Delete(more.value());
 
     count = 0;
     last = Status::Ok;
@@ -404,7 +404,7 @@ bool tables(shell::Shell& shell)
     for (size_t i = 0; i < count; ++i) {
         ok = checkStatus(shell, heapAgent.Delete(created[i]), Status::Ok, "Delete a heap") && ok;
     }
-    heapAgent.Delete(moreHeap.value());
+    (void)heapAgent.Delete(moreHeap.value());
     ok = check(shell, BufferPoolManager::usedCount() == 0 && HeapManager::usedCount() == 0, "every table is empty again")
          && ok;
     return ok;
@@ -481,7 +481,7 @@ bool heapCorruption(shell::Shell& shell)
     const ObjectId third = heapAgent.Create(otherHeapArea, sizeof otherHeapArea, nullptr, Visibility::Local).value();
     void* kept = heapAgent.Allocate(third, 40).value();
     void* freed = heapAgent.Allocate(third, 40).value();
-    heapAgent.Allocate(third, 40);
+    (void)heapAgent.Allocate(third, 40);
     ok = checkStatus(shell, heapAgent.Return(third, freed), Status::Ok, "Return") && ok;
     static_cast<volatile uint32_t*>(freed)[0] = 0x00000010; // Its next link, now naming the middle of free space.
     ok = checkStatus(shell, heapAgent.Allocate(third, 800).status(), Status::Corrupted,
@@ -604,9 +604,9 @@ void holdingEntry(uintptr_t suicide)
     h.ownHeap = ownHeap.ok() ? ownHeap.value() : ObjectId::null();
     h.ready = ok;
     if (suicide != 0) {
-        taskAgent.Delete(); // Ends with everything still held.
+        (void)taskAgent.Delete(); // Ends with everything still held.
     }
-    taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
 }
 
 bool memoryRecovery(shell::Shell& shell)
@@ -628,7 +628,7 @@ bool memoryRecovery(shell::Shell& shell)
             ok = check(shell, HeapManager::usedCount() == heapsBefore + 1, "it owns a heap") && ok;
             ok = checkStatus(shell, taskAgent.KillTask(holder), Status::Ok, "KillTask") && ok;
         } else {
-            taskAgent.SleepFor(2000000); // Let the reaper finish the suicide.
+            (void)taskAgent.SleepFor(2000000); // Let the reaper finish the suicide.
         }
         const BufferPoolStatistics pool = poolStatistics(holdings.pool);
         const HeapStatistics heap = heapStatistics(holdings.heap);
@@ -654,7 +654,7 @@ bool memoryRecovery(shell::Shell& shell)
     const dcos::Result<ObjectId> again =
         bufferPoolAgent.Create(dyingPoolArea, sizeof dyingPoolArea, 8, nullptr, Visibility::Local);
     ok = check(shell, again.ok(), "a new pool in the dead task's area") && ok;
-    bufferPoolAgent.Delete(again.value());
+    (void)bufferPoolAgent.Delete(again.value());
     return ok;
 }
 

@@ -441,7 +441,7 @@ bool waitForIrqs(unsigned count)
         if (timerAgent.Uptime() > deadline) {
             return false;
         }
-        taskAgent.SleepFor(kMillisecond);
+        (void)taskAgent.SleepFor(kMillisecond);
     }
     return true;
 }
@@ -463,7 +463,7 @@ bool interrupts(shell::Shell& shell)
     writeRegister(dacRegister(5), 0x555);
     writeRegister(kAdcStart, 5);
     ok = check(shell, waitWhileBusy(), "conversion without interrupts ends") && ok;
-    taskAgent.SleepFor(2 * kMillisecond);
+    (void)taskAgent.SleepFor(2 * kMillisecond);
     ok = check(shell, irqRecord.count == 0 && readRegister(kStatus) == kDone, "no interrupt with IRQ_ENABLE clear")
          && ok;
     writeRegister(kIrqAck, 1);
@@ -487,7 +487,7 @@ bool interrupts(shell::Shell& shell)
         writeRegister(kAdcStart, static_cast<uint16_t>(round));
         ok = check(shell, waitForIrqs(2 + round), "one interrupt per conversion") && ok;
     }
-    taskAgent.SleepFor(2 * kMillisecond);
+    (void)taskAgent.SleepFor(2 * kMillisecond);
     shell.print("%u interrupts for %u conversions with IRQ_ENABLE\r\n", irqRecord.count, kRounds + 1);
     ok = check(shell, irqRecord.count == kRounds + 1, "exactly one interrupt each") && ok;
     ok = check(shell, readRegister(kStatus) == 0, "the ISR's IRQ_ACK left nothing pending") && ok;
@@ -543,7 +543,7 @@ bool dump(shell::Shell& shell)
         writeRegister(kControl, kIrqEnable);
         writeRegister(kAdcStart, 0);
         ok = check(shell, waitWhileBusy(), "the interrupt conversion ends") && ok;
-        taskAgent.SleepFor(5 * kMillisecond);
+        (void)taskAgent.SleepFor(5 * kMillisecond);
         shell.print("MFIO irq count=%u status=%04x\r\n", irqRecord.count, readRegister(kStatus));
         writeRegister(kControl, kReset);
         ok = checkStatus(shell, systemAgent.RemoveISR(kLine), Status::Ok, "RemoveISR") && ok;

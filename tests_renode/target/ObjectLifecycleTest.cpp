@@ -43,17 +43,17 @@ void owningEntry(uintptr_t deviceIndex)
     for (ObjectId& timer : ownedTimers) {
         timer = timerAgent.Create(nullptr, dcos::Visibility::Local).value();
     }
-    timerAgent.SetPeriodicAlarm(ownedTimers[0], 5000000, dcos::AlarmNotification::event(1));
+    (void)timerAgent.SetPeriodicAlarm(ownedTimers[0], 5000000, dcos::AlarmNotification::event(1));
     ownedDevice = systemAgent.Create(nullDevices[deviceIndex], "null", dcos::Visibility::Local).value();
-    systemAgent.Open(ownedDevice);
+    (void)systemAgent.Open(ownedDevice);
     timersWhileOwned = dcos::internal::TimerManager::timerCount();
     devicesWhileOwned = deviceCount();
     ownerReady = !ownedTimers[0].isNull() && !ownedTimers[1].isNull() && !ownedTimers[2].isNull() &&
                  !ownedDevice.isNull();
     if (deviceIndex == 1) {
-        taskAgent.Delete(); // Suicide with everything still owned.
+        (void)taskAgent.Delete(); // Suicide with everything still owned.
     }
-    taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
 }
 
 size_t deviceCount() { return dcos::internal::deviceManager().usedCount(); }
@@ -79,7 +79,7 @@ bool recovery(shell::Shell& shell)
         if (variant == 0) {
             ok = checkStatus(shell, taskAgent.KillTask(owner), Status::Ok, "KillTask") && ok;
         } else {
-            taskAgent.SleepFor(2000000); // Let the reaper free the suicide's stack.
+            (void)taskAgent.SleepFor(2000000); // Let the reaper free the suicide's stack.
         }
         shell.print("%s: tasks %u->%u, timers %u->%u, devices %u->%u, stack arena %u->%u bytes free\r\n",
                     variant == 0 ? "KillTask" : "Delete", static_cast<unsigned>(tasksBefore),
@@ -101,7 +101,7 @@ bool recovery(shell::Shell& shell)
 
 DCOS_TARGET_TEST(recoveryTest, "recovery", "KillTask and Delete recover every object the task owned", recovery);
 
-void waitForeverEntry(uintptr_t) { taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever); }
+void waitForeverEntry(uintptr_t) { (void)taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever); }
 
 bool fullTable(shell::Shell& shell)
 {
@@ -134,7 +134,7 @@ bool fullTable(shell::Shell& shell)
     ok = check(shell, more == 8, "AddObjects made room for eight more") && ok;
     ok = checkStatus(shell, taskAgent.AddObjects(5), Status::InvalidArgument, "AddObjects needs groups of eight") && ok;
     for (size_t i = 0; i < count; ++i) {
-        taskAgent.KillTask(created[i]);
+        (void)taskAgent.KillTask(created[i]);
     }
     // Argument errors.
     attributes.priority = 32;
@@ -167,7 +167,7 @@ bool forgedIds(shell::Shell& shell)
     ok = checkStatus(shell, taskAgent.Suspend(ObjectId::null()), Status::InvalidId, "the null id") && ok;
     // A stale id: the generation bits of a deleted task's id no longer match.
     const ObjectId gone = spawn("short-lived", 10, waitForeverEntry);
-    taskAgent.KillTask(gone);
+    (void)taskAgent.KillTask(gone);
     const ObjectId reuse = spawn("reused", 30, waitForeverEntry);
     ok = checkStatus(shell, taskAgent.Suspend(gone), Status::StaleId, "a deleted task's id") && ok;
     ok = checkStatus(shell, taskAgent.KillTask(reuse), Status::Ok, "the live task is untouched") && ok;

@@ -151,7 +151,7 @@ volatile Status newOwnerGiveBack = Status::Ok;
 
 void newOwnerEntry(uintptr_t)
 {
-    taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
     Message message{};
     newOwnerReceive = messagePortAgent.Receive(sharedPort, message, dcos::kPoll);
     newOwnerReceived = valueOf(message);
@@ -232,7 +232,7 @@ bool portPrimitives(shell::Shell& shell)
     ok = checkStatus(shell, messagePortAgent.XferOwnership(port, newOwner), Status::Ok, "XferOwnership") && ok;
     ok = checkStatus(shell, messagePortAgent.Receive(port, message, dcos::kPoll), Status::NotOwner,
                      "the old owner no longer receives") && ok;
-    taskAgent.PostEvent(newOwner, 1);
+    (void)taskAgent.PostEvent(newOwner, 1);
     ok = waitForDone(shell, 1) && ok;
     ok = checkStatus(shell, newOwnerReceive, Status::Ok, "the new owner receives") && ok;
     ok = check(shell, newOwnerReceived == 9, "the new owner got the queued message") && ok;
@@ -295,7 +295,7 @@ bool portPrimitives(shell::Shell& shell)
     }
     ok = check(shell, more == 8, "AddObjects made room for eight more ports") && ok;
     for (size_t i = 0; i < count; ++i) {
-        messagePortAgent.Delete(ports[i]);
+        (void)messagePortAgent.Delete(ports[i]);
     }
     ok = checkStatus(shell, messagePortAgent.Delete(port), Status::Ok, "Delete the port") && ok;
     ok = checkStatus(shell, messagePortAgent.Send(port, messageOf(1), 0), Status::StaleId,
@@ -317,7 +317,7 @@ void waitingReceiverEntry(uintptr_t)
     Message message{};
     handOverStatus = messagePortAgent.Receive(handOverPort, message, dcos::kWaitForever);
     handedOver = valueOf(message);
-    messagePortAgent.Delete(handOverPort);
+    (void)messagePortAgent.Delete(handOverPort);
     finished();
 }
 
@@ -377,7 +377,7 @@ bool messageBuffers(shell::Shell& shell)
 
     // Deleting a port hands its queued buffers back.
     for (uint32_t i = 0; i < 20; ++i) {
-        messagePortAgent.Send(port, messageOf(i), static_cast<int>(i % 32) - 16);
+        (void)messagePortAgent.Send(port, messageOf(i), static_cast<int>(i % 32) - 16);
     }
     ok = check(shell, freeBuffers() == before.free + 8 - 20, "twenty buffers hold messages") && ok;
     ok = checkStatus(shell, messagePortAgent.Delete(port), Status::Ok, "Delete with messages queued") && ok;
@@ -418,7 +418,7 @@ bool checkOrder(shell::Shell& shell, PortOrder order, const Sent* sequence, size
     const bool same = expected[i] == '\0' && received[i] == '\0';
     shell.print("%s port: received \"%s\", expected \"%s\": %s\r\n", order == PortOrder::Fifo ? "FIFO" : "priority",
                 received, expected, same ? "same" : "DIFFERENT");
-    messagePortAgent.Delete(port);
+    (void)messagePortAgent.Delete(port);
     return same && ok;
 }
 
@@ -434,12 +434,12 @@ bool portOrder(shell::Shell& shell)
     ok = checkOrder(shell, PortOrder::Priority, priority, sizeof priority / sizeof priority[0], "felibhdacjgk") && ok;
     // The default order is priority.
     const ObjectId port = messagePortAgent.Create(nullptr, Visibility::Local).value();
-    messagePortAgent.Send(port, messageOf('x'), 20);
-    messagePortAgent.Send(port, messageOf('y'), 2);
+    (void)messagePortAgent.Send(port, messageOf('x'), 20);
+    (void)messagePortAgent.Send(port, messageOf('y'), 2);
     Message message{};
-    messagePortAgent.Receive(port, message, dcos::kPoll);
+    (void)messagePortAgent.Receive(port, message, dcos::kPoll);
     ok = check(shell, message.bytes[0] == 'y', "ports are priority ordered by default") && ok;
-    messagePortAgent.Delete(port);
+    (void)messagePortAgent.Delete(port);
     return ok;
 }
 
@@ -470,11 +470,11 @@ bool portTimeout(shell::Shell& shell)
     shell.print("waited %llu ns for a 10 ms time-out\r\n", static_cast<unsigned long long>(waited));
     ok = check(shell, waited >= 10 * kMillisecond && waited <= 12 * kMillisecond, "a time-out of 10 ms") && ok;
     // A message sent after a time-out is not lost: it waits for the next Receive.
-    messagePortAgent.Send(port, messageOf(5), 1);
+    (void)messagePortAgent.Send(port, messageOf(5), 1);
     ok = checkStatus(shell, messagePortAgent.Receive(port, message, 10 * kMillisecond), Status::Ok,
                      "Receive with a message queued returns at once") && ok;
     ok = check(shell, valueOf(message) == 5, "the queued message") && ok;
-    messagePortAgent.Delete(port);
+    (void)messagePortAgent.Delete(port);
 
     // Deleting a port wakes its waiting receiver with Deleted (a super user
     // may delete another task's port).
@@ -504,14 +504,14 @@ void wakeReceiverEntry(uintptr_t)
         value = status == Status::Ok ? valueOf(message) : 0xDEAD;
         Trace::record('R');
     }
-    messagePortAgent.Delete(wakePort);
+    (void)messagePortAgent.Delete(wakePort);
     finished();
 }
 
 void wakeSenderEntry(uintptr_t)
 {
     Trace::record('t');
-    messagePortAgent.Send(wakePort, messageOf(0x7A5C), 5);
+    (void)messagePortAgent.Send(wakePort, messageOf(0x7A5C), 5);
     Trace::record('T'); // After the more urgent receiver has run.
     finished();
 }
@@ -519,7 +519,7 @@ void wakeSenderEntry(uintptr_t)
 void wakeIsr(void*)
 {
     Trace::record('i');
-    messagePortAgent.Send(wakePort, messageOf(0x15F), 5);
+    (void)messagePortAgent.Send(wakePort, messageOf(0x15F), 5);
     Trace::record('I');
 }
 
@@ -580,7 +580,7 @@ void useAnotherTasksPublisher()
     const Result<uint32_t> read = dsmAgent.Read(own.value(), dcos::kNoDsmData, page, dcos::kPoll);
     dsmOther.readOwn = read.status();
     dsmOther.dataId = read.ok() && wordOf(page, 0) == 55 ? read.value() : 0;
-    dsmAgent.Close(own.value());
+    (void)dsmAgent.Close(own.value());
     dsmOther.addObjects = dsmAgent.AddObjects(8);
     dsmOther.addSubscribers = dsmAgent.AddSubscribers(8);
 }
@@ -590,7 +590,7 @@ volatile Status newWriterGiveBack = Status::Ok;
 
 void newWriterEntry(uintptr_t)
 {
-    taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
     newWriterStatus = dsmAgent.Write(sharedPublisher, pageOf(77)).status();
     newWriterGiveBack = dsmAgent.XferOwnership(sharedPublisher, testTask());
     finished();
@@ -707,7 +707,7 @@ bool dsmPrimitives(shell::Shell& shell)
     ok = checkStatus(shell, dsmAgent.XferOwnership(publisher, newWriter), Status::Ok, "XferOwnership") && ok;
     ok = checkStatus(shell, dsmAgent.Write(publisher, pageOf(1)).status(), Status::NotOwner,
                      "the old owner no longer writes") && ok;
-    taskAgent.PostEvent(newWriter, 1);
+    (void)taskAgent.PostEvent(newWriter, 1);
     ok = waitForDone(shell, 1) && ok;
     ok = checkStatus(shell, newWriterStatus, Status::Ok, "the new owner writes") && ok;
     ok = checkStatus(shell, newWriterGiveBack, Status::Ok, "the new owner gives the publisher back") && ok;
@@ -751,11 +751,11 @@ bool dsmPrimitives(shell::Shell& shell)
     ok = fillTable(shell, "publishers", dcos::internal::kPublisherCapacity,
                    [] { return dsmAgent.Create(nullptr, Visibility::Local); },
                    [](size_t count) { return dsmAgent.AddObjects(count); },
-                   [](ObjectId id) { dsmAgent.Delete(id); }) && ok;
+                   [](ObjectId id) { (void)dsmAgent.Delete(id); }) && ok;
     ok = fillTable(shell, "subscriptions", dcos::internal::kSubscriptionCapacity,
                    [] { return dsmAgent.Open(sharedPublisher); },
                    [](size_t count) { return dsmAgent.AddSubscribers(count); },
-                   [](ObjectId id) { dsmAgent.Close(id); }) && ok;
+                   [](ObjectId id) { (void)dsmAgent.Close(id); }) && ok;
 
     // Deleting the publisher invalidates the subscription; Close still works.
     ok = checkStatus(shell, dsmAgent.Delete(publisher), Status::Ok, "Delete the publisher") && ok;
@@ -794,7 +794,7 @@ void waitingReaderEntry(uintptr_t index)
         const Status again = dsmAgent.Read(subscription.value(), 0, page, dcos::kPoll).status();
         Trace::record(again == Status::Deleted ? 'd' : '?');
     }
-    dsmAgent.Close(subscription.value());
+    (void)dsmAgent.Close(subscription.value());
     finished();
 }
 
@@ -901,13 +901,13 @@ void writerEntry(uintptr_t)
             writeFailures = writeFailures + 1;
         }
         if (i % 7 == 0) {
-            dcos::schedulerAgent.Yield();
+            (void)dcos::schedulerAgent.Yield();
         }
         if (i % 50 == 0) {
             asm volatile("int $0x25" ::: "memory");
         }
         if (i % 50 == 0) {
-            taskAgent.SleepFor(kMillisecond); // Lets the less urgent reader run.
+            (void)taskAgent.SleepFor(kMillisecond); // Lets the less urgent reader run.
         }
     }
     // Deleting the publisher ends the readers: their Read returns Deleted.
@@ -942,9 +942,9 @@ void readerEntry(uintptr_t index)
                     asm volatile("int $0x25" ::: "memory");
                 }
                 if (emptyPolls % 8 == 0) {
-                    taskAgent.SleepFor(kMillisecond);
+                    (void)taskAgent.SleepFor(kMillisecond);
                 } else {
-                    dcos::schedulerAgent.Yield();
+                    (void)dcos::schedulerAgent.Yield();
                 }
             }
             continue;
@@ -1030,13 +1030,13 @@ void doomedOwnerEntry(uintptr_t variant)
     doomedPublisher = dsmAgent.Create("doomed-pub", Visibility::Local).value();
     const ObjectId own = dsmAgent.Open(doomedPublisher).value();
     const ObjectId other = dsmAgent.Open(survivingPublisher).value();
-    dsmAgent.Write(doomedPublisher, pageOf(5));
+    (void)dsmAgent.Write(doomedPublisher, pageOf(5));
     doomedReady = !doomedPort.isNull() && !doomedPublisher.isNull() && !own.isNull() && !other.isNull();
     if (variant == 0) {
         DsmPage page{};
-        dsmAgent.Read(other, dcos::kNoDsmData, page, dcos::kWaitForever);
+        (void)dsmAgent.Read(other, dcos::kNoDsmData, page, dcos::kWaitForever);
     } else {
-        taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
+        (void)taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
     }
 }
 
@@ -1066,8 +1066,8 @@ bool recovery(shell::Shell& shell)
         if (variant == 0) {
             ok = checkStatus(shell, taskAgent.KillTask(owner), Status::Ok, "KillTask while it waits in Read") && ok;
         } else {
-            taskAgent.PostEvent(owner, 1); // It returns from its entry and ends.
-            taskAgent.SleepFor(2 * kMillisecond);
+            (void)taskAgent.PostEvent(owner, 1); // It returns from its entry and ends.
+            (void)taskAgent.SleepFor(2 * kMillisecond);
         }
         shell.print("%s: buffers free %u->%u, ports %u->%u, publishers %u->%u, subscriptions %u->%u\r\n",
                     variant == 0 ? "KillTask" : "end", static_cast<unsigned>(buffersBefore),

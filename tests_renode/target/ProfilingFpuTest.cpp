@@ -25,17 +25,17 @@ void profiledEntry(uintptr_t)
 {
     const ObjectId self = taskAgent.IdOfSelf();
     // Two samples, 5 and 10 ms of CPU time.
-    schedulerAgent.StartProfiling(self);
+    (void)schedulerAgent.StartProfiling(self);
     spin(5 * kMillisecond);
-    schedulerAgent.StopProfiling(self);
-    schedulerAgent.StartProfiling(self);
+    (void)schedulerAgent.StopProfiling(self);
+    (void)schedulerAgent.StartProfiling(self);
     spin(4 * kMillisecond);
     // A more urgent task takes 10 ms in the middle; that time is not ours.
     spawn("hog", 5, hogEntry);
     spin(6 * kMillisecond);
-    schedulerAgent.StopProfiling(self);
+    (void)schedulerAgent.StopProfiling(self);
     finished();
-    taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
 }
 
 bool profiling(shell::Shell& shell)
@@ -56,7 +56,7 @@ bool profiling(shell::Shell& shell)
     ok = check(shell, near(t.maximumNs, 10 * kMillisecond), "max is 10 ms, without the 10 ms preemption") && ok;
     ok = check(shell, t.averageNs == (t.minimumNs + t.maximumNs) / 2, "average of the two") && ok;
     ok = checkStatus(shell, schedulerAgent.StopProfiling(task), Status::InvalidArgument, "StopProfiling twice") && ok;
-    taskAgent.KillTask(task);
+    (void)taskAgent.KillTask(task);
     return ok;
 }
 
@@ -70,7 +70,7 @@ void fpuEntry(uintptr_t index)
     const uint32_t value = 1000u + 111u * static_cast<uint32_t>(index);
     asm volatile("fildl %0" : : "m"(value));
     for (int i = 0; i < 5; ++i) {
-        schedulerAgent.Yield();
+        (void)schedulerAgent.Yield();
     }
     uint32_t out = 0;
     asm volatile("fistpl %0" : "=m"(out));

@@ -32,7 +32,7 @@ ObjectId urgentTask;
 void innerIsr(void*)
 {
     Trace::record('i');
-    taskAgent.PostEvent(urgentTask, 1);
+    (void)taskAgent.PostEvent(urgentTask, 1);
     Trace::record('I');
 }
 
@@ -45,7 +45,7 @@ void outerIsr(void*)
 
 void urgentEntry(uintptr_t)
 {
-    taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1, dcos::EventWait::Any, dcos::kWaitForever);
     Trace::record('H');
     finished();
 }
@@ -63,8 +63,8 @@ bool preemptionFromInterrupt(shell::Shell& shell)
     asm volatile("int $0x2A" ::: "memory"); // IRQ 10's vector.
     Trace::record('S');
     ok = ok && waitForDone(shell, 1);
-    systemAgent.RemoveISR(outerLine);
-    systemAgent.RemoveISR(innerLine);
+    (void)systemAgent.RemoveISR(outerLine);
+    (void)systemAgent.RemoveISR(innerLine);
     // The urgent task runs after the outer handler ends ('O'), before the
     // interrupted test task continues ('S'), and not at the inner exit.
     return Trace::expect(shell, "soiIOHS") && ok;
@@ -79,7 +79,7 @@ void yieldingEntry(uintptr_t mark)
 {
     for (int i = 0; i < 3; ++i) {
         Trace::record(static_cast<char>(mark));
-        schedulerAgent.Yield();
+        (void)schedulerAgent.Yield();
     }
     finished();
 }
@@ -149,7 +149,7 @@ bool timeSlicing(shell::Shell& shell)
     }
     ok = ok && waitForDone(shell, 2);
     ok = Trace::expect(shell, "AB") && ok;
-    schedulerAgent.SetTimeSliceQuantum(10 * kMillisecond);
+    (void)schedulerAgent.SetTimeSliceQuantum(10 * kMillisecond);
     ok = checkStatus(shell, schedulerAgent.SetTimeSliceQuantum(1000), Status::InvalidArgument, "quantum below a tick") && ok;
     return ok;
 }
@@ -199,16 +199,16 @@ void deadlineEntry(uintptr_t argument)
     const DeadlineSpec& spec = *reinterpret_cast<const DeadlineSpec*>(argument);
     // "Set later": the scope starts when the start event readies the task,
     // so every task's arrival is the same instant.
-    schedulerAgent.SetDeadline(dcos::DeadlineStart::AtNextBlock, spec.executionNs, spec.deadlineNs);
-    taskAgent.ReceiveEvent(kStartEvent, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)schedulerAgent.SetDeadline(dcos::DeadlineStart::AtNextBlock, spec.executionNs, spec.deadlineNs);
+    (void)taskAgent.ReceiveEvent(kStartEvent, dcos::EventWait::Any, dcos::kWaitForever);
     Trace::record(spec.mark);
-    schedulerAgent.ClearDeadline();
+    (void)schedulerAgent.ClearDeadline();
     finished();
 }
 
 void waitThenMarkEntry(uintptr_t mark)
 {
-    taskAgent.ReceiveEvent(kStartEvent, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(kStartEvent, dcos::EventWait::Any, dcos::kWaitForever);
     Trace::record(static_cast<char>(mark));
     finished();
 }
@@ -251,10 +251,10 @@ bool deadlineOrdering(shell::Shell& shell)
         {
             arch_x86::InterruptGuard guard;
             for (const ObjectId& id : ids) {
-                taskAgent.PostEvent(id, kStartEvent);
+                (void)taskAgent.PostEvent(id, kStartEvent);
             }
         }
-        schedulerAgent.ClearDeadline();
+        (void)schedulerAgent.ClearDeadline();
     }
     ok = ok && waitForDone(shell, 5);
     return Trace::expect(shell, "b21aS") && ok;
@@ -278,12 +278,12 @@ dcos::ExceptionAction recordTimingException(dcos::ExceptionInfo& info)
 void lateEntry(uintptr_t withHandler)
 {
     if (withHandler != 0) {
-        taskAgent.SetExceptionHandler(recordTimingException);
+        (void)taskAgent.SetExceptionHandler(recordTimingException);
     }
     missedDeadlineAt = dcos::timerAgent.Uptime() + 5 * kMillisecond;
-    schedulerAgent.SetDeadline(dcos::DeadlineStart::Now, 1 * kMillisecond, 5 * kMillisecond);
+    (void)schedulerAgent.SetDeadline(dcos::DeadlineStart::Now, 1 * kMillisecond, 5 * kMillisecond);
     spin(20 * kMillisecond); // Overrun the deadline.
-    schedulerAgent.ClearDeadline();
+    (void)schedulerAgent.ClearDeadline();
     Trace::record('E');
     finished();
 }

@@ -46,7 +46,7 @@ void acquireAndReportEntry(uintptr_t timeout)
 {
     waiterResult = semaphoreAgent.Acquire(shared, timeout);
     finished();
-    taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
 }
 
 bool basics(shell::Shell& shell)
@@ -62,11 +62,11 @@ bool basics(shell::Shell& shell)
 
     // Another task cannot release what this one holds.
     shared = binary;
-    semaphoreAgent.Acquire(binary, dcos::kPoll);
+    (void)semaphoreAgent.Acquire(binary, dcos::kPoll);
     const ObjectId other = spawn("sem-poller", 10, acquireAndReportEntry, dcos::kPoll);
     ok = ok && waitForDone(shell, 1);
     ok = checkStatus(shell, waiterResult, Status::WouldBlock, "a poll of a held semaphore") && ok;
-    taskAgent.KillTask(other);
+    (void)taskAgent.KillTask(other);
 
     // Time-out.
     const uint64_t before = dcos::timerAgent.Uptime();
@@ -75,8 +75,8 @@ bool basics(shell::Shell& shell)
     const uint64_t waited = dcos::timerAgent.Uptime() - before;
     ok = checkStatus(shell, waiterResult, Status::Timeout, "a timed acquire of a held semaphore") && ok;
     ok = check(shell, waited >= 10 * kMillisecond && waited <= 13 * kMillisecond, "time-out of 10 ms") && ok;
-    taskAgent.KillTask(timed);
-    semaphoreAgent.Release(binary);
+    (void)taskAgent.KillTask(timed);
+    (void)semaphoreAgent.Release(binary);
 
     // Counting semaphore with a maximum.
     const ObjectId counting = createSemaphore(SemaphoreKind::Counting, 2, false, 3);
@@ -85,7 +85,7 @@ bool basics(shell::Shell& shell)
     ok = checkStatus(shell, semaphoreAgent.Acquire(counting, dcos::kPoll), Status::Ok, "take 2 of 2") && ok;
     ok = checkStatus(shell, semaphoreAgent.Acquire(counting, dcos::kPoll), Status::WouldBlock, "none left") && ok;
     for (int i = 0; i < 3; ++i) {
-        semaphoreAgent.Release(counting);
+        (void)semaphoreAgent.Release(counting);
     }
     ok = check(shell, semaphoreAgent.GetCount(counting).value() == 3, "count 3") && ok;
     ok = checkStatus(shell, semaphoreAgent.Release(counting), Status::InvalidArgument, "beyond the maximum") && ok;
@@ -116,9 +116,9 @@ DCOS_TARGET_TEST(semaphoreBasicsTest, "semaphores", "binary and counting semapho
 
 void holdForeverEntry(uintptr_t)
 {
-    semaphoreAgent.Acquire(shared, dcos::kPoll);
+    (void)semaphoreAgent.Acquire(shared, dcos::kPoll);
     finished();
-    taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(1u << 20, dcos::EventWait::Any, dcos::kWaitForever);
 }
 
 volatile Status waitResults[3];
@@ -152,12 +152,12 @@ bool deletionAndDeath(shell::Shell& shell)
                                                                          : "waiter of a dead holder") && ok;
         }
         if (round == 0) {
-            taskAgent.KillTask(holder);
+            (void)taskAgent.KillTask(holder);
         } else {
             ok = checkStatus(shell, semaphoreAgent.Acquire(shared, dcos::kPoll), Status::Ok,
                              "the abandoned semaphore is free again") && ok;
-            semaphoreAgent.Release(shared);
-            semaphoreAgent.Delete(shared);
+            (void)semaphoreAgent.Release(shared);
+            (void)semaphoreAgent.Delete(shared);
         }
     }
     return ok;
@@ -174,27 +174,27 @@ volatile uint8_t lowPriorities[4];
 
 void lowEntry(uintptr_t)
 {
-    semaphoreAgent.Acquire(semaphoreA, dcos::kPoll);
+    (void)semaphoreAgent.Acquire(semaphoreA, dcos::kPoll);
     Trace::record('l');
-    taskAgent.ReceiveEvent(kGoEvent, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(kGoEvent, dcos::EventWait::Any, dcos::kWaitForever);
     spin(5 * kMillisecond);
     Trace::record('r');
-    semaphoreAgent.Release(semaphoreA);
+    (void)semaphoreAgent.Release(semaphoreA);
     Trace::record('L');
     finished();
 }
 
 void highEntry(uintptr_t)
 {
-    semaphoreAgent.Acquire(semaphoreA, dcos::kWaitForever);
+    (void)semaphoreAgent.Acquire(semaphoreA, dcos::kWaitForever);
     Trace::record('H');
-    semaphoreAgent.Release(semaphoreA);
+    (void)semaphoreAgent.Release(semaphoreA);
     finished();
 }
 
 void mediumEntry(uintptr_t)
 {
-    taskAgent.ReceiveEvent(kGoEvent, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(kGoEvent, dcos::EventWait::Any, dcos::kWaitForever);
     spin(20 * kMillisecond);
     Trace::record('M');
     finished();
@@ -211,12 +211,12 @@ bool lowMediumHigh(shell::Shell& shell, bool inheritance, const char* expected)
     ok = check(shell, runningPriority(low) == (inheritance ? 5 : 20), "low runs at high's priority only with inheritance") && ok;
     {
         HoldScheduling hold;
-        taskAgent.PostEvent(medium, kGoEvent);
-        taskAgent.PostEvent(low, kGoEvent);
+        (void)taskAgent.PostEvent(medium, kGoEvent);
+        (void)taskAgent.PostEvent(low, kGoEvent);
     }
     ok = waitForDone(shell, 3) && ok;
     ok = Trace::expect(shell, expected) && ok;
-    semaphoreAgent.Delete(semaphoreA);
+    (void)semaphoreAgent.Delete(semaphoreA);
     return ok;
 }
 
@@ -224,14 +224,14 @@ bool lowMediumHigh(shell::Shell& shell, bool inheritance, const char* expected)
 // priority until it releases that semaphore, then the other's.
 void doubleHolderEntry(uintptr_t)
 {
-    semaphoreAgent.Acquire(semaphoreA, dcos::kPoll);
-    semaphoreAgent.Acquire(semaphoreB, dcos::kPoll);
+    (void)semaphoreAgent.Acquire(semaphoreA, dcos::kPoll);
+    (void)semaphoreAgent.Acquire(semaphoreB, dcos::kPoll);
     finished();
-    taskAgent.ReceiveEvent(kGoEvent, dcos::EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.ReceiveEvent(kGoEvent, dcos::EventWait::Any, dcos::kWaitForever);
     lowPriorities[0] = runningPriority(taskAgent.IdOfSelf());
-    semaphoreAgent.Release(semaphoreB);
+    (void)semaphoreAgent.Release(semaphoreB);
     lowPriorities[1] = runningPriority(taskAgent.IdOfSelf());
-    semaphoreAgent.Release(semaphoreA);
+    (void)semaphoreAgent.Release(semaphoreA);
     lowPriorities[2] = runningPriority(taskAgent.IdOfSelf());
     finished();
 }
@@ -239,8 +239,8 @@ void doubleHolderEntry(uintptr_t)
 void waitOnEntry(uintptr_t which)
 {
     const ObjectId semaphore = which == 0 ? semaphoreA : semaphoreB;
-    semaphoreAgent.Acquire(semaphore, dcos::kWaitForever);
-    semaphoreAgent.Release(semaphore);
+    (void)semaphoreAgent.Acquire(semaphore, dcos::kWaitForever);
+    (void)semaphoreAgent.Release(semaphore);
     finished();
 }
 
@@ -254,20 +254,20 @@ bool twoSemaphores(shell::Shell& shell)
     ok = check(shell, runningPriority(holder) == 8, "one waiter: the holder runs at 8") && ok;
     spawn("wait-b", 5, waitOnEntry, 1);  // Lends 5 through B.
     ok = check(shell, runningPriority(holder) == 5, "two waiters: the holder runs at 5") && ok;
-    taskAgent.PostEvent(holder, kGoEvent);
+    (void)taskAgent.PostEvent(holder, kGoEvent);
     ok = waitForDone(shell, 3) && ok;
     shell.print("holder priority: %u holding both, %u after releasing B, %u after releasing A\r\n", lowPriorities[0],
                 lowPriorities[1], lowPriorities[2]);
     ok = check(shell, lowPriorities[0] == 5 && lowPriorities[1] == 8 && lowPriorities[2] == 20,
                "the holder drops back one release at a time") && ok;
-    semaphoreAgent.Delete(semaphoreA);
-    semaphoreAgent.Delete(semaphoreB);
+    (void)semaphoreAgent.Delete(semaphoreA);
+    (void)semaphoreAgent.Delete(semaphoreB);
     return ok;
 }
 
 void timedWaitEntry(uintptr_t)
 {
-    semaphoreAgent.Acquire(semaphoreA, 5 * kMillisecond);
+    (void)semaphoreAgent.Acquire(semaphoreA, 5 * kMillisecond);
     finished();
 }
 
@@ -281,15 +281,15 @@ bool inheritance(shell::Shell& shell)
 
     // A waiter that times out stops lending its priority.
     semaphoreA = createSemaphore(SemaphoreKind::Binary, 1, true);
-    semaphoreAgent.Acquire(semaphoreA, dcos::kPoll);
+    (void)semaphoreAgent.Acquire(semaphoreA, dcos::kPoll);
     const ObjectId self = taskAgent.IdOfSelf();
     const uint8_t own = runningPriority(self);
     spawn("timed-waiter", 3, timedWaitEntry);
     ok = check(shell, runningPriority(self) == 3, "a waiter lends its priority") && ok;
     ok = waitForDone(shell, 1) && ok;
     ok = check(shell, runningPriority(self) == own, "after its time-out the holder drops back") && ok;
-    semaphoreAgent.Release(semaphoreA);
-    semaphoreAgent.Delete(semaphoreA);
+    (void)semaphoreAgent.Release(semaphoreA);
+    (void)semaphoreAgent.Delete(semaphoreA);
     return ok;
 }
 

@@ -58,8 +58,8 @@ bool events(shell::Shell& shell)
     ok = checkStatus(shell, taskAgent.ReceiveEvent(0x100, EventWait::Any, dcos::kPoll).status(), Status::WouldBlock,
                      "poll") && ok;
     const ObjectId self = taskAgent.IdOfSelf();
-    taskAgent.PostEvent(self, 0x200);
-    taskAgent.PostEvent(self, 0x200);
+    (void)taskAgent.PostEvent(self, 0x200);
+    (void)taskAgent.PostEvent(self, 0x200);
     ok = check(shell, taskAgent.ReceiveEvent(0x200, EventWait::Any, dcos::kPoll).value() == 0x200, "first receive") && ok;
     ok = checkStatus(shell, taskAgent.ReceiveEvent(0x200, EventWait::Any, dcos::kPoll).status(), Status::WouldBlock,
                      "a second post of the same event is not queued") && ok;
@@ -80,7 +80,7 @@ void signalHandler(unsigned signal)
     Trace::record(static_cast<char>('0' + signal));
     if (signal == 1) {
         // A more urgent signal sent during a handler waits for it to end.
-        taskAgent.SendSignal(signalTask, 0);
+        (void)taskAgent.SendSignal(signalTask, 0);
         Trace::record('|');
     }
     Trace::record('>');
@@ -88,11 +88,11 @@ void signalHandler(unsigned signal)
 
 void signalledEntry(uintptr_t)
 {
-    taskAgent.SetSignalHandler(signalHandler);
-    taskAgent.SetSignalMask(1u << 3);
-    taskAgent.ReceiveEvent(1, EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.SetSignalHandler(signalHandler);
+    (void)taskAgent.SetSignalMask(1u << 3);
+    (void)taskAgent.ReceiveEvent(1, EventWait::Any, dcos::kWaitForever);
     Trace::record('W'); // Woken; signals 1 and 5 were delivered first.
-    taskAgent.SetSignalMask(0); // Unmasking delivers the held signal 3.
+    (void)taskAgent.SetSignalMask(0); // Unmasking delivers the held signal 3.
     Trace::record('U');
     finished();
 }
@@ -108,7 +108,7 @@ bool signals(shell::Shell& shell)
     ok = ok && checkStatus(shell, taskAgent.SendSignal(signalTask, 1), Status::Ok, "signal 1");
     ok = ok && check(shell, taskAgent.GetState(signalTask).value() == TaskState::Blocked, "signals do not wake");
     ok = ok && checkStatus(shell, taskAgent.SendSignal(signalTask, 32), Status::InvalidArgument, "signal 32");
-    taskAgent.PostEvent(signalTask, 1);
+    (void)taskAgent.PostEvent(signalTask, 1);
     ok = ok && waitForDone(shell, 1);
     // Priority order 1 before 5, signal 0 not nested inside 1's handler,
     // 3 held until unmasked.
@@ -133,16 +133,16 @@ bool suspendResume(shell::Shell& shell)
     spinCounter = 0;
     const ObjectId counter = spawn("counter", 30, counterEntry); // Runs when the test task sleeps.
     bool ok = check(shell, !counter.isNull(), "create the counting task");
-    taskAgent.SleepFor(5 * kMillisecond);
+    (void)taskAgent.SleepFor(5 * kMillisecond);
     const uint32_t running = spinCounter;
     ok = ok && check(shell, running > 0, "the counter runs while the test task sleeps");
     ok = ok && checkStatus(shell, taskAgent.Suspend(counter), Status::Ok, "Suspend");
     ok = ok && check(shell, taskAgent.GetState(counter).value() == TaskState::Suspended, "state Suspended");
     const uint32_t atSuspend = spinCounter;
-    taskAgent.SleepFor(5 * kMillisecond);
+    (void)taskAgent.SleepFor(5 * kMillisecond);
     ok = ok && check(shell, spinCounter == atSuspend, "a suspended task does not run");
     ok = ok && checkStatus(shell, taskAgent.Resume(counter), Status::Ok, "Resume");
-    taskAgent.SleepFor(5 * kMillisecond);
+    (void)taskAgent.SleepFor(5 * kMillisecond);
     ok = ok && check(shell, spinCounter > atSuspend, "a resumed task runs again");
     ok = ok && checkStatus(shell, taskAgent.Resume(counter), Status::InvalidArgument, "Resume of a running task");
     shell.print("counter: %lu before suspend, %lu after resume\r\n", static_cast<unsigned long>(atSuspend),
@@ -176,7 +176,7 @@ dcos::ExceptionAction recoverFromDivideError(dcos::ExceptionInfo& info)
 void divideEntry(uintptr_t withHandler)
 {
     if (withHandler != 0) {
-        taskAgent.SetExceptionHandler(recoverFromDivideError);
+        (void)taskAgent.SetExceptionHandler(recoverFromDivideError);
     }
     Trace::record('D');
     asm volatile("xorl %%ecx, %%ecx\n\tdivl %%ecx" ::: "eax", "ecx", "edx", "memory", "cc");
@@ -193,8 +193,8 @@ dcos::ExceptionAction continueAfterThrow(dcos::ExceptionInfo& info)
 
 void throwTargetEntry(uintptr_t)
 {
-    taskAgent.SetExceptionHandler(continueAfterThrow);
-    taskAgent.ReceiveEvent(1, EventWait::Any, dcos::kWaitForever);
+    (void)taskAgent.SetExceptionHandler(continueAfterThrow);
+    (void)taskAgent.ReceiveEvent(1, EventWait::Any, dcos::kWaitForever);
     Trace::record('C'); // Continued after the handler.
     finished();
 }
@@ -223,7 +223,7 @@ bool exceptions(shell::Shell& shell)
     ok = check(shell, !target.isNull(), "create the throw target") && ok;
     ok = checkStatus(shell, taskAgent.ThrowException(target, dcos::ExceptionClass::Asynchronous, 7), Status::Ok,
                      "ThrowException") && ok;
-    taskAgent.PostEvent(target, 1);
+    (void)taskAgent.PostEvent(target, 1);
     ok = ok && waitForDone(shell, 1);
     ok = Trace::expect(shell, "A7C") && ok;
     return ok;

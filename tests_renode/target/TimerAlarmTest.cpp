@@ -90,11 +90,11 @@ bool alarms(shell::Shell& shell)
 
     // Notification by signal.
     alarmSignals = 0;
-    taskAgent.SetSignalHandler(countAlarmSignal);
+    (void)taskAgent.SetSignalHandler(countAlarmSignal);
     ok = checkStatus(shell, timerAgent.SetWatchDogAlarm(timer, 5 * kMillisecond, AlarmNotification::signal(7)),
                      Status::Ok, "alarm by signal") && ok;
-    taskAgent.SleepFor(10 * kMillisecond);
-    taskAgent.SetSignalHandler(nullptr);
+    (void)taskAgent.SleepFor(10 * kMillisecond);
+    (void)taskAgent.SetSignalHandler(nullptr);
     ok = check(shell, alarmSignals == 1, "the alarm's signal was delivered once") && ok;
 
     // Errors.

@@ -88,7 +88,7 @@ bool countIteration()
 void workerFinished()
 {
     workersDone = workersDone + 1;
-    taskAgent.PostEvent(runner, kDoneEvent);
+    (void)taskAgent.PostEvent(runner, kDoneEvent);
 }
 
 // Waits until count workers have finished; false on a time-out.
@@ -115,11 +115,11 @@ ObjectId spawn(uint8_t priority, dcos::TaskEntry entry, uintptr_t argument)
 // Runs with the runner at priority 0 so that workers created inside wait;
 // the clock starts as the runner drops back and lets them go.
 struct Held {
-    Held() : self(taskAgent.IdOfSelf()), own(taskAgent.GetPriority(self).value()) { taskAgent.ChangePriority(self, 0); }
+    Held() : self(taskAgent.IdOfSelf()), own(taskAgent.GetPriority(self).value()) { (void)taskAgent.ChangePriority(self, 0); }
     void release()
     {
         startedAt = readTimeStampCounter();
-        taskAgent.ChangePriority(self, own);
+        (void)taskAgent.ChangePriority(self, own);
     }
     ObjectId self;
     uint8_t own;
@@ -148,7 +148,7 @@ uint64_t basicProcessing()
 void cooperativeEntry(uintptr_t)
 {
     while (!countIteration()) {
-        schedulerAgent.Yield();
+        (void)schedulerAgent.Yield();
     }
     workerFinished();
 }
@@ -178,7 +178,7 @@ constexpr uint32_t kStartEvent = 1u << 28;
 void preemptiveEntry(uintptr_t index)
 {
     if (index == 4) {
-        taskAgent.ReceiveEvent(kStartEvent, dcos::EventWait::Any, dcos::kWaitForever);
+        (void)taskAgent.ReceiveEvent(kStartEvent, dcos::EventWait::Any, dcos::kWaitForever);
     }
     for (;;) {
         if (index == 4) {
@@ -186,12 +186,12 @@ void preemptiveEntry(uintptr_t index)
                 workerFinished();
                 return;
             }
-            taskAgent.Resume(chain[3]);
+            (void)taskAgent.Resume(chain[3]);
         } else {
             if (index > 0) {
-                taskAgent.Resume(chain[index - 1]);
+                (void)taskAgent.Resume(chain[index - 1]);
             }
-            taskAgent.Suspend(chain[index]);
+            (void)taskAgent.Suspend(chain[index]);
         }
     }
 }
@@ -209,13 +209,13 @@ uint64_t preemptiveScheduling()
         }
         // Dropping back lets workers 0-3 suspend themselves and worker 4
         // wait for the start; then the clock starts.
-        taskAgent.ChangePriority(held.self, held.own);
+        (void)taskAgent.ChangePriority(held.self, held.own);
     }
     startedAt = readTimeStampCounter();
-    taskAgent.PostEvent(chain[4], kStartEvent);
+    (void)taskAgent.PostEvent(chain[4], kStartEvent);
     const bool ok = waitForWorkers(1);
     for (int i = 0; i < 4; ++i) {
-        taskAgent.KillTask(chain[i]);
+        (void)taskAgent.KillTask(chain[i]);
     }
     return ok ? stoppedAt - startedAt : 0;
 }
@@ -224,7 +224,7 @@ uint64_t preemptiveScheduling()
 
 ObjectId interruptSemaphore;
 
-void releaseFromInterrupt(void*) { semaphoreAgent.Release(interruptSemaphore); }
+void releaseFromInterrupt(void*) { (void)semaphoreAgent.Release(interruptSemaphore); }
 
 uint64_t interruptProcessing()
 {
@@ -237,7 +237,7 @@ uint64_t interruptProcessing()
     }
     interruptSemaphore = semaphore.value();
     if (systemAgent.InstallISR(kSpareLine, releaseFromInterrupt, nullptr) != Status::Ok) {
-        semaphoreAgent.Delete(interruptSemaphore);
+        (void)semaphoreAgent.Delete(interruptSemaphore);
         return 0;
     }
     bool ok = true;
@@ -247,8 +247,8 @@ uint64_t interruptProcessing()
         ok = semaphoreAgent.Acquire(interruptSemaphore, dcos::kPoll) == Status::Ok;
     }
     const uint64_t elapsed = readTimeStampCounter() - start;
-    systemAgent.RemoveISR(kSpareLine);
-    semaphoreAgent.Delete(interruptSemaphore);
+    (void)systemAgent.RemoveISR(kSpareLine);
+    (void)semaphoreAgent.Delete(interruptSemaphore);
     return ok ? elapsed : 0;
 }
 
@@ -257,14 +257,14 @@ uint64_t interruptProcessing()
 ObjectId preemptingTask;
 volatile uint32_t preemptions = 0;
 
-void resumeFromInterrupt(void*) { taskAgent.Resume(preemptingTask); }
+void resumeFromInterrupt(void*) { (void)taskAgent.Resume(preemptingTask); }
 
 void preemptingEntry(uintptr_t)
 {
     // It runs before Create returns, so it must not rely on preemptingTask yet.
     const ObjectId self = taskAgent.IdOfSelf();
     for (;;) {
-        taskAgent.Suspend(self);
+        (void)taskAgent.Suspend(self);
         preemptions = preemptions + 1;
     }
 }
@@ -281,8 +281,8 @@ uint64_t interruptPreemptionProcessing()
         raiseSpareInterrupt(); // The handler readies the task; it runs before this loop goes on.
     }
     const uint64_t elapsed = readTimeStampCounter() - start;
-    systemAgent.RemoveISR(kSpareLine);
-    taskAgent.KillTask(preemptingTask);
+    (void)systemAgent.RemoveISR(kSpareLine);
+    (void)taskAgent.KillTask(preemptingTask);
     return preemptions == kIterations ? elapsed : 0;
 }
 
@@ -304,7 +304,7 @@ uint64_t messageProcessing()
              message.bytes[0] == static_cast<uint8_t>(i);
     }
     const uint64_t elapsed = readTimeStampCounter() - start;
-    messagePortAgent.Delete(port.value());
+    (void)messagePortAgent.Delete(port.value());
     return ok ? elapsed : 0;
 }
 
@@ -324,7 +324,7 @@ uint64_t synchronisationProcessing()
              semaphoreAgent.Release(semaphore.value()) == Status::Ok;
     }
     const uint64_t elapsed = readTimeStampCounter() - start;
-    semaphoreAgent.Delete(semaphore.value());
+    (void)semaphoreAgent.Delete(semaphore.value());
     return ok ? elapsed : 0;
 }
 
@@ -346,7 +346,7 @@ uint64_t memoryAllocation()
         ok = block.ok() && dcos::bufferPoolAgent.Return(pool.value(), block.value()) == Status::Ok;
     }
     const uint64_t elapsed = readTimeStampCounter() - start;
-    dcos::bufferPoolAgent.Delete(pool.value());
+    (void)dcos::bufferPoolAgent.Delete(pool.value());
     return ok ? elapsed : 0;
 }
 

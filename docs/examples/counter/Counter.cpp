@@ -82,7 +82,7 @@ void share(Statistics& shared, const Statistics& own)
 {
     if (dcos::semaphoreAgent.Acquire(statisticsLock, kPeriodNs) == Status::Ok) {
         shared = own;
-        dcos::semaphoreAgent.Release(statisticsLock);
+        (void)dcos::semaphoreAgent.Release(statisticsLock); // Cannot fail: this task holds it.
     }
 }
 
@@ -157,7 +157,8 @@ void subscriberEntry(uintptr_t)
                 // An error that persists (a deleted publisher) must not
                 // turn this loop into a busy one.
                 ++own.readErrors;
-                dcos::taskAgent.SleepFor(kPeriodNs);
+                // A sleep cut short by a signal only makes this wait shorter.
+                (void)dcos::taskAgent.SleepFor(kPeriodNs);
             }
             share(sharedSubscriber, own);
             continue;
@@ -204,7 +205,7 @@ bool readStatistics(PublisherStatistics& publisher, SubscriberStatistics& subscr
     }
     publisher = sharedPublisher;
     subscriber = sharedSubscriber;
-    dcos::semaphoreAgent.Release(statisticsLock);
+    (void)dcos::semaphoreAgent.Release(statisticsLock); // Cannot fail: this task holds it.
     return true;
 }
 

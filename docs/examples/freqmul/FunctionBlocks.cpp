@@ -86,7 +86,7 @@ void updateShared(Update update)
 {
     if (dcos::semaphoreAgent.Acquire(stateLock, kLockTimeoutNs) == Status::Ok) {
         update(shared);
-        dcos::semaphoreAgent.Release(stateLock);
+        (void)dcos::semaphoreAgent.Release(stateLock); // Cannot fail: this task holds it.
     }
 }
 
@@ -416,7 +416,7 @@ bool readSharedState(SharedState& copy)
         return false;
     }
     copy = shared;
-    dcos::semaphoreAgent.Release(stateLock);
+    (void)dcos::semaphoreAgent.Release(stateLock); // Cannot fail: this task holds it.
     return true;
 }
 
@@ -446,7 +446,7 @@ Status requestSettings(uint32_t frequencyHz, uint32_t shiftDegrees)
                 return Status::InvalidArgument;
             }
         }
-        dcos::taskAgent.SleepFor(1000000);
+        (void)dcos::taskAgent.SleepFor(1000000); // A shorter wait only polls sooner.
     }
     return Status::Timeout;
 }

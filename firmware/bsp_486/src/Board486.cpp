@@ -119,7 +119,9 @@ void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
         // tries the polled port in case the chip merely failed the probe.
         dcosPanic("console UART not found at port 0x%x", com1Port);
     }
-    attachInterrupt(consoleLine, consoleInterrupt, nullptr);
+    if (attachInterrupt(consoleLine, consoleInterrupt, nullptr) != dcos::Status::Ok) {
+        dcosPanic("cannot attach the console's interrupt line %u", consoleLine);
+    }
 
     // An application's tick rate is checked when it is compiled; an
     // impossible one still falls back to the default rather than stop the node.
@@ -146,7 +148,9 @@ void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
                             static_cast<unsigned long>(tickRateHz));
         }
     }
-    pit.start(rate);
+    if (pit.start(rate) != dcos::Status::Ok) {
+        dcosPanic("the 8254 refused a tick of %lu Hz", static_cast<unsigned long>(rate));
+    }
 }
 
 dcos::Status attachInterrupt(unsigned line, InterruptHandler handler, void* context)

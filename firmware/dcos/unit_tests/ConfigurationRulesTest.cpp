@@ -195,6 +195,25 @@ TEST(ConfigurationRulesTest, StacksThatExceedTheArenaNameTheTaskThatOverflows)
     expectBroken(configuration.check(), ConfigurationRule::StacksExceedArena, ObjectKind::Task, "overflow");
 }
 
+TEST(ConfigurationRulesTest, AHugeStackDoesNotWrapTheTotalAround)
+{
+    // SIZE_MAX and sizes just below it used to add up past SIZE_MAX to a
+    // total that seemed to fit; the node then refused them at boot.
+    for (const size_t huge : {SIZE_MAX, SIZE_MAX - 4095, SIZE_MAX / 2 + 1, dcos::internal::kStackArenaBytes}) {
+        Configuration configuration;
+        configuration.tasks.clear();
+        configuration.tasks.push_back({.name = "huge", .entry = entry, .stackSize = huge});
+        const ConfigurationError error = configuration.check();
+        expectBroken(error, ConfigurationRule::StacksExceedArena, ObjectKind::Task, "huge");
+        EXPECT_GT(error.value, dcos::internal::kStackArenaBytes) << huge;
+        // Two stacks that each fit alone but wrap when added.
+        configuration.tasks.clear();
+        configuration.tasks.push_back({.name = "small", .entry = entry, .stackSize = 4096});
+        configuration.tasks.push_back({.name = "huge", .entry = entry, .stackSize = huge});
+        expectBroken(configuration.check(), ConfigurationRule::StacksExceedArena, ObjectKind::Task, "huge");
+    }
+}
+
 TEST(ConfigurationRulesTest, NamesMustBePresentAndShort)
 {
     Configuration unnamed;

@@ -38,7 +38,7 @@ TEST(MessageBufferPoolTest, EveryActiveBufferIsHandedOutOnceUntilGivenBack)
 {
     MessageBuffer reserve[16];
     MessageBufferPool pool(reserve, 16);
-    pool.AddMsgBufs(12);
+    (void)pool.AddMsgBufs(12);
     std::set<MessageBuffer*> taken;
     while (MessageBuffer* buffer = pool.take()) {
         EXPECT_TRUE(buffer >= reserve && buffer < reserve + 12) << "only active buffers";
@@ -55,7 +55,7 @@ TEST(MessageBufferPoolTest, AChainGoesBackWhole)
 {
     MessageBuffer reserve[8];
     MessageBufferPool pool(reserve, 8);
-    pool.AddMsgBufs(8);
+    (void)pool.AddMsgBufs(8);
     MessageBuffer* a = pool.take();
     MessageBuffer* b = pool.take();
     MessageBuffer* c = pool.take();

@@ -18,7 +18,7 @@ namespace {
 
 // A pool with its own reserve, every buffer active.
 struct Fixture {
-    explicit Fixture(size_t count) : reserve(count), pool(reserve.data(), count) { pool.AddMsgBufs(count); }
+    explicit Fixture(size_t count) : reserve(count), pool(reserve.data(), count) { (void)pool.AddMsgBufs(count); }
 
     // Takes a buffer, tags it with value and queues it with priority.
     void send(MessageQueue& queue, uint8_t value, int priority)

@@ -316,13 +316,17 @@ constexpr ConfigurationError checkTotals(const Application& application)
     if (!error.ok()) {
         return error;
     }
+    // Compared before it is added, so that a huge stack size (SIZE_MAX, say)
+    // cannot wrap the total around to a small number that seems to fit.
     size_t stackBytes = kKernelStackBytes;
     for (const TaskDeclaration& task : application.tasks) {
-        stackBytes += stackArenaBytes(task.stackSize);
-        if (stackBytes > kStackArenaBytes) {
-            return broken(ConfigurationRule::StacksExceedArena, ObjectKind::Task, task.name, stackBytes,
+        const size_t block = stackArenaBytes(task.stackSize);
+        if (block > kStackArenaBytes - stackBytes) {
+            const size_t needed = block > SIZE_MAX - stackBytes ? SIZE_MAX : stackBytes + block;
+            return broken(ConfigurationRule::StacksExceedArena, ObjectKind::Task, task.name, needed,
                           kStackArenaBytes);
         }
+        stackBytes += block;
     }
     return {};
 }

@@ -12,7 +12,10 @@
 
 namespace dcos {
 
-enum class Status : uint8_t {
+/// [[nodiscard]]: a refused request that nobody looks at is a fault nobody
+/// handles, so the compiler reports every call whose Status is dropped; write
+/// (void) before a call whose failure truly does not matter, and say why.
+enum class [[nodiscard]] Status : uint8_t {
     Ok = 0,
     InvalidId = 1,        ///< The id does not name an object: bad type, index or node.
     StaleId = 2,          ///< The id named an object that has since been deleted.
@@ -69,7 +72,7 @@ constexpr const char* statusName(Status status)
 
 /// A value or the Status that explains why there is none.
 template <typename T>
-class Result {
+class [[nodiscard]] Result {
 public:
     constexpr Result(T value) : value_(value), status_(Status::Ok) {}
     constexpr Result(Status status) : value_(), status_(status) {}

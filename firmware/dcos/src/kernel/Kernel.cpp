@@ -40,7 +40,8 @@ uintptr_t firstFreeAddress = 0;
 constexpr uint32_t consoleInputEvent = 1u << 0;
 ObjectId shellTask;
 
-void onConsoleInput(void*) { taskAgent.PostEvent(shellTask, consoleInputEvent); }
+// Between two shells there is none to wake: the new one reads what came.
+void onConsoleInput(void*) { (void)taskAgent.PostEvent(shellTask, consoleInputEvent); }
 
 void onSystemTick(void*) { internal::TimerManager::onTick(); }
 
@@ -49,7 +50,12 @@ void onSystemTick(void*) { internal::TimerManager::onTick(); }
 void shellTaskEntry(uintptr_t lifeSemaphore)
 {
     shellTask = taskAgent.IdOfSelf();
-    semaphoreAgent.Acquire(ObjectId::fromRaw(static_cast<uint32_t>(lifeSemaphore)), kPoll);
+    // The root task released the semaphore before it started this shell, so
+    // the poll takes it; were it refused, the root task would only learn of
+    // this shell's end later, when it next polls.
+    if (semaphoreAgent.Acquire(ObjectId::fromRaw(static_cast<uint32_t>(lifeSemaphore)), kPoll) != Status::Ok) {
+        runtime::format(bsp::console(), "console: the shell could not take its life semaphore\r\n");
+    }
     bsp::setConsoleInputNotifier(onConsoleInput, nullptr);
     // A new shell, with an empty line, each time the task starts.
     shell::Shell shell(bsp::console(), "dcos> ");
@@ -59,7 +65,9 @@ void shellTaskEntry(uintptr_t lifeSemaphore)
         while (bsp::consoleRead(character)) {
             shell.feed(character);
         }
-        taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
+        // The only event is console input, read at the top of the loop
+        // whatever the wait answered.
+        (void)taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
     }
 }
 
@@ -97,7 +105,8 @@ void rootTaskEntry(uintptr_t)
         // The shell, more urgent, holds the semaphore by now; this waits for its end.
         const Status ended = semaphoreAgent.Acquire(lifeSemaphore.value(), kWaitForever);
         if (ended == Status::Ok) {
-            semaphoreAgent.Release(lifeSemaphore.value());
+            // Cannot fail: this task holds it, and the next shell takes it.
+            (void)semaphoreAgent.Release(lifeSemaphore.value());
         }
         if (started + 1 >= internal::kShellRestartLimit) {
             runtime::format(bsp::console(), "console: the shell ended %u times; not starting it again\r\n",
@@ -108,7 +117,7 @@ void rootTaskEntry(uintptr_t)
     }
     // Nothing is left to do: wait for an event nobody posts to this task.
     for (;;) {
-        taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
+        (void)taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
     }
 }
 

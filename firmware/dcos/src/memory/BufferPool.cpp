@@ -144,7 +144,7 @@ size_t BufferPool::reclaimHeldBy(uint16_t holder)
         uint16_t current;
         const State state = stateOf(index, current);
         if (state == State::Invalid) {
-            fail();
+            (void)fail(); // Disables the pool, which ends the walk; recovery has no one to tell.
         } else if (state == State::Allocated && current == holder) {
             pushFree(index);
             ++free_;

@@ -159,7 +159,7 @@ size_t SegmentedHeap::reclaimHeldBy(uint16_t holder)
         if ((word(offset) & kAllocatedFlag) == 0) {
             uint32_t size;
             if (!checkFree(offset, size)) {
-                fail();
+                (void)fail(); // Disables the heap; recovery has no one to tell.
                 break;
             }
             offset += size;
@@ -167,7 +167,7 @@ size_t SegmentedHeap::reclaimHeldBy(uint16_t holder)
         }
         Allocated header{};
         if (!checkAllocated(offset, header)) {
-            fail();
+            (void)fail(); // Disables the heap; recovery has no one to tell.
             break;
         }
         if (header.holder != holder) {

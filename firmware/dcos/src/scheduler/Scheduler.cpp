@@ -57,7 +57,9 @@ void Scheduler::makeReady(Task& task)
         return;
     }
     if (task.schedulesByDeadline()) {
-        deadlineQueue_.insert(task, urgencyKey(task));
+        // Cannot fail: the queue holds a slot for every task, and a ready
+        // task is not made ready twice.
+        (void)deadlineQueue_.insert(task, urgencyKey(task));
     } else {
         readyQueues_[task.priority].pushBack(task);
         readyBitmap_.set(task.priority);
@@ -73,7 +75,7 @@ void Scheduler::makeUnready(Task& task)
         return;
     }
     if (task.isQueued()) {
-        deadlineQueue_.remove(task);
+        (void)deadlineQueue_.remove(task); // Cannot fail: it is queued.
     }
     if (static_cast<IntrusiveListNode<ReadyQueueTag>&>(task).isLinked()) {
         readyQueues_[task.priority].remove(task);

@@ -167,7 +167,7 @@ arch_x86::InterruptFrame* restoreFrame(arch_x86::InterruptFrame* trapFrame, cons
 void releaseTask(Task& task)
 {
     StackArena::release(task.stackBase, task.stackSize);
-    table.Delete(task.id);
+    (void)table.Delete(task.id); // Cannot fail: an ended task's id is still its slot's.
     task.state = TaskState::NonExistent;
 }
 
@@ -309,8 +309,10 @@ void terminateCurrentFromInterrupt()
 
 void TaskManager::initialise(TaskEntry rootEntry)
 {
-    table.setNode(bsp::nodeId());
-    table.AddObjects(kTasksActiveAtBoot);
+    if (table.setNode(bsp::nodeId()) != Status::Ok || table.AddObjects(kTasksActiveAtBoot) != Status::Ok) {
+        dcosPanic("cannot set up the task table (node %u, %lu tasks)", static_cast<unsigned>(bsp::nodeId()),
+                  static_cast<unsigned long>(kTasksActiveAtBoot));
+    }
 
     TaskAttributes idle;
     idle.name = kIdleTaskName;
@@ -371,11 +373,12 @@ Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry
     const size_t stackSize = StackArena::usableSize(attributes.stackSize);
     const Result<uint8_t*> stack = StackArena::allocate(stackSize);
     if (!stack.ok()) {
-        table.Delete(id.value());
+        (void)table.Delete(id.value()); // Cannot fail: created just above, under the same lock.
         return stack.status();
     }
-    // A task owns itself, so that its creator's death does not end it.
-    table.XferOwnership(id.value(), creator, id.value());
+    // A task owns itself, so that its creator's death does not end it. Cannot
+    // fail: the creator owns the id it has just created.
+    (void)table.XferOwnership(id.value(), creator, id.value());
 
     Task& task = tasks[slotOf(id.value())];
     task.~Task();
@@ -633,7 +636,10 @@ void TaskManager::raiseException(Task& task, const ExceptionInfo& info)
     arch_x86::InterruptGuard guard;
     if (info.exceptionClass == ExceptionClass::Fatal) {
         reportTermination(task, info);
-        kill(task);
+        if (kill(task) != Status::Ok) {
+            // Only the idle task cannot be ended, and without it nothing can run.
+            dcosPanic("fatal exception in the idle task, which cannot be ended");
+        }
         return;
     }
     task.exceptionPending = true;

@@ -9,6 +9,7 @@
 #include <dcos/internal/TimerManager.hpp>
 
 #include <arch_x86/Cpu.hpp>
+#include <boot/Panic.hpp>
 #include <bsp/Board.hpp>
 
 namespace dcos::internal {
@@ -91,7 +92,8 @@ void expire(TimeoutEntry& entry)
             // at or after each due time: never early, and no drift although
             // the tick is not a whole number of nanoseconds of the period.
             timer.nextDueNs += timer.periodNs;
-            wheel.insert(timer.entry, firstTickAtOrAfter(timer.nextDueNs));
+            // Cannot fail: the wheel has just taken the entry out.
+            (void)wheel.insert(timer.entry, firstTickAtOrAfter(timer.nextDueNs));
         } else {
             timer.kind = AlarmKind::None;
         }
@@ -128,7 +130,8 @@ Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
 // primitive one to four instructions (make bench).
 [[gnu::always_inline]] inline void replaceAlarm(TimerObject& timer, AlarmKind kind, const AlarmNotification& n)
 {
-    wheel.cancel(timer.entry);
+    // NotFound only says no alarm was armed, which is what this makes sure of.
+    (void)wheel.cancel(timer.entry);
     timer.kind = kind;
     timer.notification = n;
 }
@@ -145,9 +148,10 @@ unsigned recoverTimers(ObjectId deadTask)
 {
     arch_x86::InterruptGuard guard;
     return static_cast<unsigned>(timerTable.forEachOwnedBy(deadTask, [](ObjectId id, TimerObject*& timer) {
-        wheel.cancel(timer->entry);
+        (void)wheel.cancel(timer->entry); // NotFound: no alarm was armed.
         timer->kind = AlarmKind::None;
-        timerTable.Delete(id);
+        // Cannot fail: the walk hands out only live ids of this table.
+        (void)timerTable.Delete(id);
     }));
 }
 
@@ -158,8 +162,10 @@ uint64_t TimerManager::tickPeriodNs_ = 1000000;
 void TimerManager::initialise(uint64_t tickPeriodNs)
 {
     tickPeriodNs_ = tickPeriodNs;
-    timerTable.setNode(bsp::nodeId());
-    timerTable.AddObjects(kTimersActiveAtBoot);
+    if (timerTable.setNode(bsp::nodeId()) != Status::Ok || timerTable.AddObjects(kTimersActiveAtBoot) != Status::Ok) {
+        dcosPanic("cannot set up the timer table (node %u, %lu timers)", static_cast<unsigned>(bsp::nodeId()),
+                  static_cast<unsigned long>(kTimersActiveAtBoot));
+    }
 }
 
 void TimerManager::onTick()
@@ -224,14 +230,16 @@ Result<uint64_t> TimerManager::uptimeAtTimeOfDay(uint64_t timeOfDayNs)
 void TimerManager::arm(TimeoutEntry& entry, uint64_t dueTick)
 {
     arch_x86::InterruptGuard guard;
-    wheel.cancel(entry);
-    wheel.insert(entry, dueTick);
+    // Re-arms: cancel's NotFound only says it was not armed, and the insert
+    // after it cannot find the entry armed.
+    (void)wheel.cancel(entry);
+    (void)wheel.insert(entry, dueTick);
 }
 
 void TimerManager::cancel(TimeoutEntry& entry)
 {
     arch_x86::InterruptGuard guard;
-    wheel.cancel(entry);
+    (void)wheel.cancel(entry); // NotFound: it has expired already, which is as good.
 }
 
 uint64_t TimerManager::timeOfDayNs()
@@ -262,14 +270,17 @@ Status TimerManager::setSystemClock(const DateTime& time)
     // acceptable.
     for (TimerObject& timer : timers) {
         if (timer.kind == AlarmKind::DayClock) {
-            wheel.cancel(timer.entry);
-            wheel.insert(timer.entry, dayClockTick(timer.dayClockNs));
+            // An alarm that went off already stays off; one still armed moves.
+            if (wheel.cancel(timer.entry) == Status::Ok) {
+                (void)wheel.insert(timer.entry, dayClockTick(timer.dayClockNs)); // Cannot fail: just cancelled.
+            }
         }
     }
     TaskManager::forEachTask([](Task& task) {
         if (task.sleepsTillTimeOfDay && static_cast<TimeWheelNode<>&>(task.wakeTimeout).isLinked()) {
-            wheel.cancel(task.wakeTimeout);
-            wheel.insert(task.wakeTimeout, dayClockTick(task.wakeTimeOfDayNs));
+            // Armed, as the condition checked, so both succeed.
+            (void)wheel.cancel(task.wakeTimeout);
+            (void)wheel.insert(task.wakeTimeout, dayClockTick(task.wakeTimeOfDayNs));
         }
     });
     return Status::Ok;
@@ -306,7 +317,7 @@ Status TimerManager::deleteTimer(ObjectId id, ObjectId caller)
     if (!timer.ok()) {
         return timer.status();
     }
-    wheel.cancel(timer.value()->entry);
+    (void)wheel.cancel(timer.value()->entry); // NotFound: no alarm was armed.
     timer.value()->kind = AlarmKind::None;
     return timerTable.Delete(id);
 }
@@ -323,7 +334,7 @@ Status TimerManager::setWatchDogAlarm(ObjectId id, ObjectId caller, uint64_t int
     }
     TimerObject& t = *timer.value();
     replaceAlarm(t, AlarmKind::WatchDog, n);
-    wheel.insert(t.entry, tickAfter(intervalNs));
+    (void)wheel.insert(t.entry, tickAfter(intervalNs)); // Cannot fail: replaceAlarm disarmed it.
     return Status::Ok;
 }
 
@@ -344,7 +355,7 @@ Status TimerManager::setDayClockAlarm(ObjectId id, ObjectId caller, const DateTi
     TimerObject& t = *timer.value();
     replaceAlarm(t, AlarmKind::DayClock, n);
     t.dayClockNs = target.value();
-    wheel.insert(t.entry, dayClockTick(t.dayClockNs));
+    (void)wheel.insert(t.entry, dayClockTick(t.dayClockNs)); // Cannot fail: replaceAlarm disarmed it.
     return Status::Ok;
 }
 
@@ -364,7 +375,7 @@ Status TimerManager::setPeriodicAlarm(ObjectId id, ObjectId caller, uint64_t per
     // The schedule starts from the current tick's time, the base of every
     // interval measured in ticks.
     t.nextDueNs = incrementNs + periodNs;
-    wheel.insert(t.entry, firstTickAtOrAfter(t.nextDueNs));
+    (void)wheel.insert(t.entry, firstTickAtOrAfter(t.nextDueNs)); // Cannot fail: replaceAlarm disarmed it.
     return Status::Ok;
 }
 
@@ -378,7 +389,7 @@ Status TimerManager::cancelAlarm(ObjectId id, ObjectId caller)
     if (timer.value()->kind == AlarmKind::None) {
         return Status::InvalidArgument; // No alarm is set.
     }
-    wheel.cancel(timer.value()->entry);
+    (void)wheel.cancel(timer.value()->entry); // Cannot fail: an alarm still set is armed.
     timer.value()->kind = AlarmKind::None;
     return Status::Ok;
 }

@@ -114,7 +114,7 @@ public:
     {
         T* first = peek();
         if (first != nullptr) {
-            remove(*first);
+            (void)remove(*first); // Cannot fail: the head is queued.
         }
         return first;
     }
