@@ -21,16 +21,18 @@ PYTHON     := /usr/bin/python3
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 
 .DEFAULT_GOAL := all
-.PHONY: all deps run test test-host test-emulator bench clean firmware host-tests emulator FORCE
+.PHONY: all deps run test test-host test-emulator test-fuzz fuzz bench clean firmware host-tests host-tools emulator FORCE
 .DELETE_ON_ERROR:
 
 include mk/firmware.mk
+include mk/host_tools.mk
 include mk/host.mk
 include mk/bench.mk
 include mk/qemu.mk
 include mk/sdk.mk
+include mk/fuzz.mk
 
-all: firmware host-tests
+all: firmware host-tests host-tools
 
 deps:
 	@mk/install-deps.sh
@@ -52,6 +54,7 @@ test: deps
 	@rm -f $(BUILD)/reports/*.xml
 	@status=0; \
 	$(MAKE) --no-print-directory test-host || status=1; \
+	$(MAKE) --no-print-directory test-fuzz || status=1; \
 	$(MAKE) --no-print-directory test-emulator || status=1; \
 	$(MAKE) --no-print-directory test-examples || status=1; \
 	$(PYTHON) mk/summarize_reports.py $(BUILD)/reports || status=1; \

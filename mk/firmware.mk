@@ -13,7 +13,9 @@ FW_INCLUDES := \
 	-Ifirmware/shell/include \
 	-Ifirmware/dcos/include \
 	-Ifirmware/bsp_486/include \
-	-Idrivers/iobus/include
+	-Idrivers/iobus/include \
+	-Ifieldbus/can/include \
+	-Idrivers/can/include
 
 FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
 # How every firmware object is compiled, the kernel's and an application's
@@ -32,6 +34,8 @@ FW_LDFLAGS := -m elf_i386 -nostdlib -static -T firmware/boot/link.ld
 
 include firmware/dcos/dcos.mk
 include drivers/iobus/iobus.mk
+include fieldbus/can/can.mk
+include drivers/can/can.mk
 
 # Sources every image contains.
 FW_SRCS := \
@@ -43,7 +47,10 @@ FW_SRCS := \
 	$(DCOS_TARGET_SRCS) \
 	$(wildcard firmware/bsp_486/src/*.cpp) \
 	$(IOBUS_PORTABLE_SRCS) \
-	$(IOBUS_TARGET_SRCS)
+	$(IOBUS_TARGET_SRCS) \
+	$(CAN_PORTABLE_SRCS) \
+	$(CAN_DRIVER_PORTABLE_SRCS) \
+	$(CAN_DRIVER_TARGET_SRCS)
 
 # The on-target test suite, linked only into the test image.
 FW_TARGET_TEST_SRCS := $(wildcard tests_renode/target/*.cpp)

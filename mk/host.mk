@@ -2,7 +2,8 @@
 # with GoogleTest. DCOS_HOST_BUILD swaps port I/O for a recording mock.
 
 HOST_BUILD := $(BUILD)/host
-HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Wno-missing-field-initializers -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES)
+HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Wno-missing-field-initializers -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES) \
+	-Ihost_tools/can/include
 
 # Firmware sources with no hardware access of their own (chip drivers go
 # through the mocked port I/O).
@@ -17,9 +18,13 @@ HOST_PORTABLE_SRCS := \
 	firmware/bsp_486/src/Pit8254.cpp \
 	firmware/bsp_486/src/Rtc146818.cpp \
 	firmware/bsp_486/src/Uart16550.cpp \
-	$(IOBUS_PORTABLE_SRCS)
+	$(IOBUS_PORTABLE_SRCS) \
+	$(CAN_PORTABLE_SRCS) \
+	$(CAN_DRIVER_PORTABLE_SRCS) \
+	$(HOSTCAN_SRCS)
 
-HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp drivers/*/unit_tests/*.cpp)
+HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp drivers/*/unit_tests/*.cpp fieldbus/*/unit_tests/*.cpp \
+	host_tools/*/unit_tests/*.cpp)
 HOST_OBJS := $(patsubst %,$(HOST_BUILD)/%.o,$(HOST_PORTABLE_SRCS) $(HOST_TEST_SRCS))
 HOST_TEST_BINARY := $(HOST_BUILD)/unit_tests
 
@@ -28,7 +33,7 @@ host-tests: $(HOST_TEST_BINARY)
 $(HOST_TEST_BINARY): $(HOST_OBJS)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
-	$(Q)g++ -o $@ $^ -lgtest -lgtest_main -pthread
+	$(Q)g++ -o $@ $^ -lgtest -lgtest_main -pthread $(HOST_TOOLS_LIBS)
 
 HOST_FLAGS_STAMP := $(HOST_BUILD)/flags.stamp
 $(HOST_FLAGS_STAMP): FORCE

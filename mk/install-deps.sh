@@ -11,6 +11,11 @@ g++-multilib:gives g++ the 32-bit C++ headers the firmware is compiled against (
 binutils:links the firmware and disassembles it for the i486 instruction check
 make:runs the build
 libgtest-dev:GoogleTest for the host unit tests
+libcli11-dev:parses the host tools' command lines (dcos-can)
+libfmt-dev:formats the host tools' output
+nlohmann-json3-dev:writes the host tools' --json output
+clang:compiles the CAN link layer's fuzz targets (make fuzz, run by make test)
+libclang-rt-14-dev:libFuzzer and the address and undefined-behaviour sanitizer runtimes those fuzz targets link (clang only recommends it)
 qemu-system-data:option ROMs the emulator loads (multiboot, linuxboot), from the -L path /usr/share/qemu
 seabios:the BIOS image the emulated PC boots through
 dpkg-dev:unpacks Debian's QEMU source (apt-get source qemu) that the emulator with our board models is built from
@@ -26,6 +31,7 @@ python3-pytest-xdist:runs emulator tests side by side
 python3-pexpect:drives the make-run console in its test
 python3-serial:lets the I/O board bring-up tool (host_tools/bringup) talk to a controller's serial console
 python3-matplotlib:draws the bring-up tool's transfer-curve pictures (PNG, Agg backend)
+python3-hypothesis:fuzzes the host tools' parsers with property-based tests (tests_renode/test_host_tools_fuzz.py)
 "
 
 missing=""

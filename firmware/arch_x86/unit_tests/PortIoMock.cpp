@@ -13,7 +13,24 @@ std::vector<Access> log;
 std::map<uint16_t, std::deque<uint16_t>> queued;
 std::map<uint16_t, uint16_t> defaults;
 
-uint16_t nextRead(uint16_t port)
+struct Attached {
+    uint16_t first;
+    uint16_t size;
+    Responder* responder;
+};
+std::vector<Attached> responders;
+
+const Attached* responderFor(uint16_t port)
+{
+    for (const Attached& a : responders) {
+        if (port >= a.first && port - a.first < a.size) {
+            return &a;
+        }
+    }
+    return nullptr;
+}
+
+uint16_t nextRead(uint16_t port, int width)
 {
     auto& queue = queued[port];
     if (!queue.empty()) {
@@ -21,16 +38,29 @@ uint16_t nextRead(uint16_t port)
         queue.pop_front();
         return value;
     }
+    if (const Attached* a = responderFor(port)) {
+        return a->responder->read(static_cast<uint16_t>(port - a->first), width);
+    }
     const auto found = defaults.find(port);
     return found != defaults.end() ? found->second : 0xFF;
 }
+
+void written(uint16_t port, uint16_t value, int width)
+{
+    if (const Attached* a = responderFor(port)) {
+        a->responder->write(static_cast<uint16_t>(port - a->first), value, width);
+    }
+}
 } // namespace
+
+void attach(uint16_t first, uint16_t size, Responder* responder) { responders.push_back({first, size, responder}); }
 
 void reset()
 {
     log.clear();
     queued.clear();
     defaults.clear();
+    responders.clear();
 }
 
 std::vector<Access> takeLog()
@@ -62,21 +92,29 @@ namespace arch_x86 {
 
 uint8_t portRead8(uint16_t port)
 {
-    const uint8_t value = static_cast<uint8_t>(port_io_mock::nextRead(port));
+    const uint8_t value = static_cast<uint8_t>(port_io_mock::nextRead(port, 8));
     port_io_mock::log.push_back({false, port, value, 8});
     return value;
 }
 
 uint16_t portRead16(uint16_t port)
 {
-    const uint16_t value = port_io_mock::nextRead(port);
+    const uint16_t value = port_io_mock::nextRead(port, 16);
     port_io_mock::log.push_back({false, port, value, 16});
     return value;
 }
 
-void portWrite8(uint16_t port, uint8_t value) { port_io_mock::log.push_back({true, port, value, 8}); }
+void portWrite8(uint16_t port, uint8_t value)
+{
+    port_io_mock::log.push_back({true, port, value, 8});
+    port_io_mock::written(port, value, 8);
+}
 
-void portWrite16(uint16_t port, uint16_t value) { port_io_mock::log.push_back({true, port, value, 16}); }
+void portWrite16(uint16_t port, uint16_t value)
+{
+    port_io_mock::log.push_back({true, port, value, 16});
+    port_io_mock::written(port, value, 16);
+}
 
 } // namespace arch_x86
 

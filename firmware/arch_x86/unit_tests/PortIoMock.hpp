@@ -22,7 +22,24 @@ struct Access {
     bool operator==(const Access&) const = default;
 };
 
-/// Clears the log, the queued reads and the defaults.
+/// A register model standing in for one chip: reads of its ports come from
+/// it and writes go to it (both are still logged), so a driver's longer
+/// conversations with a chip can be tested against the chip's behaviour
+/// instead of a script of values. Offsets are from the first port.
+class Responder {
+public:
+    virtual uint16_t read(uint16_t offset, int width) = 0;
+    virtual void write(uint16_t offset, uint16_t value, int width) = 0;
+
+protected:
+    ~Responder() = default;
+};
+
+/// Lets @p responder answer @p size ports from @p first until reset().
+/// A value queued for one of its ports still comes first.
+void attach(uint16_t first, uint16_t size, Responder* responder);
+
+/// Clears the log, the queued reads, the defaults and the responders.
 void reset();
 
 /// The accesses since the last reset() or takeLog().

@@ -1,0 +1,386 @@
+// The console command `can`: bring the ISA card's CAN channels up and down,
+// send and dump frames in can-utils' text form, and show each channel's
+// state and counters (docs/can/driver.md).
+//
+// The console owns one driver object per channel of the board's card,
+// can0 and can1 (sja1000/IsaSja1000Channel.hpp). `up` installs a channel
+// with the system agent and keeps one open on it, so the chip stays on the
+// bus between commands; `down` closes and uninstalls it again. The
+// commands that wait (send, dump) wait for the driver's events, never by
+// polling, and always with a time-out.
+#include <sja1000/IsaSja1000Channel.hpp>
+
+#include <can/FrameText.hpp>
+#include <dcos/SystemAgent.hpp>
+#include <dcos/TaskAgent.hpp>
+#include <dcos/TimerAgent.hpp>
+#include <shell/Shell.hpp>
+
+namespace sja1000 {
+
+namespace {
+
+using dcos::Status;
+using dcos::systemAgent;
+using dcos::taskAgent;
+using shell::CommandResult;
+
+constexpr unsigned kChannels = 2;
+IsaSja1000Channel consoleChannels[kChannels] = {
+    IsaSja1000Channel("can0", kIsaCardDefaultBase, kIsaCardDefaultIrq0),
+    IsaSja1000Channel("can1", kIsaCardDefaultBase + kIsaSecondChannelOffset, kIsaCardDefaultIrq1),
+};
+const char* const kNames[kChannels] = {"can0", "can1"};
+
+// The console task's events for the driver; bit 0 is the console's input.
+constexpr uint32_t kReceiveEvent = 1u << 20;
+constexpr uint32_t kStateEvent = 1u << 21;
+constexpr uint32_t kSentEvent = 1u << 22;
+
+constexpr uint64_t kMillisecond = 1'000'000;
+constexpr unsigned long kDefaultSendTimeoutMs = 1000;
+constexpr unsigned long kDefaultDumpTimeoutMs = 1000;
+constexpr unsigned long kLongestTimeoutMs = 600'000;
+
+const char* stateName(ErrorState state)
+{
+    switch (state) {
+    case ErrorState::Active: return "error-active";
+    case ErrorState::Warning: return "error-warning";
+    case ErrorState::Passive: return "error-passive";
+    case ErrorState::BusOff: return "bus-off";
+    }
+    return "?";
+}
+
+// Parses a channel argument, "0", "1", "can0" or "can1"; prints why not.
+bool parseChannel(shell::Shell& shell, const char* text, unsigned& channel)
+{
+    for (unsigned i = 0; i < kChannels; ++i) {
+        if ((text[0] == static_cast<char>('0' + i) && text[1] == '\0') ||
+            (text[0] == 'c' && text[1] == 'a' && text[2] == 'n' && text[3] == static_cast<char>('0' + i) &&
+             text[4] == '\0')) {
+            channel = i;
+            return true;
+        }
+    }
+    shell.print("error: unknown channel '%s': the channels are can0 and can1 (or 0 and 1)\r\n", text);
+    return false;
+}
+
+// The channel's driver, up; prints why not.
+bool requireUp(shell::Shell& shell, unsigned channel)
+{
+    if (consoleChannels[channel].installed()) {
+        return true;
+    }
+    shell.print("error: %s is down; bring it up with 'can up %s'\r\n", kNames[channel], kNames[channel]);
+    return false;
+}
+
+// Points the driver's events at the task running the command (the shell
+// may have been restarted since the channel came up).
+void listenHere(unsigned channel)
+{
+    Notification notification{taskAgent.IdOfSelf(), kReceiveEvent, kStateEvent, kSentEvent};
+    (void)systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kSetNotification, &notification,
+                              sizeof notification); // Cannot fail: the channel is up and the argument is right.
+}
+
+BusState stateOf(unsigned channel)
+{
+    BusState state{};
+    (void)systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kGetState, &state, sizeof state);
+    return state;
+}
+
+bool parseMilliseconds(shell::Shell& shell, const char* text, unsigned long& ms)
+{
+    if (!shell::Shell::parseUnsigned(text, ms) || ms > kLongestTimeoutMs) {
+        shell.print("error: time-out '%s' is not a number of milliseconds up to %lu\r\n", text, kLongestTimeoutMs);
+        return false;
+    }
+    return true;
+}
+
+CommandResult up(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    if (argc < 3 || argc > 4) {
+        shell.print("usage: can up <channel> [bit rate]\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel)) {
+        return CommandResult::Failed;
+    }
+    unsigned long rate = Sja1000Controller::kDefaultBitRate;
+    if (argc == 4 && (!shell::Shell::parseUnsigned(argv[3], rate) || !BitTimingCalculator::forBitRate(
+                                                                         static_cast<uint32_t>(rate)).ok())) {
+        shell.print("error: bit rate '%s' cannot be made exactly; the CiA rates are 10000, 20000, 50000, 125000, "
+                    "250000, 500000, 800000 and 1000000\r\n",
+                    argv[3]);
+        return CommandResult::Failed;
+    }
+    IsaSja1000Channel& driver = consoleChannels[channel];
+    if (!driver.installed()) {
+        iobus::IsaConflict conflict;
+        const dcos::Result<dcos::ObjectId> installed = driver.install(kNames[channel], dcos::Visibility::Regional,
+                                                                      &conflict);
+        if (!installed.ok()) {
+            if (installed.status() == Status::AlreadyExists) {
+                char text[96];
+                iobus::IsaResourceManager::describe(conflict, text, sizeof text);
+                shell.print("error: %s\r\n", text);
+            } else {
+                shell.print("error: cannot install %s: %s\r\n", kNames[channel], dcos::statusName(installed.status()));
+            }
+            return CommandResult::Failed;
+        }
+        // The device belongs to the system, so that no task's recovery
+        // (the shell's, should it fail) takes the channel away.
+        (void)systemAgent.XferOwnership(installed.value(), dcos::ObjectId{});
+        const Status opened = systemAgent.Open(installed.value());
+        if (opened != Status::Ok) {
+            shell.print("error: no SJA1000 answers at 0x%03x: %s\r\n", driver.base(), dcos::statusName(opened));
+            (void)driver.uninstall(); // Not open, so it goes.
+            return CommandResult::Failed;
+        }
+    }
+    uint32_t bitRate = static_cast<uint32_t>(rate);
+    const Status set = systemAgent.Control(driver.id(), Sja1000Controller::kSetBitRate, &bitRate, sizeof bitRate);
+    if (set != Status::Ok) {
+        shell.print("error: cannot set the bit rate: %s\r\n", dcos::statusName(set));
+        return CommandResult::Failed;
+    }
+    const BusState state = stateOf(channel);
+    shell.print("%s up at 0x%03x irq %u: %lu bit/s, sample point %u.%u %%, %s\r\n", kNames[channel], driver.base(),
+                driver.irq(), static_cast<unsigned long>(state.bitRate), state.samplePointPermille / 10,
+                state.samplePointPermille % 10, stateName(state.errorState));
+    return CommandResult::Ok;
+}
+
+CommandResult down(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    if (argc != 3) {
+        shell.print("usage: can down <channel>\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return CommandResult::Failed;
+    }
+    IsaSja1000Channel& driver = consoleChannels[channel];
+    while (systemAgent.Close(driver.id()) == Status::Ok) {
+    }
+    const Status removed = driver.uninstall();
+    if (removed != Status::Ok) {
+        shell.print("error: cannot take %s down: %s\r\n", kNames[channel], dcos::statusName(removed));
+        return CommandResult::Failed;
+    }
+    shell.print("%s down\r\n", kNames[channel]);
+    return CommandResult::Ok;
+}
+
+CommandResult send(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    unsigned long timeoutMs = kDefaultSendTimeoutMs;
+    if (argc < 4 || argc > 5) {
+        shell.print("usage: can send <channel> <id>#<data> [time-out ms]\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel) ||
+        (argc == 5 && !parseMilliseconds(shell, argv[4], timeoutMs))) {
+        return CommandResult::Failed;
+    }
+    const can::LinkResult<can::CanFrame> frame = can::FrameText::parse(argv[3]);
+    if (!frame.ok()) {
+        shell.print("error: '%s' is not a frame (%s): write <id>#<data>, 3 hex digits for a standard identifier, 8 "
+                    "for an extended one, e.g. 123#DEADBEEF or 1ABCDEF0#01.02\r\n",
+                    argv[3], can::linkErrorName(frame.error()));
+        return CommandResult::Failed;
+    }
+    listenHere(channel);
+    // Any earlier sent event is stale; this one is for this frame.
+    (void)taskAgent.ReceiveEvent(kSentEvent, dcos::EventWait::Any, dcos::kPoll);
+    const dcos::Result<size_t> written =
+        systemAgent.Write(consoleChannels[channel].id(), 0, &frame.value(), sizeof(can::CanFrame));
+    if (!written.ok() || written.value() != sizeof(can::CanFrame)) {
+        shell.print("error: %s did not take the frame: %s\r\n", kNames[channel],
+                    written.ok() ? "its transmit queue is full" : dcos::statusName(written.status()));
+        return CommandResult::Failed;
+    }
+    const dcos::Result<uint32_t> woken =
+        taskAgent.ReceiveEvent(kSentEvent, dcos::EventWait::Any, timeoutMs * kMillisecond);
+    if (!woken.ok()) {
+        const BusState state = stateOf(channel);
+        shell.print("error: not sent within %lu ms: %s, %u transmit errors%s; the frame stays queued\r\n", timeoutMs,
+                    stateName(state.errorState), state.transmitErrors,
+                    state.noAcknowledge ? ", no other node acknowledges" : "");
+        return CommandResult::Failed;
+    }
+    char text[can::FrameText::kMaxFormattedLength + 1];
+    (void)can::FrameText::format(frame.value(), text, sizeof text);
+    shell.print("%s  %s  sent\r\n", kNames[channel], text);
+    return CommandResult::Ok;
+}
+
+CommandResult dump(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    unsigned long count = 1;
+    unsigned long timeoutMs = kDefaultDumpTimeoutMs;
+    if (argc < 3 || argc > 5) {
+        shell.print("usage: can dump <channel> [count] [time-out ms]\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return CommandResult::Failed;
+    }
+    if (argc >= 4 && (!shell::Shell::parseUnsigned(argv[3], count) || count == 0 || count > 10000)) {
+        shell.print("error: count '%s' is not a number from 1 to 10000\r\n", argv[3]);
+        return CommandResult::Failed;
+    }
+    if (argc == 5 && !parseMilliseconds(shell, argv[4], timeoutMs)) {
+        return CommandResult::Failed;
+    }
+    listenHere(channel);
+    const uint64_t deadline = dcos::timerAgent.Uptime() + timeoutMs * kMillisecond;
+    unsigned long shown = 0;
+    while (shown < count) {
+        can::CanFrame frames[8];
+        const dcos::Result<size_t> read = systemAgent.Read(consoleChannels[channel].id(), 0, frames, sizeof frames);
+        if (!read.ok()) {
+            shell.print("error: cannot read %s: %s\r\n", kNames[channel], dcos::statusName(read.status()));
+            return CommandResult::Failed;
+        }
+        const size_t got = read.value() / sizeof(can::CanFrame);
+        for (size_t i = 0; i < got && shown < count; ++i, ++shown) {
+            char text[can::FrameText::kMaxFormattedLength + 1];
+            (void)can::FrameText::format(frames[i], text, sizeof text);
+            shell.print("%s  %s\r\n", kNames[channel], text);
+        }
+        if (got != 0) {
+            continue;
+        }
+        const uint64_t now = dcos::timerAgent.Uptime();
+        if (now >= deadline) {
+            break;
+        }
+        // Frames that arrive between the Read and this wait have posted the
+        // event already, so the wait returns at once for them.
+        (void)taskAgent.ReceiveEvent(kReceiveEvent, dcos::EventWait::Any, deadline - now);
+    }
+    if (shown < count) {
+        shell.print("%lu of %lu frames within %lu ms\r\n", shown, count, timeoutMs);
+        return CommandResult::Failed;
+    }
+    return CommandResult::Ok;
+}
+
+void printState(shell::Shell& shell, unsigned channel)
+{
+    if (!consoleChannels[channel].installed()) {
+        shell.print("%s  down\r\n", kNames[channel]);
+        return;
+    }
+    const BusState state = stateOf(channel);
+    shell.print("%s  %s  %lu bit/s  rx errors %u  tx errors %u  queued %u%s\r\n", kNames[channel],
+                stateName(state.errorState), static_cast<unsigned long>(state.bitRate), state.receiveErrors,
+                state.transmitErrors, state.queued, state.noAcknowledge ? "  no acknowledge: held" : "");
+}
+
+CommandResult state(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    if (argc == 2) {
+        for (unsigned i = 0; i < kChannels; ++i) {
+            printState(shell, i);
+        }
+        return CommandResult::Ok;
+    }
+    if (argc != 3 || !parseChannel(shell, argv[2], channel)) {
+        if (argc != 3) {
+            shell.print("usage: can state [channel]\r\n");
+        }
+        return CommandResult::Failed;
+    }
+    printState(shell, channel);
+    return CommandResult::Ok;
+}
+
+CommandResult statistics(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    if (argc != 3) {
+        shell.print("usage: can stats <channel>\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return CommandResult::Failed;
+    }
+    ChannelStatistics s{};
+    (void)systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kGetStatistics, &s, sizeof s);
+    shell.print("%s sent=%lu received=%lu rx_queue_overruns=%lu chip_overruns=%lu malformed=%lu bus_errors=%lu "
+                "ack_errors=%lu arbitration_lost=%lu warnings=%lu passives=%lu bus_offs=%lu restarts=%lu aborts=%lu "
+                "lone_node_holds=%lu interrupts=%lu interrupt_loop_limits=%lu\r\n",
+                kNames[channel], static_cast<unsigned long>(s.framesSent),
+                static_cast<unsigned long>(s.framesReceived), static_cast<unsigned long>(s.receiveQueueOverruns),
+                static_cast<unsigned long>(s.chipOverruns), static_cast<unsigned long>(s.malformedFrames),
+                static_cast<unsigned long>(s.busErrors), static_cast<unsigned long>(s.acknowledgeErrors),
+                static_cast<unsigned long>(s.arbitrationLost), static_cast<unsigned long>(s.errorWarnings),
+                static_cast<unsigned long>(s.errorPassives), static_cast<unsigned long>(s.busOffs),
+                static_cast<unsigned long>(s.restarts), static_cast<unsigned long>(s.aborts),
+                static_cast<unsigned long>(s.loneNodeHolds), static_cast<unsigned long>(s.interrupts),
+                static_cast<unsigned long>(s.interruptLoopLimits));
+    return CommandResult::Ok;
+}
+
+struct Subcommand {
+    const char* name;
+    CommandResult (*run)(shell::Shell& shell, int argc, char** argv);
+};
+
+constexpr Subcommand kSubcommands[] = {
+    {"up", up}, {"down", down}, {"send", send}, {"dump", dump}, {"state", state}, {"stats", statistics},
+};
+
+bool equal(const char* a, const char* b)
+{
+    while (*a != '\0' && *a == *b) {
+        ++a;
+        ++b;
+    }
+    return *a == *b;
+}
+
+CommandResult canCommand(shell::Shell& shell, int argc, char** argv)
+{
+    if (argc < 2) {
+        return CommandResult::UsageError;
+    }
+    for (const Subcommand& subcommand : kSubcommands) {
+        if (equal(argv[1], subcommand.name)) {
+            return subcommand.run(shell, argc, argv);
+        }
+    }
+    shell.print("error: unknown subcommand '%s': the subcommands are", argv[1]);
+    for (const Subcommand& subcommand : kSubcommands) {
+        shell.print(" %s", subcommand.name);
+    }
+    shell.print("\r\n");
+    return CommandResult::Failed;
+}
+
+} // namespace
+
+DCOS_SHELL_COMMAND_DETAILED(canShellCommand, "can", "bring CAN channels up and down, send, dump, show their state",
+                            "can up <channel> [bit rate] | down <channel> | send <channel> <id>#<data> [ms] | "
+                            "dump <channel> [count] [ms] | state [channel] | stats <channel>",
+                            "  channels: can0 (0x280, irq 10) and can1 (0x2a0, irq 11) of the ISA SJA1000 card\r\n"
+                            "  frames: <id>#<data> as can-utils' cansend writes them: 3 hex digits for a standard\r\n"
+                            "  identifier, 8 for an extended one; <id>#R[n] is a remote frame\r\n"
+                            "  dump prints frames as candump does; send waits for the frame to be acknowledged",
+                            canCommand);
+
+} // namespace sja1000

@@ -1,0 +1,67 @@
+// The message types of the DCOS identifier (docs/protocols/can.md, "Message types").
+//
+// The type field sits just below the priority in the identifier, so at equal
+// task priority the lower type wins arbitration. The values are reserved here
+// for the layers that come next; this layer gives them no behaviour beyond
+// carrying them, and refuses the values not listed (a node cannot act on a
+// type it does not know). The values travel on the bus and are never
+// renumbered; families are spaced 0x10 apart so that a related type added
+// later sits next to its family and keeps this tie-break order.
+#pragma once
+
+#include <stdint.h>
+
+namespace can {
+
+enum class MessageType : uint8_t {
+    /// Clock synchronisation towards the global time base (seed 5.5). Lowest
+    /// value: its content depends on the moment it is sent, so it should lose
+    /// as little time in arbitration as possible.
+    TimeSync = 0x01,
+    /// The reply of a remote transaction (seed 6.4, Fig. 6.3). Ahead of the
+    /// request: it completes work a task is already blocked on.
+    RemoteReply = 0x10,
+    /// A remote service request sent by a system agent for a task (seed 6.4).
+    RemoteRequest = 0x11,
+    /// A distributed shared memory publication (seed 7.10).
+    DsmPublication = 0x20,
+    /// A segmented transfer, ISO 15765-2 (IsoTpSender, IsoTpReceiver).
+    Segmented = 0x30,
+    /// Configuration by the system engineering interface agent (seed 7.14).
+    Configuration = 0x40,
+    /// Program download into a node: the SEI agent's file transfer (seed 7.14).
+    Flashing = 0x50,
+};
+
+/// Whether @p raw is one of the assigned message types.
+constexpr bool isAssignedMessageType(uint8_t raw)
+{
+    switch (static_cast<MessageType>(raw)) {
+    case MessageType::TimeSync:
+    case MessageType::RemoteReply:
+    case MessageType::RemoteRequest:
+    case MessageType::DsmPublication:
+    case MessageType::Segmented:
+    case MessageType::Configuration:
+    case MessageType::Flashing:
+        return true;
+    }
+    return false;
+}
+
+/// A short, stable English name for @p type, for logs and the console.
+constexpr const char* messageTypeName(MessageType type)
+{
+    switch (type) {
+    case MessageType::TimeSync: return "time sync";
+    case MessageType::RemoteReply: return "remote reply";
+    case MessageType::RemoteRequest: return "remote request";
+    case MessageType::DsmPublication: return "DSM publication";
+    case MessageType::Segmented: return "segmented";
+    case MessageType::Configuration: return "configuration";
+    case MessageType::Flashing: return "flashing";
+    }
+    return "unassigned";
+}
+
+} // namespace can

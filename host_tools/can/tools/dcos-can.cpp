@@ -1,0 +1,320 @@
+// dcos-can: see, send and measure CAN traffic from a Linux host, in the
+// conventions of can-utils (candump's columns, cansend's frames, -i to name
+// the interface), with the DCOS identifier decoded (docs/guide/host-can.md).
+//
+//     dcos-can -i can0 dump [-n N] [-t MS] [--decode] [--json]
+//     dcos-can -i slcan:/dev/ttyACM0@500000 send 1ABCDEF0#0102 [123#R ...]
+//     dcos-can -i can0 stats [-s SECONDS] [--bitrate B] [--json]
+//
+// Exit status: 0 done; 1 dump ended before -n frames, or send was refused;
+// 2 bad arguments; 3 the interface kind is not available here (no
+// SocketCAN in this kernel, no such device); 4 the interface failed
+// (open, I/O, the other end went away).
+#include <hostcan/Transport.hpp>
+
+#include <can/FrameText.hpp>
+#include <can/FrameTiming.hpp>
+#include <can/MessageIdentifier.hpp>
+
+#include <dcos/Version.hpp>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+using hostcan::Received;
+using hostcan::TransportError;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kExitOk = 0;
+constexpr int kExitIncomplete = 1;
+constexpr int kExitUsage = 2;
+constexpr int kExitNotAvailable = 3;
+constexpr int kExitFailed = 4;
+
+int exitCodeOf(const TransportError& error)
+{
+    switch (error.kind) {
+    case TransportError::Kind::None: return kExitOk;
+    case TransportError::Kind::BadArgument: return kExitUsage;
+    case TransportError::Kind::NotAvailable: return kExitNotAvailable;
+    case TransportError::Kind::Refused: return kExitIncomplete;
+    default: return kExitFailed;
+    }
+}
+
+int fail(const TransportError& error)
+{
+    fmt::print(stderr, "dcos-can: {}\n", error.message);
+    return exitCodeOf(error);
+}
+
+std::string hex(const can::CanFrame& frame)
+{
+    std::string text;
+    for (uint8_t i = 0; !frame.isRemote() && i < frame.length(); ++i) {
+        text += fmt::format("{:02X}", frame.byte(i));
+    }
+    return text;
+}
+
+// What the DCOS identifier layout says of a frame, or an empty string for a
+// frame that is not a DCOS frame (standard, remote, unassigned type).
+std::string decoded(const can::CanFrame& frame)
+{
+    const can::LinkResult<can::MessageIdentifier> id = can::MessageIdentifier::fromFrame(frame);
+    if (!id.ok()) {
+        return {};
+    }
+    const can::MessageIdentifier& m = id.value();
+    return fmt::format("prio {} {} {}->{}", m.priority(), can::messageTypeName(m.type()), m.source(),
+                       m.isBroadcast() ? std::string("all") : std::to_string(m.destination()));
+}
+
+nlohmann::json frameJson(const Received& r, const std::string& interface, bool decode)
+{
+    nlohmann::json j{{"interface", interface},
+                     {"timestamp_ns", r.timestamp.count()},
+                     {"emulated_time", r.emulatedTime}};
+    if (r.kind == Received::Kind::Event) {
+        j["event"] = hostcan::busEventName(r.event);
+        j["detail"] = r.detail;
+        return j;
+    }
+    j["id"] = r.frame.id();
+    j["extended"] = r.frame.isExtended();
+    j["remote"] = r.frame.isRemote();
+    j["dlc"] = r.frame.length();
+    j["data"] = hex(r.frame);
+    if (decode) {
+        const can::LinkResult<can::MessageIdentifier> id = can::MessageIdentifier::fromFrame(r.frame);
+        if (id.ok()) {
+            j["dcos"] = {{"priority", id.value().priority()},
+                         {"type", can::messageTypeName(id.value().type())},
+                         {"source", id.value().source()},
+                         {"destination", id.value().destination()}};
+        }
+    }
+    return j;
+}
+
+struct DumpOptions {
+    long count = 0;          // 0: until the time-out or for ever.
+    long timeoutMs = 0;      // 0: no time-out.
+    bool decode = false;
+    bool errors = true;
+};
+
+int dump(hostcan::Transport& transport, const DumpOptions& options, bool json)
+{
+    const auto deadline = Clock::now() + std::chrono::milliseconds(options.timeoutMs);
+    long shown = 0;
+    while (options.count == 0 || shown < options.count) {
+        auto wait = std::chrono::milliseconds(200);
+        if (options.timeoutMs > 0) {
+            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+            if (left.count() <= 0) {
+                break;
+            }
+            wait = std::min(wait, left);
+        }
+        TransportError error;
+        const Received r = transport.receive(wait, error);
+        if (error) {
+            return fail(error);
+        }
+        if (r.kind == Received::Kind::Timeout || (r.kind == Received::Kind::Event && !options.errors)) {
+            continue;
+        }
+        const double seconds = std::chrono::duration<double>(r.timestamp).count();
+        if (json) {
+            fmt::print("{}\n", frameJson(r, transport.name(), options.decode).dump());
+        } else if (r.kind == Received::Kind::Event) {
+            fmt::print(" ({:.6f})  {}  ERROR  {}  {}\n", seconds, transport.name(), hostcan::busEventName(r.event),
+                       r.detail);
+        } else {
+            char text[can::FrameText::kMaxFormattedLength + 1];
+            (void)can::FrameText::format(r.frame, text, sizeof text);
+            const std::string annotation = options.decode ? decoded(r.frame) : std::string();
+            fmt::print(" ({:.6f})  {}  {}{}{}\n", seconds, transport.name(), text, annotation.empty() ? "" : "  ; ",
+                       annotation);
+        }
+        std::fflush(stdout);
+        if (r.kind == Received::Kind::Frame) {
+            ++shown;
+        }
+    }
+    if (options.count > 0 && shown < options.count) {
+        fmt::print(stderr, "dcos-can: {} of {} frames within {} ms\n", shown, options.count, options.timeoutMs);
+        return kExitIncomplete;
+    }
+    return kExitOk;
+}
+
+// Parses every frame before anything is opened or sent: a typo in the
+// third frame must not leave the first two on the bus.
+bool parseFrames(const std::vector<std::string>& texts, std::vector<can::CanFrame>& parsed)
+{
+    for (const std::string& text : texts) {
+        const can::LinkResult<can::CanFrame> frame = can::FrameText::parse(text.c_str());
+        if (!frame.ok()) {
+            fmt::print(stderr,
+                       "dcos-can: '{}' is not a frame ({}): write <id>#<data> as cansend does, 3 hex digits for a "
+                       "standard identifier, 8 for an extended one, e.g. 123#DEADBEEF\n",
+                       text, can::linkErrorName(frame.error()));
+            return false;
+        }
+        parsed.push_back(frame.value());
+    }
+    return true;
+}
+
+int send(hostcan::Transport& transport, const std::vector<can::CanFrame>& parsed, long timeoutMs, bool json)
+{
+    nlohmann::json sent = nlohmann::json::array();
+    for (const can::CanFrame& frame : parsed) {
+        if (TransportError error = transport.send(frame, std::chrono::milliseconds(timeoutMs))) {
+            return fail(error);
+        }
+        sent.push_back({{"id", frame.id()}, {"extended", frame.isExtended()}, {"data", hex(frame)}});
+    }
+    if (json) {
+        fmt::print("{}\n", nlohmann::json{{"interface", transport.name()}, {"sent", sent}}.dump());
+    }
+    return kExitOk;
+}
+
+int stats(hostcan::Transport& transport, double seconds, uint32_t bitRate, bool json)
+{
+    const uint32_t rate = bitRate != 0 ? bitRate : transport.bitRate().value_or(0);
+    const auto start = Clock::now();
+    const auto end = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    uint64_t frames = 0;
+    uint64_t extended = 0;
+    uint64_t busyNs = 0;
+    std::map<std::string, uint64_t> events;
+    std::string lastState = "error-active";
+    while (Clock::now() < end) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now());
+        TransportError error;
+        const Received r = transport.receive(std::max(left, std::chrono::milliseconds(1)), error);
+        if (error) {
+            return fail(error);
+        }
+        if (r.kind == Received::Kind::Frame) {
+            ++frames;
+            extended += r.frame.isExtended() ? 1 : 0;
+            busyNs += can::frameNanoseconds(r.frame, rate);
+        } else if (r.kind == Received::Kind::Event) {
+            ++events[hostcan::busEventName(r.event)];
+            switch (r.event) {
+            case hostcan::BusEventKind::ErrorWarning:
+            case hostcan::BusEventKind::ErrorPassive:
+            case hostcan::BusEventKind::BusOff:
+            case hostcan::BusEventKind::ErrorActive:
+                lastState = hostcan::busEventName(r.event);
+                break;
+            case hostcan::BusEventKind::Restarted:
+                lastState = "error-active";
+                break;
+            default:
+                break;
+            }
+        }
+    }
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    const double load = rate != 0 && elapsed > 0 ? 100.0 * static_cast<double>(busyNs) / (elapsed * 1e9) : -1.0;
+    if (json) {
+        nlohmann::json j{{"interface", transport.name()}, {"seconds", elapsed},  {"frames", frames},
+                         {"extended_frames", extended},   {"frames_per_second", frames / elapsed},
+                         {"state", lastState},            {"events", events}};
+        j["bit_rate"] = rate != 0 ? nlohmann::json(rate) : nlohmann::json(nullptr);
+        j["bus_load_percent"] = load >= 0 ? nlohmann::json(load) : nlohmann::json(nullptr);
+        fmt::print("{}\n", j.dump());
+        return kExitOk;
+    }
+    fmt::print("{}: {} frames in {:.1f} s ({:.1f}/s, {} extended), state {}\n", transport.name(), frames, elapsed,
+               frames / elapsed, extended, lastState);
+    if (load >= 0) {
+        fmt::print("bus load {:.1f} % at {} bit/s (worst-case bit stuffing)\n", load, rate);
+    } else {
+        fmt::print("bus load unknown: give --bitrate\n");
+    }
+    for (const auto& [name, count] : events) {
+        fmt::print("{}: {}\n", name, count);
+    }
+    return kExitOk;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"dcos-can: dump, send and measure CAN traffic (candump/cansend conventions, DCOS frames decoded)",
+                 "dcos-can"};
+    app.set_version_flag("--version", std::string("dcos-can ") + dcos::versionString);
+    app.require_subcommand(1);
+    app.footer("exit status: 0 done, 1 incomplete (dump ended early, send refused), 2 bad arguments, "
+               "3 interface not available here, 4 interface failed\n"
+               "interfaces: can0 (SocketCAN), slcan:/dev/ttyACM0[@bitrate], slcan-socket:/path[@bitrate]");
+    std::string interface;
+    bool json = false;
+    app.add_option("-i,--interface", interface, "the CAN interface")->required();
+    app.add_flag("--json", json, "machine-readable output: one JSON object per line");
+
+    DumpOptions dumpOptions;
+    CLI::App* dumpCommand = app.add_subcommand("dump", "print frames as candump does");
+    dumpCommand->add_option("-n,--count", dumpOptions.count, "stop after this many frames")->check(CLI::PositiveNumber);
+    dumpCommand->add_option("-t,--timeout-ms", dumpOptions.timeoutMs, "stop after this long")
+        ->check(CLI::Range(1L, 86'400'000L));
+    dumpCommand->add_flag("--decode", dumpOptions.decode, "decode the DCOS identifier (priority, type, nodes)");
+    bool noErrors = false;
+    dumpCommand->add_flag("--no-errors", noErrors, "leave out the bus's error events");
+
+    std::vector<std::string> frames;
+    long sendTimeoutMs = 1000;
+    CLI::App* sendCommand = app.add_subcommand("send", "send frames written as cansend takes them");
+    sendCommand->add_option("frames", frames, "<id>#<data>, e.g. 123#DEADBEEF, 1ABCDEF0#01.02, 123#R")->required();
+    sendCommand->add_option("--timeout-ms", sendTimeoutMs, "how long a full interface queue is waited for")
+        ->check(CLI::Range(0L, 600'000L));
+
+    double seconds = 1.0;
+    uint32_t bitRate = 0;
+    CLI::App* statsCommand = app.add_subcommand("stats", "frame rate, bus load and error events over a time");
+    statsCommand->add_option("-s,--seconds", seconds, "how long to listen")->check(CLI::Range(0.01, 86400.0));
+    statsCommand->add_option("--bitrate", bitRate, "the bus's bit rate, for the load")
+        ->check(CLI::Range(1'000u, 1'000'000u));
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& error) {
+        const int code = app.exit(error);
+        return code == 0 ? kExitOk : kExitUsage;
+    }
+    dumpOptions.errors = !noErrors;
+
+    std::vector<can::CanFrame> parsed;
+    if (*sendCommand && !parseFrames(frames, parsed)) {
+        return kExitUsage;
+    }
+    TransportError error;
+    const std::unique_ptr<hostcan::Transport> transport = hostcan::openTransport(interface, error);
+    if (!transport) {
+        return fail(error);
+    }
+    if (*dumpCommand) {
+        return dump(*transport, dumpOptions, json);
+    }
+    if (*sendCommand) {
+        return send(*transport, parsed, sendTimeoutMs, json);
+    }
+    return stats(*transport, seconds, bitRate, json);
+}

@@ -1,0 +1,68 @@
+# Fuzzing the CAN link layer (fieldbus/can) with libFuzzer.
+#
+#   make fuzz        builds the fuzz targets, replays each seed corpus once,
+#                    then fuzzes each target for FUZZ_SECONDS; fails on any crash
+#   make test-fuzz   the same without installing packages first (run by 'make test');
+#                    both write $(FUZZ_REPORT) for the closing summary
+#
+# The targets are compiled by Debian's clang with libFuzzer and the address and
+# undefined-behaviour sanitizers (packages clang and libclang-rt-14-dev). Any
+# sanitizer report aborts the target, so it counts as a crash; the input that
+# caused it is kept in $(FUZZ_BUILD)/artifacts/<target>/.
+
+FUZZ_BUILD := $(BUILD)/fuzz
+# Fuzzing time per target; four targets, so 'make test' spends about 80 s here.
+FUZZ_SECONDS ?= 20
+FUZZ_TARGETS := frame isotp slcan frametext
+FUZZ_CORPUS := fieldbus/can/fuzz/corpus
+FUZZ_REPORT := $(BUILD)/reports/fuzz-tests.xml
+
+FUZZ_CXX := clang++
+FUZZ_SANITIZERS := address,undefined
+FUZZ_CXXFLAGS := -std=c++20 -O1 -g -fno-omit-frame-pointer -fno-sanitize-recover=all \
+	-Wall -Wextra -Wno-missing-field-initializers -Werror -MMD -MP \
+	-Ifieldbus/can/include -Ifirmware/dcos/include
+# Objects are instrumented for coverage without libFuzzer's main; the
+# targets are linked with it.
+FUZZ_COMPILE_FLAGS := $(FUZZ_CXXFLAGS) -fsanitize=fuzzer-no-link,$(FUZZ_SANITIZERS)
+FUZZ_LINK_FLAGS := -fsanitize=fuzzer,$(FUZZ_SANITIZERS)
+
+FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(CAN_PORTABLE_SRCS))
+FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o,$(FUZZ_TARGETS))
+FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(FUZZ_TARGETS))
+# Reached only through the pattern rule below, the objects would count as
+# intermediate files and be deleted after every build.
+.SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS)
+
+.PHONY: fuzz test-fuzz fuzz-targets
+
+fuzz: deps
+	@$(MAKE) --no-print-directory test-fuzz
+
+fuzz-targets: $(FUZZ_BINARIES)
+
+# A target that does not build is reported as a failed test case, so the
+# summary shows it instead of a missing suite.
+test-fuzz:
+	@mkdir -p $(dir $(FUZZ_REPORT))
+	@if $(MAKE) --no-print-directory fuzz-targets; then built=; else built=--build-failed; fi; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(FUZZ_REPORT) $(FUZZ_TARGETS)
+
+$(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^
+
+FUZZ_FLAGS_STAMP := $(FUZZ_BUILD)/flags.stamp
+$(FUZZ_FLAGS_STAMP): FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(FUZZ_COMPILE_FLAGS) $(FUZZ_LINK_FLAGS)' > $@.new
+	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+
+$(FUZZ_BUILD)/%.cpp.o: %.cpp $(FUZZ_FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_COMPILE_FLAGS) -c $< -o $@
+
+-include $(shell find $(FUZZ_BUILD) -name '*.d' 2>/dev/null)
