@@ -15,7 +15,11 @@
 #   share/dcos/boards/           the emulated boards
 #   share/dcos/python/           the emulator lab (dcoslab) and its launcher
 #   share/dcos/pytest.ini        pytest settings for applications' tests
-#   share/dcos/tools/            the i486 instruction check, the configuration error summary
+#   share/dcos/tools/            the i486 instruction check, the configuration error summary,
+#                                the plant simulator, bringup/ (the I/O board bring-up tool)
+#   bin/mfio_bringup.py          the I/O board bring-up tool (a relative link into share/dcos/tools)
+#   bin/plant_simulator.py       the plant simulator for the emulated I/O board (likewise)
+#   bin/dcos-can                 dump, send and measure CAN traffic (docs/guide/host-can.md)
 #   libexec/dcos/                the emulator built with the DCOS board models
 #
 # Nothing installed refers back to the source tree, and the paths inside are
@@ -23,25 +27,40 @@
 # when their content changes, so a repeated install is quick and keeps times.
 set -eu
 
-[ $# -eq 5 ] || { echo "usage: $0 <prefix> <library> <production image> <board flags file> <emulator>" >&2; exit 2; }
+[ $# -eq 6 ] || { echo "usage: $0 <prefix> <library> <production image> <board flags file> <emulator> <host tools bin>" >&2; exit 2; }
 prefix=$1
 library=$2
 image=$3
 board_flags=$4
 emulator=$5
+host_tools_bin=$6
 
 # Copies a file if it differs, creating directories on the way, with mode
 # $3 (default 644: readable by everyone, whatever the source's mode, e.g. a
-# private temporary file).
+# private temporary file). The mode is set again on an unchanged file, so an
+# earlier install with another mode is corrected.
 put() {
     mkdir -p "$(dirname "$2")"
     if ! cmp -s "$1" "$2"; then
         install -m "${3:-644}" "$1" "$2.new"
         mv "$2.new" "$2"
+    else
+        chmod "${3:-644}" "$2"
     fi
 }
 
-for include_dir in firmware/*/include drivers/*/include; do
+# Makes $2 a symbolic link to $1 (relative to $2's directory, so the prefix
+# can move), replacing whatever is there in one rename.
+link() {
+    mkdir -p "$(dirname "$2")"
+    if [ ! -L "$2" ] || [ "$(readlink "$2")" != "$1" ]; then
+        rm -f "$2.new"
+        ln -s "$1" "$2.new"
+        mv -fT "$2.new" "$2"
+    fi
+}
+
+for include_dir in firmware/*/include drivers/*/include fieldbus/*/include; do
     (cd "$include_dir" && find . -name '*.hpp' -type f) | while read -r header; do
         put "$include_dir/$header" "$prefix/include/$header"
     done
@@ -56,6 +75,19 @@ put "$board_flags" "$prefix/share/dcos/board-486.mk"
 put host_tools/isa_check/check_i486.py "$prefix/share/dcos/tools/check_i486.py"
 put host_tools/app_build/explain_configuration_error.py "$prefix/share/dcos/tools/explain_configuration_error.py"
 put tests_renode/pytest.ini "$prefix/share/dcos/pytest.ini"
+
+# The engineers' host tools, started through bin/. The bring-up tool finds
+# bringup_report.py beside its real path and the emulator lab (for
+# --emulator) in share/dcos/python; the plant simulator needs nothing else.
+put host_tools/bringup/mfio_bringup.py "$prefix/share/dcos/tools/bringup/mfio_bringup.py" 755
+put host_tools/bringup/bringup_report.py "$prefix/share/dcos/tools/bringup/bringup_report.py"
+put host_tools/plant_simulator/plant_simulator.py "$prefix/share/dcos/tools/plant_simulator.py" 755
+link ../share/dcos/tools/bringup/mfio_bringup.py "$prefix/bin/mfio_bringup.py"
+link ../share/dcos/tools/plant_simulator.py "$prefix/bin/plant_simulator.py"
+# The compiled host tools (docs/guide/host-can.md).
+for tool in "$host_tools_bin"/*; do
+    put "$tool" "$prefix/bin/$(basename "$tool")" 755
+done
 put tests_renode/launch.py "$prefix/share/dcos/python/launch.py"
 for module in tests_renode/dcoslab/*.py; do
     put "$module" "$prefix/share/dcos/python/dcoslab/$(basename "$module")"

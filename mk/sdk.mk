@@ -42,9 +42,11 @@ $(QEMU_BINARY):
 SDK_INPUTS := $(LIBRARY_486) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) mk/install-sdk.sh mk/application.mk \
 	firmware/boot/link.ld host_tools/isa_check/check_i486.py host_tools/app_build/explain_configuration_error.py tests_renode/launch.py tests_renode/pytest.ini \
 	$(wildcard tests_renode/dcoslab/*.py tests_renode/boards/*.json) \
-	$(shell find firmware/*/include drivers/*/include -name '*.hpp')
+	host_tools/bringup/mfio_bringup.py host_tools/bringup/bringup_report.py host_tools/plant_simulator/plant_simulator.py \
+	$(HOST_TOOLS) \
+	$(shell find firmware/*/include drivers/*/include fieldbus/*/include -name '*.hpp')
 
-install_sdk = mk/install-sdk.sh '$(1)' $(LIBRARY_486) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY)
+install_sdk = mk/install-sdk.sh '$(1)' $(LIBRARY_486) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) $(HOST_TOOLS_BIN)
 
 $(SDK_STAMP): $(SDK_INPUTS)
 	@echo "  STAGE   $(SDK_STAGE)"

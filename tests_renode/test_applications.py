@@ -8,6 +8,7 @@ makes at once. The on-target loader tests live in
 tests_renode/target/ApplicationLoaderTest.cpp.
 """
 
+import json
 import os
 import re
 import shutil
@@ -303,7 +304,9 @@ def test_out_of_tree_application_against_the_tree_and_an_installed_dcos(tmp_path
     run_make(["install", f"PREFIX={prefix}"])
     for installed in ["include/dcos/Application.hpp", "lib/dcos/486/libdcos486.a", "lib/dcos/486/link.ld",
                       "share/dcos/application.mk", "share/dcos/boards/isa486.json",
-                      "share/dcos/python/dcoslab/pytest_plugin.py", "libexec/dcos/qemu-system-i386"]:
+                      "share/dcos/python/dcoslab/pytest_plugin.py", "libexec/dcos/qemu-system-i386",
+                      "bin/mfio_bringup.py", "bin/plant_simulator.py", "share/dcos/tools/bringup/bringup_report.py",
+                      "bin/dcos-can", "include/can/CanFrame.hpp", "include/sja1000/Sja1000Controller.hpp"]:
         assert (prefix / installed).exists(), installed
     assert text_files_mentioning(str(prefix), REPOSITORY) == [], "the installation refers to the source tree"
     unreadable = [os.path.join(directory, name) for directory, _, names in os.walk(prefix) for name in names
@@ -325,6 +328,34 @@ def test_out_of_tree_application_against_the_tree_and_an_installed_dcos(tmp_path
     run_make([f"DCOS={moved}", "clean"], cwd=str(counter))
     output = run_make([f"DCOS={moved}", "test"], cwd=str(counter))
     assert passed_count(output) >= 1
+
+    # The engineers' host tools run from the moved installation, through its bin/.
+    bringup, plant = moved / "bin" / "mfio_bringup.py", moved / "bin" / "plant_simulator.py"
+    for tool in (bringup, plant):
+        assert os.access(tool, os.X_OK), f"{tool} is not executable"
+        result = subprocess.run([str(tool), "--help"], capture_output=True, text=True, timeout=60)
+        assert result.returncode == 0 and "exit status" in result.stdout.lower(), result.stdout + result.stderr
+    dcos_can = moved / "bin" / "dcos-can"
+    result = subprocess.run([str(dcos_can), "--version"], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0 and result.stdout.startswith("dcos-can "), result.stdout + result.stderr
+    result = subprocess.run([str(dcos_can), "-i", "slcan:/nonexistent", "dump"], capture_output=True, text=True,
+                            timeout=60)
+    assert result.returncode == 3 and "cannot open /nonexistent" in result.stderr, result.stdout + result.stderr
+    result = subprocess.run([str(plant), "--tau", "0", "--gain", "2"], input="SAMPLE 0 1.5 0 0 0 0 0 0 0 0001\n",
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0 and result.stdout.startswith("INPUT 3.000000 "), result.stdout + result.stderr
+    # The bring-up tool boots the installed emulator with the installed board and image, and passes it.
+    work = tmp_path / "bringup"
+    work.mkdir()
+    result = subprocess.run([str(bringup), "--emulator", "--timeout", "240", "--connect-timeout", "60",
+                             "--json", "result.json", "--png", "sheet.png"], cwd=str(work), capture_output=True,
+                            text=True, timeout=BUILD_TIMEOUT)
+    assert result.returncode == 0, result.stdout + result.stderr
+    with open(work / "result.json", encoding="utf-8") as handle:
+        document = json.load(handle)
+    assert document["verdict"] == "pass" and document["firmware"]["version"] == "0.1.0"
+    assert document["connection"]["emulator"][0] == str(moved / "libexec" / "dcos" / "qemu-system-i386")
+    assert (work / "sheet.png").exists()
 
 
 # --- The guide's own application ----------------------------------------------

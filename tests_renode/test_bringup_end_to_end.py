@@ -13,6 +13,7 @@ Contracts: docs/iobus/bringup-protocol.md (the report),
 docs/iobus/mfio-register-map.md (the model's fault properties).
 """
 
+import datetime
 import json
 import os
 import re
@@ -25,6 +26,7 @@ import pytest
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TOOL = os.path.join(REPOSITORY, "host_tools", "bringup", "mfio_bringup.py")
+IMAGE = os.path.join(REPOSITORY, "build", "486", "dcos486.elf")
 
 # Bounds a hung run; a healthy one takes a few seconds.
 RUN_TIMEOUT = 300
@@ -95,6 +97,39 @@ def test_healthy_board_all_pass(bringup):
     assert document["irq"]["requested"] > 0 and document["irq"]["delivered"] == document["irq"]["requested"]
     width, height = png_dimensions(run.png)
     assert width > 400 and height > 400 and os.path.getsize(run.png) > 10_000
+    # The result says when, which firmware and which board: the revision is the one built into the image.
+    measured = datetime.datetime.strptime(document["timestamp"], "%Y-%m-%dT%H:%M:%SZ")
+    assert abs((datetime.datetime.utcnow() - measured).total_seconds()) < RUN_TIMEOUT + 60
+    firmware = document["firmware"]
+    assert firmware["version"] == "0.1.0" and re.fullmatch(r"[0-9A-Za-z._+-]+", firmware["revision"]), firmware
+    with open(IMAGE, "rb") as handle:
+        assert firmware["revision"].encode() in handle.read(), firmware
+    assert document["board"]["revision"] is not None
+    # Every sweep pooled its 8 conversions a point: 9 points (63 degrees of freedom), 5 at gain 1000.
+    assert {(entry["gain"], entry["samples"], entry["noise_dof"]) for entry in document["adc"]} == \
+        {(1, 8, 63), (10, 8, 63), (100, 8, 63), (1000, 8, 35)}
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_board_with_noise_below_the_limit_passes(bringup, seed):
+    # 0.6 LSB of Gaussian noise against the 1.0 LSB limit: judged by the largest single step's deviation, the
+    # board failed several of its 32 sweeps by chance; pooled over each sweep it passes.
+    run = bringup("--model-property", "noise-lsb=0.6", "--model-property", f"noise-seed={seed}")
+    assert run.code == EXIT_PASS, run.explain()
+    pooled = [entry["noise_pooled_lsb"] for entry in run.document["adc"]]
+    assert all(0.4 <= value <= 0.9 for value in pooled), pooled
+    # The largest single-step deviations scatter far wider: above the limit on some sweeps (7 of 32 with seed
+    # 1), each of which the judgement on noise_lsb alone failed.
+    assert any(entry["noise_lsb"] > 1.0 for entry in run.document["adc"]), run.explain()
+
+
+def test_a_board_with_noise_above_the_limit_fails_on_its_noise(bringup):
+    run = bringup("--model-property", "noise-lsb=1.5")
+    assert run.code == EXIT_FAILURES, run.explain()
+    noisy = {(failure["channel"], failure["gain"]) for failure in run.failures
+             if failure.get("metric") == "noise_pooled_lsb"}
+    assert len(noisy) >= 24, run.explain()
+    assert all(failure["kind"] == "adc" for failure in run.failures), run.explain()
 
 
 @pytest.mark.parametrize("bit, level, pattern", [(4, 0, "walking ones"), (11, 1, "walking zeros")])

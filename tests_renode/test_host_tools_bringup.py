@@ -6,8 +6,10 @@ socket (and behind --exec) stands in for the controller where the console
 plumbing is tested.
 """
 
+import datetime
 import json
 import os
+import signal
 import socket
 import struct
 import subprocess
@@ -31,14 +33,21 @@ GAINS = (1, 10, 100, 1000)
 
 
 def transcript(stuck_bit=None, stuck_level=0, dead_channel=None, delivered=64, absent=False, end=True,
-               max_error=None, noise=0.0, latency_max=5000):
-    """A console transcript as the controller prints it, with the chosen faults."""
+               max_error=None, noise=0.0, latency_max=5000, pooled=True, dof=63, samples=8):
+    """A console transcript as the controller prints it, with the chosen faults.
+
+    noise is both the largest per-point deviation and the pooled one; with
+    pooled=False the ADC lines are those of firmware before the pooled noise.
+    """
     out = ["DCOS 0.1.0 - Distributed Controller Operating System", "dcos> iobus bringup",
            "BRINGUP BEGIN base=0x300 irq=5"]
     if absent:
         return "\r\n".join(out + ["BRINGUP PROBE absent", "BRINGUP END failures=1", "dcos> "])
     failures = 0
     out.append("BRINGUP PROBE ok id=4d46 revision=0100")
+    out.append("BRINGUP FIRMWARE version=0.1.0 revision=c7f45ba-dirty")
+    noise_fields = f"noise_lsb={noise:.2f}" + (f" noise_pooled_lsb={noise:.2f} noise_dof={dof} samples={samples}"
+                                               if pooled else "")
     for pattern in ("walking-ones", "walking-zeros"):
         # As the controller walks: the first pattern in which the stuck bit differs is reported.
         failed = None
@@ -63,15 +72,17 @@ def transcript(stuck_bit=None, stuck_level=0, dead_channel=None, delivered=64, a
             if channel == dead_channel:
                 failures += 1
                 points = ",".join(f"{code}:2048.0" for code in codes)
+                dead_noise = "noise_lsb=0.00" + (f" noise_pooled_lsb=0.00 noise_dof={dof} samples={samples}"
+                                                 if pooled else "")
                 out.append(f"BRINGUP ADC channel={channel} gain={gain} offset_lsb=0.00 gain_error_pct=-100.00 "
-                           f"max_error_lsb={gain * span:.2f} noise_lsb=0.00 overrange=0 points={points}")
+                           f"max_error_lsb={gain * span:.2f} {dead_noise} overrange=0 points={points}")
                 continue
             error = 0.5
             if max_error and (channel, gain) in max_error:
                 error = max_error[(channel, gain)]
             points = ",".join(f"{code}:{2048 + gain * (code - 2048):.1f}" for code in codes)
             out.append(f"BRINGUP ADC channel={channel} gain={gain} offset_lsb=0.25 gain_error_pct=-0.02 "
-                       f"max_error_lsb={error:.2f} noise_lsb={noise:.2f} overrange=0 points={points}")
+                       f"max_error_lsb={error:.2f} {noise_fields} overrange=0 points={points}")
     if delivered < 64:
         failures += 1
     out.append(f"BRINGUP IRQ delivered={delivered} requested=64 latency_min_ns=1200 latency_max_ns={latency_max}")
@@ -97,8 +108,11 @@ def test_a_healthy_board_passes_with_every_result_parsed():
     assert judgement.verdict == "pass" and judgement.exit_code == br.EXIT_PASS
     assert messages(judgement) == []
     assert (report.base, report.irq_line, report.board_id, report.revision) == (0x300, 5, 0x4D46, 0x0100)
+    assert (report.firmware_version, report.firmware_revision) == ("0.1.0", "c7f45ba-dirty")
     assert len(report.adc) == 32 and all(judgement.adc_pass.values()) and len(judgement.adc_pass) == 32
     assert report.adc[0].points[0] == (48, 48.0) and len(report.adc[0].points) == 9
+    assert (report.adc[0].noise_pooled_lsb, report.adc[0].noise_dof, report.adc[0].samples) == (0.0, 63, 8)
+    assert judgement.warnings == []
     assert report.irq == br.IrqResult(64, 64, 1200.0, 5000.0)
     assert report.controller_failures == 0 and report.ended
 
@@ -176,9 +190,21 @@ def test_no_report_at_all_is_incomplete():
 @pytest.mark.parametrize("bad, reason", [
     ("BRINGUP ADC channel=2 gain=10 offset_lsb=0.2", "missing gain_error_pct"),
     ("BRINGUP ADC channel=2 gain=10 offset_lsb=zz gain_error_pct=0 max_error_lsb=0 noise_lsb=0 points=1:1",
-     "could not convert"),
+     "offset_lsb 'zz' is not a decimal number"),
     ("BRINGUP ADC channel=9 gain=10 offset_lsb=0 gain_error_pct=0 max_error_lsb=0 noise_lsb=0 points=1:1",
-     "channel 9 is not 0..7"),
+     "channel 9 is not from 0 to 7"),
+    ("BRINGUP ADC channel=2 gain=10 offset_lsb=0 gain_error_pct=0 max_error_lsb=0 noise_lsb=0 noise_dof=7 "
+     "points=1:1", "noise_pooled_lsb, noise_dof and samples go together; missing noise_pooled_lsb, samples"),
+    ("BRINGUP ADC channel=2 gain=10 offset_lsb=0 gain_error_pct=0 max_error_lsb=0 noise_lsb=0 points=1:5000.0",
+     "mean ADC code 5000.0 is not from 0.0 to 4095.0"),
+    ("BRINGUP ADC channel=2 gain=10 offset_lsb=nan gain_error_pct=0 max_error_lsb=0 noise_lsb=0 points=1:1",
+     "offset_lsb 'nan' is not a decimal number"),
+    ("BRINGUP ADC channel=2 gain=10 offset_lsb=1e400 gain_error_pct=0 max_error_lsb=0 noise_lsb=0 points=1:1",
+     "offset_lsb '1e400' is not a decimal number"),
+    ("BRINGUP DIO walking-ones fail bits=0x10000 wrote=0x0001 read=0x0000", "bits 65536 is not from 0 to 65535"),
+    ("BRINGUP IRQ delivered=65 requested=64", "delivered 65 exceeds requested 64"),
+    ("BRINGUP FIRMWARE version=0.1.0", "missing revision"),
+    ("BRINGUP FIRMWARE version=0.1.0 revision=a;b", "is not letters, digits and ._+-"),
     ("BRINGUP ADC channel=2 gain=7 offset_lsb=0 gain_error_pct=0 max_error_lsb=0 noise_lsb=0 points=1:1",
      "gain 7 is not one of"),
     ("BRINGUP DIO walking-sideways ok", "DIO needs"),
@@ -200,6 +226,16 @@ def test_a_garbled_line_replacing_a_result_names_the_missing_result():
     _, judgement = judged(text)
     assert "ADC channel 6 gain 1000: not reported" in messages(judgement)
     assert any(m.startswith("unreadable report line") for m in messages(judgement))
+
+
+def test_a_sweep_with_no_points_fails_whatever_the_minimum():
+    text = transcript()
+    line = next(l for l in text.split("\r\n") if l.startswith("BRINGUP ADC channel=4 gain=10 "))
+    empty = line[:line.index("points=")] + "points=,"
+    for minimum in (1, 3):
+        _, judgement = judged(text.replace(line, empty), min_points=minimum)
+        assert judgement.verdict == "fail"
+        assert messages(judgement) == ["ADC channel 4 gain 10: sweep empty: no points measured"]
 
 
 def test_a_sweep_with_too_few_points_is_named():
@@ -227,12 +263,17 @@ def test_a_controller_failure_count_the_limits_do_not_confirm_is_a_warning():
 
 
 def test_limits_can_be_tightened_and_relaxed():
-    # Noise 0.8 LSB passes the default 1.0 limit and fails a tightened 0.5 one, on every channel and gain.
+    # Pooled noise 0.8 LSB over 63 degrees of freedom passes the default 1.0 limit; against a tightened 0.5 one
+    # its 99.9 % lower bound (0.8 x sqrt(63 / 103.44) = 0.62) is above, on every channel and gain.
     _, default = judged(transcript(noise=0.8))
     assert default.verdict == "pass"
     _, tight = judged(transcript(noise=0.8), max_noise_lsb=0.5)
     assert len(tight.failures) == 32
-    assert "ADC channel 0 gain 1: noise 0.8 LSB > limit 0.5" in messages(tight)
+    assert "ADC channel 0 gain 1: noise 0.80 LSB over 63 degrees of freedom, at least 0.62 with 99.9 % confidence " \
+           "> limit 0.5" in messages(tight)
+    # A lower confidence asks for less evidence: 0.56 LSB is not shown above 0.5 at 99.9 % but is at 60 %.
+    assert judged(transcript(noise=0.56), max_noise_lsb=0.5)[1].verdict == "pass"
+    assert judged(transcript(noise=0.56), max_noise_lsb=0.5, noise_confidence=0.6)[1].verdict == "fail"
     # The injected 12.5 LSB error passes a relaxed limit.
     _, relaxed = judged(transcript(max_error={(3, 100): 12.5}), max_error_lsb=20.0)
     assert relaxed.verdict == "pass"
@@ -273,9 +314,9 @@ def png_size(path):
     return width, height
 
 
-def run_tool(*args, stdin=None):
+def run_tool(*args, stdin=None, cwd=None):
     return subprocess.run([sys.executable, TOOL] + list(args), input=stdin, capture_output=True, text=True,
-                          timeout=TIMEOUT)
+                          timeout=TIMEOUT, cwd=cwd)
 
 
 @pytest.fixture
@@ -301,15 +342,23 @@ def test_tool_healthy_exit_0_json_and_png(workdir):
     result, document = run_on_transcript(workdir, transcript())
     assert result.returncode == 0, result.stdout + result.stderr
     assert "PASS: every check within its limits" in result.stdout
-    assert document["format"] == "dcos-iobus-bringup-result" and document["version"] == 1
+    assert document["format"] == "dcos-iobus-bringup-result" and document["version"] == 2
     assert document["verdict"] == "pass" and document["exit_code"] == 0
     assert document["board"] == {"base": 0x300, "irq": 5, "probe": "ok", "id": 0x4D46, "revision": 0x100}
+    assert document["firmware"] == {"version": "0.1.0", "revision": "c7f45ba-dirty"}
+    measured = datetime.datetime.strptime(document["timestamp"], "%Y-%m-%dT%H:%M:%SZ").replace(
+        tzinfo=datetime.timezone.utc)
+    assert abs((datetime.datetime.now(datetime.timezone.utc) - measured).total_seconds()) < 120
     assert document["limits"]["max_error_lsb"] == 2.0
     assert len(document["adc"]) == 32 and all(entry["passed"] for entry in document["adc"])
     first = document["adc"][0]
     assert (first["channel"], first["gain"], first["points"][0], first["ideal"][0]) == (0, 1, [48, 48.0], 48)
+    assert (first["noise_pooled_lsb"], first["noise_dof"], first["samples"], first["noise_lower_bound_lsb"]) == \
+        (0.0, 63, 8, 0.0)
     assert document["irq"]["delivered"] == 64 and document["failures"] == []
-    assert len(document["report_lines"]) == 2 + 2 + 32 + 2
+    assert len(document["report_lines"]) == 3 + 2 + 32 + 2
+    # Written through a temporary file and a rename: nothing else is left in the directory.
+    assert sorted(os.listdir(workdir)) == ["console.txt", "curves.png", "result.json"]
     width, height = png_size(os.path.join(workdir, "curves.png"))
     assert width > 400 and height > 400
     assert os.path.getsize(os.path.join(workdir, "curves.png")) > 10_000
@@ -348,17 +397,16 @@ def test_tool_limit_options_override_the_defaults(workdir):
     result, document = run_on_transcript(workdir, transcript(max_error={(3, 100): 12.5}), "--max-error-lsb", "15",
                                          "--max-noise-lsb", "0.2", "--min-irq-delivered-pct", "50",
                                          "--max-irq-latency-ns", "3000", "--max-offset-lsb", "1",
-                                         "--max-gain-error-pct", "0.5")
+                                         "--max-gain-error-pct", "0.5", "--noise-confidence", "0.99")
     assert result.returncode == 1
     assert document["limits"] == {"max_offset_lsb": 1.0, "max_gain_error_pct": 0.5, "max_error_lsb": 15.0,
-                                  "max_noise_lsb": 0.2, "min_irq_delivered_pct": 50.0, "max_irq_latency_ns": 3000.0,
-                                  "min_points": 3}
+                                  "max_noise_lsb": 0.2, "noise_confidence": 0.99, "min_irq_delivered_pct": 50.0,
+                                  "max_irq_latency_ns": 3000.0, "min_points": 3}
     assert [f["message"] for f in document["failures"]] == ["interrupt: max latency 5000 ns > limit 3000"]
 
 
 def test_tool_reads_a_transcript_from_stdin_and_can_skip_outputs(workdir):
-    os.chdir(workdir)
-    result = run_tool("--transcript", "-", "--json", "", "--png", "", stdin=transcript(stuck_bit=2))
+    result = run_tool("--transcript", "-", "--json", "", "--png", "", stdin=transcript(stuck_bit=2), cwd=workdir)
     assert result.returncode == 1
     assert "FAIL: DI bit 2 stuck: walking ones wrote 0x0004 read 0x0000; walking zeros wrote 0xfffe read 0xfffa" \
         in result.stdout
@@ -373,8 +421,14 @@ def test_tool_help_lists_every_option_limit_and_exit_status():
         assert option in result.stdout
     for name in br.LIMIT_DESCRIPTIONS:
         assert "--" + name.replace("_", "-") in result.stdout
-    for line in ("0  every check passed", "1  failures found", "3  board absent", "4  no connection"):
+    for line in ("0    every check passed", "1    failures found", "2    bad options", "3    board absent",
+                 "4    no connection", "5    a result file", "130  interrupted"):
         assert line in result.stdout
+    # The README documents the same statuses.
+    with open(os.path.join(BRINGUP_DIRECTORY, "README.md"), encoding="utf-8") as handle:
+        readme = handle.read()
+    for status in ("| 0 |", "| 1 |", "| 2 |", "| 3 |", "| 4 |", "| 5 |", "| 130 |"):
+        assert status in readme
 
 
 def test_tool_bad_options_exit_2():
@@ -534,10 +588,320 @@ def test_tool_stops_when_the_controller_has_no_bringup_command(workdir):
 
 def test_tool_exits_4_without_a_connection(workdir):
     result = run_tool("--socket", os.path.join(workdir, "nobody.sock"), "--connect-timeout", "0.5",
-                      "--json", os.path.join(workdir, "r.json"))
+                      "--json", os.path.join(workdir, "r.json"), "--png", "")
     assert result.returncode == 4
     assert "cannot connect to console socket" in result.stderr
     with open(os.path.join(workdir, "r.json"), encoding="utf-8") as handle:
         document = json.load(handle)
     assert document["verdict"] == "incomplete" and document["exit_code"] == 4
     assert document["failures"][0]["message"].startswith("cannot connect to console socket")
+
+
+def test_a_report_from_firmware_before_the_pooled_noise_is_judged_as_before_with_a_warning():
+    _, judgement = judged(transcript(noise=0.8, pooled=False), max_noise_lsb=0.5)
+    assert "ADC channel 0 gain 1: noise 0.8 LSB > limit 0.5" in messages(judgement)
+    assert any("no pooled noise estimate" in warning for warning in judgement.warnings)
+    assert judged(transcript(noise=0.8, pooled=False))[1].verdict == "pass"
+
+
+def test_a_sweep_without_repeated_conversions_has_no_noise_measurement():
+    _, judgement = judged(transcript(dof=0, samples=1))
+    assert judgement.verdict == "fail"
+    assert "ADC channel 5 gain 10: noise not measured: 1 conversion(s) per point give no degrees of freedom" \
+        in messages(judgement)
+
+
+# -- hostile input: the tool answers with a named failure and a documented status, never a traceback ----
+
+
+def replace_line(text, prefix, new):
+    line = next(l for l in text.split("\r\n") if l.startswith(prefix))
+    return text.replace(line, new(line))
+
+
+UNREADABLE = "FAIL: unreadable report line ("
+HOSTILE_TRANSCRIPTS = {
+    "a 401-digit number": (lambda t: t.replace("requested=64", "requested=" + "1" * 401), UNREADABLE),
+    "a 4,000-digit base": (lambda t: t.replace("base=0x300", "base=0x" + "f" * 4000), UNREADABLE),
+    "a 4,000-digit decimal base": (lambda t: t.replace("base=0x300", "base=" + "9" * 4000), UNREADABLE),
+    "a sweep with no points": (lambda t: replace_line(t, "BRINGUP ADC channel=4 gain=10 ",
+                                                      lambda l: l[:l.index("points=")] + "points=,"),
+                               "FAIL: ADC channel 4 gain 10: sweep empty: no points measured"),
+    "a NaN offset": (lambda t: t.replace("offset_lsb=0.25", "offset_lsb=nan", 1), UNREADABLE),
+    "an infinite mean": (lambda t: replace_line(t, "BRINGUP ADC channel=1 gain=1 ",
+                                                lambda l: l.replace(":48.0", ":1e999")), UNREADABLE),
+    "a 100,000-character line": (lambda t: t.replace("BRINGUP IRQ", "BRINGUP DIO " + "x" * 100_000
+                                                     + "\r\nBRINGUP IRQ"), UNREADABLE),
+    "a NUL and non-ASCII bytes": (lambda t: t.replace("BRINGUP END", "BRINGUP \x00\xff\u00e9 z=1\r\nBRINGUP END"),
+                                  UNREADABLE),
+}
+
+
+@pytest.mark.parametrize("name", sorted(HOSTILE_TRANSCRIPTS))
+def test_tool_answers_hostile_reports_with_a_named_failure(workdir, name):
+    change, expected = HOSTILE_TRANSCRIPTS[name]
+    result, document = run_on_transcript(workdir, change(transcript()))
+    assert "Traceback" not in result.stderr, result.stderr
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert any(line.startswith(expected) for line in result.stdout.splitlines()), result.stdout
+    # The whole document was written: it parses, it names the failure, and nothing else is left behind.
+    assert document["verdict"] == "fail" and document["exit_code"] == 1
+    assert any(f"FAIL: {failure['message']}".startswith(expected) for failure in document["failures"])
+    assert sorted(os.listdir(workdir)) == ["console.txt", "curves.png", "result.json"]
+
+
+def test_tool_checks_output_paths_before_it_runs(workdir):
+    missing = os.path.join(workdir, "missing", "x")
+    text = transcript()
+    for option in ("--json", "--png", "--save-transcript"):
+        arguments = {"--json": os.path.join(workdir, "r.json"), "--png": os.path.join(workdir, "r.png"),
+                     "--save-transcript": os.path.join(workdir, "t.txt")}
+        arguments[option] = missing
+        result = run_tool("--transcript", "-", *[word for pair in arguments.items() for word in pair], stdin=text)
+        assert result.returncode == 2, result.stdout + result.stderr
+        # Nothing ran: no verdict printed, nothing written, and the error names the option and the directory.
+        assert result.stdout == ""
+        assert f"{option} {missing}: directory {os.path.dirname(missing)} does not exist" in result.stderr
+        assert os.listdir(workdir) == []
+    result = run_tool("--transcript", "-", "--json", workdir, "--png", "", stdin=text)
+    assert result.returncode == 2 and "is a directory" in result.stderr
+    same = os.path.join(workdir, "same")
+    result = run_tool("--transcript", "-", "--json", same, "--png", same, stdin=text)
+    assert result.returncode == 2 and "name the same file" in result.stderr
+
+
+FLOAT_OPTIONS = ["--max-offset-lsb", "--max-gain-error-pct", "--max-error-lsb", "--max-noise-lsb",
+                 "--noise-confidence", "--min-irq-delivered-pct", "--max-irq-latency-ns", "--timeout",
+                 "--connect-timeout"]
+
+
+def refused(capsys, *arguments):
+    """Runs the tool's main() in this process on options it must refuse; returns its error output."""
+    import mfio_bringup
+
+    with pytest.raises(SystemExit) as stop:
+        mfio_bringup.main(["--transcript", "-", "--json", "", "--png", ""] + list(arguments))
+    captured = capsys.readouterr()
+    assert stop.value.code == 2 and captured.out == "", captured.out
+    return captured.err
+
+
+@pytest.mark.parametrize("option", FLOAT_OPTIONS)
+def test_tool_refuses_nan_infinite_and_negative_numbers(capsys, option):
+    for value in ("nan", "inf", "-inf", "-1", "1e999", "x", "1" * 5000):
+        assert f"argument {option}:" in refused(capsys, f"{option}={value}"), value
+
+
+@pytest.mark.parametrize("option, value", [("--min-points", "0"), ("--min-points", "-3"), ("--min-points", "2.5"),
+                                           ("--noise-confidence", "1"), ("--min-irq-delivered-pct", "101"),
+                                           ("--baud", "0"), ("--base", "0x10000"), ("--base", "-2"),
+                                           ("--base", "0x301"), ("--base", "9" * 5000), ("--irq", "16"),
+                                           ("--prompt", "(")])
+def test_tool_refuses_other_values_out_of_range(capsys, option, value):
+    assert option in refused(capsys, f"{option}={value}")
+
+
+def test_tool_does_not_hang_on_a_nan_connect_timeout(workdir):
+    started = time.monotonic()
+    result = run_tool("--socket", os.path.join(workdir, "nobody.sock"), "--connect-timeout", "nan",
+                      "--json", os.path.join(workdir, "r.json"))
+    assert result.returncode == 2 and time.monotonic() - started < 20
+
+
+def test_a_run_without_a_picture_removes_an_older_one(workdir):
+    png, json_path = os.path.join(workdir, "curves.png"), os.path.join(workdir, "result.json")
+    result, _ = run_on_transcript(workdir, transcript())
+    assert result.returncode == 0 and os.path.exists(png)
+    # The next run gets no report, so it draws nothing: the older picture must not pass for this run's.
+    result, document = run_on_transcript(workdir, "dcos> iobus bringup\r\nunknown command: iobus\r\ndcos> ")
+    assert result.returncode == 4
+    assert not os.path.exists(png)
+    assert f"removed the older {png}" in result.stderr
+    assert document["verdict"] == "incomplete"
+    assert sorted(os.listdir(workdir)) == ["console.txt", "result.json"]
+
+
+# -- the picture -----------------------------------------------------------------
+
+
+TIMESTAMP = "2025-01-31T14:05:09Z"
+
+
+def sheet(text, **limits):
+    report, judgement = judged(text, **limits)
+    return report, judgement, br.Limits(**limits)
+
+
+def panel(figure, label):
+    (axis,) = [axis for axis in figure.axes if axis.get_label() == label]
+    return axis
+
+
+def failing_mark(axis):
+    """The panel's title says FAIL in red, and its frame is red."""
+    title = axis.title
+    return "FAIL" in title.get_text() and title.get_color() == br.RED
+
+
+def test_the_pictures_of_a_passing_a_stuck_di_and_a_no_irq_board_differ():
+    pictures = {name: br.render_png(*sheet(text), TIMESTAMP) for name, text in
+                (("pass", transcript()), ("stuck", transcript(stuck_bit=4)), ("no-irq", transcript(delivered=0)))}
+    assert len(set(pictures.values())) == 3
+    # Equal inputs draw equal bytes, so the differences come from what the boards did.
+    assert br.render_png(*sheet(transcript()), TIMESTAMP) == pictures["pass"]
+    for data in pictures.values():
+        assert data.startswith(b"\x89PNG\r\n\x1a\n")
+
+
+def test_failing_panels_and_sections_are_marked():
+    import matplotlib.pyplot as pyplot
+
+    cases = {
+        "pass": (transcript(), set()),
+        "stuck": (transcript(stuck_bit=4), {"dio", "header"}),
+        "no-irq": (transcript(delivered=0), {"irq", "header"}),
+        "error": (transcript(max_error={(3, 100): 12.5}), {"adc-3-100", "header"}),
+        "dead": (transcript(dead_channel=6), {"adc-6-1", "adc-6-10", "adc-6-100", "adc-6-1000", "header"}),
+    }
+    for name, (text, failing) in cases.items():
+        report, judgement, limits = sheet(text)
+        figure = br.bringup_figure(report, judgement, limits, TIMESTAMP)
+        try:
+            labels = {axis.get_label() for axis in figure.axes}
+            assert {"header", "dio", "irq"} | {f"adc-{c}-{g}" for c in range(8) for g in GAINS} <= labels
+            marked = {label for label in labels if label != "header" and failing_mark(panel(figure, label))}
+            assert marked == failing - {"header"}, name
+            header = panel(figure, "header")
+            verdict = header.texts[0]
+            assert verdict.get_text() == ("PASS: every check within its limits" if not failing
+                                          else f"FAILED: {len(judgement.failures)} failure(s)"), name
+            assert (verdict.get_color() == br.RED) == bool(failing), name
+            if name == "stuck":
+                assert "bit 4 stuck" in panel(figure, "dio").title.get_text()
+            if name == "error":
+                assert "max error" in panel(figure, "adc-3-100").title.get_text()
+        finally:
+            pyplot.close(figure)
+
+
+# -- what --exec starts, it ends -------------------------------------------------
+
+
+FAKE_EMULATOR = r"""
+import os, signal, sys, time
+mode, report_path, pid_path = sys.argv[1:4]
+if mode == "stubborn":
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+with open(pid_path + ".tmp", "w") as handle:
+    handle.write(str(os.getpid()))
+os.rename(pid_path + ".tmp", pid_path)
+def write(text):
+    os.write(1, text.encode())
+report = open(report_path).read().replace("dcos> iobus bringup\r\n", "")
+write("DCOS 0.1.0\r\ndcos> ")
+line = b""
+while True:
+    data = os.read(0, 1)
+    if not data:
+        break
+    if data != b"\r":
+        line += data
+        continue
+    command, line = line.decode(), b""
+    write(command + "\r\n")
+    if command.startswith("iobus bringup"):
+        write(report if mode == "report" else report[:report.index("BRINGUP ADC channel=2")])
+    else:
+        write("dcos> ")
+# Like an emulator, it does not end when its input does.
+time.sleep(60)
+"""
+
+
+def alive(pid):
+    """True while the process exists and is not a zombie (an orphan's zombie may wait for a busy init)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="latin-1") as handle:
+            state = handle.read().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError, IndexError):
+        return False
+    return state not in ("Z", "X")
+
+
+def fake_emulator(workdir, mode, report):
+    program = os.path.join(workdir, "fake_emulator.py")
+    with open(program, "w", encoding="utf-8") as handle:
+        handle.write(FAKE_EMULATOR)
+    report_path = os.path.join(workdir, "report.txt")
+    with open(report_path, "w", encoding="latin-1") as handle:
+        handle.write(report)
+    pid_path = os.path.join(workdir, "emulator.pid")
+    # "; true" keeps the shell alive as the emulator's parent, as any command with a redirection or a pipe does.
+    return f"{sys.executable} {program} {mode} {report_path} {pid_path}; true", pid_path
+
+
+def emulator_pid(pid_path):
+    with open(pid_path, encoding="utf-8") as handle:
+        return int(handle.read())
+
+
+def assert_ended(pid):
+    deadline = time.monotonic() + 5
+    while alive(pid) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not alive(pid), f"the emulator (pid {pid}) is still running after the tool ended"
+
+
+@pytest.mark.parametrize("mode, report, arguments, code", [
+    ("report", transcript(), [], 0),
+    ("report", transcript(stuck_bit=9), [], 1),
+    ("stall", transcript(), ["--timeout", "2"], 4),
+    ("stubborn", transcript(), ["--timeout", "2"], 4),
+], ids=["success", "failure", "time-out", "time-out, SIGTERM ignored"])
+def test_tool_ends_the_program_it_started(workdir, mode, report, arguments, code):
+    command, pid_path = fake_emulator(workdir, mode, report)
+    result = run_tool("--exec", command, "--json", os.path.join(workdir, "r.json"), "--png", "", *arguments)
+    assert result.returncode == code, result.stdout + result.stderr
+    assert_ended(emulator_pid(pid_path))
+
+
+def test_tool_ends_the_program_it_started_on_ctrl_c(workdir):
+    command, pid_path = fake_emulator(workdir, "stall", transcript())
+    json_path = os.path.join(workdir, "r.json")
+    tool = subprocess.Popen([sys.executable, TOOL, "--exec", command, "--json", json_path, "--png", "",
+                             "--timeout", "60"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + TIMEOUT
+        while not os.path.exists(pid_path):
+            assert tool.poll() is None and time.monotonic() < deadline, "the program was not started"
+            time.sleep(0.05)
+        time.sleep(1.0)  # The command is sent and the report has begun.
+        tool.send_signal(signal.SIGINT)
+        stdout, stderr = tool.communicate(timeout=TIMEOUT)
+    finally:
+        if tool.poll() is None:
+            tool.kill()
+            tool.wait()
+    assert tool.returncode == 130, stdout + stderr
+    assert "Traceback" not in stderr and "interrupted" in stderr
+    assert "INTERRUPTED: the bring-up was stopped before it finished" in stdout
+    with open(json_path, encoding="utf-8") as handle:
+        document = json.load(handle)
+    assert document["verdict"] == "interrupted" and document["exit_code"] == 130
+    assert_ended(emulator_pid(pid_path))
+
+
+def test_tool_shows_the_error_of_a_program_that_does_not_start(workdir):
+    program = os.path.join(workdir, "broken_emulator.py")
+    with open(program, "w", encoding="utf-8") as handle:
+        handle.write("import sys\nsys.stderr.write('qemu-system-i386: -kernel nope.elf: could not load kernel\\n')\n"
+                     "sys.exit(1)\n")
+    started = time.monotonic()
+    result = run_tool("--exec", f"{sys.executable} {program}", "--json", os.path.join(workdir, "r.json"),
+                      "--png", "", "--connect-timeout", "30")
+    assert result.returncode == 4, result.stdout + result.stderr
+    assert time.monotonic() - started < 20
+    assert "the program exited with status 1" in result.stderr
+    assert "qemu-system-i386: -kernel nope.elf: could not load kernel" in result.stderr
+    with open(os.path.join(workdir, "r.json"), encoding="utf-8") as handle:
+        assert "could not load kernel" in json.load(handle)["connection"]["problem"]

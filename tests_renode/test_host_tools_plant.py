@@ -266,3 +266,94 @@ def test_socket_mode_gives_up_when_no_client_comes():
                                  "--accept-timeout", "0.3"], capture_output=True, text=True, timeout=TIMEOUT)
         assert result.returncode == 3
         assert "no client connected within 0.3 s" in result.stderr
+
+
+# -- hostile input: every line is checked, none is fatal, the state stays finite --------------
+
+
+def test_one_huge_input_does_not_poison_the_simulation():
+    # 1e308 V times the gain 2 would be infinite, and every later answer with it: the line is refused instead.
+    messages = tempfile.TemporaryFile("w+")
+    simulator = plant_simulator.PlantSimulator(
+        plant_simulator.build_parser().parse_args(["--tau", "0.5", "--gain", "2"]), log=messages)
+    simulator.handle_line(sample(0, dacs_with(0, 1.0)))
+    previous = simulator.handle_line(sample(100_000_000, dacs_with(0, 1.0)))
+    assert simulator.handle_line("SAMPLE 200000000 1e308 0 0 0 0 0 0 0 0000", 3) == previous
+    for text in ("nan", "inf", "-1e308", "10.5"):
+        assert simulator.handle_line(f"SAMPLE 200000000 {text} 0 0 0 0 0 0 0 0000", 4) == previous
+    volts, _ = parse_input(simulator.handle_line(sample(300_000_000, dacs_with(0, 1.0))))
+    assert volts[0] == pytest.approx(fopdt_step(0.3, 2, 0.5, 0.0, 1.0), abs=2e-6)
+    assert simulator.errors == 5 and math.isfinite(simulator.process.y)
+    messages.seek(0)
+    text = messages.read()
+    assert "DAC0 value '1e308' is outside the DAC's -10..+10 V" in text
+    assert "DAC0 value 'nan' is not finite" in text
+
+
+@pytest.mark.parametrize("time_text, reason", [
+    ("9" * 400, "is beyond 2^63 - 1 ns, the model's clock"),
+    ("9223372036854775808", "is beyond 2^63 - 1 ns"),
+    ("1" * 5000, "line longer than 4096 characters"),
+])
+def test_an_over_long_time_is_answered_not_fatal(time_text, reason):
+    with tempfile.TemporaryDirectory() as directory:
+        lines = [sample(0, dacs_with(0, 1.0)), f"SAMPLE {time_text} 1 0 0 0 0 0 0 0 0000",
+                 sample(1_000_000_000, dacs_with(0, 1.0))]
+        result = run_stdio(["--tau", "1", "--csv", os.path.join(directory, "log.csv")], "\n".join(lines) + "\n")
+    assert result.returncode == 0 and "Traceback" not in result.stderr, result.stderr
+    replies = result.stdout.splitlines()
+    assert len(replies) == 3 and replies[1] == replies[0]
+    assert parse_input(replies[2])[0][0] == pytest.approx(fopdt_step(1.0, 1, 1, 0, 1.0), abs=2e-6)
+    assert reason in result.stderr and "plant: 2 samples, 1 malformed lines" in result.stderr
+
+
+def test_a_line_without_end_is_not_buffered_without_limit():
+    # A megabyte without a newline is dropped as it arrives; the lines around it are answered.
+    text = sample(0, dacs_with(0, 1.0)) + "\n" + "x" * 1_000_000 + "\n" + sample(10, dacs_with(0, 1.0)) + "\n"
+    result = run_stdio(["--tau", "0"], text)
+    assert result.returncode == 0, result.stderr
+    assert len(result.stdout.splitlines()) == 3
+    assert "line 2: line longer than 4096 characters" in result.stderr
+
+
+PLANT_FLOAT_OPTIONS = ["--gain", "--tau", "--dead-time", "--initial", "--initial-input", "--offset", "--disturbance",
+                       "--disturbance-at", "--noise", "--accept-timeout", "--idle-timeout"]
+
+
+@pytest.mark.parametrize("option", PLANT_FLOAT_OPTIONS)
+def test_number_options_must_be_finite_and_in_range(capsys, option):
+    for value in ("nan", "inf", "-inf", "1e999", "1e300", "x"):
+        with pytest.raises(SystemExit) as stop:
+            plant_simulator.main([f"{option}={value}"])
+        assert stop.value.code == 2, (option, value)
+        assert f"argument {option}" in capsys.readouterr().err
+
+
+def test_other_options_are_checked_too(capsys, tmp_path):
+    for arguments in (["--ai-constant", "3=nan"], ["--ai-constant", "3=1e999"], ["--max-error-messages", "-1"],
+                      ["--seed", "9" * 5000], ["--output-channel", "9" * 5000], ["--initial-input", "11"],
+                      ["--csv", str(tmp_path / "missing" / "log.csv")]):
+        with pytest.raises(SystemExit) as stop:
+            plant_simulator.main(arguments)
+        assert stop.value.code == 2, arguments
+        error = capsys.readouterr().err
+        assert "Traceback" not in error and arguments[0] in error, error
+
+
+def test_the_answers_stop_quietly_when_their_reader_goes():
+    process = subprocess.Popen([sys.executable, PLANT, "--tau", "0"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        process.stdin.write(sample(0) + "\n")
+        process.stdin.flush()
+        assert process.stdout.readline().startswith("INPUT ")
+        process.stdout.close()
+        for step in range(1, 200):
+            process.stdin.write(sample(step) + "\n")
+        process.stdin.close()
+    except BrokenPipeError:
+        pass
+    finally:
+        stderr = process.stderr.read()
+        process.wait(timeout=TIMEOUT)
+    assert process.returncode == 0 and "Traceback" not in stderr, stderr

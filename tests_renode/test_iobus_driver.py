@@ -53,7 +53,8 @@ def test_iobus_tests_pass_again_in_the_same_boot(boot, isa486):
 BRINGUP_LINE = re.compile(r"^BRINGUP .*$", re.MULTILINE)
 ADC_LINE = re.compile(
     r"^BRINGUP ADC channel=(\d) gain=(\d+) offset_lsb=(-?\d+\.\d\d) gain_error_pct=(-?\d+\.\d\d) "
-    r"max_error_lsb=(\d+\.\d\d) noise_lsb=(\d+\.\d\d) overrange=(\d+) points=((?:\d+:\d+\.\d,?)+)$"
+    r"max_error_lsb=(\d+\.\d\d) noise_lsb=(\d+\.\d\d) noise_pooled_lsb=(\d+\.\d\d) noise_dof=(\d+) "
+    r"samples=(\d+) overrange=(\d+) points=((?:\d+:\d+\.\d,?)+)$"
 )
 
 
@@ -69,17 +70,21 @@ def test_bringup_on_a_healthy_board_reports_every_step_and_no_failure(boot, isa4
     lines = bringup(boot(isa486, icount=True))
     assert lines[0] == "BRINGUP BEGIN base=0x300 irq=5", lines
     assert lines[1] == "BRINGUP PROBE ok id=4d46 revision=0100", lines
-    assert lines[2] == "BRINGUP DIO walking-ones ok", lines
-    assert lines[3] == "BRINGUP DIO walking-zeros ok", lines
-    adc = [ADC_LINE.match(line) for line in lines[4:-2]]
+    assert re.fullmatch(r"BRINGUP FIRMWARE version=\d+\.\d+\.\d+ revision=\S+", lines[2]), lines
+    assert lines[3] == "BRINGUP DIO walking-ones ok", lines
+    assert lines[4] == "BRINGUP DIO walking-zeros ok", lines
+    adc = [ADC_LINE.match(line) for line in lines[5:-2]]
     assert all(adc), lines
     assert [(int(m.group(1)), int(m.group(2))) for m in adc] == [
         (channel, gain) for channel in range(8) for gain in (1, 10, 100, 1000)
     ]
     for match in adc:
         gain = int(match.group(2))
-        assert match.group(3, 4, 5, 6, 7) == ("0.00", "0.00", "0.00", "0.00", "0"), match.group(0)
-        for point in match.group(8).split(","):
+        assert match.group(3, 4, 5, 6, 7, 10) == ("0.00", "0.00", "0.00", "0.00", "0.00", "0"), match.group(0)
+        points = match.group(11).split(",")
+        samples = int(match.group(9))
+        assert int(match.group(8)) == len(points) * (samples - 1), match.group(0)
+        for point in points:
             output, mean = point.split(":")
             ideal = 2048 + (int(output) - 2048) * gain
             assert float(mean) == ideal, match.group(0)

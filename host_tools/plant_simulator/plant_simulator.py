@@ -23,7 +23,18 @@ lines received, so a closed loop under -icount is repeatable run for run.
 
 The digital part copies DO to DI by default, or follows a configurable
 mapping. Every line in gets exactly one line out: a malformed line is
-answered with the previous inputs and counted, never fatal.
+answered with the previous inputs and counted, never fatal. Every line is
+checked in full before it touches the simulation: a time beyond 2^63 - 1 ns,
+a DAC value that is not finite or outside the DAC's +-10 V, a line longer
+than 4096 characters are each rejected with a message on stderr, and a line
+that would make the state or an answer non-finite is rejected and leaves the
+state as it was. The options are checked the same way (finite, in range), so
+the simulation stays finite whatever it is sent.
+
+Exit status: 0 at a normal end (end of input, the client disconnected,
+SIGTERM or Ctrl-C), 2 for bad options (a value out of range, NaN or
+infinite, or a --csv file that cannot be created), 3 when the socket cannot
+be opened or no client connects within --accept-timeout.
 
 Run `plant_simulator.py --help` for every option; README.md next to this file
 explains them with examples.
@@ -32,6 +43,7 @@ explains them with examples.
 import argparse
 import csv
 import math
+import re
 import os
 import random
 import select
@@ -44,6 +56,20 @@ import time
 CHANNELS = 8
 DIGITAL_BITS = 16
 PROTOCOL_INPUT_FIELDS = 1 + 1 + CHANNELS + 1  # keyword, time, 8 volts, DO
+# A SAMPLE line is about 100 characters; anything this long is not one, and
+# the reader drops the rest of it instead of buffering without end.
+MAX_LINE_LENGTH = 4096
+# The model sends its virtual clock, a signed 64-bit count of nanoseconds.
+MAX_TIME_NS = 2**63 - 1
+# The DACs span -10 V to +10 V (docs/iobus/mfio-register-map.md).
+DAC_LIMIT_V = 10.0
+# Bounds of the options: wide enough for any plant, small enough that every
+# product and sum of them stays finite.
+MAX_VOLTS = 1e6
+MAX_GAIN = 1e6
+MAX_SECONDS = 1e9
+MAX_TIMEOUT_S = 1e6
+TIME_TEXT = re.compile(r"-?[0-9]+")
 
 EXIT_OK = 0
 EXIT_USAGE = 2
@@ -54,32 +80,50 @@ class ProtocolError(ValueError):
     """A SAMPLE line that does not follow the protocol."""
 
 
+class OverlongLine(str):
+    """The start of a line longer than MAX_LINE_LENGTH; the reader dropped the rest."""
+
+
+def _short(text):
+    return repr(text) if len(text) <= 20 else repr(text[:20]) + f"... ({len(text)} characters)"
+
+
 def parse_sample(line):
     """Parses one SAMPLE line into (time_ns, [8 volts], do_word).
 
-    Raises ProtocolError with a message that says what is wrong.
+    Raises ProtocolError with a message that says what is wrong; anything it
+    returns is in range: 0 <= time_ns <= 2^63 - 1, every volt finite and
+    within the DACs' +-10 V, the DO word 16 bits.
     """
+    if isinstance(line, OverlongLine) or len(line) > MAX_LINE_LENGTH:
+        raise ProtocolError(f"line longer than {MAX_LINE_LENGTH} characters")
     fields = line.split()
     if not fields:
         raise ProtocolError("empty line")
     if fields[0] != "SAMPLE":
-        raise ProtocolError(f"expected the keyword SAMPLE, got {fields[0][:20]!r}")
+        raise ProtocolError(f"expected the keyword SAMPLE, got {_short(fields[0])}")
     if len(fields) != PROTOCOL_INPUT_FIELDS:
         raise ProtocolError(f"expected {PROTOCOL_INPUT_FIELDS} fields, got {len(fields)}")
-    try:
-        time_ns = int(fields[1], 10)
-    except ValueError:
-        raise ProtocolError(f"time {fields[1][:20]!r} is not a whole number of ns") from None
-    if time_ns < 0:
-        raise ProtocolError(f"time {time_ns} is negative")
+    if not TIME_TEXT.fullmatch(fields[1]):
+        raise ProtocolError(f"time {_short(fields[1])} is not a whole number of ns")
+    if fields[1].startswith("-"):
+        raise ProtocolError(f"time {_short(fields[1])} is negative")
+    # Checked by length before conversion: int() of thousands of digits is slow or refused.
+    if len(fields[1].lstrip("0")) > 19 or int(fields[1], 10) > MAX_TIME_NS:
+        raise ProtocolError(f"time {_short(fields[1])} is beyond 2^63 - 1 ns, the model's clock")
+    time_ns = int(fields[1], 10)
     volts = []
     for index, text in enumerate(fields[2:2 + CHANNELS]):
         try:
-            value = float(text)
+            value = float(text) if len(text) <= 40 else None
         except ValueError:
-            raise ProtocolError(f"DAC{index} value {text[:20]!r} is not a number") from None
+            value = None
+        if value is None:
+            raise ProtocolError(f"DAC{index} value {_short(text)} is not a number")
         if not math.isfinite(value):
-            raise ProtocolError(f"DAC{index} value {text[:20]!r} is not finite")
+            raise ProtocolError(f"DAC{index} value {_short(text)} is not finite")
+        if abs(value) > DAC_LIMIT_V:
+            raise ProtocolError(f"DAC{index} value {_short(text)} is outside the DAC's -10..+10 V")
         volts.append(value)
     do_text = fields[-1]
     if len(do_text) != 4 or any(c not in "0123456789abcdefABCDEF" for c in do_text):
@@ -133,6 +177,14 @@ class Fopdt:
         latest = self.fifo[-1][1] if self.fifo else self.delayed_input
         if value != latest:
             self.fifo.append((time_ns + self.dead_ns, value))
+
+    def save(self):
+        """The whole state, for restore() when a step must be undone."""
+        return self.y, self.time_ns, self.delayed_input, list(self.fifo)
+
+    def restore(self, state):
+        self.y, self.time_ns, self.delayed_input, fifo = state
+        self.fifo = list(fifo)
 
     def _pop_arrived(self, time_ns):
         while self.fifo and self.fifo[0][0] <= time_ns:
@@ -193,16 +245,42 @@ def parse_di_map(text):
     return mapping
 
 
+def float_in(low, high):
+    """An argparse type: a finite number from low to high (NaN and the infinities are refused)."""
+    def parse(text):
+        try:
+            value = float(text) if len(text) <= 40 else math.nan
+        except ValueError:
+            value = math.nan
+        if not math.isfinite(value) or not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{_short(text)} is not a finite number from {low:g} to {high:g}")
+        return value
+    return parse
+
+
+def int_in(low, high):
+    """An argparse type: a whole number from low to high."""
+    def parse(text):
+        try:
+            value = int(text, 10) if len(text) <= 40 else None
+        except ValueError:
+            value = None
+        if value is None or not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{_short(text)} is not a whole number from {low} to {high}")
+        return value
+    return parse
+
+
 def parse_constant(text):
     """Parses 'CH=VOLTS' for --ai-constant."""
     left, sep, right = text.partition("=")
     try:
-        channel, volts = int(left), float(right)
+        channel, volts = int(left), (float(right) if len(right) <= 40 else math.nan)
     except ValueError:
         channel = -1
         volts = 0.0
-    if not sep or not 0 <= channel < CHANNELS or not math.isfinite(volts):
-        raise argparse.ArgumentTypeError(f"{text!r} is not CH=VOLTS with CH in 0..7")
+    if not sep or not 0 <= channel < CHANNELS or not math.isfinite(volts) or abs(volts) > MAX_VOLTS:
+        raise argparse.ArgumentTypeError(f"{_short(text)} is not CH=VOLTS with CH in 0..7 and |VOLTS| <= 1e6")
     return channel, volts
 
 
@@ -217,9 +295,12 @@ def hex_word(text):
 
 
 def channel_number(text):
-    value = int(text)
+    try:
+        value = int(text) if len(text) <= 8 else -1
+    except ValueError:
+        value = -1
     if not 0 <= value < CHANNELS:
-        raise argparse.ArgumentTypeError(f"channel {value} is not in 0..7")
+        raise argparse.ArgumentTypeError(f"channel {_short(text)} is not in 0..7")
     return value
 
 
@@ -247,6 +328,7 @@ class PlantSimulator:
         self.csv_writer = None
         self._csv_file = None
         if options.csv:
+            # An OSError here (a missing directory) is the caller's to report as a bad option.
             self._csv_file = open(options.csv, "w", newline="", encoding="utf-8")
             self.csv_writer = csv.writer(self._csv_file)
             self.csv_writer.writerow(
@@ -291,40 +373,69 @@ class PlantSimulator:
             if self.messages_left == 0:
                 print("plant: further line errors are counted but not printed", file=self.log)
 
+    def _step(self, time_ns, dacs, do_word):
+        """Advances the simulation to one sample; undoes it all and raises ProtocolError if anything would
+        not be finite, so that no line can poison the state for the lines after it."""
+        if self.process.time_ns is not None and time_ns < self.process.time_ns:
+            raise ProtocolError(f"time went backwards from {self.process.time_ns} to {time_ns} ns")
+        saved, noise_state = self.process.save(), self.random.getstate()
+        try:
+            self.process.apply_input(time_ns, dacs[self.options.input_channel])
+            y = self.process.advance(time_ns)
+            volts = self._analog(y, dacs)
+            if not math.isfinite(y) or not all(math.isfinite(v) for v in volts):
+                raise ProtocolError("the sample would make the simulation non-finite")
+        except (ValueError, ArithmeticError) as error:
+            self.process.restore(saved)
+            self.random.setstate(noise_state)
+            raise ProtocolError(str(error)) from None
+        return y, volts
+
     def handle_line(self, line, number=0):
-        """Returns the reply (without newline) to one received line."""
-        line = line.strip("\r\n")
+        """Returns the reply (without newline) to one received line; never raises for what the line holds."""
+        if not isinstance(line, OverlongLine):
+            line = line.strip("\r\n")
         try:
             time_ns, dacs, do_word = parse_sample(line)
-            u = dacs[self.options.input_channel]
-            self.process.apply_input(time_ns, u)
-            y = self.process.advance(time_ns)
-        except (ProtocolError, ValueError) as error:
+            y, volts = self._step(time_ns, dacs, do_word)
+        except ProtocolError as error:
             self._error(number, error)
             return self.last_reply
         self.samples += 1
         di = self._digital(do_word)
-        volts = self._analog(y, dacs)
         reply = format_input(volts, di)
         if self.csv_writer is not None:
-            disturbance = 0.0
-            if self.process.disturbance_at_ns is not None and time_ns >= self.process.disturbance_at_ns:
-                disturbance = self.process.disturbance
+            self._log(time_ns, dacs, do_word, y, volts, di)
+        self.last_dacs, self.last_do, self.last_di, self.last_reply = dacs, do_word, di, reply
+        return reply
+
+    def _log(self, time_ns, dacs, do_word, y, volts, di):
+        disturbance = 0.0
+        if self.process.disturbance_at_ns is not None and time_ns >= self.process.disturbance_at_ns:
+            disturbance = self.process.disturbance
+        try:
             self.csv_writer.writerow(
                 [time_ns, f"{time_ns / 1e9:.9f}"] + [f"{v:.6f}" for v in dacs]
                 + [f"{do_word:04x}", f"{self.process.delayed_input:.6f}", f"{y:.6f}", f"{disturbance:.6f}"]
                 + [f"{v:.6f}" for v in volts] + [f"{di:04x}"]
             )
             self._csv_file.flush()
-        self.last_dacs, self.last_do, self.last_di, self.last_reply = dacs, do_word, di, reply
-        return reply
+        except OSError as error:
+            # A full disk ends the log, not the simulation the emulator depends on.
+            print(f"plant: the CSV log stops here: {error}", file=self.log)
+            self.csv_writer = None
+            try:
+                self._csv_file.close()
+            except OSError:
+                pass
+            self._csv_file = None
 
     def summary(self):
         return f"plant: {self.samples} samples, {self.errors} malformed lines"
 
 
 def serve_stream(simulator, read_line, write_line, idle_timeout):
-    """Answers lines until end of input or idle_timeout seconds without a line."""
+    """Answers lines until end of input, the output closing, or idle_timeout seconds without a line."""
     number = 0
     while True:
         line = read_line(idle_timeout)
@@ -333,22 +444,38 @@ def serve_stream(simulator, read_line, write_line, idle_timeout):
         if line == "":
             return f"no line for {idle_timeout:g} s (--idle-timeout)"
         number += 1
-        write_line(simulator.handle_line(line, number))
+        try:
+            write_line(simulator.handle_line(line, number))
+        except OSError as error:
+            return f"the output closed ({error.strerror or error})"
 
 
 class LineReader:
-    """Reads whole lines from a file descriptor with a time-out per line."""
+    """Reads whole lines from a file descriptor with a time-out per line.
+
+    A line longer than MAX_LINE_LENGTH is not buffered whole: its start is
+    kept, the rest is dropped up to its newline, and it comes back as an
+    OverlongLine that the simulator rejects.
+    """
 
     def __init__(self, fd):
         self.fd = fd
         self.buffer = b""
         self.eof = False
+        self.overlong = None  # the start of a line being dropped
 
     def __call__(self, timeout):
         """A decoded line, None at end of input, '' on time-out."""
         deadline = time.monotonic() + timeout if timeout > 0 else None
         while b"\n" not in self.buffer:
+            if len(self.buffer) > MAX_LINE_LENGTH:
+                if self.overlong is None:
+                    self.overlong = self.buffer[:40].decode("latin-1")
+                self.buffer = b""
             if self.eof:
+                if self.overlong is not None:
+                    line, self.overlong, self.buffer = self.overlong, None, b""
+                    return OverlongLine(line)
                 if self.buffer:
                     line, self.buffer = self.buffer, b""
                     return line.decode("latin-1")
@@ -364,6 +491,10 @@ class LineReader:
                 self.eof = True
             self.buffer += data
         line, _, self.buffer = self.buffer.partition(b"\n")
+        if self.overlong is not None or len(line) > MAX_LINE_LENGTH:
+            start = self.overlong if self.overlong is not None else line[:40].decode("latin-1")
+            self.overlong = None
+            return OverlongLine(start)
         # A line is at least "\n"-terminated; keep it non-empty so '' means time-out.
         return line.decode("latin-1") + "\n"
 
@@ -375,7 +506,11 @@ def run_stdio(simulator, options):
         sys.stdout.write(text + "\n")
         sys.stdout.flush()
 
-    return serve_stream(simulator, reader, write_line, options.idle_timeout)
+    why = serve_stream(simulator, reader, write_line, options.idle_timeout)
+    if why.startswith("the output closed"):
+        # Nothing reads the answers any more; the interpreter's final flush must not fail on them too.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    return why
 
 
 def run_socket(simulator, options):
@@ -438,24 +573,28 @@ def build_parser():
         epilog=(
             "Transport: with --socket the program listens on a Unix socket and the emulator connects as the "
             "client (QEMU: -chardev socket,id=plant,path=SOCK -device isa-mfio,wiring=plant,plant=plant); "
-            "without it, lines are read from stdin and answered on stdout. A malformed line is answered "
-            "with the previous inputs and counted. Exit status: 0 normal end, 2 bad options, 3 socket "
-            "error or no client within --accept-timeout."
+            "without it, lines are read from stdin and answered on stdout. A malformed line (wrong keyword or "
+            "field count, a time that is not 0 to 2^63-1 ns or goes backwards, a DAC value that is not finite or "
+            "outside -10..+10 V, a line over 4096 characters) is answered with the previous inputs, reported "
+            "on stderr and counted; it never ends the program. Volts options are finite and at most 1e6 in size. "
+            "Exit status: 0 normal end (end of input, client gone, SIGTERM or Ctrl-C), 2 bad options (out of "
+            "range, NaN, infinite, or a --csv file that cannot be created), 3 socket error or no client within "
+            "--accept-timeout."
         ),
     )
     process = parser.add_argument_group("process (FOPDT)")
-    process.add_argument("--gain", "-K", type=float, default=1.0, help="process gain K, output volts per input volt (default 1.0)")
-    process.add_argument("--tau", type=float, default=1.0, help="time constant tau in seconds of emulated time; 0 makes a pure gain with dead time (default 1.0)")
-    process.add_argument("--dead-time", "--theta", type=float, default=0.0, help="dead time theta in seconds of emulated time (default 0)")
+    process.add_argument("--gain", "-K", type=float_in(-MAX_GAIN, MAX_GAIN), default=1.0, help="process gain K, output volts per input volt, |K| <= 1e6 (default 1.0)")
+    process.add_argument("--tau", type=float_in(0.0, MAX_SECONDS), default=1.0, help="time constant tau in seconds of emulated time, 0 to 1e9; 0 makes a pure gain with dead time (default 1.0)")
+    process.add_argument("--dead-time", "--theta", type=float_in(0.0, MAX_SECONDS), default=0.0, help="dead time theta in seconds of emulated time, 0 to 1e9 (default 0)")
     process.add_argument("--input-channel", type=channel_number, default=0, help="DAC channel n (0..7) that drives the process (default 0)")
     process.add_argument("--output-channel", type=channel_number, default=0, help="ADC channel m (0..7) that measures the process output (default 0)")
-    process.add_argument("--initial", type=float, default=0.0, help="process output y in volts at the first SAMPLE's time (default 0)")
-    process.add_argument("--initial-input", type=float, default=0.0, help="input u in volts assumed before the first SAMPLE, seen during the first dead time (default 0, the DAC's reset value)")
-    process.add_argument("--offset", type=float, default=0.0, help="steady-state output in volts at zero input (default 0)")
-    process.add_argument("--disturbance", type=float, default=0.0, help="size in volts of a load disturbance step added to the lag's target (default 0: none)")
-    process.add_argument("--disturbance-at", type=float, default=None, help="emulated time in seconds at which the disturbance steps in (default: never)")
-    process.add_argument("--noise", type=float, default=0.0, help="standard deviation in volts of Gaussian measurement noise on the output channel; the process state is noise-free (default 0)")
-    process.add_argument("--seed", type=int, default=1, help="seed of the noise generator; equal seeds give equal noise (default 1)")
+    process.add_argument("--initial", type=float_in(-MAX_VOLTS, MAX_VOLTS), default=0.0, help="process output y in volts at the first SAMPLE's time (default 0)")
+    process.add_argument("--initial-input", type=float_in(-DAC_LIMIT_V, DAC_LIMIT_V), default=0.0, help="input u in volts (-10 to 10, the DAC's range) assumed before the first SAMPLE, seen during the first dead time (default 0, the DAC's reset value)")
+    process.add_argument("--offset", type=float_in(-MAX_VOLTS, MAX_VOLTS), default=0.0, help="steady-state output in volts at zero input (default 0)")
+    process.add_argument("--disturbance", type=float_in(-MAX_VOLTS, MAX_VOLTS), default=0.0, help="size in volts of a load disturbance step added to the lag's target (default 0: none)")
+    process.add_argument("--disturbance-at", type=float_in(0.0, MAX_SECONDS), default=None, help="emulated time in seconds at which the disturbance steps in (default: never)")
+    process.add_argument("--noise", type=float_in(0.0, MAX_VOLTS), default=0.0, help="standard deviation in volts of Gaussian measurement noise on the output channel; the process state is noise-free (default 0)")
+    process.add_argument("--seed", type=int_in(-2**63, 2**63 - 1), default=1, help="seed of the noise generator; equal seeds give equal noise (default 1)")
     analog = parser.add_argument_group("other analog inputs")
     analog.add_argument("--other-inputs", choices=("zero", "loopback"), default="zero", help="what the ADC channels other than --output-channel read: 0 V, or the DAC of the same channel (default zero)")
     analog.add_argument("--ai-constant", type=parse_constant, action="append", metavar="CH=VOLTS", help="ADC channel CH reads a constant VOLTS; may be repeated; overrides --other-inputs for that channel")
@@ -465,22 +604,21 @@ def build_parser():
     digital.add_argument("--di-invert", type=hex_word, default=0, metavar="HEX", help="DI bits to invert after the mapping, as hex (default 0000)")
     transport = parser.add_argument_group("transport and logging")
     transport.add_argument("--socket", metavar="PATH", help="listen on this Unix socket for the emulator (default: use stdin and stdout)")
-    transport.add_argument("--accept-timeout", type=float, default=120.0, help="seconds to wait for the emulator to connect; 0 waits forever (default 120)")
-    transport.add_argument("--idle-timeout", type=float, default=3600.0, help="seconds without a line after which the session ends; 0 waits forever (default 3600)")
+    transport.add_argument("--accept-timeout", type=float_in(0.0, MAX_TIMEOUT_S), default=120.0, help="seconds to wait for the emulator to connect, 0 to 1e6; 0 waits forever (default 120)")
+    transport.add_argument("--idle-timeout", type=float_in(0.0, MAX_TIMEOUT_S), default=3600.0, help="seconds without a line after which the session ends, 0 to 1e6; 0 waits forever (default 3600)")
     transport.add_argument("--keep-listening", action="store_true", help="after the client disconnects, wait for the next one (the process state carries on)")
     transport.add_argument("--csv", metavar="PATH", help="write the trajectory, one row per SAMPLE: time, DACs, DO, process input (after the dead time), output, disturbance, AIs, DI")
-    transport.add_argument("--max-error-messages", type=int, default=20, help="print at most this many malformed-line messages on stderr; all are counted (default 20)")
+    transport.add_argument("--max-error-messages", type=int_in(0, 10**9), default=20, help="print at most this many malformed-line messages on stderr; all are counted (default 20)")
     return parser
 
 
 def main(argv=None):
     parser = build_parser()
     options = parser.parse_args(argv)
-    if options.tau < 0 or options.dead_time < 0:
-        parser.error("--tau and --dead-time must not be negative")
-    if options.noise < 0:
-        parser.error("--noise must not be negative")
-    simulator = PlantSimulator(options)
+    try:
+        simulator = PlantSimulator(options)
+    except OSError as error:
+        parser.error(f"--csv {options.csv}: cannot create it: {error.strerror or error}")
 
     def stop(signum, frame):
         raise KeyboardInterrupt

@@ -8,6 +8,7 @@
 
 #include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
+#include <dcos/Version.hpp>
 
 namespace iobus {
 
@@ -25,6 +26,68 @@ void printHundredths(runtime::CharacterSink& out, int32_t hundredths)
                                               : static_cast<uint32_t>(hundredths);
     runtime::format(out, "%s%lu.%02lu", hundredths < 0 ? "-" : "", static_cast<unsigned long>(magnitude / 100u),
                     static_cast<unsigned long>(magnitude % 100u));
+}
+
+// The noise of one sweep pooled over its points: every point's repeated
+// conversions scatter around that point's own mean, so the within-point sums
+// of squares add up to one estimate of the converter's noise variance with
+// sum(n_i - 1) degrees of freedom. One estimate per sweep, with its degrees
+// of freedom, lets the host judge the noise with a statistical test, where
+// the largest of many small-sample deviations exceeds a limit by chance.
+struct PooledNoise {
+    int32_t deviationHundredths; ///< The pooled standard deviation, in hundredths of an LSB, rounded.
+    uint32_t degreesOfFreedom;   ///< sum(n_i - 1) over the points.
+    uint32_t samplesPerPoint;    ///< The fewest conversions of any point (every point's count when complete).
+};
+
+PooledNoise pooledNoise(const LinearityFit& fit)
+{
+    // Within-point sum of squares x 10^4: (n x sum(x^2) - sum(x)^2) x 10^4 / n,
+    // divided before it is scaled so that it stays below 2^64 with 12-bit
+    // codes up to 10^5 conversions a point.
+    uint64_t squares = 0;
+    uint32_t freedom = 0;
+    uint32_t fewest = 0;
+    for (size_t i = 0; i < fit.count(); ++i) {
+        const LinearityFit::Point& p = fit.point(i);
+        fewest = (i == 0 || p.samples < fewest) ? p.samples : fewest;
+        if (p.samples < 2) {
+            continue;
+        }
+        const uint64_t n = p.samples;
+        const uint64_t spread = n * p.sumSquares - uint64_t{p.sum} * p.sum;
+        squares += spread / n * 10000u + spread % n * 10000u / n;
+        freedom += p.samples - 1u;
+    }
+    if (freedom == 0) {
+        return PooledNoise{0, 0, fewest};
+    }
+    const uint64_t variance = (squares + freedom / 2u) / freedom;
+    // Rounds the square root to the nearest hundredth: r + 1 when variance > r^2 + r.
+    uint64_t root = integerSquareRoot(variance);
+    if (variance - root * root > root) {
+        ++root;
+    }
+    return PooledNoise{static_cast<int32_t>(root), freedom, fewest};
+}
+
+// Prints the firmware's release and build revision, each word kept to the
+// characters a key=value field may hold, so the host can tell which firmware
+// measured a board.
+void printFirmware(runtime::CharacterSink& out)
+{
+    char revision[48];
+    const char* text = dcos::buildRevision();
+    size_t length = 0;
+    for (; text != nullptr && text[length] != '\0' && length + 1 < sizeof revision; ++length) {
+        const char c = text[length];
+        const bool plain = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '.' ||
+                           c == '-' || c == '_' || c == '+';
+        revision[length] = plain ? c : '_';
+    }
+    revision[length] = '\0';
+    runtime::format(out, "BRINGUP FIRMWARE version=%s revision=%s\r\n", dcos::versionString,
+                    length == 0 ? "unknown" : revision);
 }
 
 Status setMode(dcos::ObjectId id, ConversionMode mode)
@@ -136,6 +199,11 @@ unsigned measureChannel(runtime::CharacterSink& out, dcos::ObjectId id, unsigned
     printHundredths(out, fit.maximumErrorHundredths());
     runtime::format(out, " noise_lsb=");
     printHundredths(out, fit.noiseHundredths());
+    const PooledNoise pooled = pooledNoise(fit);
+    runtime::format(out, " noise_pooled_lsb=");
+    printHundredths(out, pooled.deviationHundredths);
+    runtime::format(out, " noise_dof=%lu samples=%lu", static_cast<unsigned long>(pooled.degreesOfFreedom),
+                    static_cast<unsigned long>(pooled.samplesPerPoint));
     runtime::format(out, " overrange=%lu points=", static_cast<unsigned long>(overranges));
     for (size_t i = 0; i < fit.count(); ++i) {
         const int32_t mean = fit.meanTenths(i);
@@ -207,6 +275,7 @@ unsigned measureInterrupts(runtime::CharacterSink& out, dcos::ObjectId id, const
 
 unsigned runBringupSteps(runtime::CharacterSink& out, dcos::ObjectId id, const BringupSettings& settings)
 {
+    printFirmware(out);
     unsigned failures = 0;
     failures += walk(out, id, true);
     failures += walk(out, id, false);
