@@ -32,6 +32,11 @@ python3-pexpect:drives the make-run console in its test
 python3-serial:lets the I/O board bring-up tool (host_tools/bringup) talk to a controller's serial console
 python3-matplotlib:draws the bring-up tool's transfer-curve pictures (PNG, Agg backend)
 python3-hypothesis:fuzzes the host tools' parsers with property-based tests (tests_renode/test_host_tools_fuzz.py)
+qemu-system-x86:runs the lab VM, Debian's Linux with real SocketCAN, as this machine's kernel may have no CAN (docs/guide/lab-vm.md)
+busybox-static:makes the lab VM's initramfs: its /init, modprobe and depmod
+iproute2:creates the lab VM's vcan and slcan interfaces (ip link)
+can-utils:candump, cansend, slcand, isotpsend and isotprecv, run in the lab VM against the Linux CAN stack (tests_renode/test_labvm.py)
+python3-can:python-can, tested in the lab VM against real SocketCAN (tests_renode/test_labvm.py)
 "
 
 missing=""

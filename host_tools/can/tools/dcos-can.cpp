@@ -5,11 +5,14 @@
 //     dcos-can -i can0 dump [-n N] [-t MS] [--decode] [--json]
 //     dcos-can -i slcan:/dev/ttyACM0@500000 send 1ABCDEF0#0102 [123#R ...]
 //     dcos-can -i can0 stats [-s SECONDS] [--bitrate B] [--json]
+//     dcos-can -i can0 isotp-send -s 7E0 -d 7E8 "01 02 03 ..."   (as can-utils' isotpsend)
+//     dcos-can -i can0 isotp-recv -s 7E8 -d 7E0 [-t MS]          (as isotprecv)
 //
 // Exit status: 0 done; 1 dump ended before -n frames, or send was refused;
 // 2 bad arguments; 3 the interface kind is not available here (no
 // SocketCAN in this kernel, no such device); 4 the interface failed
 // (open, I/O, the other end went away).
+#include <hostcan/IsoTpEndpoint.hpp>
 #include <hostcan/Transport.hpp>
 
 #include <can/FrameText.hpp>
@@ -22,6 +25,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -254,6 +258,117 @@ int stats(hostcan::Transport& transport, double seconds, uint32_t bitRate, bool 
     return kExitOk;
 }
 
+// An ISO-TP identifier as isotpsend takes it: hexadecimal, extended when it
+// does not fit 11 bits or is written with 8 digits.
+bool parseIsoTpId(const std::string& text, uint32_t& id, bool& extended)
+{
+    if (text.empty() || text.size() > 8) {
+        return false;
+    }
+    size_t used = 0;
+    unsigned long value = 0;
+    try {
+        value = std::stoul(text, &used, 16);
+    } catch (const std::exception&) {
+        return false;
+    }
+    if (used != text.size() || value > can::CanFrame::kMaxExtendedId) {
+        return false;
+    }
+    id = static_cast<uint32_t>(value);
+    extended = value > can::CanFrame::kMaxStandardId || text.size() == 8;
+    return true;
+}
+
+struct IsoTpOptions {
+    std::string source;
+    std::string destination;
+    std::string data;
+    long timeoutMs = 10'000;
+    bool padding = false;
+};
+
+bool isoTpConfig(const IsoTpOptions& options, can::IsoTpConfig& config)
+{
+    bool sourceExtended = false;
+    bool destinationExtended = false;
+    if (!parseIsoTpId(options.source, config.txId, sourceExtended) ||
+        !parseIsoTpId(options.destination, config.rxId, destinationExtended)) {
+        fmt::print(stderr, "dcos-can: '{}' and '{}' must be CAN identifiers in hexadecimal, e.g. 7E0 or 18DA00F1\n",
+                   options.source, options.destination);
+        return false;
+    }
+    config.format = sourceExtended || destinationExtended ? can::IdFormat::Extended : can::IdFormat::Standard;
+    config.padding.enabled = options.padding;
+    return true;
+}
+
+int isoTpResult(const hostcan::IsoTpOutcome& outcome)
+{
+    if (outcome.transport) {
+        return fail(outcome.transport);
+    }
+    if (outcome.error != can::LinkError::Ok) {
+        fmt::print(stderr, "dcos-can: ISO-TP transfer failed: {}\n", can::linkErrorName(outcome.error));
+        return kExitIncomplete;
+    }
+    return kExitOk;
+}
+
+int isoTpSend(hostcan::Transport& transport, const can::IsoTpConfig& config, const std::vector<uint8_t>& message,
+              bool json)
+{
+    const hostcan::IsoTpOutcome outcome = hostcan::isoTpSend(transport, config, message);
+    const int status = isoTpResult(outcome);
+    if (status == kExitOk && json) {
+        fmt::print("{}\n", nlohmann::json{{"interface", transport.name()}, {"sent_bytes", message.size()}}.dump());
+    }
+    return status;
+}
+
+int isoTpReceive(hostcan::Transport& transport, const can::IsoTpConfig& config, long timeoutMs, bool json)
+{
+    const hostcan::IsoTpOutcome outcome =
+        hostcan::isoTpReceive(transport, config, std::chrono::milliseconds(timeoutMs));
+    const int status = isoTpResult(outcome);
+    if (status != kExitOk) {
+        return status;
+    }
+    std::string text;
+    for (uint8_t byte : outcome.message) {
+        text += fmt::format("{}{:02X}", text.empty() ? "" : " ", byte);
+    }
+    if (json) {
+        fmt::print("{}\n", nlohmann::json{{"interface", transport.name()}, {"length", outcome.message.size()},
+                                          {"data", text}}.dump());
+    } else {
+        fmt::print("{} \n", text); // isotprecv's form: bytes, then a space before the line end.
+    }
+    return kExitOk;
+}
+
+// "01 02 ff" or "0102ff" into bytes; false for anything else.
+bool parseBytes(const std::string& text, std::vector<uint8_t>& bytes)
+{
+    std::string digits;
+    for (char c : text) {
+        if (c == ' ') {
+            continue;
+        }
+        if (!std::isxdigit(static_cast<unsigned char>(c))) {
+            return false;
+        }
+        digits += c;
+    }
+    if (digits.empty() || digits.size() % 2 != 0 || digits.size() / 2 > 4095) {
+        return false;
+    }
+    for (size_t i = 0; i < digits.size(); i += 2) {
+        bytes.push_back(static_cast<uint8_t>(std::stoul(digits.substr(i, 2), nullptr, 16)));
+    }
+    return true;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -293,6 +408,23 @@ int main(int argc, char** argv)
     statsCommand->add_option("--bitrate", bitRate, "the bus's bit rate, for the load")
         ->check(CLI::Range(1'000u, 1'000'000u));
 
+    IsoTpOptions isoTp;
+    CLI::App* isoTpSendCommand = app.add_subcommand("isotp-send", "send one ISO 15765-2 message, as isotpsend does");
+    isoTpSendCommand->add_option("-s,--source", isoTp.source, "the identifier this end sends on (hex)")->required();
+    isoTpSendCommand->add_option("-d,--destination", isoTp.destination, "the identifier of the flow control (hex)")
+        ->required();
+    isoTpSendCommand->add_option("data", isoTp.data, "1 to 4095 bytes in hexadecimal, e.g. \"01 02 03\"")->required();
+    isoTpSendCommand->add_flag("-p,--padding", isoTp.padding, "pad every frame to 8 bytes with 0xCC");
+    CLI::App* isoTpReceiveCommand =
+        app.add_subcommand("isotp-recv", "receive one ISO 15765-2 message and print it, as isotprecv does");
+    isoTpReceiveCommand->add_option("-s,--source", isoTp.source, "the identifier of the flow control this end sends (hex)")
+        ->required();
+    isoTpReceiveCommand->add_option("-d,--destination", isoTp.destination, "the identifier the message comes on (hex)")
+        ->required();
+    isoTpReceiveCommand->add_option("-t,--timeout-ms", isoTp.timeoutMs, "how long to wait for the message to begin")
+        ->check(CLI::Range(1L, 86'400'000L));
+    isoTpReceiveCommand->add_flag("-p,--padding", isoTp.padding, "pad the flow control to 8 bytes with 0xCC");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {
@@ -305,6 +437,15 @@ int main(int argc, char** argv)
     if (*sendCommand && !parseFrames(frames, parsed)) {
         return kExitUsage;
     }
+    can::IsoTpConfig isoTpSettings;
+    std::vector<uint8_t> message;
+    if ((*isoTpSendCommand || *isoTpReceiveCommand) && !isoTpConfig(isoTp, isoTpSettings)) {
+        return kExitUsage;
+    }
+    if (*isoTpSendCommand && !parseBytes(isoTp.data, message)) {
+        fmt::print(stderr, "dcos-can: '{}' is not 1 to 4095 bytes in hexadecimal\n", isoTp.data);
+        return kExitUsage;
+    }
     TransportError error;
     const std::unique_ptr<hostcan::Transport> transport = hostcan::openTransport(interface, error);
     if (!transport) {
@@ -315,6 +456,12 @@ int main(int argc, char** argv)
     }
     if (*sendCommand) {
         return send(*transport, parsed, sendTimeoutMs, json);
+    }
+    if (*isoTpSendCommand) {
+        return isoTpSend(*transport, isoTpSettings, message, json);
+    }
+    if (*isoTpReceiveCommand) {
+        return isoTpReceive(*transport, isoTpSettings, isoTp.timeoutMs, json);
     }
     return stats(*transport, seconds, bitRate, json);
 }

@@ -1,7 +1,8 @@
 // An slcan (Lawicel) adapter as a transport: CANable, USBtin and the like on
-// a serial device, or the same protocol over a unix socket (the lab VM's
-// second serial port). The line protocol is the link layer's SlcanCodec
-// (fieldbus/can), the same code the firmware would use as an adapter.
+// a serial device, or the same protocol over a unix socket (an adapter that
+// a lab program emulates, a serial server).
+// The line protocol is the link layer's SlcanCodec (fieldbus/can), the same
+// code the firmware would use as an adapter.
 //
 // Opening closes the channel (`C`), sets the bit rate (`Sn`) and opens it
 // (`O`), and checks each reply: an adapter that answers BELL, or nothing

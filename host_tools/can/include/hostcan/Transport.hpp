@@ -85,7 +85,7 @@ public:
 ///
 ///     can0, vcan0, slcan0 ...         SocketCAN network interface (raw socket, error frames on)
 ///     slcan:/dev/ttyACM0[@bitrate]    an slcan (Lawicel) adapter on a serial device, default 500000 bit/s
-///     slcan-socket:/path[@bitrate]    the same protocol over a unix socket (the lab VM's serial port)
+///     slcan-socket:/path[@bitrate]    an slcan adapter behind a unix socket (we play the host side)
 ///     lab:/path/to/hub.sock:bus       a participant of the lab's CAN bus hub
 ///
 /// BadArgument for a name of none of these forms.
