@@ -336,40 +336,13 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
     return CommandResult::Ok;
 }
 
-struct Subcommand {
-    const char* name;
-    CommandResult (*run)(shell::Shell& shell, int argc, char** argv);
-};
-
-constexpr Subcommand kSubcommands[] = {
+constexpr shell::Subcommand kSubcommands[] = {
     {"up", up}, {"down", down}, {"send", send}, {"dump", dump}, {"state", state}, {"stats", statistics},
 };
 
-bool equal(const char* a, const char* b)
-{
-    while (*a != '\0' && *a == *b) {
-        ++a;
-        ++b;
-    }
-    return *a == *b;
-}
-
 CommandResult canCommand(shell::Shell& shell, int argc, char** argv)
 {
-    if (argc < 2) {
-        return CommandResult::UsageError;
-    }
-    for (const Subcommand& subcommand : kSubcommands) {
-        if (equal(argv[1], subcommand.name)) {
-            return subcommand.run(shell, argc, argv);
-        }
-    }
-    shell.print("error: unknown subcommand '%s': the subcommands are", argv[1]);
-    for (const Subcommand& subcommand : kSubcommands) {
-        shell.print(" %s", subcommand.name);
-    }
-    shell.print("\r\n");
-    return CommandResult::Failed;
+    return shell::runSubcommand(shell, argc, argv, kSubcommands);
 }
 
 } // namespace

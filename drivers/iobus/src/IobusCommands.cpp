@@ -398,45 +398,14 @@ CommandResult statistics(shell::Shell& shell, int argc, char**)
     return CommandResult::Ok;
 }
 
-struct Subcommand {
-    const char* name;
-    CommandResult (*run)(shell::Shell& shell, int argc, char** argv);
-};
-
-constexpr Subcommand kSubcommands[] = {
+constexpr shell::Subcommand kSubcommands[] = {
     {"probe", probe},         {"read", read},       {"write", write},           {"gain", gain},
     {"bringup", bringup},     {"resources", resources}, {"stats", statistics},
 };
 
-bool equal(const char* a, const char* b)
-{
-    for (unsigned i = 0; i < 16; ++i) {
-        if (a[i] != b[i]) {
-            return false;
-        }
-        if (a[i] == '\0') {
-            return true;
-        }
-    }
-    return false;
-}
-
 CommandResult iobus(shell::Shell& shell, int argc, char** argv)
 {
-    if (argc < 2) {
-        return CommandResult::UsageError;
-    }
-    for (const Subcommand& subcommand : kSubcommands) {
-        if (equal(argv[1], subcommand.name)) {
-            return subcommand.run(shell, argc, argv);
-        }
-    }
-    shell.print("error: unknown subcommand '%s': the subcommands are", argv[1]);
-    for (const Subcommand& subcommand : kSubcommands) {
-        shell.print(" %s", subcommand.name);
-    }
-    shell.print("\r\n");
-    return CommandResult::Failed;
+    return shell::runSubcommand(shell, argc, argv, kSubcommands);
 }
 
 } // namespace

@@ -1,4 +1,5 @@
-// Commands every image has: help and echo.
+// Commands every image has, help and echo, and the subcommand dispatch
+// commands with several subcommands share.
 #include <shell/Shell.hpp>
 
 namespace shell {
@@ -61,6 +62,30 @@ CommandResult echo(Shell& shell, int argc, char** argv)
 }
 
 } // namespace
+
+CommandResult runSubcommand(Shell& shell, int argc, char** argv, const Subcommand* table, size_t count)
+{
+    if (argc < 2) {
+        return CommandResult::UsageError;
+    }
+    for (size_t i = 0; i < count; ++i) {
+        const char* a = argv[1];
+        const char* b = table[i].name;
+        while (*a != '\0' && *a == *b) {
+            ++a;
+            ++b;
+        }
+        if (*a == *b) {
+            return table[i].run(shell, argc, argv);
+        }
+    }
+    shell.print("error: unknown subcommand '%s': the subcommands are", argv[1]);
+    for (size_t i = 0; i < count; ++i) {
+        shell.print(" %s", table[i].name);
+    }
+    shell.print("\r\n");
+    return CommandResult::Failed;
+}
 
 DCOS_SHELL_COMMAND(helpCommand, "help", "list commands, or show one command's usage", "help [command]", help);
 DCOS_SHELL_COMMAND(echoCommand, "echo", "print the arguments", "echo [text...]", echo);

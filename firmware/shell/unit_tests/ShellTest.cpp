@@ -154,3 +154,46 @@ TEST(Shell, ParseUnsignedAcceptsDecimalAndHexOnly)
 }
 
 } // namespace
+
+namespace {
+
+shell::CommandResult firstSubcommand(shell::Shell& shell, int, char**)
+{
+    shell.print("first\r\n");
+    return shell::CommandResult::Ok;
+}
+
+shell::CommandResult secondSubcommand(shell::Shell& shell, int argc, char** argv)
+{
+    shell.print("second %d %s\r\n", argc, argv[1]);
+    return shell::CommandResult::Failed;
+}
+
+constexpr shell::Subcommand kTestSubcommands[] = {{"first", firstSubcommand}, {"second", secondSubcommand}};
+
+TEST(Subcommands, RunTheNamedOneAndNameAnUnknownOneWithTheList)
+{
+    StringSink out;
+    shell::Shell shell(out, "> ");
+    char first[] = "first";
+    char second[] = "second";
+    char fir[] = "fir";
+    char firstly[] = "firstly";
+    char command[] = "cmd";
+    char* argv[] = {command, first, nullptr};
+    EXPECT_EQ(shell::runSubcommand(shell, 2, argv, kTestSubcommands), shell::CommandResult::Ok);
+    EXPECT_EQ(out.take(), "first\r\n");
+    argv[1] = second;
+    EXPECT_EQ(shell::runSubcommand(shell, 2, argv, kTestSubcommands), shell::CommandResult::Failed);
+    EXPECT_EQ(out.take(), "second 2 second\r\n");
+    for (char* unknown : {fir, firstly}) {
+        argv[1] = unknown;
+        EXPECT_EQ(shell::runSubcommand(shell, 2, argv, kTestSubcommands), shell::CommandResult::Failed);
+        EXPECT_EQ(out.take(), "error: unknown subcommand '" + std::string(unknown) +
+                                  "': the subcommands are first second\r\n");
+    }
+    EXPECT_EQ(shell::runSubcommand(shell, 1, argv, kTestSubcommands), shell::CommandResult::UsageError);
+    EXPECT_EQ(out.take(), "");
+}
+
+} // namespace

@@ -33,6 +33,24 @@ struct ShellCommand {
     const char* details = nullptr;
 };
 
+/// One subcommand of a command that has several (`iobus read`, `can up`).
+struct Subcommand {
+    const char* name;
+    /// Runs the subcommand; argv[0] is the command, argv[1] the subcommand.
+    CommandResult (*run)(Shell& shell, int argc, char** argv);
+};
+
+/// Runs the subcommand argv[1] names from @p table (@p count entries). With
+/// no subcommand it is a usage error; an unknown one is named, with the list.
+CommandResult runSubcommand(Shell& shell, int argc, char** argv, const Subcommand* table, size_t count);
+
+/// The same for a table array.
+template <size_t Count>
+CommandResult runSubcommand(Shell& shell, int argc, char** argv, const Subcommand (&table)[Count])
+{
+    return runSubcommand(shell, argc, argv, table, Count);
+}
+
 /// The commands linked into this image, in link order.
 class CommandTable {
 public:
