@@ -26,8 +26,10 @@ class EmulatorError(AssertionError):
 
 class Emulator:
     def __init__(self, board, image, append="", icount=False, cpu=None, memory_mib=None, accel=None,
-                 device_properties=None, without_devices=(), extra_args=()):
+                 device_properties=None, without_devices=(), extra_args=(), name=None):
         self.board = board
+        # What failures call this emulator, e.g. "board2" among several boards.
+        self.name = name or board.name
         self.image = image
         self.append = append
         self.icount = icount
@@ -133,7 +135,7 @@ class Emulator:
         transcript = self.transcript
         code = explain(transcript, self.image)
         return EmulatorError(
-            f"{what}\n----- console transcript -----\n{transcript}\n----- end of transcript -----\n"
+            f"{self.name}: {what}\n----- console transcript -----\n{transcript}\n----- end of transcript -----\n"
             + (f"----- code addresses in the transcript ({self.image}) -----\n{code}" if code else "")
             + (f"emulator said: {self.emulator_messages()}" if self.emulator_messages() else "")
         )

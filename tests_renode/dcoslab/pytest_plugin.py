@@ -11,10 +11,14 @@ Fixtures:
 - `dcos_board`: the board named by --dcos-board (default isa486);
 - `dcos_image`: the image named by --dcos-image (an application's tests);
 - `application`: a booted emulator running --dcos-image on --dcos-board,
-  with exact emulated time (-icount), at its first shell prompt.
+  with exact emulated time (-icount), at its first shell prompt;
+- `canlab(buses, wiring, pace=None, kind="test")`: the CAN bus hub with
+  the named buses and bit rates, and the boards wired to them, booted in
+  step (dcoslab/canlab.py).
 
-The console transcript of every emulator a test started is attached to the
-report of a failing test, so it is always printed with the failure.
+The console transcript of every emulator a test started, and the bus log of
+every CAN hub, are attached to the report of a failing test, so they are
+always printed with the failure.
 """
 
 import os
@@ -22,6 +26,7 @@ import os
 import pytest
 
 from .board import load_board
+from .canlab import CanLab
 from .emulator import Emulator
 from .symbolize import explain
 
@@ -66,16 +71,37 @@ def boot(request):
     request.node.dcos_emulators = started
 
     def start(board, kind="production", append="", icount=False, device_properties=None, without_devices=(),
-              extra_args=()):
+              extra_args=(), name=None):
         image = kind if os.path.sep in kind else board.image(kind)
         emulator = Emulator(board, image, append=append, icount=icount, device_properties=device_properties,
-                            without_devices=without_devices, extra_args=extra_args)
+                            without_devices=without_devices, extra_args=extra_args, name=name)
         started.append(emulator)
         return emulator.start()
 
     yield start
     for emulator in started:
         emulator.close()
+
+
+@pytest.fixture
+def canlab(request, boot, isa486):
+    """canlab(buses, wiring, pace=None, kind="test") -> CanLab, stopped after the test.
+
+    buses maps bus names to bit rates ({"can0": 500_000}); wiring maps board
+    names to their card's channels ({"board1": {"bus0": "can0"}}). The ISA
+    486 board is booted once per name, in step with the others.
+    """
+    labs = []
+    request.node.dcos_canlabs = labs
+
+    def start(buses, wiring, pace=None, kind="test"):
+        lab = CanLab(boot, isa486, buses, wiring, pace=pace, kind=kind)
+        labs.append(lab)
+        return lab
+
+    yield start
+    for lab in labs:
+        lab.close()
 
 
 @pytest.fixture
@@ -93,8 +119,14 @@ def pytest_runtest_makereport(item, call):
     if report.failed:
         for index, emulator in enumerate(getattr(item, "dcos_emulators", [])):
             report.sections.append(
-                (f"console transcript of emulator {index + 1}: {' '.join(getattr(emulator, 'argv', []))}", emulator.transcript)
+                (f"console transcript of emulator {index + 1} ({emulator.name}): "
+                 f"{' '.join(getattr(emulator, 'argv', []))}", emulator.transcript)
             )
             code = explain(emulator.transcript, getattr(emulator, "image", None))
             if code:
                 report.sections.append((f"code addresses in the transcript of emulator {index + 1}", code))
+        for index, lab in enumerate(getattr(item, "dcos_canlabs", [])):
+            hub = lab.hub
+            problems = "".join(f"hub error: {error}\n" for error in hub.errors)
+            report.sections.append((f"CAN bus log of lab {index + 1} ({', '.join(f'{bus.name} {bus.bitrate} bit/s' for bus in hub.buses.values())}, "
+                                    f"quantum {hub.quantum_ns} ns)", problems + hub.log_text()))

@@ -1,0 +1,2485 @@
+/*
+ * DCOS two-channel ISA SJA1000 CAN card ("isa-sja1000") and the link that
+ * joins a board to the lab's CAN bus hub ("labbus-link").
+ *
+ * The card is a PC/104-style board with two Philips/NXP SJA1000 stand-alone
+ * CAN controllers, port mapped: channel 0 answers the 32 ports from iobase,
+ * channel 1 the 32 ports from iobase + 0x20 (register n of a chip at port
+ * base + n, as Linux's sja1000_isa driver addresses a port-mapped chip with
+ * reg_shift 0). Each channel has its own ISA interrupt line. The chips run
+ * from the usual 16 MHz crystal (CAN clock 8 MHz), so BRP 0 is a time
+ * quantum of 125 ns.
+ *
+ * The chip itself is QEMU's reviewed SJA1000 core (hw/net/can/can_sja1000.c):
+ * register file, acceptance filters, receive FIFO, frame buffers, BasicCAN
+ * and PeliCAN modes. That core is idealised: a transmission completes inside
+ * the register write, BTR0/BTR1 and the error counters read as constants and
+ * there is no fault confinement. This front end therefore takes over what
+ * the core lacks, reading and writing the core's public state
+ * (CanSJA1000State) where the two meet:
+ *
+ *  - the bus timing registers, decoded into a bit time and sample point;
+ *  - transmission: TR, SRR and single shot (AT with TR or SRR) go to the bus
+ *    with the exact emulated time of the register write, and complete only
+ *    when the bus says so (TBS, TCS, TS, TI; ALI and ALC on lost
+ *    arbitration); AT cancels a request not yet under way;
+ *  - the error counters RXERR and TXERR, EWLR, ECC and the error states of
+ *    ISO 11898-1 fault confinement (error active, warning ES, error passive
+ *    with EPI, bus-off BS with the chip entering reset mode) and their
+ *    interrupts EI, EPI and BEI;
+ *  - reception: frames are handed to the core's can_sja_receive at their
+ *    exact emulated completion time, from a QEMU_CLOCK_VIRTUAL timer;
+ *  - listen-only (no acknowledge, no transmission, frozen counters), self
+ *    test, sleep and wake-up.
+ *
+ * A channel named to a lab bus (bus0, bus1) joins the hub through the
+ * card's link (properties hub and hub-name), a child object that holds the
+ * board's emulated time at quantum boundaries so that every board on the
+ * hub stays in step. (QEMU 7.2 creates with -object only the types its
+ * QAPI schema lists, so the link is made by the card rather than by the
+ * user; one board has one link, so one card per board may use a hub.) The hub
+ * is tests_renode/dcoslab/canbus.py; docs/protocols/labbus.md specifies the
+ * protocol, the lock-step and the timing model this file follows. A channel
+ * without a bus is a chip on a bus with no other node: the card simulates
+ * that lone bus itself, with the same timing model, so its frames are never
+ * acknowledged.
+ *
+ * Register names and sections ("DS 6.4.5") refer to the SJA1000 data sheet
+ * (Philips Semiconductors, product specification, 2000 Jan 04).
+ *
+ * This file lives in the DCOS repository under tests_renode/models/ and is
+ * copied into Debian's QEMU 7.2 source tree by
+ * tests_renode/qemu/build_qemu.sh.
+ *
+ * This program is free software; you can redistribute it and/or
+ * modify it under the terms of the GNU General Public License as
+ * published by the Free Software Foundation; either version 2 or
+ * (at your option) any later version.
+ */
+
+#include "qemu/osdep.h"
+#include "qemu/cutils.h"
+#include "qemu/error-report.h"
+#include "qemu/main-loop.h"
+#include "qemu/module.h"
+#include "qemu/queue.h"
+#include "qemu/timer.h"
+#include "qapi/error.h"
+#include "qom/object.h"
+#include "hw/irq.h"
+#include "hw/isa/isa.h"
+#include "hw/qdev-properties.h"
+#include "hw/net/can/can_sja1000.h"
+#include "net/can_emu.h"
+#include "sysemu/cpu-timers.h"
+
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+
+/* ======================================================================== */
+/* The lab bus link                                                          */
+/* ======================================================================== */
+
+#define TYPE_LABBUS_LINK "labbus-link"
+OBJECT_DECLARE_SIMPLE_TYPE(LabBusLink, LABBUS_LINK)
+
+/* The protocol version of docs/protocols/labbus.md this file speaks. */
+#define LABBUS_PROTOCOL_VERSION 1
+/* The longest line either side may send, newline included. */
+#define LABBUS_LINE_MAX 256
+/* The most words in one line (the longest, RX, has 9). */
+#define LABBUS_MAX_WORDS 16
+/* Ports one board's link may attach (the card's channels take two). */
+#define LABBUS_MAX_PORTS 8
+
+typedef void (*LabBusEventFn)(void *opaque, int argc, char **argv);
+
+typedef struct LabBusPort {
+    char *bus;
+    LabBusEventFn event;
+    void *opaque;
+} LabBusPort;
+
+struct LabBusLink {
+    Object parent_obj;
+
+    /* Properties. */
+    char *path;
+    char *name;
+    uint32_t timeout_s;
+
+    int fd;
+    uint64_t quantum_ns;
+    QEMUTimer *boundary_timer;
+    /* The boundary the timer is set for. */
+    int64_t boundary;
+    LabBusPort ports[LABBUS_MAX_PORTS];
+    unsigned port_count;
+    /* Bytes received and not yet consumed as lines. */
+    char input[LABBUS_LINE_MAX * 8];
+    size_t input_length;
+    /* Quantum boundaries held so far; readable as "boundaries". */
+    uint64_t boundaries;
+    /* Boundaries reached late (see labbus_link_boundary). */
+    uint64_t late_boundaries;
+};
+
+/*
+ * The link cannot go on without the hub: the board's emulated time is only
+ * meaningful in step with the others. A dead or silent hub therefore ends
+ * the emulator with a message, which the lab prints with the console
+ * transcript, instead of letting the board run on alone.
+ */
+static G_NORETURN void labbus_link_fatal(LabBusLink *link,
+                                         const char *format, ...)
+    G_GNUC_PRINTF(2, 3);
+
+static void labbus_link_fatal(LabBusLink *link, const char *format, ...)
+{
+    va_list args;
+    char *why;
+
+    va_start(args, format);
+    why = g_strdup_vprintf(format, args);
+    va_end(args);
+    error_report("labbus-link %s: %s; the board cannot keep in step with the "
+                 "lab bus and stops", link->name ? link->name : "?", why);
+    g_free(why);
+    exit(EXIT_FAILURE);
+}
+
+static int64_t labbus_remaining_ms(int64_t deadline_ms)
+{
+    int64_t remaining = deadline_ms - qemu_clock_get_ms(QEMU_CLOCK_REALTIME);
+
+    return remaining > 0 ? remaining : 0;
+}
+
+/* Sends one whole line; false if the hub is gone or took none in time. */
+static bool labbus_send_raw(LabBusLink *link, const char *text, size_t length)
+{
+    int64_t deadline_ms = qemu_clock_get_ms(QEMU_CLOCK_REALTIME) +
+                          (int64_t)link->timeout_s * 1000;
+    size_t sent = 0;
+
+    while (sent < length) {
+        ssize_t count = send(link->fd, text + sent, length - sent,
+                             MSG_NOSIGNAL | MSG_DONTWAIT);
+
+        if (count > 0) {
+            sent += count;
+        } else if (count < 0 && errno == EINTR) {
+            continue;
+        } else if (count < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            struct pollfd pfd = { .fd = link->fd, .events = POLLOUT };
+            int64_t remaining = labbus_remaining_ms(deadline_ms);
+
+            if (remaining == 0 || poll(&pfd, 1, remaining) <= 0) {
+                return false;
+            }
+        } else {
+            return false;
+        }
+    }
+    return true;
+}
+
+static void G_GNUC_PRINTF(2, 3)
+labbus_link_send(LabBusLink *link, const char *format, ...)
+{
+    char line[LABBUS_LINE_MAX];
+    va_list args;
+    int length;
+
+    va_start(args, format);
+    length = vsnprintf(line, sizeof(line) - 1, format, args);
+    va_end(args);
+    if (length < 0 || length >= (int)sizeof(line) - 1) {
+        labbus_link_fatal(link, "a message did not fit in %d bytes",
+                          LABBUS_LINE_MAX);
+    }
+    line[length++] = '\n';
+    if (!labbus_send_raw(link, line, length)) {
+        labbus_link_fatal(link, "could not send to the hub at %s (%s)",
+                          link->path, strerror(errno));
+    }
+}
+
+/*
+ * Returns the next line from the hub without its newline, or NULL with
+ * *why set when the hub closed the connection, sent a line that is too
+ * long, or sent nothing for timeout_s seconds. The line stays valid until
+ * the next call.
+ */
+static char *labbus_read_line(LabBusLink *link, const char **why)
+{
+    static char line[LABBUS_LINE_MAX];
+    int64_t deadline_ms = qemu_clock_get_ms(QEMU_CLOCK_REALTIME) +
+                          (int64_t)link->timeout_s * 1000;
+
+    for (;;) {
+        char *newline = memchr(link->input, '\n', link->input_length);
+        ssize_t count;
+
+        if (newline) {
+            size_t length = newline - link->input;
+
+            if (length >= sizeof(line)) {
+                *why = "the hub sent a line that is too long";
+                return NULL;
+            }
+            memcpy(line, link->input, length);
+            line[length] = '\0';
+            if (length > 0 && line[length - 1] == '\r') {
+                line[length - 1] = '\0';
+            }
+            link->input_length -= length + 1;
+            memmove(link->input, newline + 1, link->input_length);
+            return line;
+        }
+        if (link->input_length >= sizeof(link->input)) {
+            *why = "the hub sent a line that is too long";
+            return NULL;
+        }
+        count = recv(link->fd, link->input + link->input_length,
+                     sizeof(link->input) - link->input_length, MSG_DONTWAIT);
+        if (count > 0) {
+            link->input_length += count;
+        } else if (count == 0) {
+            *why = "the hub closed the connection";
+            return NULL;
+        } else if (errno == EINTR) {
+            continue;
+        } else if (errno == EAGAIN || errno == EWOULDBLOCK) {
+            struct pollfd pfd = { .fd = link->fd, .events = POLLIN };
+            int64_t remaining = labbus_remaining_ms(deadline_ms);
+            int ready;
+
+            if (remaining == 0) {
+                *why = "the hub did not answer in time";
+                return NULL;
+            }
+            ready = poll(&pfd, 1, remaining);
+            if (ready < 0 && errno != EINTR) {
+                *why = "poll() on the hub connection failed";
+                return NULL;
+            }
+        } else {
+            *why = "reading from the hub failed";
+            return NULL;
+        }
+    }
+}
+
+/* Splits line in place at spaces; returns the number of words. */
+static int labbus_split(char *line, char **argv)
+{
+    int argc = 0;
+    char *cursor = line;
+
+    while (*cursor && argc < LABBUS_MAX_WORDS) {
+        while (*cursor == ' ') {
+            cursor++;
+        }
+        if (!*cursor) {
+            break;
+        }
+        argv[argc++] = cursor;
+        while (*cursor && *cursor != ' ') {
+            cursor++;
+        }
+        if (*cursor) {
+            *cursor++ = '\0';
+        }
+    }
+    return argc;
+}
+
+static bool labbus_parse_u64(const char *text, uint64_t *value)
+{
+    const char *end;
+
+    return qemu_strtou64(text, &end, 10, value) == 0 && *end == '\0';
+}
+
+/* Hands one event line to the port it names. */
+static void labbus_dispatch(LabBusLink *link, char *line)
+{
+    char *argv[LABBUS_MAX_WORDS];
+    int argc = labbus_split(line, argv);
+    uint64_t port;
+
+    if (argc == 0) {
+        return;
+    }
+    if (!strcmp(argv[0], "ERROR")) {
+        labbus_link_fatal(link, "the hub reported an error: %s",
+                          argc > 1 ? argv[1] : "(no reason)");
+    }
+    if (argc < 4 || !labbus_parse_u64(argv[1], &port) ||
+        port >= link->port_count) {
+        labbus_link_fatal(link, "the hub sent '%s', which is no event for a "
+                          "port of this board", argv[0]);
+    }
+    link->ports[port].event(link->ports[port].opaque, argc, argv);
+}
+
+/*
+ * The lock-step (docs/protocols/labbus.md, "Lock-step"): at every quantum
+ * boundary the board reports SYNC and waits for the hub's GO, taking in the
+ * events the hub sends before it. Under -icount this callback runs in the
+ * vCPU thread with the big lock held and the guest's budget ends exactly
+ * at the deadline, so the board stands still at the boundary to the
+ * nanosecond. The lock is kept while waiting: releasing it would let the
+ * main loop stop or reset the machine while this callback cannot return.
+ */
+static void labbus_link_boundary(void *opaque)
+{
+    LabBusLink *link = opaque;
+    int64_t now = qemu_clock_get_ns(QEMU_CLOCK_VIRTUAL);
+    const char *why = NULL;
+
+    /*
+     * A timer is out of its list while its callback runs, and QEMU's
+     * icount skips an idle vCPU's clock to the next deadline whenever a
+     * QEMU_CLOCK_VIRTUAL timer becomes the first of its list
+     * (timerlist_rearm). The events taken in below arm the card's timers:
+     * without this timer in the list, such a skip would carry the board
+     * past the boundary it is holding at. Set for now, it keeps the
+     * deadline at zero until GO sets the next boundary.
+     */
+    timer_mod_ns(link->boundary_timer, now);
+
+    /*
+     * The boundary is the one the hub set, even if the clock is past it.
+     * Under -icount,sleep=off the main loop skips an idle vCPU's clock to
+     * the next deadline; a vCPU that an I/O thread woke a moment before can
+     * still execute a few hundred instructions during that skip, so now and
+     * then the timer runs that many nanoseconds late. The hub is told by
+     * how much, and takes what the board sent in that time as sent in the
+     * next quantum.
+     */
+    if (now > link->boundary) {
+        link->late_boundaries++;
+        labbus_link_send(link, "SYNC %" PRId64 " %" PRId64, link->boundary,
+                         now - link->boundary);
+    } else {
+        labbus_link_send(link, "SYNC %" PRId64, link->boundary);
+    }
+    for (;;) {
+        char *line = labbus_read_line(link, &why);
+        uint64_t next;
+
+        if (!line) {
+            labbus_link_fatal(link, "at boundary %" PRId64 " ns: %s", now,
+                              why);
+        }
+        if (!strncmp(line, "GO ", 3)) {
+            if (!labbus_parse_u64(line + 3, &next) ||
+                (int64_t)next <= link->boundary) {
+                labbus_link_fatal(link, "the hub sent '%s' at boundary %"
+                                  PRId64 " ns", line, now);
+            }
+            link->boundaries++;
+            link->boundary = next;
+            timer_mod_ns(link->boundary_timer, next);
+            return;
+        }
+        labbus_dispatch(link, line);
+    }
+}
+
+/*
+ * Attaches one port to the named bus; called by a device at realize.
+ * Returns the port number, or -1 with errp set.
+ */
+static int labbus_link_attach(LabBusLink *link, const char *bus,
+                              const char *label, LabBusEventFn event,
+                              void *opaque, Error **errp)
+{
+    unsigned port = link->port_count;
+    const char *why = NULL;
+    char *line;
+
+    if (port >= LABBUS_MAX_PORTS) {
+        error_setg(errp, "labbus-link %s: no more than %d ports per board",
+                   link->name, LABBUS_MAX_PORTS);
+        return -1;
+    }
+    link->ports[port].bus = g_strdup(bus);
+    link->ports[port].event = event;
+    link->ports[port].opaque = opaque;
+    link->port_count++;
+    labbus_link_send(link, "ATTACH %u %s %s", port, bus, label);
+    line = labbus_read_line(link, &why);
+    if (!line) {
+        error_setg(errp, "labbus-link %s: attaching to bus %s: %s",
+                   link->name, bus, why);
+        return -1;
+    }
+    if (!strncmp(line, "ATTACHED ", 9)) {
+        return port;
+    }
+    if (!strncmp(line, "REFUSED ", 8)) {
+        /* "REFUSED <port> <reason...>": the reason follows the number. */
+        const char *reason = strchr(line + 8, ' ');
+
+        error_setg(errp, "labbus-link %s: the hub refused bus %s: %s",
+                   link->name, bus, reason ? reason + 1 : line + 8);
+        return -1;
+    }
+    error_setg(errp, "labbus-link %s: the hub answered ATTACH with '%s'",
+               link->name, line);
+    return -1;
+}
+
+/*
+ * Connects to the hub and greets it; the first quantum boundary is armed.
+ * Called by the card at realize, so the socket is open before the machine
+ * runs (a chardev would not do: the main loop stands still during a hold).
+ */
+static void labbus_link_connect(LabBusLink *link, Error **errp)
+{
+    struct sockaddr_un address = { .sun_family = AF_UNIX };
+    const char *why = NULL;
+    char *argv[LABBUS_MAX_WORDS];
+    char *line;
+    int argc;
+    uint64_t version;
+
+    if (!link->path || !*link->path) {
+        error_setg(errp, "labbus-link: path=<hub socket> is required");
+        return;
+    }
+    if (strlen(link->path) >= sizeof(address.sun_path)) {
+        error_setg(errp, "labbus-link: the socket path %s is too long",
+                   link->path);
+        return;
+    }
+    if (!link->name || !*link->name) {
+        g_free(link->name);
+        link->name = g_strdup_printf("board%d", (int)getpid());
+    }
+    if (strchr(link->name, ' ') || strchr(link->name, '.') ||
+        strlen(link->name) > 32) {
+        error_setg(errp, "labbus-link: the name '%s' must be one word of at "
+                   "most 32 characters without dots", link->name);
+        return;
+    }
+    if (link->timeout_s == 0) {
+        error_setg(errp, "isa-sja1000: hub-timeout must be at least 1 s");
+        return;
+    }
+    if (!icount_enabled()) {
+        warn_report("labbus-link %s: without -icount the board's emulated "
+                    "time follows the host, so bus timing is not exact",
+                    link->name);
+    }
+
+    link->fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (link->fd < 0) {
+        error_setg_errno(errp, errno, "labbus-link: socket");
+        return;
+    }
+    pstrcpy(address.sun_path, sizeof(address.sun_path), link->path);
+    if (connect(link->fd, (struct sockaddr *)&address, sizeof(address)) < 0) {
+        error_setg_errno(errp, errno, "labbus-link %s: cannot connect to the "
+                         "lab bus hub at %s", link->name, link->path);
+        close(link->fd);
+        link->fd = -1;
+        return;
+    }
+    labbus_link_send(link, "HELLO %d %s emulated", LABBUS_PROTOCOL_VERSION,
+                     link->name);
+    line = labbus_read_line(link, &why);
+    if (!line) {
+        error_setg(errp, "labbus-link %s: no WELCOME from the hub: %s",
+                   link->name, why);
+        return;
+    }
+    argc = labbus_split(line, argv);
+    if (argc >= 2 && !strcmp(argv[0], "ERROR")) {
+        error_setg(errp, "labbus-link %s: the hub refused the board: %s",
+                   link->name, line + strlen(argv[0]) + 1);
+        return;
+    }
+    if (argc < 4 || strcmp(argv[0], "WELCOME") ||
+        !labbus_parse_u64(argv[1], &version) ||
+        version != LABBUS_PROTOCOL_VERSION ||
+        !labbus_parse_u64(argv[2], &link->quantum_ns) ||
+        link->quantum_ns == 0) {
+        error_setg(errp, "labbus-link %s: the hub's greeting '%s' is not "
+                   "protocol version %d", link->name, argv[0],
+                   LABBUS_PROTOCOL_VERSION);
+        return;
+    }
+    /*
+     * Boundaries count from QEMU's start: realize runs at emulated time 0,
+     * so the first is one quantum in.
+     */
+    link->boundary_timer = timer_new_ns(QEMU_CLOCK_VIRTUAL,
+                                        labbus_link_boundary, link);
+    link->boundary = qemu_clock_get_ns(QEMU_CLOCK_VIRTUAL) + link->quantum_ns;
+    timer_mod_ns(link->boundary_timer, link->boundary);
+}
+
+static void labbus_link_instance_init(Object *obj)
+{
+    LabBusLink *link = LABBUS_LINK(obj);
+
+    link->fd = -1;
+    object_property_add_uint64_ptr(obj, "boundaries", &link->boundaries,
+                                   OBJ_PROP_FLAG_READ);
+    object_property_add_uint64_ptr(obj, "late-boundaries",
+                                   &link->late_boundaries, OBJ_PROP_FLAG_READ);
+}
+
+static void labbus_link_instance_finalize(Object *obj)
+{
+    LabBusLink *link = LABBUS_LINK(obj);
+    unsigned i;
+
+    if (link->boundary_timer) {
+        timer_free(link->boundary_timer);
+    }
+    if (link->fd >= 0) {
+        close(link->fd);
+    }
+    for (i = 0; i < link->port_count; i++) {
+        g_free(link->ports[i].bus);
+    }
+    g_free(link->path);
+    g_free(link->name);
+}
+
+static const TypeInfo labbus_link_info = {
+    .name = TYPE_LABBUS_LINK,
+    .parent = TYPE_OBJECT,
+    .instance_size = sizeof(LabBusLink),
+    .instance_init = labbus_link_instance_init,
+    .instance_finalize = labbus_link_instance_finalize,
+};
+
+/* The board's one link, made by the first card that names a hub. */
+static LabBusLink *labbus_board_link;
+
+/* ======================================================================== */
+/* SJA1000 registers and constants (data sheet sections in brackets)        */
+/* ======================================================================== */
+
+/* The card: two chips, 32 ports each. */
+#define SJA_CARD_CHANNELS     2
+#define SJA_CHANNEL_PORTS     0x20
+#define SJA_CARD_PORTS        (SJA_CARD_CHANNELS * SJA_CHANNEL_PORTS)
+
+/* The crystal of the usual ISA cards; CAN clock = crystal / 2 (DS 6.5.1). */
+#define SJA_XTAL_HZ           16000000ULL
+
+/* PeliCAN addresses the core's enum lacks (DS 6.4.1, Table 7). */
+#define SJA_PEL_RESERVED5     0x05
+#define SJA_PEL_TEST          0x09
+#define SJA_PEL_RXERR         0x0e   /* RX error counter (DS 6.4.11) */
+#define SJA_PEL_TXERR         0x0f   /* TX error counter (DS 6.4.12) */
+#define SJA_PEL_FRAME_FIRST   0x10   /* transmit/receive buffer (DS 6.4.13) */
+#define SJA_PEL_FRAME_LAST    0x1c
+#define SJA_PEL_ACR_AMR_LAST  0x17   /* ACR0..3, AMR0..3 in reset mode */
+
+/* BasicCAN addresses (DS 6.3.1, Table 2). */
+#define SJA_BAS_ACR           0x04   /* acceptance code (DS 6.3.9) */
+#define SJA_BAS_AMR           0x05   /* acceptance mask (DS 6.3.9) */
+#define SJA_BAS_TXB_FIRST     0x0a   /* transmit buffer (DS 6.3.7) */
+#define SJA_BAS_TXB_LAST      0x13
+#define SJA_BAS_RXB_FIRST     0x14   /* receive buffer (DS 6.3.8) */
+
+/* Common registers (DS 6.5). */
+#define SJA_BTR0              0x06
+#define SJA_BTR1              0x07
+#define SJA_OCR_ADDR          0x08
+
+/* MOD, mode register (DS 6.4.3). */
+#define MOD_RM                0x01   /* reset mode */
+#define MOD_LOM               0x02   /* listen only mode */
+#define MOD_STM               0x04   /* self test mode */
+#define MOD_AFM               0x08   /* acceptance filter mode */
+#define MOD_SM                0x10   /* sleep mode */
+#define MOD_WRITABLE          0x1f
+
+/* CR, BasicCAN control register (DS 6.3.3). */
+#define CR_RR                 0x01   /* reset request */
+#define CR_RIE                0x02
+#define CR_TIE                0x04
+#define CR_EIE                0x08
+#define CR_OIE                0x10
+
+/* CMR, command register (DS 6.4.4; BasicCAN DS 6.3.4). */
+#define CMR_TR                0x01   /* transmission request */
+#define CMR_AT                0x02   /* abort transmission */
+#define CMR_RRB               0x04   /* release receive buffer */
+#define CMR_CDO               0x08   /* clear data overrun */
+#define CMR_SRR               0x10   /* PeliCAN: self reception request */
+#define CMR_GTS               0x10   /* BasicCAN: go to sleep */
+/* A read of CMR returns all ones (DS 6.4.4). */
+#define CMR_READ_VALUE        0xff
+
+/* SR, status register (DS 6.4.5; BasicCAN DS 6.3.5). */
+#define SR_RBS                0x01   /* receive buffer status */
+#define SR_DOS                0x02   /* data overrun status */
+#define SR_TBS                0x04   /* transmit buffer status: released */
+#define SR_TCS                0x08   /* transmission complete status */
+#define SR_RS                 0x10   /* receive status */
+#define SR_TS                 0x20   /* transmit status */
+#define SR_ES                 0x40   /* error status */
+#define SR_BS                 0x80   /* bus status: bus-off */
+/* The bits the core keeps (its receive FIFO); the front end owns the rest. */
+#define SR_CORE_BITS          (SR_RBS | SR_DOS)
+
+/* IR and IER bits (DS 6.4.6, 6.4.7). */
+#define IR_RI                 0x01   /* receive interrupt */
+#define IR_TI                 0x02   /* transmit interrupt */
+#define IR_EI                 0x04   /* error warning interrupt */
+#define IR_DOI                0x08   /* data overrun interrupt */
+#define IR_WUI                0x10   /* wake-up interrupt */
+#define IR_EPI                0x20   /* error passive interrupt */
+#define IR_ALI                0x40   /* arbitration lost interrupt */
+#define IR_BEI                0x80   /* bus error interrupt */
+
+/* CDR, clock divider register (DS 6.5.4). */
+#define CDR_PELICAN           0x80   /* CAN mode */
+#define CDR_CBP               0x40   /* comparator bypass */
+/* CAN mode and CBP can be written only in reset mode. */
+#define CDR_RESET_ONLY_BITS   (CDR_PELICAN | CDR_CBP)
+
+/* BTR0 and BTR1 fields (DS 6.5.1, 6.5.2). */
+#define BTR0_BRP_MASK         0x3f
+#define BTR1_TSEG1_MASK       0x0f
+#define BTR1_TSEG2_SHIFT      4
+#define BTR1_TSEG2_MASK       0x07
+
+/* Frame information byte of the PeliCAN buffers (DS 6.4.13). */
+#define FRAME_FF              0x80   /* extended frame format */
+#define FRAME_RTR             0x40
+#define FRAME_DLC_MASK        0x0f
+/* BasicCAN descriptor, second byte (DS 6.3.7). */
+#define BAS_DESC_RTR          0x10
+
+/* ECC, error code capture (DS 6.4.9, Tables 28 and 29). */
+#define ECC_ERRC_BIT          0x00
+#define ECC_ERRC_FORM         0x40
+#define ECC_ERRC_STUFF        0x80
+#define ECC_ERRC_OTHER        0xc0
+#define ECC_DIR_RX            0x20
+#define ECC_SEG_MASK          0x1f
+#define ECC_SEG_ACK_SLOT      0x19
+
+/* EWLR after a hardware reset (DS 6.4.10). */
+#define EWLR_RESET_VALUE      96
+/* TXERR loaded on bus-off, to count 128 bus-free signals (DS 6.4.12). */
+#define TXERR_AT_BUS_OFF      127
+/* A CPU write of 255 to TXERR forces a bus-off event (DS 6.4.12). */
+#define TXERR_FORCE_BUS_OFF   255
+
+/* ISO 11898-1 fault confinement. */
+#define FC_PASSIVE_LIMIT      128    /* error passive from 128 */
+#define FC_BUS_OFF_LIMIT      256    /* bus-off above 255 */
+#define FC_TX_ERROR_STEP      8      /* a transmitter's error */
+#define FC_RX_ERROR_STEP      1      /* a receiver's error */
+#define FC_REC_AFTER_PASSIVE  119    /* REC > 127 after a good frame */
+#define FC_COUNTER_MAX        255    /* RXERR saturates in 8 bits */
+#define FC_BUS_FREE_BITS      11     /* one bus-free signal */
+#define FC_RECOVERY_SIGNALS   128    /* bus-free signals to leave bus-off */
+#define FC_SUSPEND_BITS       8      /* error-passive suspend transmission */
+
+/*
+ * Frame geometry with worst-case bit stuffing, as in the hub
+ * (docs/protocols/labbus.md, "Timing model"): g bits from SOF to the end of
+ * the CRC sequence without data, 8n data bits, floor((g + 8n - 1) / 4)
+ * stuff bits, then CRC delimiter, ACK slot, ACK delimiter, 7 EOF bits and 3
+ * intermission bits.
+ */
+#define GEOM_STANDARD_BITS    34
+#define GEOM_EXTENDED_BITS    54
+#define GEOM_TAIL_BITS        13
+#define GEOM_ERROR_FLAG_BITS  6
+#define GEOM_ERROR_DELIM_BITS 8
+#define GEOM_INTERMISSION     3
+
+/* ======================================================================== */
+/* The card                                                                  */
+/* ======================================================================== */
+
+#define TYPE_ISA_SJA1000 "isa-sja1000"
+OBJECT_DECLARE_SIMPLE_TYPE(IsaSja1000State, ISA_SJA1000)
+
+/*
+ * How the channel takes part in the bus, as reported to the hub
+ * (docs/protocols/labbus.md, STATE): off in reset mode or bus-off, wait
+ * after reset mode until a bus-free signal, recover while counting the 128
+ * bus-free signals after bus-off, sleep in sleep mode, on otherwise.
+ */
+typedef enum ChanBusMode {
+    BUS_MODE_OFF,
+    BUS_MODE_WAIT,
+    BUS_MODE_ON,
+    BUS_MODE_RECOVER,
+    BUS_MODE_SLEEP,
+} ChanBusMode;
+
+static const char *const bus_mode_names[] = {
+    [BUS_MODE_OFF] = "off",
+    [BUS_MODE_WAIT] = "wait",
+    [BUS_MODE_ON] = "on",
+    [BUS_MODE_RECOVER] = "recover",
+    [BUS_MODE_SLEEP] = "sleep",
+};
+
+/* What happens on the bus to one channel, at one emulated instant. */
+typedef enum ChanEventKind {
+    EV_SOF,          /* a frame starts: arg is SOF_TX, SOF_RX or SOF_WAKE */
+    EV_LOST,         /* arbitration lost: arg is the ALC bit number */
+    EV_TXOK,         /* own frame sent */
+    EV_RX,           /* a frame received */
+    EV_ERR,          /* a bus error: arg is the ECC byte */
+    EV_IDLE,         /* the frame or error frame is over */
+    EV_ABORTED,      /* the pending request was cancelled */
+    EV_JOIN,         /* bus-free seen after reset mode */
+    EV_BUSFREE,      /* a bus-free signal during bus-off recovery */
+    EV_FAULT,        /* forced by the lab: arg is FAULT_PASSIVE/BUS_OFF */
+    EV_LONE_ATTEMPT, /* lone bus: the next transmission attempt starts */
+} ChanEventKind;
+
+#define SOF_TX           0
+#define SOF_RX           1
+#define SOF_WAKE         2
+#define FAULT_PASSIVE    0
+#define FAULT_BUS_OFF    1
+
+#define EVF_ACK          0x01   /* an ACK error (ISO 11898-1 exception) */
+#define EVF_SELF         0x02   /* a self-received frame */
+
+typedef struct ChanEvent {
+    int64_t time;
+    uint32_t epoch;
+    ChanEventKind kind;
+    uint8_t arg;
+    uint16_t count;
+    unsigned flags;
+    /* EV_RX: the frame, and its DLC as sent (the core keeps at most 8). */
+    qemu_can_frame frame;
+    uint8_t raw_dlc;
+    QTAILQ_ENTRY(ChanEvent) next;
+} ChanEvent;
+
+typedef struct Sja1000Channel {
+    IsaSja1000State *card;
+    unsigned index;
+
+    /* QEMU's SJA1000: registers, filters, FIFO, buffers. */
+    CanSJA1000State core;
+
+    /* Registers the core does not model. */
+    uint8_t btr0;
+    uint8_t btr1;
+    uint8_t ocr;
+    uint8_t alc;
+    uint8_t ecc;
+    uint8_t ewlr;
+    bool alc_captured;     /* ALC is held until read (DS 6.4.8) */
+    bool ecc_captured;     /* ECC is held until read (DS 6.4.9) */
+    unsigned tec;          /* transmit error count, 0..256 */
+    unsigned rec;          /* receive error count, 0..255 */
+    /* SR bits TBS, TCS, RS, TS, ES and BS. */
+    uint8_t status;
+
+    /* Error states. */
+    bool bus_off;
+    bool passive;
+    /* A bus-off flag cleared by a TXERR write: EI when reset mode ends. */
+    bool deferred_ei;
+    bool joined;           /* a bus-free signal seen since reset mode */
+    bool sleeping;
+    unsigned recovery_signals;
+
+    /* The transmit buffer's request. */
+    bool tx_pending;
+    bool tx_single_shot;
+    bool tx_self;
+    bool tx_abort_requested;
+    qemu_can_frame tx_frame;
+    uint8_t tx_raw_dlc;
+
+    /* Participation as last reported; epoch drops stale events. */
+    ChanBusMode mode;
+    uint32_t epoch;
+    bool reported;
+    ChanBusMode reported_mode;
+    bool reported_passive;
+    uint64_t reported_bit_ns;
+    uint8_t reported_mod;
+
+    /* The hub port, or -1 for a lone bus. */
+    int port;
+
+    QTAILQ_HEAD(, ChanEvent) events;
+    QEMUTimer *event_timer;
+    /* Set while due events are applied, which may queue more. */
+    bool running_events;
+
+    /* The lone bus (no hub): when it is free and whether a frame is on it. */
+    int64_t lone_free_at;
+    bool lone_in_attempt;
+    /* The one attempt scheduled, or -1: a request has one at a time. */
+    int64_t lone_next_attempt;
+} Sja1000Channel;
+
+struct IsaSja1000State {
+    ISADevice parent_obj;
+
+    MemoryRegion io;
+    LabBusLink *link;
+
+    /* Properties: jumpers, and the lab buses the channels are wired to. */
+    uint32_t iobase;
+    uint32_t irq_line[SJA_CARD_CHANNELS];
+    char *hub_path;
+    char *hub_name;
+    uint32_t hub_timeout_s;
+    char *bus_name[SJA_CARD_CHANNELS];
+
+    Sja1000Channel chan[SJA_CARD_CHANNELS];
+};
+
+/* -- mode and register helpers ------------------------------------------- */
+
+static bool chan_pelican(Sja1000Channel *ch)
+{
+    return ch->core.clock & CDR_PELICAN;
+}
+
+static bool chan_in_reset(Sja1000Channel *ch)
+{
+    return chan_pelican(ch) ? (ch->core.mode & MOD_RM) :
+                              (ch->core.control & CR_RR);
+}
+
+/*
+ * The chip has one reset bit, seen as MOD.RM in PeliCAN mode and CR.RR in
+ * BasicCAN mode; the core keeps the two views apart, so both are set.
+ */
+static void chan_set_reset_bit(Sja1000Channel *ch, bool on)
+{
+    if (on) {
+        ch->core.mode |= MOD_RM;
+        ch->core.control |= CR_RR;
+    } else {
+        ch->core.mode &= ~MOD_RM;
+        ch->core.control &= ~CR_RR;
+    }
+}
+
+static bool chan_listen_only(Sja1000Channel *ch)
+{
+    return chan_pelican(ch) && (ch->core.mode & MOD_LOM);
+}
+
+static bool chan_self_test(Sja1000Channel *ch)
+{
+    return chan_pelican(ch) && (ch->core.mode & MOD_STM);
+}
+
+static int64_t chan_now(void)
+{
+    return qemu_clock_get_ns(QEMU_CLOCK_VIRTUAL);
+}
+
+/* One time quantum: 2 * tCLK * (BRP + 1) (DS 6.5.1). */
+static uint64_t chan_tq_ns(Sja1000Channel *ch)
+{
+    return 2 * ((uint64_t)(ch->btr0 & BTR0_BRP_MASK) + 1) *
+           NANOSECONDS_PER_SECOND / SJA_XTAL_HZ;
+}
+
+/* TSEG1 and TSEG2 in time quanta (DS 6.5.2). */
+static unsigned chan_tseg1(Sja1000Channel *ch)
+{
+    return (ch->btr1 & BTR1_TSEG1_MASK) + 1;
+}
+
+static unsigned chan_tseg2(Sja1000Channel *ch)
+{
+    return ((ch->btr1 >> BTR1_TSEG2_SHIFT) & BTR1_TSEG2_MASK) + 1;
+}
+
+/* The nominal bit time: SYNC_SEG + TSEG1 + TSEG2 (DS 6.5.2). */
+static uint64_t chan_bit_ns(Sja1000Channel *ch)
+{
+    return chan_tq_ns(ch) * (1 + chan_tseg1(ch) + chan_tseg2(ch));
+}
+
+/* The sample point, at the end of TSEG1, in thousandths of a bit. */
+static unsigned chan_sample_permille(Sja1000Channel *ch)
+{
+    unsigned bit_tq = 1 + chan_tseg1(ch) + chan_tseg2(ch);
+
+    return (1000 * (1 + chan_tseg1(ch)) + bit_tq / 2) / bit_tq;
+}
+
+/* -- interrupts ----------------------------------------------------------- */
+
+/* The core's INT rule, for both modes (its update functions are static). */
+static void chan_update_irq(Sja1000Channel *ch)
+{
+    bool level;
+
+    if (chan_pelican(ch)) {
+        level = ch->core.interrupt_en & ch->core.interrupt_pel;
+    } else {
+        level = (ch->core.control >> 1) & ch->core.interrupt_bas;
+    }
+    qemu_set_irq(ch->core.irq, level);
+}
+
+/*
+ * Sets an IR bit if its enable bit is set: in PeliCAN mode every IR bit is
+ * set only "if enabled" (DS 6.4.6); in BasicCAN mode TI and EI follow
+ * CR.TIE and CR.EIE, and WUI has no enable bit (DS 6.3.6).
+ */
+static void chan_raise(Sja1000Channel *ch, uint8_t bit)
+{
+    if (chan_pelican(ch)) {
+        if (ch->core.interrupt_en & bit) {
+            ch->core.interrupt_pel |= bit;
+        }
+    } else if (bit == IR_TI || bit == IR_EI) {
+        if ((ch->core.control >> 1) & bit) {
+            ch->core.interrupt_bas |= bit;
+        }
+    } else if (bit == IR_WUI) {
+        ch->core.interrupt_bas |= bit;
+    }
+    chan_update_irq(ch);
+}
+
+/*
+ * The core sets RI and DOI whether or not they are enabled; the data sheet
+ * sets RI only while the FIFO holds a message and RIE is set, and DOI only
+ * if DOIE is set (DS 6.4.6). Called after every core access that may
+ * change them.
+ */
+static void chan_normalise_rx_interrupts(Sja1000Channel *ch)
+{
+    if (chan_pelican(ch)) {
+        if ((ch->core.interrupt_en & IR_RI) && ch->core.rxmsg_cnt) {
+            ch->core.interrupt_pel |= IR_RI;
+        } else {
+            ch->core.interrupt_pel &= ~IR_RI;
+        }
+        if (!(ch->core.interrupt_en & IR_DOI)) {
+            ch->core.interrupt_pel &= ~IR_DOI;
+        }
+    } else {
+        if ((ch->core.control & CR_RIE) && ch->core.rxmsg_cnt) {
+            ch->core.interrupt_bas |= IR_RI;
+        } else {
+            ch->core.interrupt_bas &= ~IR_RI;
+        }
+        if (!(ch->core.control & CR_OIE)) {
+            ch->core.interrupt_bas &= ~IR_DOI;
+        }
+    }
+    chan_update_irq(ch);
+}
+
+/* -- reporting to the hub -------------------------------------------------- */
+
+static ChanBusMode chan_compute_mode(Sja1000Channel *ch)
+{
+    if (chan_in_reset(ch)) {
+        return BUS_MODE_OFF;
+    }
+    if (ch->bus_off) {
+        return BUS_MODE_RECOVER;
+    }
+    if (ch->sleeping) {
+        return BUS_MODE_SLEEP;
+    }
+    return ch->joined ? BUS_MODE_ON : BUS_MODE_WAIT;
+}
+
+static void chan_lone_next_step(Sja1000Channel *ch);
+
+/*
+ * Re-derives the channel's bus mode and tells the hub when it or the
+ * flags the hub needs changed. Leaving the bus (reset mode, bus-off,
+ * sleep) starts a new epoch, so events the hub announced before it knew
+ * (a frame the chip left by entering reset mode) are dropped when they
+ * come due. Joining the bus keeps the epoch: the hub counts a channel in
+ * from the bus-free signal it computed, before the board hears of it.
+ */
+static void chan_update_mode(Sja1000Channel *ch)
+{
+    ChanBusMode mode = chan_compute_mode(ch);
+    bool mode_changed = mode != ch->mode;
+    uint64_t bit_ns = chan_bit_ns(ch);
+    uint8_t mod_flags = ch->core.mode & (MOD_LOM | MOD_STM);
+    IsaSja1000State *card = ch->card;
+
+    if (mode_changed) {
+        ch->mode = mode;
+        if (mode == BUS_MODE_OFF || mode == BUS_MODE_SLEEP) {
+            ch->epoch++;
+        }
+        if (mode == BUS_MODE_RECOVER) {
+            ch->recovery_signals = 0;
+        }
+    }
+    if (ch->port >= 0) {
+        if (!ch->reported || mode_changed || ch->reported_mode != mode ||
+            ch->reported_passive != ch->passive ||
+            ch->reported_bit_ns != bit_ns || ch->reported_mod != mod_flags) {
+            char flags[32] = "";
+
+            if (ch->passive) {
+                g_strlcat(flags, ",passive", sizeof(flags));
+            }
+            if (chan_listen_only(ch)) {
+                g_strlcat(flags, ",listen", sizeof(flags));
+            }
+            if (chan_self_test(ch)) {
+                g_strlcat(flags, ",selftest", sizeof(flags));
+            }
+            labbus_link_send(card->link, "STATE %d %" PRId64 " %" PRIu32
+                             " %s %" PRIu64 " %u %s", ch->port, chan_now(),
+                             ch->epoch, bus_mode_names[mode], bit_ns,
+                             chan_sample_permille(ch),
+                             flags[0] ? flags + 1 : "-");
+            ch->reported = true;
+            ch->reported_mode = mode;
+            ch->reported_passive = ch->passive;
+            ch->reported_bit_ns = bit_ns;
+            ch->reported_mod = mod_flags;
+        }
+    } else if (mode_changed) {
+        chan_lone_next_step(ch);
+    }
+}
+
+/* -- the event queue --------------------------------------------------------- */
+
+static void chan_apply_event(Sja1000Channel *ch, ChanEvent *event);
+
+static void chan_arm_event_timer(Sja1000Channel *ch)
+{
+    ChanEvent *first = QTAILQ_FIRST(&ch->events);
+
+    if (first) {
+        timer_mod_ns(ch->event_timer, first->time);
+    } else {
+        timer_del(ch->event_timer);
+    }
+}
+
+/*
+ * Applies every event that is due, in time order, then re-arms the timer.
+ * A register access calls it too, and finds nothing due nearly always: the
+ * timer is then left alone, since setting it again would make QEMU end
+ * the guest's translation block at once.
+ */
+static void chan_run_events(Sja1000Channel *ch)
+{
+    int64_t now = chan_now();
+    ChanEvent *event = QTAILQ_FIRST(&ch->events);
+
+    if (ch->running_events) {
+        /* The loop below picks up what an event queues for now. */
+        return;
+    }
+    if (!event || event->time > now) {
+        return;
+    }
+    ch->running_events = true;
+    while ((event = QTAILQ_FIRST(&ch->events)) && event->time <= now) {
+        QTAILQ_REMOVE(&ch->events, event, next);
+        if (event->epoch == ch->epoch) {
+            chan_apply_event(ch, event);
+        }
+        g_free(event);
+    }
+    ch->running_events = false;
+    chan_arm_event_timer(ch);
+}
+
+static void chan_event_timer_cb(void *opaque)
+{
+    Sja1000Channel *ch = opaque;
+
+    /*
+     * Back in its list for now while the events run (see
+     * labbus_link_boundary): an idle skip of the clock triggered meanwhile
+     * cannot pass this channel's next event. Then it is set for that
+     * event, or deleted.
+     */
+    timer_mod_ns(ch->event_timer, chan_now());
+    chan_run_events(ch);
+    chan_arm_event_timer(ch);
+}
+
+/*
+ * Queues an event at its emulated time, after any event already queued
+ * for the same instant, so events keep the order they were announced in.
+ */
+static void chan_queue_event(Sja1000Channel *ch, ChanEvent *event)
+{
+    ChanEvent *before = QTAILQ_LAST(&ch->events);
+
+    while (before && before->time > event->time) {
+        before = QTAILQ_PREV(before, next);
+    }
+    if (before) {
+        QTAILQ_INSERT_AFTER(&ch->events, before, event, next);
+    } else {
+        QTAILQ_INSERT_HEAD(&ch->events, event, next);
+    }
+    if (event->time <= chan_now()) {
+        chan_run_events(ch);
+    } else {
+        chan_arm_event_timer(ch);
+    }
+}
+
+static ChanEvent *chan_new_event(Sja1000Channel *ch, ChanEventKind kind,
+                                 int64_t time)
+{
+    ChanEvent *event = g_new0(ChanEvent, 1);
+
+    event->kind = kind;
+    event->time = time;
+    event->epoch = ch->epoch;
+    return event;
+}
+
+static void chan_drop_events(Sja1000Channel *ch)
+{
+    ChanEvent *event;
+
+    while ((event = QTAILQ_FIRST(&ch->events))) {
+        QTAILQ_REMOVE(&ch->events, event, next);
+        g_free(event);
+    }
+    timer_del(ch->event_timer);
+}
+
+/* -- fault confinement ------------------------------------------------------- */
+
+static void chan_enter_reset(Sja1000Channel *ch);
+
+/*
+ * Bus-off (DS 6.4.3 note, 6.4.11, 6.4.12): BS set, the chip enters reset
+ * mode, TXERR is loaded with 127 to count the bus-free signals of the
+ * recovery, RXERR is cleared, and EI is raised. ES stays set until the
+ * recovery is over.
+ */
+static void chan_enter_bus_off(Sja1000Channel *ch)
+{
+    ch->bus_off = true;
+    ch->passive = false;
+    ch->tec = TXERR_AT_BUS_OFF;
+    ch->rec = 0;
+    ch->status |= SR_BS | SR_ES;
+    chan_enter_reset(ch);
+    chan_raise(ch, IR_EI);
+    chan_update_mode(ch);
+}
+
+/*
+ * Re-evaluates ES and the error-passive state after the counters changed,
+ * raising EI on a change of ES and EPI on entering or leaving error
+ * passive (DS 6.4.6). In reset mode a CPU-forced change of the counters or
+ * of EWLR takes effect only when reset mode ends (DS 6.4.11 note).
+ */
+static void chan_update_error_state(Sja1000Channel *ch)
+{
+    bool es;
+    bool passive;
+
+    if (ch->bus_off || chan_in_reset(ch)) {
+        return;
+    }
+    if (ch->tec >= FC_BUS_OFF_LIMIT) {
+        chan_enter_bus_off(ch);
+        return;
+    }
+    es = ch->tec >= ch->ewlr || ch->rec >= ch->ewlr;
+    passive = ch->tec >= FC_PASSIVE_LIMIT || ch->rec >= FC_PASSIVE_LIMIT;
+    if (es != !!(ch->status & SR_ES) || ch->deferred_ei) {
+        ch->deferred_ei = false;
+        ch->status = es ? (ch->status | SR_ES) : (ch->status & ~SR_ES);
+        chan_raise(ch, IR_EI);
+    }
+    if (passive != ch->passive) {
+        ch->passive = passive;
+        chan_raise(ch, IR_EPI);
+    }
+    chan_update_mode(ch);
+}
+
+/* Listen-only mode stops the error counters (DS 6.4.3). */
+static bool chan_counters_frozen(Sja1000Channel *ch)
+{
+    return chan_listen_only(ch);
+}
+
+/* A transmitter's error (ISO 11898-1 fault confinement rules 3 and 4). */
+static void chan_count_tx_error(Sja1000Channel *ch, bool ack_error)
+{
+    if (chan_counters_frozen(ch)) {
+        return;
+    }
+    /*
+     * The exception of rule 3: an error-passive transmitter that sees an
+     * ACK error and no dominant bit during its passive error flag keeps its
+     * count. On the lab bus nobody else signals an error after a missing
+     * acknowledge, so the exception applies to every such ACK error.
+     */
+    if (ack_error && ch->passive) {
+        return;
+    }
+    ch->tec += FC_TX_ERROR_STEP;
+    chan_update_error_state(ch);
+}
+
+/* A receiver's error (rule 1). */
+static void chan_count_rx_error(Sja1000Channel *ch)
+{
+    if (chan_counters_frozen(ch)) {
+        return;
+    }
+    ch->rec = MIN(ch->rec + FC_RX_ERROR_STEP, FC_COUNTER_MAX);
+    chan_update_error_state(ch);
+}
+
+/* A frame sent (rule 7) and a frame received (rule 8). */
+static void chan_count_tx_success(Sja1000Channel *ch)
+{
+    if (!chan_counters_frozen(ch) && ch->tec > 0) {
+        ch->tec--;
+        chan_update_error_state(ch);
+    }
+}
+
+static void chan_count_rx_success(Sja1000Channel *ch)
+{
+    if (chan_counters_frozen(ch)) {
+        return;
+    }
+    if (ch->rec > FC_PASSIVE_LIMIT - 1) {
+        ch->rec = FC_REC_AFTER_PASSIVE;
+    } else if (ch->rec > 0) {
+        ch->rec--;
+    }
+    chan_update_error_state(ch);
+}
+
+/* Captures ECC unless it still holds an unread error (DS 6.4.9). */
+static void chan_capture_ecc(Sja1000Channel *ch, uint8_t ecc)
+{
+    if (!ch->ecc_captured) {
+        ch->ecc = ecc;
+        ch->ecc_captured = true;
+    }
+    chan_raise(ch, IR_BEI);
+}
+
+/* -- transmission ----------------------------------------------------------- */
+
+/* The transmit buffer is released: TBS set, TI (DS 6.4.6). */
+static void chan_release_tx(Sja1000Channel *ch, bool complete)
+{
+    ch->tx_pending = false;
+    ch->tx_abort_requested = false;
+    ch->status |= SR_TBS;
+    if (complete) {
+        ch->status |= SR_TCS;
+    }
+    chan_raise(ch, IR_TI);
+}
+
+/* Does an unsuccessful attempt end the request (single shot or AT)? */
+static bool chan_tx_final(Sja1000Channel *ch)
+{
+    return ch->tx_single_shot || ch->tx_abort_requested;
+}
+
+static void chan_frame_text(const qemu_can_frame *frame, uint8_t raw_dlc,
+                            char *text, size_t size)
+{
+    bool ext = frame->can_id & QEMU_CAN_EFF_FLAG;
+    bool rtr = frame->can_id & QEMU_CAN_RTR_FLAG;
+    uint32_t id = frame->can_id & (ext ? QEMU_CAN_EFF_MASK : QEMU_CAN_SFF_MASK);
+    size_t used;
+    int i;
+
+    used = snprintf(text, size, "%" PRIx32 " %c%c %u ", id, ext ? 'X' : 'S',
+                    rtr ? 'R' : 'D', raw_dlc);
+    if (rtr || frame->can_dlc == 0) {
+        g_strlcat(text, "-", size);
+        return;
+    }
+    for (i = 0; i < frame->can_dlc && used + 3 < size; i++) {
+        used += snprintf(text + used, size - used, "%02x", frame->data[i]);
+    }
+}
+
+/* Decodes the transmit buffer in the current mode (DS 6.4.13, 6.3.7). */
+static void chan_decode_tx_buffer(Sja1000Channel *ch)
+{
+    const uint8_t *buff = ch->core.tx_buff;
+    qemu_can_frame *frame = &ch->tx_frame;
+    const uint8_t *data;
+    int i;
+
+    memset(frame, 0, sizeof(*frame));
+    if (chan_pelican(ch)) {
+        ch->tx_raw_dlc = buff[0] & FRAME_DLC_MASK;
+        if (buff[0] & FRAME_FF) {
+            frame->can_id = QEMU_CAN_EFF_FLAG |
+                            ((uint32_t)buff[1] << 21) |
+                            ((uint32_t)buff[2] << 13) |
+                            ((uint32_t)buff[3] << 5) | (buff[4] >> 3);
+            data = buff + 5;
+        } else {
+            frame->can_id = ((uint32_t)buff[1] << 3) | (buff[2] >> 5);
+            data = buff + 3;
+        }
+        if (buff[0] & FRAME_RTR) {
+            frame->can_id |= QEMU_CAN_RTR_FLAG;
+        }
+    } else {
+        ch->tx_raw_dlc = buff[1] & FRAME_DLC_MASK;
+        frame->can_id = ((uint32_t)buff[0] << 3) | (buff[1] >> 5);
+        if (buff[1] & BAS_DESC_RTR) {
+            frame->can_id |= QEMU_CAN_RTR_FLAG;
+        }
+        data = buff + 2;
+    }
+    /* DLC 9..15 are sent as they are, with eight data bytes (ISO 11898-1). */
+    frame->can_dlc = MIN(ch->tx_raw_dlc, 8);
+    for (i = 0; i < frame->can_dlc; i++) {
+        frame->data[i] = data[i];
+    }
+}
+
+/* Frame geometry in bits; see GEOM_* above. */
+static unsigned geom_data_bits(const qemu_can_frame *frame)
+{
+    return (frame->can_id & QEMU_CAN_RTR_FLAG) ? 0 : 8 * frame->can_dlc;
+}
+
+/* Bit index of the CRC delimiter from SOF, with worst-case stuffing. */
+static unsigned geom_crc_delimiter(const qemu_can_frame *frame)
+{
+    unsigned stuffable = ((frame->can_id & QEMU_CAN_EFF_FLAG) ?
+                          GEOM_EXTENDED_BITS : GEOM_STANDARD_BITS) +
+                         geom_data_bits(frame);
+
+    return stuffable + (stuffable - 1) / 4;
+}
+
+/*
+ * The lone bus: a channel without a hub is the only node on its bus, so no
+ * frame is ever acknowledged. Each attempt is the frame up to its ACK slot,
+ * where the transmitter sees the ACK error, then its error flag, error
+ * delimiter and intermission; an error-passive transmitter waits another 8
+ * bits (suspend transmission) before the next attempt. In self test mode
+ * the transmission succeeds without acknowledge. The times are those the
+ * hub computes for a bus with one node (docs/protocols/labbus.md).
+ */
+static void chan_lone_attempt(Sja1000Channel *ch)
+{
+    int64_t s = chan_now();
+    uint64_t bit = chan_bit_ns(ch);
+    unsigned crc_delimiter = geom_crc_delimiter(&ch->tx_frame);
+    ChanEvent *event;
+
+    ch->lone_in_attempt = true;
+    chan_queue_event(ch, chan_new_event(ch, EV_SOF, s));
+    if (chan_self_test(ch)) {
+        int64_t eof_end = s + (crc_delimiter + 10) * bit;
+
+        chan_queue_event(ch, chan_new_event(ch, EV_TXOK, eof_end));
+        if (ch->tx_self) {
+            event = chan_new_event(ch, EV_RX, eof_end);
+            event->frame = ch->tx_frame;
+            event->raw_dlc = ch->tx_raw_dlc;
+            event->flags = EVF_SELF;
+            chan_queue_event(ch, event);
+        }
+        chan_queue_event(ch, chan_new_event(ch, EV_IDLE, eof_end));
+        ch->lone_free_at = eof_end + GEOM_INTERMISSION * bit;
+        return;
+    }
+    /* The ACK error is seen at the end of the ACK slot. */
+    event = chan_new_event(ch, EV_ERR, s + (crc_delimiter + 2) * bit);
+    event->arg = ECC_ERRC_OTHER | ECC_SEG_ACK_SLOT;
+    event->flags = EVF_ACK;
+    chan_queue_event(ch, event);
+    chan_queue_event(ch, chan_new_event(ch, EV_IDLE,
+                     s + (crc_delimiter + 2 + GEOM_ERROR_FLAG_BITS +
+                          GEOM_ERROR_DELIM_BITS) * bit));
+    ch->lone_free_at = s + (crc_delimiter + 2 + GEOM_ERROR_FLAG_BITS +
+                            GEOM_ERROR_DELIM_BITS + GEOM_INTERMISSION) * bit;
+}
+
+/*
+ * Schedules what the lone bus does next for this channel: a bus-free
+ * signal after reset mode or during bus-off recovery (one every 11 bit
+ * times, as the bus is idle), or the next transmission attempt.
+ */
+static void chan_lone_next_step(Sja1000Channel *ch)
+{
+    uint64_t bit = chan_bit_ns(ch);
+    int64_t now = chan_now();
+    int64_t at;
+
+    switch (ch->mode) {
+    case BUS_MODE_WAIT:
+        chan_queue_event(ch, chan_new_event(ch, EV_JOIN,
+                         now + FC_BUS_FREE_BITS * bit));
+        break;
+    case BUS_MODE_RECOVER: {
+        ChanEvent *event = chan_new_event(ch, EV_BUSFREE,
+                                          now + FC_BUS_FREE_BITS * bit);
+
+        event->count = ch->recovery_signals + 1;
+        chan_queue_event(ch, event);
+        break;
+    }
+    case BUS_MODE_ON:
+        if (ch->tx_pending && !ch->lone_in_attempt &&
+            ch->lone_next_attempt < 0) {
+            /*
+             * The channel sent the last frame on its lone bus: error passive,
+             * it suspends transmission for 8 bits after the intermission.
+             */
+            at = MAX(now, ch->lone_free_at +
+                          (ch->passive ? FC_SUSPEND_BITS * bit : 0));
+            ch->lone_next_attempt = at;
+            chan_queue_event(ch, chan_new_event(ch, EV_LONE_ATTEMPT, at));
+        }
+        break;
+    default:
+        break;
+    }
+}
+
+/*
+ * TR, SRR, and the single-shot forms AT+TR, AT+SRR and TR+SRR (DS 6.4.4
+ * notes): the request goes to the bus with the time of this register write.
+ */
+static void chan_request_transmission(Sja1000Channel *ch, bool single_shot,
+                                      bool self)
+{
+    if (chan_in_reset(ch) || ch->tx_pending || chan_listen_only(ch)) {
+        /*
+         * Nothing is sent in reset mode, while the buffer is locked, or in
+         * listen-only mode, where the chip never drives the bus.
+         */
+        return;
+    }
+    chan_decode_tx_buffer(ch);
+    ch->tx_pending = true;
+    ch->tx_single_shot = single_shot;
+    ch->tx_self = self;
+    ch->tx_abort_requested = false;
+    ch->status &= ~(SR_TBS | SR_TCS);
+    if (ch->port >= 0) {
+        char frame[64];
+        char options[16] = "";
+
+        chan_frame_text(&ch->tx_frame, ch->tx_raw_dlc, frame, sizeof(frame));
+        if (single_shot) {
+            g_strlcat(options, ",once", sizeof(options));
+        }
+        if (self) {
+            g_strlcat(options, ",self", sizeof(options));
+        }
+        labbus_link_send(ch->card->link, "TX %d %" PRId64 " %s %s", ch->port,
+                         chan_now(), frame, options[0] ? options + 1 : "-");
+    } else {
+        chan_lone_next_step(ch);
+    }
+}
+
+/*
+ * AT alone: a request not yet under way is cancelled (TBS set, TCS clear,
+ * TI); one on the bus finishes, and is not repeated if it fails (DS 6.4.4).
+ */
+static void chan_abort_transmission(Sja1000Channel *ch)
+{
+    if (!ch->tx_pending) {
+        return;
+    }
+    ch->tx_abort_requested = true;
+    if (ch->port >= 0) {
+        labbus_link_send(ch->card->link, "ABORT %d %" PRId64, ch->port,
+                         chan_now());
+    } else if (!ch->lone_in_attempt) {
+        /* Between attempts on the lone bus: nothing is under way. */
+        chan_release_tx(ch, false);
+    }
+}
+
+/* -- reset, sleep ------------------------------------------------------------ */
+
+/*
+ * Entering reset mode, by the CPU or by bus-off (DS 6.4.2, Table 8, and
+ * DS 6.3.2): the receive FIFO is emptied, a pending transmission is
+ * dropped (TBS set, no TI), RS and TS are set, sleep ends.
+ */
+static void chan_enter_reset(Sja1000Channel *ch)
+{
+    chan_set_reset_bit(ch, true);
+    ch->core.rxmsg_cnt = 0;
+    ch->core.rx_cnt = 0;
+    ch->core.rxbuf_start = 0;
+    ch->core.rx_ptr = 0;
+    ch->core.status_pel &= ~SR_CORE_BITS;
+    ch->core.status_bas &= ~SR_CORE_BITS;
+    ch->core.interrupt_pel &= ~(IR_RI | IR_DOI);
+    ch->core.interrupt_bas &= ~(IR_RI | IR_DOI);
+    ch->tx_pending = false;
+    ch->tx_abort_requested = false;
+    ch->status |= SR_TBS | SR_RS | SR_TS;
+    ch->sleeping = false;
+    ch->joined = false;
+    ch->lone_in_attempt = false;
+    ch->lone_next_attempt = -1;
+    chan_drop_events(ch);
+    chan_update_irq(ch);
+}
+
+/*
+ * Leaving reset mode: the chip waits for one bus-free signal, or for 128
+ * after bus-off (DS 6.3.3 note 4), and then takes part in the bus. Counter
+ * and EWLR changes made in reset mode take effect now.
+ */
+static void chan_leave_reset(Sja1000Channel *ch)
+{
+    chan_set_reset_bit(ch, false);
+    ch->joined = false;
+    ch->status |= SR_RS | SR_TS;
+    chan_update_error_state(ch);
+    chan_update_mode(ch);
+}
+
+/*
+ * MOD.SM / CMR.GTS: the chip sleeps only if the bus is idle and no
+ * interrupt is pending; otherwise the request gives a wake-up interrupt
+ * (DS 6.4.3, 6.3.4 note 1).
+ */
+static void chan_request_sleep(Sja1000Channel *ch, bool sleep)
+{
+    if (sleep == ch->sleeping) {
+        return;
+    }
+    if (!sleep) {
+        ch->sleeping = false;
+        ch->core.mode &= ~MOD_SM;
+        ch->joined = false;
+        chan_raise(ch, IR_WUI);
+        chan_update_mode(ch);
+        return;
+    }
+    if (chan_in_reset(ch) ||
+        (ch->status & (SR_RS | SR_TS)) || ch->tx_pending ||
+        (chan_pelican(ch) ?
+         (ch->core.interrupt_en & ch->core.interrupt_pel) :
+         ((ch->core.control >> 1) & ch->core.interrupt_bas))) {
+        ch->core.mode &= ~MOD_SM;
+        if (!chan_in_reset(ch)) {
+            chan_raise(ch, IR_WUI);
+        }
+        return;
+    }
+    ch->sleeping = true;
+    ch->core.mode |= MOD_SM;
+    chan_update_mode(ch);
+}
+
+/* -- bus events --------------------------------------------------------------- */
+
+/*
+ * The single acceptance filter's test of a standard frame's identifier and
+ * RTR bit (DS 6.4.15, single filter, standard frame): ACR0 and ACR1 bits
+ * 7-4 hold ID.10-ID.0 and RTR, AMR0 and AMR1 bits 7-4 mark the bits that
+ * do not matter; ACR1 bits 3-0 are unused.
+ */
+static bool chan_single_filter_id_matches(Sja1000Channel *ch,
+                                          const qemu_can_frame *frame)
+{
+    const uint8_t *acr = ch->core.code_mask;
+    const uint8_t *amr = ch->core.code_mask + 4;
+    uint16_t code = ((uint16_t)acr[0] << 4) | (acr[1] >> 4);
+    uint16_t mask = ((uint16_t)amr[0] << 4) | (amr[1] >> 4);
+    uint16_t value = ((frame->can_id & QEMU_CAN_SFF_MASK) << 1) |
+                     !!(frame->can_id & QEMU_CAN_RTR_FLAG);
+
+    return !((value ^ code) & ~mask & 0xfff);
+}
+
+/* Hands a received frame to the core, keeping the DLC as it was sent. */
+static void chan_deliver_frame(Sja1000Channel *ch, const qemu_can_frame *frame,
+                               uint8_t raw_dlc)
+{
+    uint8_t messages = ch->core.rxmsg_cnt;
+    uint32_t start = ch->core.rx_ptr;
+    bool single_standard = chan_pelican(ch) && (ch->core.mode & MOD_AFM) &&
+                           !(frame->can_id & QEMU_CAN_EFF_FLAG);
+    uint8_t saved[2][2] = {
+        { ch->core.code_mask[0], ch->core.code_mask[1] },
+        { ch->core.code_mask[4], ch->core.code_mask[5] },
+    };
+
+    if (!chan_pelican(ch)) {
+        /*
+         * BasicCAN receives standard frames only, through its 8-bit
+         * acceptance filter on ID.10..ID.3 (DS 6.3.9); the core's BasicCAN
+         * path applies no filter of its own.
+         */
+        uint8_t top = (frame->can_id & QEMU_CAN_SFF_MASK) >> 3;
+
+        if ((frame->can_id & QEMU_CAN_EFF_FLAG) ||
+            ((top ^ ch->core.code) & ~ch->core.mask)) {
+            return;
+        }
+    }
+    if (single_standard) {
+        /*
+         * The core builds this filter's identifier mask from AMR1 << 5
+         * where the layout needs AMR1 >> 5 (can_sja_single_filter), so
+         * its mask never covers ID.2-0 and it compares them with ACR1
+         * bits 7-5 whatever AMR1 says: "accept all" would drop most
+         * frames. The identifier and RTR are matched here instead, and for
+         * the call the core's ACR0 and ACR1 hold the frame's own
+         * identifier, AMR0 and AMR1 all ones. It still compares the two
+         * data bytes with ACR2 and ACR3, which it does right.
+         */
+        uint32_t id = frame->can_id & QEMU_CAN_SFF_MASK;
+
+        if (!chan_single_filter_id_matches(ch, frame)) {
+            return;
+        }
+        ch->core.code_mask[0] = id >> 3;
+        ch->core.code_mask[1] = (id & 7) << 5;
+        ch->core.code_mask[4] = 0xff;
+        ch->core.code_mask[5] = 0xff;
+    }
+    can_sja_receive(&ch->core.bus_client, frame, 1);
+    if (single_standard) {
+        ch->core.code_mask[0] = saved[0][0];
+        ch->core.code_mask[1] = saved[0][1];
+        ch->core.code_mask[4] = saved[1][0];
+        ch->core.code_mask[5] = saved[1][1];
+    }
+    if (ch->core.rxmsg_cnt != messages && raw_dlc > 8) {
+        /* The core stores at most DLC 8; the chip keeps the DLC received. */
+        uint32_t at = chan_pelican(ch) ? start : start + 1;
+
+        at %= SJA_RCV_BUF_LEN;
+        ch->core.rx_buff[at] = (ch->core.rx_buff[at] & ~FRAME_DLC_MASK) |
+                               raw_dlc;
+    }
+    chan_normalise_rx_interrupts(ch);
+}
+
+static void chan_apply_event(Sja1000Channel *ch, ChanEvent *event)
+{
+    switch (event->kind) {
+    case EV_SOF:
+        if (event->arg == SOF_WAKE) {
+            /*
+             * A sleeping chip wakes on bus activity and misses that frame
+             * until it has seen a bus-free signal (DS 6.4.4 note 1).
+             */
+            if (ch->sleeping) {
+                chan_request_sleep(ch, false);
+            }
+        } else if (event->arg == SOF_TX) {
+            ch->status |= SR_TS;
+            ch->status &= ~SR_RS;
+        } else {
+            ch->status |= SR_RS;
+        }
+        break;
+    case EV_LOST:
+        ch->status &= ~SR_TS;
+        ch->status |= SR_RS;
+        if (!ch->alc_captured) {
+            ch->alc = event->arg;
+            ch->alc_captured = true;
+        }
+        chan_raise(ch, IR_ALI);
+        if (ch->tx_pending && chan_tx_final(ch)) {
+            chan_release_tx(ch, false);
+        }
+        break;
+    case EV_TXOK:
+        ch->status &= ~SR_TS;
+        ch->lone_in_attempt = false;
+        if (ch->tx_pending) {
+            chan_release_tx(ch, true);
+        }
+        chan_count_tx_success(ch);
+        break;
+    case EV_RX:
+        ch->status &= ~SR_RS;
+        chan_deliver_frame(ch, &event->frame, event->raw_dlc);
+        if (!(event->flags & EVF_SELF)) {
+            chan_count_rx_success(ch);
+        }
+        break;
+    case EV_ERR:
+        chan_capture_ecc(ch, event->arg);
+        if (event->arg & ECC_DIR_RX) {
+            chan_count_rx_error(ch);
+        } else {
+            bool final = ch->tx_pending && chan_tx_final(ch);
+
+            chan_count_tx_error(ch, event->flags & EVF_ACK);
+            /* Bus-off may have dropped the request already. */
+            if (final && ch->tx_pending) {
+                chan_release_tx(ch, false);
+            }
+        }
+        break;
+    case EV_IDLE:
+        if (!chan_in_reset(ch)) {
+            ch->status &= ~(SR_RS | SR_TS);
+        }
+        if (ch->port < 0 && ch->lone_in_attempt) {
+            ch->lone_in_attempt = false;
+            if (ch->tx_pending && ch->tx_abort_requested) {
+                chan_release_tx(ch, false);
+            } else if (ch->tx_pending && ch->mode == BUS_MODE_ON) {
+                uint64_t bit = chan_bit_ns(ch);
+                int64_t at = ch->lone_free_at +
+                             (ch->passive ? FC_SUSPEND_BITS * bit : 0);
+
+                ch->lone_next_attempt = at;
+                chan_queue_event(ch, chan_new_event(ch, EV_LONE_ATTEMPT, at));
+            }
+        }
+        break;
+    case EV_ABORTED:
+        if (ch->tx_pending) {
+            chan_release_tx(ch, false);
+        }
+        break;
+    case EV_JOIN:
+        ch->joined = true;
+        ch->status &= ~(SR_RS | SR_TS);
+        chan_update_mode(ch);
+        break;
+    case EV_BUSFREE:
+        /* TXERR counts the recovery down (DS 6.4.12). */
+        ch->recovery_signals = event->count;
+        if (ch->recovery_signals >= FC_RECOVERY_SIGNALS) {
+            ch->bus_off = false;
+            ch->tec = 0;
+            ch->rec = 0;
+            ch->joined = true;
+            ch->status &= ~(SR_BS | SR_ES | SR_RS | SR_TS);
+            chan_raise(ch, IR_EI);
+            chan_update_mode(ch);
+        } else {
+            ch->tec = TXERR_AT_BUS_OFF - ch->recovery_signals;
+            if (ch->port < 0) {
+                chan_lone_next_step(ch);
+            }
+        }
+        break;
+    case EV_FAULT:
+        if (event->arg == FAULT_BUS_OFF) {
+            if (!ch->bus_off) {
+                ch->tec = FC_BUS_OFF_LIMIT;
+                chan_enter_bus_off(ch);
+            }
+        } else if (!ch->bus_off && ch->tec < FC_PASSIVE_LIMIT) {
+            ch->tec = FC_PASSIVE_LIMIT;
+            chan_update_error_state(ch);
+        }
+        break;
+    case EV_LONE_ATTEMPT:
+        if (event->time != ch->lone_next_attempt) {
+            /* Superseded: the request it was for has gone. */
+            break;
+        }
+        ch->lone_next_attempt = -1;
+        if (ch->tx_pending && ch->mode == BUS_MODE_ON && !ch->lone_in_attempt) {
+            if (ch->tx_abort_requested) {
+                chan_release_tx(ch, false);
+            } else {
+                chan_lone_attempt(ch);
+            }
+        }
+        break;
+    }
+    chan_update_irq(ch);
+}
+
+/* -- events from the hub ---------------------------------------------------- */
+
+static G_NORETURN void chan_bad_event(Sja1000Channel *ch, int argc,
+                                      char **argv)
+{
+    labbus_link_fatal(ch->card->link, "the hub sent a malformed %s event for "
+                      "channel %u (%d words)", argv[0], ch->index, argc);
+}
+
+static uint64_t chan_event_number(Sja1000Channel *ch, int argc, char **argv,
+                                  int index, int base)
+{
+    const char *end;
+    uint64_t value;
+
+    if (index >= argc || qemu_strtou64(argv[index], &end, base, &value) ||
+        *end) {
+        chan_bad_event(ch, argc, argv);
+    }
+    return value;
+}
+
+/* Parses "<id> <format> <dlc> <data>" from argv[index]. */
+static void chan_parse_frame(Sja1000Channel *ch, int argc, char **argv,
+                             int index, ChanEvent *event)
+{
+    uint64_t id = chan_event_number(ch, argc, argv, index, 16);
+    uint64_t dlc = chan_event_number(ch, argc, argv, index + 2, 10);
+    const char *format = index + 1 < argc ? argv[index + 1] : "";
+    const char *data = index + 3 < argc ? argv[index + 3] : "";
+    qemu_can_frame *frame = &event->frame;
+    int i;
+
+    if (strlen(format) != 2 || (format[0] != 'S' && format[0] != 'X') ||
+        (format[1] != 'D' && format[1] != 'R') || dlc > 15 ||
+        id > (format[0] == 'X' ? QEMU_CAN_EFF_MASK : QEMU_CAN_SFF_MASK)) {
+        chan_bad_event(ch, argc, argv);
+    }
+    frame->can_id = id;
+    if (format[0] == 'X') {
+        frame->can_id |= QEMU_CAN_EFF_FLAG;
+    }
+    if (format[1] == 'R') {
+        frame->can_id |= QEMU_CAN_RTR_FLAG;
+    }
+    event->raw_dlc = dlc;
+    frame->can_dlc = MIN(dlc, 8);
+    if (format[1] == 'R' || frame->can_dlc == 0) {
+        if (strcmp(data, "-")) {
+            chan_bad_event(ch, argc, argv);
+        }
+        return;
+    }
+    if (strlen(data) != 2u * frame->can_dlc) {
+        chan_bad_event(ch, argc, argv);
+    }
+    for (i = 0; i < frame->can_dlc; i++) {
+        char byte[3] = { data[2 * i], data[2 * i + 1], '\0' };
+        const char *end;
+        unsigned long value;
+
+        if (qemu_strtoul(byte, &end, 16, &value) || *end) {
+            chan_bad_event(ch, argc, argv);
+        }
+        frame->data[i] = value;
+    }
+}
+
+static bool chan_has_flag(const char *list, const char *flag)
+{
+    size_t length = strlen(flag);
+    const char *cursor = list;
+
+    while ((cursor = strstr(cursor, flag))) {
+        if ((cursor == list || cursor[-1] == ',') &&
+            (cursor[length] == '\0' || cursor[length] == ',')) {
+            return true;
+        }
+        cursor += length;
+    }
+    return false;
+}
+
+/*
+ * "<EVENT> <port> <epoch> <time> [arguments]" (docs/protocols/labbus.md,
+ * "Events"): queued for its emulated time; the hub never announces an
+ * event before the boundary it sends it at.
+ */
+static void chan_link_event(void *opaque, int argc, char **argv)
+{
+    Sja1000Channel *ch = opaque;
+    const char *verb = argv[0];
+    ChanEvent *event = g_new0(ChanEvent, 1);
+
+    event->epoch = chan_event_number(ch, argc, argv, 2, 10);
+    event->time = chan_event_number(ch, argc, argv, 3, 10);
+    if (!strcmp(verb, "SOF") && argc == 5) {
+        event->kind = EV_SOF;
+        if (!strcmp(argv[4], "tx")) {
+            event->arg = SOF_TX;
+        } else if (!strcmp(argv[4], "rx")) {
+            event->arg = SOF_RX;
+        } else if (!strcmp(argv[4], "wake")) {
+            event->arg = SOF_WAKE;
+        } else {
+            chan_bad_event(ch, argc, argv);
+        }
+    } else if (!strcmp(verb, "LOST") && argc == 6) {
+        event->kind = EV_LOST;
+        event->arg = chan_event_number(ch, argc, argv, 4, 10) & 0x1f;
+    } else if (!strcmp(verb, "TXOK") && argc == 4) {
+        event->kind = EV_TXOK;
+    } else if (!strcmp(verb, "RX") && argc == 9) {
+        event->kind = EV_RX;
+        chan_parse_frame(ch, argc, argv, 4, event);
+        if (!strcmp(argv[8], "1")) {
+            event->flags |= EVF_SELF;
+        }
+    } else if (!strcmp(verb, "ERR") && argc == 7) {
+        event->kind = EV_ERR;
+        event->arg = chan_event_number(ch, argc, argv, 5, 16);
+        if ((!strcmp(argv[4], "rx")) != !!(event->arg & ECC_DIR_RX)) {
+            chan_bad_event(ch, argc, argv);
+        }
+        if (chan_has_flag(argv[6], "ack")) {
+            event->flags |= EVF_ACK;
+        }
+    } else if (!strcmp(verb, "IDLE") && argc == 4) {
+        event->kind = EV_IDLE;
+    } else if (!strcmp(verb, "ABORTED") && argc == 4) {
+        event->kind = EV_ABORTED;
+    } else if (!strcmp(verb, "JOIN") && argc == 4) {
+        event->kind = EV_JOIN;
+    } else if (!strcmp(verb, "BUSFREE") && argc == 5) {
+        event->kind = EV_BUSFREE;
+        event->count = MIN(chan_event_number(ch, argc, argv, 4, 10),
+                           FC_RECOVERY_SIGNALS);
+    } else if (!strcmp(verb, "FAULT") && argc == 5) {
+        event->kind = EV_FAULT;
+        if (!strcmp(argv[4], "passive")) {
+            event->arg = FAULT_PASSIVE;
+        } else if (!strcmp(argv[4], "busoff")) {
+            event->arg = FAULT_BUS_OFF;
+        } else {
+            chan_bad_event(ch, argc, argv);
+        }
+    } else {
+        chan_bad_event(ch, argc, argv);
+    }
+    chan_queue_event(ch, event);
+}
+
+/* -- register access ---------------------------------------------------------- */
+
+static uint8_t chan_read_status(Sja1000Channel *ch)
+{
+    uint8_t core_bits = chan_pelican(ch) ? ch->core.status_pel :
+                                           ch->core.status_bas;
+
+    return (core_bits & SR_CORE_BITS) | (ch->status & ~SR_CORE_BITS);
+}
+
+static uint8_t chan_read(Sja1000Channel *ch, unsigned addr)
+{
+    uint8_t value;
+
+    /* Events due now (a frame that ends at this instant) come first. */
+    chan_run_events(ch);
+    switch (addr) {
+    case SJA_CMR:
+        return CMR_READ_VALUE;
+    case SJA_SR:
+        return chan_read_status(ch);
+    case SJA_BTR0:
+        return ch->btr0;
+    case SJA_BTR1:
+        return ch->btr1;
+    case SJA_OCR_ADDR:
+        return ch->ocr;
+    case SJA_CDR:
+        return ch->core.clock;
+    default:
+        break;
+    }
+    if (!chan_pelican(ch)) {
+        value = can_sja_mem_read(&ch->core, addr, 1);
+        if (addr == SJA_BCAN_IR) {
+            chan_normalise_rx_interrupts(ch);
+        }
+        return value;
+    }
+    switch (addr) {
+    case SJA_ALC:
+        /* Reading ALC lets the next lost arbitration be captured. */
+        ch->alc_captured = false;
+        return ch->alc;
+    case SJA_ECC:
+        ch->ecc_captured = false;
+        return ch->ecc;
+    case SJA_EWLR:
+        return ch->ewlr;
+    case SJA_PEL_RXERR:
+        return ch->rec;
+    case SJA_PEL_TXERR:
+        /* In bus-off TXERR counts the recovery; 256 never shows. */
+        return MIN(ch->tec, FC_COUNTER_MAX);
+    case SJA_RMC:
+        return ch->core.rxmsg_cnt;
+    case SJA_RBSA:
+        return ch->core.rxbuf_start;
+    default:
+        value = can_sja_mem_read(&ch->core, addr, 1);
+        if (addr == SJA_IR) {
+            chan_normalise_rx_interrupts(ch);
+        }
+        return value;
+    }
+}
+
+/* A write to MOD (DS 6.4.3): LOM, STM and AFM only in reset mode, SM only
+ * in operating mode. */
+static void chan_write_mode(Sja1000Channel *ch, uint8_t value)
+{
+    bool was_reset = chan_in_reset(ch);
+    uint8_t mode = ch->core.mode;
+
+    value &= MOD_WRITABLE;
+    if (was_reset) {
+        mode = (mode & ~(MOD_LOM | MOD_STM | MOD_AFM)) |
+               (value & (MOD_LOM | MOD_STM | MOD_AFM));
+    }
+    /* The core stores the result (its only action on MOD). */
+    can_sja_mem_write(&ch->core, SJA_MOD, mode, 1);
+    if (!was_reset && (value & MOD_RM)) {
+        chan_enter_reset(ch);
+        chan_update_mode(ch);
+    } else if (was_reset && !(value & MOD_RM)) {
+        chan_leave_reset(ch);
+        if (value & MOD_SM) {
+            /* Sleep cannot be entered before a bus-free signal. */
+            chan_request_sleep(ch, true);
+        }
+    } else if (!was_reset) {
+        chan_request_sleep(ch, value & MOD_SM);
+    } else {
+        chan_update_mode(ch);
+    }
+}
+
+/* BasicCAN CR (DS 6.3.3): RR and the four interrupt enables. */
+static void chan_write_control(Sja1000Channel *ch, uint8_t value)
+{
+    bool was_reset = chan_in_reset(ch);
+
+    /*
+     * The core's CR write treats a write with RR clear in operating mode
+     * as a software reset; the chip only changes the enables then, so the
+     * register is written here.
+     */
+    ch->core.control = (value & (CR_RR | CR_RIE | CR_TIE | CR_EIE | CR_OIE));
+    if (!was_reset && (value & CR_RR)) {
+        chan_enter_reset(ch);
+        chan_update_mode(ch);
+    } else if (was_reset && !(value & CR_RR)) {
+        chan_leave_reset(ch);
+    }
+    chan_normalise_rx_interrupts(ch);
+}
+
+static void chan_write_command(Sja1000Channel *ch, uint8_t value)
+{
+    bool pelican = chan_pelican(ch);
+
+    if (pelican && (value & (CMR_TR | CMR_SRR))) {
+        /*
+         * AT with TR or SRR, and TR with SRR, send once (DS 6.4.4 notes);
+         * SRR receives the frame itself.
+         */
+        bool single = (value & CMR_AT) ||
+                      ((value & CMR_TR) && (value & CMR_SRR));
+
+        chan_request_transmission(ch, single,
+                                  (value & CMR_SRR) && !(value & CMR_TR));
+    } else if (!pelican && (value & CMR_TR)) {
+        chan_request_transmission(ch, value & CMR_AT, false);
+    } else if (value & CMR_AT) {
+        chan_abort_transmission(ch);
+    }
+    if (!pelican && (value & CMR_GTS)) {
+        chan_request_sleep(ch, true);
+    } else if (!pelican && ch->sleeping) {
+        /* GTS cleared: wake up (DS 6.3.4 note 1). */
+        chan_request_sleep(ch, false);
+    }
+    /* The core releases the receive buffer and clears the overrun. */
+    if (value & (CMR_RRB | CMR_CDO)) {
+        can_sja_mem_write(&ch->core, SJA_CMR, value & (CMR_RRB | CMR_CDO), 1);
+        chan_normalise_rx_interrupts(ch);
+    }
+}
+
+static void chan_write(Sja1000Channel *ch, unsigned addr, uint8_t value)
+{
+    bool reset = chan_in_reset(ch);
+    bool pelican = chan_pelican(ch);
+
+    chan_run_events(ch);
+    switch (addr) {
+    case SJA_CMR:
+        chan_write_command(ch, value);
+        return;
+    case SJA_SR:
+    case SJA_IR:
+        return;
+    case SJA_BTR0:
+    case SJA_BTR1:
+    case SJA_OCR_ADDR:
+        /* Written in reset mode only, read only otherwise (DS 6.5). */
+        if (reset) {
+            if (addr == SJA_BTR0) {
+                ch->btr0 = value;
+            } else if (addr == SJA_BTR1) {
+                ch->btr1 = value;
+            } else {
+                ch->ocr = value;
+            }
+            chan_update_mode(ch);
+        }
+        return;
+    case SJA_CDR:
+        if (!reset) {
+            value = (value & ~CDR_RESET_ONLY_BITS) |
+                    (ch->core.clock & CDR_RESET_ONLY_BITS);
+        }
+        can_sja_mem_write(&ch->core, SJA_CDR, value, 1);
+        chan_normalise_rx_interrupts(ch);
+        chan_update_mode(ch);
+        return;
+    default:
+        break;
+    }
+    if (!pelican) {
+        switch (addr) {
+        case SJA_BCAN_CTR:
+            chan_write_control(ch, value);
+            return;
+        case SJA_BAS_ACR:
+        case SJA_BAS_AMR:
+            /* The acceptance filter is programmed in reset mode (DS 6.3.9). */
+            if (reset) {
+                can_sja_mem_write(&ch->core, addr, value, 1);
+            }
+            return;
+        case SJA_BAS_TXB_FIRST ... SJA_BAS_TXB_LAST:
+            /* A locked buffer loses the byte (DS 6.3.5 note 5). */
+            if (!reset && !ch->tx_pending) {
+                can_sja_mem_write(&ch->core, addr, value, 1);
+            }
+            return;
+        default:
+            return;
+        }
+    }
+    switch (addr) {
+    case SJA_MOD:
+        chan_write_mode(ch, value);
+        return;
+    case SJA_IER:
+        can_sja_mem_write(&ch->core, addr, value, 1);
+        chan_normalise_rx_interrupts(ch);
+        return;
+    case SJA_EWLR:
+        if (reset) {
+            ch->ewlr = value;
+        }
+        return;
+    case SJA_PEL_RXERR:
+        /* Reset mode only; no effect while bus-off (DS 6.4.11). */
+        if (reset && !ch->bus_off) {
+            ch->rec = value;
+        }
+        return;
+    case SJA_PEL_TXERR:
+        if (!reset) {
+            return;
+        }
+        if (value == TXERR_FORCE_BUS_OFF) {
+            /* A CPU-driven bus-off event (DS 6.4.12). */
+            if (!ch->bus_off) {
+                chan_enter_bus_off(ch);
+            }
+        } else {
+            if (ch->bus_off) {
+                /*
+                 * 0..254 in bus-off clears BS; the chip then waits for one
+                 * bus-free signal once reset mode ends (DS 6.4.12).
+                 */
+                ch->bus_off = false;
+                ch->status &= ~SR_BS;
+                ch->deferred_ei = true;
+            }
+            ch->tec = value;
+        }
+        return;
+    case SJA_RBSA:
+        /* RBSA is writable in reset mode, where the FIFO is empty. */
+        if (reset) {
+            ch->core.rxbuf_start = value % SJA_RCV_BUF_LEN;
+            ch->core.rx_ptr = ch->core.rxbuf_start;
+        }
+        return;
+    case SJA_PEL_FRAME_FIRST ... SJA_PEL_FRAME_LAST:
+        if (!reset && ch->tx_pending) {
+            /* A locked transmit buffer loses the byte (DS 6.4.5 note). */
+            return;
+        }
+        can_sja_mem_write(&ch->core, addr, value, 1);
+        return;
+    default:
+        /* ALC, ECC, RMC, the test and reserved registers ignore writes. */
+        return;
+    }
+}
+
+static uint64_t sja_card_read(void *opaque, hwaddr addr, unsigned size)
+{
+    IsaSja1000State *card = opaque;
+
+    return chan_read(&card->chan[addr / SJA_CHANNEL_PORTS],
+                     addr % SJA_CHANNEL_PORTS);
+}
+
+static void sja_card_write(void *opaque, hwaddr addr, uint64_t value,
+                           unsigned size)
+{
+    IsaSja1000State *card = opaque;
+
+    chan_write(&card->chan[addr / SJA_CHANNEL_PORTS],
+               addr % SJA_CHANNEL_PORTS, value);
+}
+
+static const MemoryRegionOps sja_card_ops = {
+    .read = sja_card_read,
+    .write = sja_card_write,
+    /*
+     * The chips sit on the card's 8-bit data path: a 16- or 32-bit access
+     * is split into byte accesses at consecutive ports, lowest first.
+     */
+    .valid.min_access_size = 1,
+    .valid.max_access_size = 4,
+    .impl.min_access_size = 1,
+    .impl.max_access_size = 1,
+    .endianness = DEVICE_LITTLE_ENDIAN,
+};
+
+/* -- life cycle ----------------------------------------------------------------- */
+
+/*
+ * Hardware reset of one chip (DS 6.3.2 and 6.4.2, Tables 3 and 8): the
+ * core's registers, the front end's counters and captures, EWLR 96, no
+ * request; BTR0, BTR1 and OCR keep their contents as on the chip, where a
+ * hardware reset leaves them undefined.
+ */
+static void chan_hardware_reset(Sja1000Channel *ch)
+{
+    can_sja_hardware_reset(&ch->core);
+    chan_drop_events(ch);
+    ch->alc = 0;
+    ch->ecc = 0;
+    ch->alc_captured = false;
+    ch->ecc_captured = false;
+    ch->ewlr = EWLR_RESET_VALUE;
+    ch->tec = 0;
+    ch->rec = 0;
+    ch->status = SR_TBS | SR_TCS | SR_RS | SR_TS;
+    ch->bus_off = false;
+    ch->passive = false;
+    ch->deferred_ei = false;
+    ch->joined = false;
+    ch->sleeping = false;
+    ch->recovery_signals = 0;
+    ch->tx_pending = false;
+    ch->tx_abort_requested = false;
+    ch->lone_free_at = 0;
+    ch->lone_in_attempt = false;
+    ch->lone_next_attempt = -1;
+    chan_set_reset_bit(ch, true);
+    chan_update_irq(ch);
+    chan_update_mode(ch);
+}
+
+static void sja_card_realize(DeviceState *dev, Error **errp)
+{
+    ERRP_GUARD();
+    ISADevice *isa = ISA_DEVICE(dev);
+    IsaSja1000State *card = ISA_SJA1000(dev);
+    unsigned i;
+
+    if (card->iobase > 0x10000 - SJA_CARD_PORTS ||
+        (card->iobase & (SJA_CHANNEL_PORTS - 1))) {
+        error_setg(errp, "isa-sja1000: iobase 0x%" PRIx32 " must be a "
+                   "multiple of 0x%x with 0x%x ports below 0x10000",
+                   card->iobase, SJA_CHANNEL_PORTS, SJA_CARD_PORTS);
+        return;
+    }
+    for (i = 0; i < SJA_CARD_CHANNELS; i++) {
+        if (card->irq_line[i] >= ISA_NUM_IRQS) {
+            error_setg(errp, "isa-sja1000: irq%u %" PRIu32 " is not an ISA "
+                       "line (0..15)", i, card->irq_line[i]);
+            return;
+        }
+    }
+    if (card->irq_line[0] == card->irq_line[1]) {
+        /*
+         * ISA interrupts are edge triggered and not shared: one line per
+         * chip, as the card's jumpers allow.
+         */
+        error_setg(errp, "isa-sja1000: irq0 and irq1 are both %" PRIu32
+                   "; each channel needs its own line", card->irq_line[0]);
+        return;
+    }
+    for (i = 0; i < SJA_CARD_CHANNELS; i++) {
+        bool named = card->bus_name[i] && *card->bus_name[i];
+
+        if (named && !(card->hub_path && *card->hub_path)) {
+            error_setg(errp, "isa-sja1000: bus%u=%s needs hub=<socket of the "
+                       "lab bus hub>", i, card->bus_name[i]);
+            return;
+        }
+    }
+    if (card->hub_path && *card->hub_path) {
+        if (labbus_board_link) {
+            error_setg(errp, "isa-sja1000: this board is joined to a hub "
+                       "already; one card per board may name hub=");
+            return;
+        }
+        card->link = LABBUS_LINK(object_new(TYPE_LABBUS_LINK));
+        card->link->path = g_strdup(card->hub_path);
+        card->link->name = g_strdup(card->hub_name);
+        card->link->timeout_s = card->hub_timeout_s;
+        object_property_add_child(OBJECT(card), "link", OBJECT(card->link));
+        object_unref(OBJECT(card->link));
+        labbus_link_connect(card->link, errp);
+        if (*errp) {
+            object_unparent(OBJECT(card->link));
+            card->link = NULL;
+            return;
+        }
+        labbus_board_link = card->link;
+    }
+
+    memory_region_init_io(&card->io, OBJECT(dev), &sja_card_ops, card,
+                          TYPE_ISA_SJA1000, SJA_CARD_PORTS);
+    isa_register_ioport(isa, &card->io, card->iobase);
+    for (i = 0; i < SJA_CARD_CHANNELS; i++) {
+        Sja1000Channel *ch = &card->chan[i];
+
+        ch->card = card;
+        ch->index = i;
+        ch->port = -1;
+        QTAILQ_INIT(&ch->events);
+        ch->event_timer = timer_new_ns(QEMU_CLOCK_VIRTUAL,
+                                       chan_event_timer_cb, ch);
+        can_sja_init(&ch->core, isa_get_irq(isa, card->irq_line[i]));
+        if (card->bus_name[i] && *card->bus_name[i]) {
+            char label[8];
+
+            snprintf(label, sizeof(label), "%u", i);
+            ch->port = labbus_link_attach(card->link, card->bus_name[i],
+                                          label, chan_link_event, ch, errp);
+            if (ch->port < 0) {
+                return;
+            }
+        }
+    }
+}
+
+static void sja_card_unrealize(DeviceState *dev)
+{
+    IsaSja1000State *card = ISA_SJA1000(dev);
+    unsigned i;
+
+    for (i = 0; i < SJA_CARD_CHANNELS; i++) {
+        chan_drop_events(&card->chan[i]);
+        timer_free(card->chan[i].event_timer);
+        card->chan[i].event_timer = NULL;
+    }
+    if (card->link && labbus_board_link == card->link) {
+        labbus_board_link = NULL;
+    }
+}
+
+static void sja_card_reset(DeviceState *dev)
+{
+    IsaSja1000State *card = ISA_SJA1000(dev);
+    unsigned i;
+
+    for (i = 0; i < SJA_CARD_CHANNELS; i++) {
+        chan_hardware_reset(&card->chan[i]);
+    }
+}
+
+static Property sja_card_properties[] = {
+    DEFINE_PROP_UINT32("iobase", IsaSja1000State, iobase, 0x280),
+    DEFINE_PROP_UINT32("irq0", IsaSja1000State, irq_line[0], 10),
+    DEFINE_PROP_UINT32("irq1", IsaSja1000State, irq_line[1], 11),
+    DEFINE_PROP_STRING("hub", IsaSja1000State, hub_path),
+    DEFINE_PROP_STRING("hub-name", IsaSja1000State, hub_name),
+    DEFINE_PROP_UINT32("hub-timeout", IsaSja1000State, hub_timeout_s, 60),
+    DEFINE_PROP_STRING("bus0", IsaSja1000State, bus_name[0]),
+    DEFINE_PROP_STRING("bus1", IsaSja1000State, bus_name[1]),
+    DEFINE_PROP_END_OF_LIST(),
+};
+
+static void sja_card_class_init(ObjectClass *klass, void *data)
+{
+    DeviceClass *dc = DEVICE_CLASS(klass);
+
+    dc->desc = "DCOS two-channel ISA SJA1000 CAN card (16 MHz)";
+    dc->realize = sja_card_realize;
+    dc->unrealize = sja_card_unrealize;
+    dc->reset = sja_card_reset;
+    device_class_set_props(dc, sja_card_properties);
+    object_class_property_set_description(klass, "iobase",
+        "base port: channel 0 at iobase, channel 1 at iobase + 0x20");
+    object_class_property_set_description(klass, "irq0",
+        "ISA interrupt line of channel 0 (jumper)");
+    object_class_property_set_description(klass, "irq1",
+        "ISA interrupt line of channel 1 (jumper)");
+    object_class_property_set_description(klass, "hub",
+        "unix socket of the lab bus hub (dcoslab/canbus.py); none: no hub");
+    object_class_property_set_description(klass, "hub-name",
+        "this board's participant name at the hub, e.g. board1");
+    object_class_property_set_description(klass, "hub-timeout",
+        "seconds to wait for a silent hub before stopping the board");
+    object_class_property_set_description(klass, "bus0",
+        "lab bus channel 0 is wired to (none: a bus without other nodes)");
+    object_class_property_set_description(klass, "bus1",
+        "lab bus channel 1 is wired to (none: a bus without other nodes)");
+    set_bit(DEVICE_CATEGORY_NETWORK, dc->categories);
+}
+
+static const TypeInfo sja_card_info = {
+    .name          = TYPE_ISA_SJA1000,
+    .parent        = TYPE_ISA_DEVICE,
+    .instance_size = sizeof(IsaSja1000State),
+    .class_init    = sja_card_class_init,
+};
+
+static void sja_card_register_types(void)
+{
+    type_register_static(&labbus_link_info);
+    type_register_static(&sja_card_info);
+}
+
+type_init(sja_card_register_types)
