@@ -11,6 +11,8 @@
 #include <sja1000/IsaSja1000Channel.hpp>
 
 #include <can/FrameText.hpp>
+#include <can/IsoTpReceiver.hpp>
+#include <can/IsoTpSender.hpp>
 #include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
@@ -278,6 +280,190 @@ CommandResult dump(shell::Shell& shell, int argc, char** argv)
     return CommandResult::Ok;
 }
 
+// -- ISO 15765-2 transfers, with the link layer's state machines ------------
+
+// An ISO-TP identifier as can-utils' isotpsend takes it: hexadecimal,
+// extended when it does not fit 11 bits or is written with 8 digits.
+bool parseIsoTpId(shell::Shell& shell, const char* text, uint32_t& id, bool& extended)
+{
+    unsigned digits = 0;
+    uint32_t value = 0;
+    for (const char* p = text; *p != '\0'; ++p, ++digits) {
+        const char c = *p;
+        const int digit = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10
+                                                          : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+        if (digit < 0 || digits == 8) {
+            digits = 9;
+            break;
+        }
+        value = (value << 4) | static_cast<uint32_t>(digit);
+    }
+    if (digits == 0 || digits > 8 || value > can::CanFrame::kMaxExtendedId) {
+        shell.print("error: '%s' is not a CAN identifier in hexadecimal (e.g. 7E0 or 18DA00F1)\r\n", text);
+        return false;
+    }
+    id = value;
+    extended = value > can::CanFrame::kMaxStandardId || digits == 8;
+    return true;
+}
+
+// The channel, source and destination of an isotp subcommand (argv[2..4]).
+bool isoTpConnection(shell::Shell& shell, char** argv, unsigned& channel, can::IsoTpConfig& config)
+{
+    bool sourceExtended = false;
+    bool destinationExtended = false;
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel) ||
+        !parseIsoTpId(shell, argv[3], config.txId, sourceExtended) ||
+        !parseIsoTpId(shell, argv[4], config.rxId, destinationExtended)) {
+        return false;
+    }
+    config.format = sourceExtended || destinationExtended ? can::IdFormat::Extended : can::IdFormat::Standard;
+    return true;
+}
+
+// Puts one frame of a transfer on the bus and waits until it was sent: the
+// confirmation ISO-TP's N_As measures.
+bool sendConfirmed(unsigned channel, const can::CanFrame& frame, uint64_t timeoutNs)
+{
+    (void)taskAgent.ReceiveEvent(kSentEvent, dcos::EventWait::Any, dcos::kPoll); // A stale one means nothing.
+    const dcos::Result<size_t> written =
+        systemAgent.Write(consoleChannels[channel].id(), 0, &frame, sizeof(can::CanFrame));
+    if (!written.ok() || written.value() != sizeof(can::CanFrame)) {
+        return false;
+    }
+    return taskAgent.ReceiveEvent(kSentEvent, dcos::EventWait::Any, timeoutNs).ok();
+}
+
+// Waits for the next received frame until @p deadlineNs (uptime); false when none came.
+bool nextFrame(unsigned channel, uint64_t deadlineNs, can::CanFrame& frame)
+{
+    for (;;) {
+        const dcos::Result<size_t> read =
+            systemAgent.Read(consoleChannels[channel].id(), 0, &frame, sizeof(can::CanFrame));
+        if (read.ok() && read.value() == sizeof(can::CanFrame)) {
+            return true;
+        }
+        const uint64_t now = dcos::timerAgent.Uptime();
+        if (now >= deadlineNs) {
+            return false;
+        }
+        (void)taskAgent.ReceiveEvent(kReceiveEvent, dcos::EventWait::Any, deadlineNs - now);
+    }
+}
+
+// Frames of other connections read while waiting are dropped: the console's
+// transfers own the channel while they run, as isotpsend owns its socket.
+CommandResult isoTpSend(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    can::IsoTpConfig config;
+    if (argc != 6) {
+        shell.print("usage: can isotp-send <channel> <source id> <destination id> <hex bytes, e.g. 0102A0>\r\n");
+        return CommandResult::Failed;
+    }
+    if (!isoTpConnection(shell, argv, channel, config)) {
+        return CommandResult::Failed;
+    }
+    static uint8_t message[4095];
+    size_t length = 0;
+    for (const char* p = argv[5]; *p != '\0'; p += 2) {
+        unsigned long byte = 0;
+        char pair[5] = {'0', 'x', p[0], p[1], '\0'};
+        if (p[1] == '\0' || length == sizeof message || !shell::Shell::parseUnsigned(pair, byte)) {
+            shell.print("error: '%s' is not 1 to 4095 bytes in hexadecimal\r\n", argv[5]);
+            return CommandResult::Failed;
+        }
+        message[length++] = static_cast<uint8_t>(byte);
+    }
+    const can::LinkResult<can::IsoTpSender> created = can::IsoTpSender::create(config);
+    if (!created.ok()) {
+        shell.print("error: %s\r\n", can::linkErrorName(created.error()));
+        return CommandResult::Failed;
+    }
+    listenHere(channel);
+    can::IsoTpSender sender = created.value();
+    can::IsoTpStep step = sender.start(message, length, dcos::timerAgent.Uptime());
+    while (!step.completed && step.aborted == can::LinkError::Ok &&
+           (step.rejected == can::LinkError::Ok || step.transmit || !sender.idle())) {
+        if (step.transmit) {
+            if (!sendConfirmed(channel, step.frame, config.timeoutAsNs)) {
+                step = sender.poll(dcos::timerAgent.Uptime() + config.timeoutAsNs); // N_As has run out.
+                continue;
+            }
+            step = sender.onTransmitConfirmed(dcos::timerAgent.Uptime());
+            continue;
+        }
+        can::CanFrame frame;
+        if (nextFrame(channel, sender.nextDeadlineNs(), frame)) {
+            step = sender.onFrame(frame, dcos::timerAgent.Uptime());
+        } else {
+            step = sender.poll(dcos::timerAgent.Uptime());
+        }
+        if (!step.transmit && !step.completed && step.aborted == can::LinkError::Ok) {
+            step.rejected = can::LinkError::Ok; // A frame of another connection: not ours to judge.
+        }
+    }
+    if (!step.completed) {
+        const can::LinkError why = step.aborted != can::LinkError::Ok ? step.aborted : step.rejected;
+        shell.print("error: ISO-TP transfer failed: %s\r\n", can::linkErrorName(why));
+        return CommandResult::Failed;
+    }
+    shell.print("%s  isotp %lu bytes sent\r\n", kNames[channel], static_cast<unsigned long>(length));
+    return CommandResult::Ok;
+}
+
+CommandResult isoTpReceive(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    can::IsoTpConfig config;
+    unsigned long timeoutMs = kDefaultDumpTimeoutMs;
+    if (argc < 5 || argc > 6) {
+        shell.print("usage: can isotp-recv <channel> <source id> <destination id> [time-out ms]\r\n");
+        return CommandResult::Failed;
+    }
+    if (!isoTpConnection(shell, argv, channel, config) || (argc == 6 && !parseMilliseconds(shell, argv[5], timeoutMs))) {
+        return CommandResult::Failed;
+    }
+    static uint8_t buffer[4095];
+    const can::LinkResult<can::IsoTpReceiver> created = can::IsoTpReceiver::create(config, buffer, sizeof buffer);
+    if (!created.ok()) {
+        shell.print("error: %s\r\n", can::linkErrorName(created.error()));
+        return CommandResult::Failed;
+    }
+    listenHere(channel);
+    can::IsoTpReceiver receiver = created.value();
+    const uint64_t giveUp = dcos::timerAgent.Uptime() + timeoutMs * kMillisecond;
+    for (;;) {
+        const uint64_t deadline = receiver.idle() ? giveUp : receiver.nextDeadlineNs();
+        can::CanFrame frame;
+        can::IsoTpStep step;
+        if (nextFrame(channel, deadline, frame)) {
+            step = receiver.onFrame(frame, dcos::timerAgent.Uptime());
+        } else if (receiver.idle()) {
+            shell.print("error: no ISO-TP message began within %lu ms\r\n", timeoutMs);
+            return CommandResult::Failed;
+        } else {
+            step = receiver.poll(dcos::timerAgent.Uptime());
+        }
+        if (step.transmit && !sendConfirmed(channel, step.frame, config.timeoutAsNs)) {
+            shell.print("error: the flow control could not be sent\r\n");
+            return CommandResult::Failed;
+        }
+        if (step.completed) {
+            shell.print("%s  isotp %u bytes:", kNames[channel], static_cast<unsigned>(step.length));
+            for (uint16_t i = 0; i < step.length; ++i) {
+                shell.print(" %02X", receiver.buffer()[i]);
+            }
+            shell.print("\r\n");
+            return CommandResult::Ok;
+        }
+        if (step.aborted != can::LinkError::Ok) {
+            shell.print("error: ISO-TP transfer failed: %s\r\n", can::linkErrorName(step.aborted));
+            return CommandResult::Failed;
+        }
+    }
+}
+
 void printState(shell::Shell& shell, unsigned channel)
 {
     if (!consoleChannels[channel].installed()) {
@@ -337,7 +523,8 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
 }
 
 constexpr shell::Subcommand kSubcommands[] = {
-    {"up", up}, {"down", down}, {"send", send}, {"dump", dump}, {"state", state}, {"stats", statistics},
+    {"up", up},       {"down", down},   {"send", send},           {"dump", dump},
+    {"state", state}, {"stats", statistics}, {"isotp-send", isoTpSend}, {"isotp-recv", isoTpReceive},
 };
 
 CommandResult canCommand(shell::Shell& shell, int argc, char** argv)
@@ -349,11 +536,14 @@ CommandResult canCommand(shell::Shell& shell, int argc, char** argv)
 
 DCOS_SHELL_COMMAND_DETAILED(canShellCommand, "can", "bring CAN channels up and down, send, dump, show their state",
                             "can up <channel> [bit rate] | down <channel> | send <channel> <id>#<data> [ms] | "
-                            "dump <channel> [count] [ms] | state [channel] | stats <channel>",
+                            "dump <channel> [count] [ms] | state [channel] | stats <channel> | "
+                            "isotp-send <channel> <src> <dst> <hex> | isotp-recv <channel> <src> <dst> [ms]",
                             "  channels: can0 (0x280, irq 10) and can1 (0x2a0, irq 11) of the ISA SJA1000 card\r\n"
                             "  frames: <id>#<data> as can-utils' cansend writes them: 3 hex digits for a standard\r\n"
                             "  identifier, 8 for an extended one; <id>#R[n] is a remote frame\r\n"
-                            "  dump prints frames as candump does; send waits for the frame to be acknowledged",
+                            "  dump prints frames as candump does; send waits for the frame to be acknowledged\r\n"
+                            "  isotp-send and isotp-recv move one ISO 15765-2 message, as can-utils' isotpsend\r\n"
+                            "  and isotprecv do: src is the identifier this end sends on, dst the one it receives on",
                             canCommand);
 
 } // namespace sja1000

@@ -1,3 +1,4 @@
+#include <hostcan/LabBusTransport.hpp>
 #include <hostcan/SlcanTransport.hpp>
 #include <hostcan/SocketCanTransport.hpp>
 #include <hostcan/Transport.hpp>
@@ -58,10 +59,21 @@ std::unique_ptr<Transport> openTransport(const std::string& spec, TransportError
             return SlcanTransport::open(path, std::string(prefix) == "slcan-socket:", bitRate, error);
         }
     }
+    if (startsWith(spec, "lab:")) {
+        // lab:<socket path>:<bus>; the path may hold colons, the bus name does not.
+        const std::string rest = spec.substr(4);
+        const size_t colon = rest.rfind(':');
+        if (colon == std::string::npos || colon == 0 || colon + 1 == rest.size()) {
+            error = {TransportError::Kind::BadArgument,
+                     "'" + spec + "': write lab:<hub socket>:<bus>, e.g. lab:/tmp/lab.sock:can0"};
+            return nullptr;
+        }
+        return LabBusTransport::open(rest.substr(0, colon), rest.substr(colon + 1), error);
+    }
     if (spec.find(':') != std::string::npos || spec.find('/') != std::string::npos) {
         error = {TransportError::Kind::BadArgument,
-                 "'" + spec + "' is not an interface: write a SocketCAN interface (can0), slcan:<device>[@<bit rate>] "
-                              "or slcan-socket:<path>[@<bit rate>]"};
+                 "'" + spec + "' is not an interface: write a SocketCAN interface (can0), slcan:<device>[@<bit rate>], "
+                              "slcan-socket:<path>[@<bit rate>] or lab:<hub socket>:<bus>"};
         return nullptr;
     }
     return SocketCanTransport::open(spec, error);

@@ -379,7 +379,8 @@ int main(int argc, char** argv)
     app.require_subcommand(1);
     app.footer("exit status: 0 done, 1 incomplete (dump ended early, send refused), 2 bad arguments, "
                "3 interface not available here, 4 interface failed\n"
-               "interfaces: can0 (SocketCAN), slcan:/dev/ttyACM0[@bitrate], slcan-socket:/path[@bitrate]");
+               "interfaces: can0 (SocketCAN), slcan:/dev/ttyACM0[@bitrate], slcan-socket:/path[@bitrate], "
+               "lab:<hub socket>:<bus> (the emulator lab's CAN bus)");
     std::string interface;
     bool json = false;
     app.add_option("-i,--interface", interface, "the CAN interface")->required();

@@ -86,7 +86,7 @@ public:
 ///     can0, vcan0, slcan0 ...         SocketCAN network interface (raw socket, error frames on)
 ///     slcan:/dev/ttyACM0[@bitrate]    an slcan (Lawicel) adapter on a serial device, default 500000 bit/s
 ///     slcan-socket:/path[@bitrate]    an slcan adapter behind a unix socket (we play the host side)
-///     lab:/path/to/hub.sock:bus       a participant of the lab's CAN bus hub
+///     lab:/path/to/hub.sock:bus       a participant of the lab's CAN bus hub (docs/protocols/labbus.md)
 ///
 /// BadArgument for a name of none of these forms.
 std::unique_ptr<Transport> openTransport(const std::string& spec, TransportError& error);

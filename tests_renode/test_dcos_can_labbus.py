@@ -1,0 +1,107 @@
+"""dcos-can on the lab's CAN bus hub (docs/protocols/labbus.md, "Joining from a host tool").
+
+The hub runs in this process with no board: its clock follows the wall
+clock. A Python participant (dcoslab.canbus.Client) plays the other node;
+dcos-can must see its frames with their emulated times, and its own frames
+must reach it.
+"""
+
+import json
+import os
+import subprocess
+import tempfile
+
+import pytest
+
+from dcoslab.board import REPOSITORY
+from dcoslab.canbus import Client, Frame, Hub
+
+DCOS_CAN = os.path.join(REPOSITORY, "build", "host_tools", "bin", "dcos-can")
+TIMEOUT = 60
+
+
+@pytest.fixture
+def hub():
+    directory = tempfile.mkdtemp(prefix="dcos-labbus-")
+    path = os.path.join(directory, "hub.sock")
+    running = Hub(path, {"can0": 500_000, "can1": 125_000}).start()
+    yield running
+    running.stop()
+    os.rmdir(directory) if not os.listdir(directory) else None
+
+
+def tool(hub, *arguments, bus="can0"):
+    return subprocess.Popen([DCOS_CAN, "-i", f"lab:{hub.socket_path}:{bus}", *arguments], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def wait_for_participants(hub, count):
+    hub.wait_for(lambda: len(hub.participants) >= count, TIMEOUT, f"{count} participants")
+
+
+def test_dump_shows_another_nodes_frames_with_emulated_times(hub):
+    dump = tool(hub, "--json", "dump", "-n", "2", "-t", "30000", "--decode")
+    wait_for_participants(hub, 1)
+    other = Client(hub.socket_path, "other")
+    try:
+        assert other.attach(0, "can0") == 2000
+        other.transmit(0, Frame(0x0320FF05, extended=True, dlc=2, data=bytes([1, 2])))
+        other.transmit(0, Frame(0x123, dlc=0))
+        output, errors = dump.communicate(timeout=TIMEOUT)
+    finally:
+        other.close()
+    assert dump.returncode == 0, errors
+    frames = [json.loads(line) for line in output.splitlines()]
+    assert [(f["id"], f["extended"], f["data"]) for f in frames] == [(0x0320FF05, True, "0102"), (0x123, False, "")]
+    assert all(f["emulated_time"] for f in frames)
+    # The second frame starts after the first (extended, 2 bytes: 93 bits with intermission, 2 us each).
+    assert frames[1]["timestamp_ns"] - frames[0]["timestamp_ns"] >= 52 * 2000, frames
+    assert frames[0]["dcos"] == {"priority": 3, "type": "DSM publication", "source": 5, "destination": 255}
+
+
+def test_frames_dcos_can_sends_reach_another_node(hub):
+    other = Client(hub.socket_path, "other")
+    try:
+        other.attach(0, "can0")
+        send = tool(hub, "send", "123#DEADBEEF", "1ABCDEF0#R4")
+        _, errors = send.communicate(timeout=TIMEOUT)
+        assert send.returncode == 0, errors
+        lines = other.events(lambda got: sum(line.startswith("RX ") for line in got) >= 2, TIMEOUT)
+    finally:
+        other.close()
+    received = [line.split()[4:8] for line in lines if line.startswith("RX ")]
+    assert received == [["123", "SD", "4", "deadbeef"], ["1abcdef0", "XR", "4", "-"]], lines
+
+
+def test_stats_take_the_bit_rate_from_the_hub(hub):
+    stats = tool(hub, "--json", "stats", "-s", "3", bus="can1")
+    wait_for_participants(hub, 1)
+    other = Client(hub.socket_path, "other")
+    try:
+        other.attach(0, "can1")
+        for index in range(4):
+            other.transmit(0, Frame(0x100 + index, dlc=8, data=bytes(8)))
+        output, errors = stats.communicate(timeout=TIMEOUT)
+    finally:
+        other.close()
+    assert stats.returncode == 0, errors
+    result = json.loads(output)
+    assert result["bit_rate"] == 125_000 and result["frames"] == 4, result
+
+
+def test_an_unknown_bus_and_a_missing_hub_are_named(hub):
+    refused = tool(hub, "dump", "-n", "1", bus="can7")
+    _, errors = refused.communicate(timeout=TIMEOUT)
+    assert refused.returncode == 4 and "refused bus 'can7'" in errors, errors
+    missing = subprocess.run([DCOS_CAN, "-i", "lab:/nonexistent/hub.sock:can0", "dump"], capture_output=True,
+                             text=True, timeout=TIMEOUT)
+    assert missing.returncode == 3 and "no lab bus hub at /nonexistent/hub.sock" in missing.stderr, missing.stderr
+    malformed = subprocess.run([DCOS_CAN, "-i", "lab:can0", "dump"], capture_output=True, text=True, timeout=TIMEOUT)
+    assert malformed.returncode == 2 and "lab:<hub socket>:<bus>" in malformed.stderr, malformed.stderr
+
+
+def test_a_frame_nobody_acknowledges_is_reported_not_lost_silently(hub):
+    alone = tool(hub, "send", "--timeout-ms", "500", "123#01")
+    _, errors = alone.communicate(timeout=TIMEOUT)
+    assert alone.returncode == 1, errors
+    assert "not on the lab bus within 500 ms" in errors and "acknowledge" in errors, errors
