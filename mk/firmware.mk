@@ -15,6 +15,7 @@ FW_INCLUDES := \
 	-Ifirmware/bsp_486/include \
 	-Idrivers/iobus/include \
 	-Ifieldbus/can/include \
+	-Ifieldbus/modbus/include \
 	-Idrivers/can/include
 
 FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
@@ -35,6 +36,7 @@ FW_LDFLAGS := -m elf_i386 -nostdlib -static -T firmware/boot/link.ld
 include firmware/dcos/dcos.mk
 include drivers/iobus/iobus.mk
 include fieldbus/can/can.mk
+include fieldbus/modbus/modbus.mk
 include drivers/can/can.mk
 
 # Sources every image contains.
@@ -49,6 +51,7 @@ FW_SRCS := \
 	$(IOBUS_PORTABLE_SRCS) \
 	$(IOBUS_TARGET_SRCS) \
 	$(CAN_PORTABLE_SRCS) \
+	$(MODBUS_PORTABLE_SRCS) \
 	$(CAN_DRIVER_PORTABLE_SRCS) \
 	$(CAN_DRIVER_TARGET_SRCS)
 

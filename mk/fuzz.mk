@@ -1,4 +1,5 @@
-# Fuzzing the CAN link layer (fieldbus/can) with libFuzzer.
+# Fuzzing the CAN link layer (fieldbus/can) and the Modbus stack
+# (fieldbus/modbus) with libFuzzer.
 #
 #   make fuzz        builds the fuzz targets, replays each seed corpus once,
 #                    then fuzzes each target for FUZZ_SECONDS; fails on any crash
@@ -11,17 +12,21 @@
 # caused it is kept in $(FUZZ_BUILD)/artifacts/<target>/.
 
 FUZZ_BUILD := $(BUILD)/fuzz
-# Fuzzing time per target; four targets, so 'make test' spends about 80 s here.
-FUZZ_SECONDS ?= 20
+# Fuzzing time per target; seven targets, so 'make test' spends about 105 s here.
+FUZZ_SECONDS ?= 15
 FUZZ_TARGETS := frame isotp slcan frametext
 FUZZ_CORPUS := fieldbus/can/fuzz/corpus
 FUZZ_REPORT := $(BUILD)/reports/fuzz-tests.xml
+# The Modbus targets: sources, seeds and report of their own, run by the same script.
+MODBUS_FUZZ_TARGETS := rtu_receiver slave master
+MODBUS_FUZZ_CORPUS := fieldbus/modbus/fuzz/corpus
+MODBUS_FUZZ_REPORT := $(BUILD)/reports/fuzz-modbus-tests.xml
 
 FUZZ_CXX := clang++
 FUZZ_SANITIZERS := address,undefined
 FUZZ_CXXFLAGS := -std=c++20 -O1 -g -fno-omit-frame-pointer -fno-sanitize-recover=all \
 	-Wall -Wextra -Wno-missing-field-initializers -Werror -MMD -MP \
-	-Ifieldbus/can/include -Ifirmware/dcos/include
+	-Ifieldbus/can/include -Ifieldbus/modbus/include -Ifirmware/dcos/include
 # Objects are instrumented for coverage without libFuzzer's main; the
 # targets are linked with it.
 FUZZ_COMPILE_FLAGS := $(FUZZ_CXXFLAGS) -fsanitize=fuzzer-no-link,$(FUZZ_SANITIZERS)
@@ -30,16 +35,19 @@ FUZZ_LINK_FLAGS := -fsanitize=fuzzer,$(FUZZ_SANITIZERS)
 FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(CAN_PORTABLE_SRCS))
 FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o,$(FUZZ_TARGETS))
 FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(FUZZ_TARGETS))
+MODBUS_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(MODBUS_PORTABLE_SRCS))
+MODBUS_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/fieldbus/modbus/fuzz/fuzz_%.cpp.o,$(MODBUS_FUZZ_TARGETS))
+MODBUS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(MODBUS_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as
 # intermediate files and be deleted after every build.
-.SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS)
+.SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS) $(MODBUS_FUZZ_LIBRARY_OBJS) $(MODBUS_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
 fuzz: deps
 	@$(MAKE) --no-print-directory test-fuzz
 
-fuzz-targets: $(FUZZ_BINARIES)
+fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite.
@@ -47,9 +55,18 @@ test-fuzz:
 	@mkdir -p $(dir $(FUZZ_REPORT))
 	@if $(MAKE) --no-print-directory fuzz-targets; then built=; else built=--build-failed; fi; \
 	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(FUZZ_REPORT) $(FUZZ_TARGETS)
+		--seconds $(FUZZ_SECONDS) --report $(FUZZ_REPORT) $(FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(MODBUS_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(MODBUS_FUZZ_REPORT) $(MODBUS_FUZZ_TARGETS) || status=1; \
+	exit $${status:-0}
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^
+
+# A static pattern rule, so the Modbus targets never fall to the CAN one.
+$(MODBUS_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/modbus/fuzz/fuzz_%.cpp.o $(MODBUS_FUZZ_LIBRARY_OBJS)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^
