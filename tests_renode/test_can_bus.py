@@ -437,8 +437,7 @@ def send_frame(board, frame, **options):
     return board.send(0, frame.id, frame.data, extended=frame.extended, remote=frame.remote, dlc=frame.dlc, **options)
 
 
-# Every CiA rate the card makes exactly (CIA_BIT_TIMING in dcoslab/canlab.py).
-@pytest.mark.parametrize("bitrate", [10_000, 20_000, 50_000, 100_000, 125_000, 250_000, 500_000, 800_000, 1_000_000])
+@pytest.mark.parametrize("bitrate", [125_000, 500_000, 1_000_000])
 def test_frame_latency_on_the_boards_matches_its_bit_length(canlab, bitrate):
     lab = canlab({"can0": bitrate}, TWO_BOARDS)
     sender, receiver = lab.board("board1"), lab.board("board2")
