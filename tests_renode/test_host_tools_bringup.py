@@ -891,13 +891,18 @@ def test_tool_ends_the_program_it_started_on_ctrl_c(workdir):
     assert_ended(emulator_pid(pid_path))
 
 
-def test_tool_shows_the_error_of_a_program_that_does_not_start(workdir):
+# The second program closes its output a while before it exits, as an
+# emulator tearing down does: the console ends before the exit status exists.
+@pytest.mark.parametrize("exit_delay_s", [0, 0.5])
+def test_tool_shows_the_error_of_a_program_that_does_not_start(workdir, exit_delay_s):
     program = os.path.join(workdir, "broken_emulator.py")
     with open(program, "w", encoding="utf-8") as handle:
-        handle.write("import sys\nsys.stderr.write('qemu-system-i386: -kernel nope.elf: could not load kernel\\n')\n"
-                     "sys.exit(1)\n")
+        handle.write("import os, sys, time\n"
+                     "sys.stderr.write('qemu-system-i386: -kernel nope.elf: could not load kernel\\n')\n"
+                     f"os.close(1)\ntime.sleep({exit_delay_s})\nsys.exit(1)\n")
     started = time.monotonic()
-    result = run_tool("--exec", f"{sys.executable} {program}", "--json", os.path.join(workdir, "r.json"),
+    # exec: the program itself holds the console, not a shell waiting for it.
+    result = run_tool("--exec", f"exec {sys.executable} {program}", "--json", os.path.join(workdir, "r.json"),
                       "--png", "", "--connect-timeout", "30")
     assert result.returncode == 4, result.stdout + result.stderr
     assert time.monotonic() - started < 20

@@ -54,6 +54,8 @@ DEFAULT_PROMPT = r"dcos> "
 MAX_TIMEOUT_S = 1e6
 # How long the program or emulator that was started gets to end after SIGTERM before SIGKILL.
 TERMINATE_GRACE_S = 3.0
+# How long a report waits for a program whose console closed to exit.
+EXIT_STATUS_WAIT_S = 2.0
 
 
 def lab_directory():
@@ -105,6 +107,7 @@ class FdConsole:
     def __init__(self, read_fd, write):
         self.read_fd = read_fd
         self._write = write
+        self.ended = False  # the far end closed the console
 
     def write(self, data):
         try:
@@ -119,8 +122,11 @@ class FdConsole:
         try:
             data = os.read(self.read_fd, 4096)
         except OSError:
+            data = b""
+        if not data:
+            self.ended = True
             return None
-        return data if data else None
+        return data
 
     def diagnostics(self):
         return ""
@@ -201,7 +207,13 @@ class ProcessConsole(FdConsole):
         super().__init__(self.process.stdout.fileno(), write)
 
     def diagnostics(self):
-        status = self.process.poll()
+        # The console ends when the program closes its output, a moment
+        # before the program itself has exited and can be reaped: give it
+        # that moment, so that its exit status is part of the report.
+        try:
+            status = self.process.wait(EXIT_STATUS_WAIT_S) if self.ended else self.process.poll()
+        except subprocess.TimeoutExpired:
+            status = None
         parts = []
         if status is not None:
             parts.append(f"the program exited with status {status}" if status >= 0
