@@ -248,6 +248,28 @@ class LogRecord:
                    words[8], names("rx"), names("ack"), lost)
 
 
+def candump_line(record):
+    """A frame that went through, as `candump -l` logs it: its emulated completion time, bus and frame.
+
+    The time is the end of its EOF, when its receivers take it, in seconds
+    of emulated time; the frame is written as can-utils' lib.c writes it
+    (upper-case hex, R for a remote frame with its DLC, the data in pairs).
+    """
+    frame = record.frame
+    ident = f"{frame.id:08X}" if frame.extended else f"{frame.id:03X}"
+    if frame.remote:
+        # A remote frame's DLC follows R when it is not 0; one of 9-15 is
+        # written as 8 and then the raw code, as can-utils does.
+        body = "R" + ("" if frame.dlc == 0 else f"{frame.dlc:X}" if frame.dlc <= 8 else f"8{frame.dlc:X}")
+    else:
+        body = frame.data.hex().upper()
+        if frame.dlc > 8:
+            # A DLC of 9-15 carries 8 bytes; can-utils writes it after an underscore.
+            body += f"_{frame.dlc:X}"
+    seconds, nanoseconds = divmod(record.end, 1_000_000_000)
+    return f"({seconds:010d}.{nanoseconds // 1000:06d}) {record.bus} {ident}#{body}"
+
+
 def parse_log(text):
     """The records of a bus log, skipping its comment lines."""
     return [LogRecord.parse(line) for line in text.splitlines() if line.strip() and not line.startswith("#")]
@@ -418,7 +440,7 @@ class Hub:
     """The hub, run in a thread of this process (start/stop) or in the foreground (serve_forever)."""
 
     def __init__(self, socket_path, buses, expect=(), quantum_ns=None, pace=None, timeout=DEFAULT_TIMEOUT,
-                 log_path=None, echo_log=False):
+                 log_path=None, echo_log=False, candump_path=None):
         if not buses:
             raise ValueError("the hub needs at least one bus")
         self.socket_path = socket_path
@@ -434,6 +456,7 @@ class Hub:
         self.timeout = timeout
         self.log_path = log_path
         self.echo_log = echo_log
+        self.candump_path = candump_path
 
         self.boundary = self.quantum_ns
         self.started = False
@@ -460,6 +483,10 @@ class Hub:
         self._listener = None
         self._wake_r, self._wake_w = os.pipe()
         self._log_file = None
+        self._candump_file = None
+        # Per port and per bus counters, kept as records come (statistics()).
+        self._port_counts = collections.defaultdict(collections.Counter)
+        self._bus_busy_ns = collections.Counter()
 
     # -- life cycle -----------------------------------------------------------
 
@@ -477,6 +504,8 @@ class Hub:
         self._selector.register(self._wake_r, selectors.EVENT_READ, "wake")
         if self.log_path:
             self._log_file = open(self.log_path, "w", encoding="ascii")
+        if self.candump_path:
+            self._candump_file = open(self.candump_path, "w", encoding="ascii")
 
     def start(self):
         """Listens and runs the hub in a background thread."""
@@ -521,8 +550,13 @@ class Hub:
             except OSError:
                 pass
         if self._log_file is not None:
+            for line in self.statistics_lines():
+                self._log_file.write(line + "\n")
             self._log_file.close()
             self._log_file = None
+        if self._candump_file is not None:
+            self._candump_file.close()
+            self._candump_file = None
         for fd in (self._wake_r, self._wake_w):
             try:
                 os.close(fd)
@@ -1422,10 +1456,67 @@ class Hub:
     # -- output -----------------------------------------------------------------
 
     def _record(self, record):
+        bus = self.buses[record.bus]
         with self._lock:
             self.records.append(record)
             self._log_lines.append(record.line())
+            # The attempt holds the bus from SOF to its end and the 3-bit
+            # intermission after it; nothing else can use that time.
+            self._bus_busy_ns[record.bus] += record.end - record.start + 3 * bus.bit_ns
+            sender = self._port_counts[record.sender]
+            if record.outcome == "ok":
+                sender["sent"] += 1
+            else:
+                sender["failed"] += 1
+            for name, _ in record.lost:
+                self._port_counts[name]["lost"] += 1
+            for name in record.rx:
+                if name != record.sender:
+                    self._port_counts[name]["received"] += 1
         self._write_log(record.line())
+        if self._candump_file is not None and record.outcome == "ok":
+            self._candump_file.write(candump_line(record) + "\n")
+            self._candump_file.flush()
+
+    def statistics(self):
+        """Frames, errors and bus load so far, per bus and per port.
+
+        A port's "sent" counts its frames that went through, "failed" its
+        attempts that ended in an error frame, "lost" the arbitrations it
+        lost, "received" the valid frames of others it took. A bus's load is
+        the share of the emulated time so far its frames and error frames
+        (with their intermission) held it.
+        """
+        with self._lock:
+            elapsed = self.boundary - self.quantum_ns
+            buses = {}
+            for name, bus in self.buses.items():
+                records = [r for r in self.records if r.bus == name]
+                buses[name] = {
+                    "bitrate": bus.bitrate,
+                    "frames": sum(1 for r in records if r.outcome == "ok"),
+                    "errors": sum(1 for r in records if r.outcome != "ok"),
+                    "load": self._bus_busy_ns[name] / elapsed if elapsed > 0 else 0.0,
+                }
+            ports = {}
+            for bus in self.buses.values():
+                for name in sorted(bus.ports):
+                    counts = self._port_counts.get(name, collections.Counter())
+                    ports[name] = {"bus": bus.name, **{key: counts[key] for key in
+                                                       ("sent", "failed", "lost", "received")}}
+            return {"time_ns": elapsed, "buses": buses, "ports": ports}
+
+    def statistics_lines(self):
+        """statistics() as the bus log's closing comment lines."""
+        stats = self.statistics()
+        lines = [f"# {stats['time_ns']} statistics"]
+        for name, bus in stats["buses"].items():
+            lines.append(f"# {stats['time_ns']} bus {name} {bus['bitrate']} bit/s frames={bus['frames']} "
+                         f"errors={bus['errors']} load={100 * bus['load']:.2f}%")
+        for name, port in stats["ports"].items():
+            lines.append(f"# {stats['time_ns']} port {name} sent={port['sent']} failed={port['failed']} "
+                         f"lost={port['lost']} received={port['received']}")
+        return lines
 
     def _comment(self, text, boundary=None):
         at = self.boundary if boundary is None else boundary
@@ -1571,12 +1662,14 @@ def main(argv=None):
                         help="hold the clock until this board has joined (repeatable)")
     parser.add_argument("--pace", type=float, default=None,
                         help="at most this many emulated seconds per wall second (default: as fast as possible)")
-    parser.add_argument("--log", default=None, help="also write the bus log to this file")
+    parser.add_argument("--log", default=None, help="also write the bus log to this file (statistics at its end)")
+    parser.add_argument("--candump", default=None, metavar="FILE",
+                        help="write the frames that went through to FILE in candump -l format, with emulated times")
     parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT,
                         help="seconds to wait for a silent board before dropping it")
     arguments = parser.parse_args(argv)
     hub = Hub(arguments.socket, dict(arguments.bus), expect=arguments.expect, pace=arguments.pace,
-              timeout=arguments.timeout, log_path=arguments.log, echo_log=True)
+              timeout=arguments.timeout, log_path=arguments.log, echo_log=True, candump_path=arguments.candump)
     print(f"# hub on {arguments.socket}: "
           + ", ".join(f"{bus.name} {bus.bitrate} bit/s" for bus in hub.buses.values())
           + f", quantum {hub.quantum_ns} ns", flush=True)
@@ -1585,6 +1678,8 @@ def main(argv=None):
     except KeyboardInterrupt:
         pass
     finally:
+        for line in hub.statistics_lines():
+            print(line, flush=True)
         hub._close_all()
     return 0
 
