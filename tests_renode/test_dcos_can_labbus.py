@@ -105,3 +105,27 @@ def test_a_frame_nobody_acknowledges_is_reported_not_lost_silently(hub):
     _, errors = alone.communicate(timeout=TIMEOUT)
     assert alone.returncode == 1, errors
     assert "not on the lab bus within 500 ms" in errors and "acknowledge" in errors, errors
+
+
+def test_stats_count_bus_errors_and_frames_with_a_bad_length(hub):
+    """Corrupted frames and a DLC of 12 show as bus errors in dcos-can stats; the good frames are all counted."""
+    stats = tool(hub, "--json", "stats", "-s", "4")
+    wait_for_participants(hub, 1)
+    other = Client(hub.socket_path, "other")
+    try:
+        other.attach(0, "can0")
+        hub.corrupt("other.0", 2)
+        for index in range(3):
+            other.transmit(0, Frame.data_frame(0x200 + index, bytes([index] * 8)))
+        hub.inject("can0", "lab", Frame(0x300, dlc=12, data=bytes(range(8))))
+        output, errors = stats.communicate(timeout=TIMEOUT)
+    finally:
+        other.close()
+    assert stats.returncode == 0, errors
+    result = json.loads(output)
+    corrupted = [r for r in hub.frames() if r.outcome == "form-error"]
+    assert len(corrupted) == 2, hub.log_text()
+    # The three frames and the one of DLC 12 went through; the tool counts the three and drops the fourth.
+    assert result["frames"] == 3, result
+    assert result["events"] == {"bus-error": 3}, result
+    assert result["state"] == "error-active", result
