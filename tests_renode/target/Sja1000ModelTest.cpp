@@ -1007,6 +1007,10 @@ shell::CommandResult canlabSend(shell::Shell& shell, unsigned channel, int argc,
             }
             loadFrame(channel, id, extended, remote, static_cast<uint8_t>(dlc), data);
         }
+        // The uptime and the request it dates are one step: an interrupt
+        // between them (the tick's takes over a microsecond) would date the
+        // request early by its length.
+        arch_x86::InterruptGuard guard;
         requests[n] = timerAgent.Uptime();
         wr(channel, kCmr, command);
     }
@@ -1075,8 +1079,12 @@ shell::CommandResult canlab(shell::Shell& shell, int argc, char** argv)
         const uint8_t mod = rd(channel, kMod);
         const uint8_t next = runtime::textEquals(verb, "reset") ? static_cast<uint8_t>(mod | kModRm)
                                                                 : static_cast<uint8_t>(mod & ~kModRm);
-        const uint64_t now = timerAgent.Uptime();
-        wr(channel, kMod, next);
+        uint64_t now;
+        {
+            arch_x86::InterruptGuard guard;  // the uptime dates this write, not an interrupt before it
+            now = timerAgent.Uptime();
+            wr(channel, kMod, next);
+        }
         shell.print("CANMODE %u %llu mod=%02x\r\n", channel, static_cast<unsigned long long>(now), rd(channel, kMod));
         return shell::CommandResult::Ok;
     }
