@@ -28,6 +28,8 @@ A failing test's report carries the board's console, the VM's console, the
 bridge's log and the bus log.
 """
 
+import json
+import os
 import re
 import socket
 import time
@@ -35,7 +37,7 @@ import warnings
 
 import pytest
 
-from dcoslab.board import load_board
+from dcoslab.board import REPOSITORY, load_board
 from dcoslab.canbus import Client, Frame, Hub
 from dcoslab.canlab import CanLab
 from dcoslab.emulator import Emulator
@@ -104,6 +106,23 @@ echo "@@RAW"; cut -d' ' -f2- /tmp/raw.log; echo "@@END RAW@@"
 # -- python-can as a peer --
 timeout 150 /usr/bin/python3 /run/labvm/files/peer.py
 echo "@@PYTHON status=$?@@"
+
+# -- dcos-can (our host tool, on the kernel's SocketCAN) as a peer --
+cp /run/labvm/files/dcos-can /tmp/dcos-can
+chmod 755 /tmp/dcos-can
+timeout 150 candump -n 1 can0,7F4:7FF >/dev/null &
+go=$!
+labvm_wait_receiver can0 raw 7f4 30
+before=$(labvm_count_receivers can0 raw 0)
+timeout 150 /tmp/dcos-can -i can0 --json dump -n 1 -t 120000 >/tmp/dcos-dump.json &
+dump=$!
+labvm_wait_receivers can0 raw 0 $((before + 1)) 30
+echo "@@READY dcos-can@@"
+wait $dump
+echo "@@DCOSDUMP status=$? $(tr '\n' '\t' </tmp/dcos-dump.json)@@"
+wait $go
+/tmp/dcos-can -i can0 send 5A6#CA.FE.00.42
+echo "@@DCOSSEND status=$?@@"
 
 # -- ISO-TP: the controller sends, the kernel receives (again after a time-out, at most 3 times) --
 attempt=1
@@ -208,6 +227,15 @@ def _boot(board, kind, icount=False, name=None, device_properties=None, extra_ar
 _boot.started = []
 
 
+def _dcos_can_binary():
+    """The host tool, carried into the VM as a file (the host's /tmp, where a CI clone may live, is not visible)."""
+    path = os.path.join(REPOSITORY, "build", "host_tools", "bin", "dcos-can")
+    if not os.path.exists(path):
+        pytest.fail(f"{path} is not built; run make", pytrace=False)
+    with open(path, "rb") as handle:
+        return handle.read()
+
+
 @pytest.fixture(scope="module")
 def world():
     world = World()
@@ -219,7 +247,8 @@ def world():
         world.board = world.lab.board("board1")
         world.mark("board booted")
         world.vm = LabVM(VM_SCRIPT, slcan=SlcanSetup("can0", BITRATE), connect_slcan=False,
-                         files={"peer.py": PYTHON_PEER}, boot_timeout=BOOT_TIMEOUT, timeout=600)
+                         files={"peer.py": PYTHON_PEER, "dcos-can": _dcos_can_binary()},
+                         boot_timeout=BOOT_TIMEOUT, timeout=600)
         world.vm.start()
         # At once: slcand's C, S6, O come once, when the VM's setup runs.
         world.bridge = SlcanBridge(world.vm.slcan_socket_path, world.lab.socket_path, "can0").start()
@@ -369,6 +398,28 @@ def test_python_can_in_the_vm_is_a_peer_of_the_controller(world):
     world.mark("python: done")
     assert got == "GOT 456 std DEADBEEF", got
     world.vm.expect(r"@@PYTHON status=0@@", timeout=STEP)
+
+
+def test_dcos_can_on_the_kernels_socketcan_is_a_peer_of_the_controller(world):
+    """Our host tool over real SocketCAN (the kernel's can-raw on slcan) and the controller, both ways."""
+    world.vm.expect(r"@@READY dcos-can@@", timeout=STEP)
+    world.mark("dcos-can: VM ready")
+    board = world.board
+    output = board.command("can send can0 01F0A5A5#0102030405")
+    assert "can0  01F0A5A5   [5]  01 02 03 04 05  sent" in output, output
+    dumped = world.vm.expect(r"@@DCOSDUMP status=(\d+) (.*?)@@", timeout=STEP)
+    assert dumped.group(1) == b"0", dumped.group(0)
+    lines = [json.loads(line) for line in dumped.group(2).decode().split("\t") if line.startswith("{")]
+    assert [(line.get("id"), line.get("extended"), line.get("data")) for line in lines if "event" not in line] == [
+        (0x01F0A5A5, True, "0102030405")], dumped.group(0)
+    board.emulator.send("can dump can0 2 60000\r")
+    board.emulator.expect(r"can dump can0 2 60000\r\n")
+    go(world, 0x7F4, 4)
+    board.emulator.expect(r"can0  7F4        \[1\]  04\r\n", timeout=STEP)
+    board.emulator.expect(r"can0  5A6        \[4\]  CA FE 00 42\r\n", timeout=STEP)
+    board.emulator.expect(r"dcos> ", timeout=STEP)
+    world.vm.expect(r"@@DCOSSEND status=0@@", timeout=STEP)
+    world.mark("dcos-can: done")
 
 
 # ISO 15765-2's time-outs (1 s between frames, in both worlds) are the one place where the two clocks meet:

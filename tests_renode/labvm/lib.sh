@@ -16,12 +16,26 @@ labvm_uptime() {
 #   between starting a receiver in the background and sending, instead of a
 #   sleep. Returns 1, with the receive lists on stderr, on time-out.
 labvm_wait_receiver() {
+    labvm_wait_receivers "$1" "$2" "${3:-}" 1 "${4:-10}"
+}
+
+# labvm_count_receivers DEVICE IDENT [CAN_ID]
+#   Prints how many CAN sockets of kind IDENT receive on DEVICE (for CAN_ID).
+labvm_count_receivers() {
     _device=$1 _ident=$2 _id=${3:-[0-9a-fA-F]+}
-    _deadline=$(( $(labvm_uptime) + ${4:-10} ))
-    while ! grep -Eiqh "^ +$_device +0*$_id +[0-9a-f]+ +[0-9a-f]+ +[0-9a-f]+ +[0-9]+ +$_ident\$" \
-            /proc/net/can/rcvlist_*; do
+    grep -Eich "^ +$_device +0*$_id +[0-9a-f]+ +[0-9a-f]+ +[0-9a-f]+ +[0-9]+ +$_ident\$" \
+        /proc/net/can/rcvlist_* | { _sum=0; while read -r _n; do _sum=$((_sum + _n)); done; echo $_sum; }
+}
+
+# labvm_wait_receivers DEVICE IDENT CAN_ID COUNT [SECONDS]
+#   As labvm_wait_receiver, until at least COUNT such sockets receive: for a
+#   new receiver where others of its kind listen already, wait for one more
+#   than labvm_count_receivers printed before it started.
+labvm_wait_receivers() {
+    _deadline=$(( $(labvm_uptime) + ${5:-10} ))
+    while [ "$(labvm_count_receivers "$1" "$2" "$3")" -lt "$4" ]; do
         if [ "$(labvm_uptime)" -ge "$_deadline" ]; then
-            echo "labvm_wait_receiver: no '$_ident' receiver on $_device${3:+ for id $3} after ${4:-10} s" >&2
+            echo "labvm_wait_receivers: fewer than $4 '$2' receivers on $1${3:+ for id $3} after ${5:-10} s" >&2
             cat /proc/net/can/rcvlist_* >&2
             return 1
         fi
