@@ -106,6 +106,9 @@ Result<dcos::ObjectId> Sja1000Controller::installController(const char* name, dc
     noAcknowledge_ = false;
     acknowledgeErrorsInARow_ = 0;
     errorState_ = ErrorState::Active;
+    stateLogHead_ = 0;
+    stateLogCount_ = 0;
+    stateLogLost_ = 0;
     return created;
 }
 
@@ -360,6 +363,11 @@ void Sja1000Controller::onReceive()
             ++statistics_.malformedFrames;
             continue;
         }
+        if (!filter_.takesFormat(frame.value().isExtended())) {
+            // The chip's filter cannot tell the formats apart (AcceptanceFilter).
+            ++statistics_.badIdentifiers;
+            continue;
+        }
         ++statistics_.framesReceived;
         received = true;
         if (receiveCount_ == kReceiveQueueLength) {
@@ -404,8 +412,17 @@ void Sja1000Controller::onStateChange()
     if (state == errorState_) {
         return;
     }
+    const ErrorState previous = errorState_;
     errorState_ = state;
-    if (state == ErrorState::Warning) {
+    recordStateChange(previous, state);
+    if (previous == ErrorState::BusOff) {
+        // The chip counted its 128 bus-free signals (or was restarted by
+        // kRestart from a state other than bus-off): it is on the bus again.
+        ++statistics_.recoveries;
+    }
+    if (state == ErrorState::Active) {
+        ++statistics_.errorActives;
+    } else if (state == ErrorState::Warning) {
         ++statistics_.errorWarnings;
     } else if (state == ErrorState::Passive) {
         ++statistics_.errorPassives;
@@ -420,6 +437,21 @@ void Sja1000Controller::onStateChange()
         }
     }
     notify(notification_.stateEvent);
+}
+
+void Sja1000Controller::recordStateChange(ErrorState from, ErrorState to)
+{
+    const ErrorCounters counters = chip_.errorCounters();
+    if (stateLogCount_ == StateChanges::kCapacity) {
+        // The owner has not read for a while: the oldest change goes, and it is counted.
+        stateLogHead_ = (stateLogHead_ + 1) % StateChanges::kCapacity;
+        --stateLogCount_;
+        ++stateLogLost_;
+        ++statistics_.stateChangesLost;
+    }
+    stateLog_[(stateLogHead_ + stateLogCount_) % StateChanges::kCapacity] =
+        StateChange{from, to, counters.receive, counters.transmit};
+    ++stateLogCount_;
 }
 
 void Sja1000Controller::releaseHold()
@@ -490,7 +522,7 @@ Status Sja1000Controller::Control(uint32_t command, void* argument, size_t lengt
     }
     case kSetFilter: {
         const AcceptanceFilter* filter = argumentAs<AcceptanceFilter>(argument, length);
-        if (filter == nullptr) {
+        if (filter == nullptr || static_cast<uint8_t>(filter->formats) > static_cast<uint8_t>(FrameFormats::Standard)) {
             return Status::InvalidArgument;
         }
         filter_ = *filter;
@@ -547,16 +579,39 @@ Status Sja1000Controller::Control(uint32_t command, void* argument, size_t lengt
         busOffPolicy_ = static_cast<BusOffPolicy>(*policy);
         return Status::Ok;
     }
-    case kRestart:
+    case kRestart: {
         if (length != 0) {
             return Status::InvalidArgument;
         }
-        {
-            arch_x86::InterruptGuard guard;
-            noAcknowledge_ = false;
-            ++statistics_.restarts;
+        arch_x86::InterruptGuard guard;
+        noAcknowledge_ = false;
+        ++statistics_.restarts;
+        if (started_ && errorState_ == ErrorState::BusOff && chip_.inReset()) {
+            // Leaving reset mode with the counters as the chip left them
+            // begins its own recovery: ISO 11898-1 lets a bus-off node back
+            // only after 128 times 11 recessive bits, and writing the
+            // counters now would cut that short (DS 6.4.11). The chip
+            // reports the end of it with EI, and the queue waits until then.
+            return chip_.start(busMode_);
         }
         return startChip();
+    }
+    case kReadStateChanges: {
+        StateChanges* out = argumentAs<StateChanges>(argument, length);
+        if (out == nullptr) {
+            return Status::InvalidArgument;
+        }
+        arch_x86::InterruptGuard guard;
+        out->count = static_cast<uint32_t>(stateLogCount_);
+        out->lost = stateLogLost_;
+        for (size_t i = 0; i < stateLogCount_; ++i) {
+            out->changes[i] = stateLog_[(stateLogHead_ + i) % StateChanges::kCapacity];
+        }
+        stateLogHead_ = 0;
+        stateLogCount_ = 0;
+        stateLogLost_ = 0;
+        return Status::Ok;
+    }
     case kFlushTransmit: {
         if (length != 0) {
             return Status::InvalidArgument;
