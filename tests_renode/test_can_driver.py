@@ -82,6 +82,11 @@ def test_a_lone_node_backs_off_instead_of_flooding_the_bus(canlab):
     assert all(r.outcome == "ack-error" for r in lab.hub.frames()), lab.hub.log_text()
     stats = board.command("can stats can0")
     assert re.search(r"ack_errors=1[67] .* lone_node_holds=1 ", stats), stats
+    # The owner learned it: the counters' way to error-passive, then the hold.
+    output = board.command("can events can0")
+    assert re.findall(r"^can0  (.*?)  rx errors (\d+)  tx errors (\d+)\r?$", output, re.MULTILINE) == [
+        ("error-warning  was error-active", "0", "96"), ("error-passive  was error-warning", "0", "128"),
+        ("no acknowledge: held  error-passive", "0", "128")], output
     # Held: nothing more goes on the bus while nobody is there.
     board.command("can dump can0 1 500")
     assert len([r for r in lab.hub.frames() if r.sender == "board1.0"]) == attempts, lab.hub.log_text()

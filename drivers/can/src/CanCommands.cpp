@@ -538,6 +538,12 @@ CommandResult events(shell::Shell& shell, int argc, char** argv)
         }
         for (uint32_t i = 0; i < log.count; ++i, ++shown) {
             const StateChange& change = log.changes[i];
+            if (change.holdChanged != 0) {
+                shell.print("%s  %s  %s  rx errors %u  tx errors %u\r\n", kNames[channel],
+                            change.noAcknowledge != 0 ? "no acknowledge: held" : "acknowledge hold released",
+                            stateName(change.to), change.receiveErrors, change.transmitErrors);
+                continue;
+            }
             shell.print("%s  %s  was %s  rx errors %u  tx errors %u\r\n", kNames[channel], stateName(change.to),
                         stateName(change.from), change.receiveErrors, change.transmitErrors);
         }

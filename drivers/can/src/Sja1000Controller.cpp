@@ -402,6 +402,7 @@ void Sja1000Controller::onBusError()
         if (!abortRequested_) {
             chip_.abortTransmission();
         }
+        recordStateChange(errorState_, errorState_, true);
         notify(notification_.stateEvent);
     }
 }
@@ -439,7 +440,7 @@ void Sja1000Controller::onStateChange()
     notify(notification_.stateEvent);
 }
 
-void Sja1000Controller::recordStateChange(ErrorState from, ErrorState to)
+void Sja1000Controller::recordStateChange(ErrorState from, ErrorState to, bool holdChanged)
 {
     const ErrorCounters counters = chip_.errorCounters();
     if (stateLogCount_ == StateChanges::kCapacity) {
@@ -450,7 +451,8 @@ void Sja1000Controller::recordStateChange(ErrorState from, ErrorState to)
         ++statistics_.stateChangesLost;
     }
     stateLog_[(stateLogHead_ + stateLogCount_) % StateChanges::kCapacity] =
-        StateChange{from, to, counters.receive, counters.transmit};
+        StateChange{from, to, counters.receive, counters.transmit, static_cast<uint8_t>(holdChanged ? 1 : 0),
+                    static_cast<uint8_t>(noAcknowledge_ ? 1 : 0)};
     ++stateLogCount_;
 }
 
@@ -458,6 +460,7 @@ void Sja1000Controller::releaseHold()
 {
     noAcknowledge_ = false;
     acknowledgeErrorsInARow_ = 0;
+    recordStateChange(errorState_, errorState_, true);
     notify(notification_.stateEvent);
 }
 
@@ -489,11 +492,13 @@ void Sja1000Controller::handleInterrupt()
             (void)chip_.arbitrationLostBit(); // Frees ALC for the next loss.
             ++statistics_.arbitrationLost;
         }
-        if ((causes & reg::kInterruptBusError) != 0) {
-            onBusError();
-        }
+        // The state first: a bus error that begins the lone-node hold is
+        // then logged for the owner with the state it brought about.
         if ((causes & (reg::kInterruptErrorWarning | reg::kInterruptErrorPassive)) != 0) {
             onStateChange();
+        }
+        if ((causes & reg::kInterruptBusError) != 0) {
+            onBusError();
         }
         if ((causes & reg::kInterruptTransmit) != 0) {
             onTransmitDone();

@@ -371,6 +371,19 @@ TEST_F(Sja1000ControllerTest, ALoneNodeStopsRepeatingAndTriesAgainWhenItHearsAno
     const std::vector<CanFrame> sent = drainBus();
     ASSERT_EQ(sent.size(), 1u);
     EXPECT_EQ(sent[0], extended(0x42, {1}));
+    // The owner's log: warning, passive, then the hold (seen in the state
+    // it came in) and its release.
+    sja1000::StateChanges log{};
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kReadStateChanges, &log, sizeof log), Status::Ok);
+    ASSERT_EQ(log.count, 4u);
+    EXPECT_EQ(log.changes[0].to, sja1000::ErrorState::Warning);
+    EXPECT_EQ(log.changes[1].to, sja1000::ErrorState::Passive);
+    EXPECT_EQ(log.changes[2].holdChanged, 1);
+    EXPECT_EQ(log.changes[2].noAcknowledge, 1);
+    EXPECT_EQ(log.changes[2].from, log.changes[2].to) << "the error state did not change";
+    EXPECT_EQ(log.changes[3].holdChanged, 1);
+    EXPECT_EQ(log.changes[3].noAcknowledge, 0);
+    EXPECT_EQ(log.changes[0].holdChanged, 0);
 }
 
 TEST_F(Sja1000ControllerTest, ErrorStatesAreFollowedAndReportedToTheListener)

@@ -96,13 +96,15 @@ struct Notification {
     uint32_t sentEvent = 0;     ///< Posted when a frame has been sent.
 };
 
-/// One change of the error state, as the interrupt service routine saw it
-/// (kReadStateChanges): what the owner of the channel learns.
+/// One change of the error state or of the lone-node hold, as the driver
+/// saw it (kReadStateChanges): what the owner of the channel learns.
 struct StateChange {
     ErrorState from = ErrorState::Active;
-    ErrorState to = ErrorState::Active;
+    ErrorState to = ErrorState::Active; ///< Equal to from when only the hold changed.
     uint8_t receiveErrors = 0;  ///< RXERR when the change was seen.
     uint8_t transmitErrors = 0; ///< TXERR when the change was seen.
+    uint8_t holdChanged = 0;    ///< 1: this entry is the lone-node hold beginning or ending.
+    uint8_t noAcknowledge = 0;  ///< 1 while the queue is held for want of an acknowledge, after this change.
 };
 
 /// The state changes not yet read, oldest first (kReadStateChanges); reading
@@ -202,7 +204,7 @@ private:
     void onStateChange();
     void notify(uint32_t events);
     void releaseHold();
-    void recordStateChange(ErrorState from, ErrorState to);
+    void recordStateChange(ErrorState from, ErrorState to, bool holdChanged = false);
 
     const char* claimant_;
     Sja1000Chip chip_;
