@@ -284,6 +284,8 @@ def test_frames_with_a_bad_identifier_are_rejected_and_counted_and_the_next_good
     # standard frames with ID.10 set as well (it has no format bit to compare).
     assert "can0  filter extended only" in board.command("can filter can0 ext 10000000 10000000")
     assert "can0  filter extended only" in other.command("can filter can0 ext 10000043 1FFFFFFF")
+    assert "error: '800' is not a hexadecimal number up to 7FF" in board.command("can filter can0 std 800 7FF")
+    assert "usage: can policy" in board.command("can policy can0 sometimes")
     wrong_format = Frame.data_frame(0x400, b"\x01\x02")    # through the chip's filter, not the driver's
     filtered = Frame.data_frame(0x123, b"\x03")              # stopped by the chip's filter, never seen
     good = Frame.data_frame(0x10000042, bytes.fromhex("DEADBEEF"), extended=True)

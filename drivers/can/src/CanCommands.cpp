@@ -19,6 +19,7 @@
 #include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
+#include <runtime/Text.hpp>
 #include <shell/Shell.hpp>
 
 namespace sja1000 {
@@ -565,10 +566,8 @@ CommandResult events(shell::Shell& shell, int argc, char** argv)
 CommandResult policy(shell::Shell& shell, int argc, char** argv)
 {
     unsigned channel;
-    const bool automatic = argc == 4 && argv[3][0] == 'a' && argv[3][1] == 'u' && argv[3][2] == 't' &&
-                           argv[3][3] == 'o' && argv[3][4] == '\0';
-    const bool manual = argc == 4 && argv[3][0] == 'm' && argv[3][1] == 'a' && argv[3][2] == 'n' &&
-                        argv[3][3] == 'u' && argv[3][4] == 'a' && argv[3][5] == 'l' && argv[3][6] == '\0';
+    const bool automatic = argc == 4 && runtime::textEquals(argv[3], "auto");
+    const bool manual = argc == 4 && runtime::textEquals(argv[3], "manual");
     if (!automatic && !manual) {
         shell.print("usage: can policy <channel> auto|manual  (after bus-off: recover at once, or on 'can restart')\r\n");
         return CommandResult::Failed;
@@ -610,15 +609,15 @@ CommandResult restart(shell::Shell& shell, int argc, char** argv)
 // Parses a hexadecimal number up to @p limit; prints why not.
 bool parseHex(shell::Shell& shell, const char* text, uint32_t limit, uint32_t& value)
 {
+    // parseUnsigned reads hexadecimal after "0x"; an identifier is written without it, as cansend takes it.
     unsigned long parsed = 0;
-    char prefixed[16] = {'0', 'x'};
-    size_t length = 0;
-    while (text[length] != '\0' && length < sizeof prefixed - 3) {
-        prefixed[2 + length] = text[length];
-        ++length;
+    char prefixed[2 + 8 + 1] = {'0', 'x'};
+    const size_t length = runtime::textLength(text);
+    for (size_t i = 0; i < length && i < 8; ++i) {
+        prefixed[2 + i] = text[i];
     }
-    prefixed[2 + length] = '\0';
-    if (length == 0 || text[length] != '\0' || !shell::Shell::parseUnsigned(prefixed, parsed) || parsed > limit) {
+    prefixed[2 + (length < 8 ? length : 8)] = '\0';
+    if (length == 0 || length > 8 || !shell::Shell::parseUnsigned(prefixed, parsed) || parsed > limit) {
         shell.print("error: '%s' is not a hexadecimal number up to %lX\r\n", text, static_cast<unsigned long>(limit));
         return false;
     }
@@ -629,11 +628,9 @@ bool parseHex(shell::Shell& shell, const char* text, uint32_t limit, uint32_t& v
 CommandResult filter(shell::Shell& shell, int argc, char** argv)
 {
     unsigned channel;
-    const bool all = argc == 4 && argv[3][0] == 'a' && argv[3][1] == 'l' && argv[3][2] == 'l' && argv[3][3] == '\0';
-    const bool extendedOnly = argc == 6 && argv[3][0] == 'e' && argv[3][1] == 'x' && argv[3][2] == 't' &&
-                              argv[3][3] == '\0';
-    const bool standardOnly = argc == 6 && argv[3][0] == 's' && argv[3][1] == 't' && argv[3][2] == 'd' &&
-                              argv[3][3] == '\0';
+    const bool all = argc == 4 && runtime::textEquals(argv[3], "all");
+    const bool extendedOnly = argc == 6 && runtime::textEquals(argv[3], "ext");
+    const bool standardOnly = argc == 6 && runtime::textEquals(argv[3], "std");
     if (!all && !extendedOnly && !standardOnly) {
         shell.print("usage: can filter <channel> all | ext <id> <mask> | std <id> <mask>  (hexadecimal; a mask bit "
                     "set must match)\r\n");
