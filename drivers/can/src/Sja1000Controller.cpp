@@ -184,8 +184,19 @@ Status Sja1000Controller::startChip()
         return started;
     }
     started_ = true;
-    errorState_ = ErrorState::Active;
     acknowledgeErrorsInARow_ = 0;
+    // The counters were cleared: a channel that was not error-active is
+    // again, and its owner learns of it as of any other change.
+    const ErrorState previous = errorState_;
+    errorState_ = ErrorState::Active;
+    if (previous != ErrorState::Active) {
+        recordStateChange(previous, ErrorState::Active);
+        ++statistics_.errorActives;
+        if (previous == ErrorState::BusOff) {
+            ++statistics_.recoveries;
+        }
+        notify(notification_.stateEvent);
+    }
     loadNext();
     return Status::Ok;
 }

@@ -484,6 +484,23 @@ TEST_F(Sja1000ControllerTest, TheOwnerReadsEveryStateChangeInOrder)
     EXPECT_EQ(log.count, 0u) << "reading empties the log";
 }
 
+TEST_F(Sja1000ControllerTest, ARestartWithClearedCountersIsReportedAsAReturnToErrorActive)
+{
+    const ObjectId id = open();
+    fake->setCounters(0, 130);
+    interrupt();
+    uint32_t rate = 500'000;
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kSetBitRate, &rate, sizeof rate), Status::Ok);
+    EXPECT_EQ(state(id).errorState, sja1000::ErrorState::Active);
+    sja1000::StateChanges log{};
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kReadStateChanges, &log, sizeof log), Status::Ok);
+    ASSERT_EQ(log.count, 2u);
+    EXPECT_EQ(log.changes[1].from, sja1000::ErrorState::Passive);
+    EXPECT_EQ(log.changes[1].to, sja1000::ErrorState::Active);
+    EXPECT_EQ(log.changes[1].transmitErrors, 0) << "the counters were cleared";
+    EXPECT_EQ(statistics(id).errorActives, 1u);
+}
+
 TEST_F(Sja1000ControllerTest, AFullStateLogKeepsTheNewestAndCountsTheLost)
 {
     const ObjectId id = open();
