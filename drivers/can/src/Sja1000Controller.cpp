@@ -428,8 +428,7 @@ void Sja1000Controller::onStateChange()
     errorState_ = state;
     recordStateChange(previous, state);
     if (previous == ErrorState::BusOff) {
-        // The chip counted its 128 bus-free signals (or was restarted by
-        // kRestart from a state other than bus-off): it is on the bus again.
+        // The chip counted its 128 bus-free signals: it is on the bus again.
         ++statistics_.recoveries;
     }
     if (state == ErrorState::Active) {
@@ -600,7 +599,9 @@ Status Sja1000Controller::Control(uint32_t command, void* argument, size_t lengt
             return Status::InvalidArgument;
         }
         arch_x86::InterruptGuard guard;
-        noAcknowledge_ = false;
+        if (noAcknowledge_) {
+            releaseHold();
+        }
         ++statistics_.restarts;
         if (started_ && errorState_ == ErrorState::BusOff && chip_.inReset()) {
             // Leaving reset mode with the counters as the chip left them

@@ -78,7 +78,7 @@ struct ChannelStatistics {
     uint32_t errorWarnings = 0;        ///< Entries into the warning state.
     uint32_t errorPassives = 0;        ///< Entries into error-passive.
     uint32_t busOffs = 0;
-    uint32_t restarts = 0;             ///< Restarts after bus-off (the recovery begun).
+    uint32_t restarts = 0;             ///< Recoveries begun by the policy after bus-off, and every kRestart.
     uint32_t recoveries = 0;           ///< Recoveries from bus-off completed: back on the bus, error-active.
     uint32_t errorActives = 0;         ///< Returns to error-active from warning, passive or bus-off.
     uint32_t stateChangesLost = 0;     ///< State changes the owner had not read when the log was full.
@@ -133,7 +133,7 @@ public:
         kGetStatistics = 5,    ///< ChannelStatistics, filled in.
         kSetNotification = 6,  ///< Notification.
         kSetBusOffPolicy = 7,  ///< BusOffPolicy (uint32_t).
-        kRestart = 8,          ///< No argument: back onto the bus after bus-off, the counters cleared.
+        kRestart = 8,          ///< No argument: after bus-off begins the chip's recovery; else restarts it, counters cleared.
         kFlushTransmit = 9,    ///< No argument: drops every queued frame, the one in the chip too.
         kReadStateChanges = 10, ///< StateChanges: the error-state changes since the last read, oldest first.
     };
