@@ -16,7 +16,7 @@ from dcoslab.emulator import Emulator
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "bench"))
 
-from run_benchmarks import LIST_LINE, parse_run  # noqa: E402
+from run_benchmarks import CAN_RECEIVE_PIECES, CAN_SEND_PIECES, LIST_LINE, can_summary, parse_run  # noqa: E402
 from seed_figures import SEED_FIGURES  # noqa: E402
 
 PROMPT = r"dcos> "
@@ -153,3 +153,25 @@ def test_agent_benchmarks_report_exact_counts_for_8_and_4096_objects(boot_bench)
                 if entry["cost"] == "constant" and not irq[name]:
                     assert low == high == entry["median"][objects], (
                         f"{name} with {objects} objects: an O(1) path must count the same on every call: {entry}")
+
+
+def test_can_frame_benchmarks_move_real_frames_through_the_chip_with_exact_counts(boot_bench):
+    # Each CAN piece's setup and restore pass a frame through the card's chip
+    # (self test, self reception) and fail when the chip does not deliver
+    # (setup failed), and each measured call fails when it finds no frame
+    # (measured call failed): a figure means a frame was handled. The
+    # routines run with interrupts disabled on a fixed path, so the count
+    # is the same on every call.
+    emulator = boot_bench()
+    output = emulator.command("bench run Can", timeout=180)
+    assert output.splitlines()[-1] == "BENCH done", output
+    _, results = parse_run(output)
+    assert set(results) == set(CAN_RECEIVE_PIECES + CAN_SEND_PIECES), output
+    for name, entry in results.items():
+        for objects in (8, 4096):
+            assert isinstance(entry[objects], tuple), f"{name} with {objects} objects: {entry[objects]}"
+            low, high = entry[objects]
+            assert 0 < low == high == entry["median"][objects], f"{name}: {entry}"
+    summary = can_summary(results)
+    assert summary["received"]["instructions_per_frame"] == sum(results[name][8][0] for name in CAN_RECEIVE_PIECES)
+    assert summary["sent"]["instructions_per_second"] == 7407 * sum(results[name][8][0] for name in CAN_SEND_PIECES)

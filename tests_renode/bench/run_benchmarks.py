@@ -15,6 +15,9 @@ writes two JSON reports:
        "cycles_min_8": n, "cycles_max_8": n, "cycles_min_4096": n, "cycles_max_4096": n}
   kernel.json      the kernel core's subset (Kernel, Task, Scheduler, Timer,
                    System) with the instruction fields only.
+  can.json         instructions per received and per sent CAN frame through
+                   the SJA1000 driver and the link layer (the Can.* pieces
+                   added up) and the CPU share at 7,407 frames/s.
 
 n is the smallest instruction count of one call with that many objects (null
 when setup failed). Where /dev/kvm is usable and the bench image runs under
@@ -300,6 +303,63 @@ def print_table(results, overhead, cpu, kvm_results=None, kvm_repeat=0, selectio
           f"(the others are not in DCOS yet)")
 
 
+# One CAN frame through the SJA1000 driver and the link layer
+# (tests_renode/bench/CanBench.cpp): the pieces of a received and of a sent
+# frame, and the worst-case frame rate of the issue: 8-byte standard frames
+# at 1 Mbit/s, 135 bit times each with worst-case stuffing and the
+# interframe space, 10^6 / 135 = 7,407 frames per second.
+CAN_RECEIVE_PIECES = ("Can.ReceiveInterrupt", "Can.ReadFrame")
+CAN_SEND_PIECES = ("Can.WriteFrame", "Can.TransmitInterrupt")
+CAN_WORST_FRAME_RATE = 7407
+# Instructions per second of the emulated CPU under -icount shift=0 (one per
+# nanosecond), and, for orientation only, of an i486DX2-66 at an assumed
+# average of two clock cycles per instruction (docs/performance.md).
+EMULATED_INSTRUCTION_RATE = 1_000_000_000
+REFERENCE_486_INSTRUCTION_RATE = 33_000_000
+
+
+def can_summary(results):
+    """Instructions per received and per sent CAN frame and the CPU share at
+    CAN_WORST_FRAME_RATE; None when the CAN benchmarks did not all run."""
+    def figure(name):
+        entry = results.get(name)
+        return smallest(entry, 8) if entry is not None else None
+
+    pieces = {name: figure(name) for name in CAN_RECEIVE_PIECES + CAN_SEND_PIECES}
+    if any(value is None for value in pieces.values()):
+        return None
+    entry = figure("Kernel.InterruptLatency")
+    summary = {"frames_per_second": CAN_WORST_FRAME_RATE, "pieces": pieces,
+               "interrupt_entry_instructions": entry}
+    for direction, names in (("received", CAN_RECEIVE_PIECES), ("sent", CAN_SEND_PIECES)):
+        per_frame = sum(pieces[name] for name in names)
+        per_second = per_frame * CAN_WORST_FRAME_RATE
+        summary[direction] = {
+            "instructions_per_frame": per_frame,
+            "instructions_per_second": per_second,
+            "share_of_emulated_cpu": per_second / EMULATED_INSTRUCTION_RATE,
+            "share_of_reference_486": per_second / REFERENCE_486_INSTRUCTION_RATE,
+        }
+    return summary
+
+
+def print_can_summary(summary):
+    print()
+    print(f"CAN frames through the SJA1000 driver and the link layer, at the worst-case rate of 1 Mbit/s "
+          f"({summary['frames_per_second']} frames/s; 8 data bytes, extended DCOS identifier)")
+    for direction, names in (("received", CAN_RECEIVE_PIECES), ("sent", CAN_SEND_PIECES)):
+        figures = summary[direction]
+        parts = " + ".join(f"{name} {summary['pieces'][name]}" for name in names)
+        print(f"  per {direction} frame: {figures['instructions_per_frame']} instructions ({parts}); "
+              f"{figures['instructions_per_second'] / 1e6:.2f} million/s: "
+              f"{100 * figures['share_of_emulated_cpu']:.2f} % of the emulated CPU (10^9/s), "
+              f"{100 * figures['share_of_reference_486']:.1f} % of a 486 retiring 33 million/s")
+    if summary["interrupt_entry_instructions"] is not None:
+        print(f"  not included: the kernel's interrupt entry per routine (Kernel.InterruptLatency "
+              f"{summary['interrupt_entry_instructions']}) and exit, and the ISA bus's wait states on the chip's "
+              "18 port accesses per frame (docs/performance.md)")
+
+
 def write_json(path, report):
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w", encoding="utf-8") as handle:
@@ -324,6 +384,8 @@ def main():
                         help="measured calls per object count in the KVM pass, whose median is reported")
     parser.add_argument("--timeout", type=float, default=120.0, help="seconds for each wait on the emulator")
     parser.add_argument("--strict", action="store_true", help="exit 1 when an O(1) benchmark is NOT FLAT")
+    parser.add_argument("--can", default=os.path.join(REPOSITORY, "build", "bench", "can.json"),
+                        help="JSON report of the CAN frame costs to write (when the CAN benchmarks ran)")
     arguments = parser.parse_args()
 
     board = load_board(arguments.board)
@@ -354,6 +416,9 @@ def main():
     if kvm_argv:
         print("emulator (KVM pass): " + " ".join(kvm_argv))
     print_table(results, overhead, board.benchmark_cpu, kvm_results, arguments.kvm_repeat, arguments.select)
+    can = can_summary(results)
+    if can is not None:
+        print_can_summary(can)
     if kvm_results is None:
         print(f"KVM not available: real cycle figures not reported ({kvm_reason}). "
               "Every figure above is an exact instruction count under QEMU TCG with -icount.")
@@ -363,6 +428,8 @@ def main():
     write_json(arguments.primitives, {
         name: primitive_entry(name, results[name], kvm_results.get(name) if kvm_results is not None else None)
         for name in sorted(results)})
+    if can is not None:
+        write_json(arguments.can, can)
     if arguments.strict and any(order_check(entry) == "NOT FLAT" for entry in results.values()):
         return 1
     return 0

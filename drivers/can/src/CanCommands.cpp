@@ -5,7 +5,10 @@
 // The console owns one driver object per channel of the board's card,
 // can0 and can1 (sja1000/IsaSja1000Channel.hpp). `up` installs a channel
 // with the system agent and keeps one open on it, so the chip stays on the
-// bus between commands; `down` closes and uninstalls it again. The
+// bus between commands; `down` closes and uninstalls it again. The console
+// task is the channel's owner: `up` registers it for the driver's events,
+// so every change of the error state is posted to it and kept in the
+// driver's state log until `events` reads it. The
 // commands that wait (send, dump) wait for the driver's events, never by
 // polling, and always with a time-out.
 #include <sja1000/IsaSja1000Channel.hpp>
@@ -16,6 +19,7 @@
 #include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
+#include <runtime/Text.hpp>
 #include <shell/Shell.hpp>
 
 namespace sja1000 {
@@ -148,6 +152,9 @@ CommandResult up(shell::Shell& shell, int argc, char** argv)
             return CommandResult::Failed;
         }
     }
+    // The owner learns of every state change from now on, not only while a
+    // command that sends or receives runs.
+    listenHere(channel);
     uint32_t bitRate = static_cast<uint32_t>(rate);
     const Status set = systemAgent.Control(driver.id(), Sja1000Controller::kSetBitRate, &bitRate, sizeof bitRate);
     if (set != Status::Ok) {
@@ -464,6 +471,195 @@ CommandResult isoTpReceive(shell::Shell& shell, int argc, char** argv)
     }
 }
 
+// Queues frames without waiting for them to be sent: what a task does when
+// it has several frames for the bus at once.
+CommandResult queue(shell::Shell& shell, int argc, char** argv)
+{
+    constexpr int kMostFrames = static_cast<int>(Sja1000Controller::kTransmitQueueLength);
+    unsigned channel;
+    if (argc < 4 || argc - 3 > kMostFrames) {
+        shell.print("usage: can queue <channel> <id>#<data> ... (1 to %d frames)\r\n", kMostFrames);
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return CommandResult::Failed;
+    }
+    can::CanFrame frames[Sja1000Controller::kTransmitQueueLength];
+    const int count = argc - 3;
+    for (int i = 0; i < count; ++i) {
+        const can::LinkResult<can::CanFrame> frame = can::FrameText::parse(argv[3 + i]);
+        if (!frame.ok()) {
+            shell.print("error: '%s' is not a frame (%s); nothing was queued\r\n", argv[3 + i],
+                        can::linkErrorName(frame.error()));
+            return CommandResult::Failed;
+        }
+        frames[i] = frame.value();
+    }
+    const dcos::Result<size_t> written = systemAgent.Write(consoleChannels[channel].id(), 0, frames,
+                                                           static_cast<size_t>(count) * sizeof(can::CanFrame));
+    if (!written.ok()) {
+        shell.print("error: %s did not take the frames: %s\r\n", kNames[channel], dcos::statusName(written.status()));
+        return CommandResult::Failed;
+    }
+    const size_t taken = written.value() / sizeof(can::CanFrame);
+    shell.print("%s  %lu of %d frames queued\r\n", kNames[channel], static_cast<unsigned long>(taken), count);
+    return taken == static_cast<size_t>(count) ? CommandResult::Ok : CommandResult::Failed;
+}
+
+// Prints the state changes the driver reported to its owner, the console
+// task, oldest first; with a count, waits for that many (a time-out bounds it).
+CommandResult events(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    unsigned long wanted = 0;
+    unsigned long timeoutMs = kDefaultDumpTimeoutMs;
+    if (argc < 3 || argc > 5) {
+        shell.print("usage: can events <channel> [count] [time-out ms]\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return CommandResult::Failed;
+    }
+    if (argc >= 4 && (!shell::Shell::parseUnsigned(argv[3], wanted) || wanted > 10000)) {
+        shell.print("error: count '%s' is not a number from 0 to 10000\r\n", argv[3]);
+        return CommandResult::Failed;
+    }
+    if (argc == 5 && !parseMilliseconds(shell, argv[4], timeoutMs)) {
+        return CommandResult::Failed;
+    }
+    listenHere(channel);
+    const uint64_t deadline = dcos::timerAgent.Uptime() + timeoutMs * kMillisecond;
+    unsigned long shown = 0;
+    for (;;) {
+        static StateChanges log;
+        (void)systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kReadStateChanges, &log,
+                                  sizeof log); // Cannot fail: the channel is up and the argument is right.
+        if (log.lost != 0) {
+            shell.print("%s  %lu earlier state changes lost\r\n", kNames[channel], static_cast<unsigned long>(log.lost));
+        }
+        for (uint32_t i = 0; i < log.count; ++i, ++shown) {
+            const StateChange& change = log.changes[i];
+            if (change.holdChanged != 0) {
+                shell.print("%s  %s  %s  rx errors %u  tx errors %u\r\n", kNames[channel],
+                            change.noAcknowledge != 0 ? "no acknowledge: held" : "acknowledge hold released",
+                            stateName(change.to), change.receiveErrors, change.transmitErrors);
+                continue;
+            }
+            shell.print("%s  %s  was %s  rx errors %u  tx errors %u\r\n", kNames[channel], stateName(change.to),
+                        stateName(change.from), change.receiveErrors, change.transmitErrors);
+        }
+        const uint64_t now = dcos::timerAgent.Uptime();
+        if (shown >= wanted || now >= deadline) {
+            break;
+        }
+        // A change reported between the read and this wait has posted the
+        // event already, so the wait returns at once for it.
+        (void)taskAgent.ReceiveEvent(kStateEvent, dcos::EventWait::Any, deadline - now);
+    }
+    if (shown < wanted) {
+        shell.print("%lu of %lu state changes within %lu ms\r\n", shown, wanted, timeoutMs);
+        return CommandResult::Failed;
+    }
+    return CommandResult::Ok;
+}
+
+CommandResult policy(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    const bool automatic = argc == 4 && runtime::textEquals(argv[3], "auto");
+    const bool manual = argc == 4 && runtime::textEquals(argv[3], "manual");
+    if (!automatic && !manual) {
+        shell.print("usage: can policy <channel> auto|manual  (after bus-off: recover at once, or on 'can restart')\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return CommandResult::Failed;
+    }
+    uint32_t value = static_cast<uint32_t>(automatic ? BusOffPolicy::RestartAtOnce : BusOffPolicy::WaitForRestart);
+    const Status set = systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kSetBusOffPolicy, &value,
+                                           sizeof value);
+    if (set != Status::Ok) {
+        shell.print("error: %s\r\n", dcos::statusName(set));
+        return CommandResult::Failed;
+    }
+    shell.print("%s  after bus-off: %s\r\n", kNames[channel],
+                automatic ? "recover at once" : "wait for 'can restart'");
+    return CommandResult::Ok;
+}
+
+CommandResult restart(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    if (argc != 3) {
+        shell.print("usage: can restart <channel>\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return CommandResult::Failed;
+    }
+    const Status restarted = systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kRestart, nullptr, 0);
+    if (restarted != Status::Ok) {
+        shell.print("error: cannot restart %s: %s\r\n", kNames[channel], dcos::statusName(restarted));
+        return CommandResult::Failed;
+    }
+    shell.print("%s  restarted\r\n", kNames[channel]);
+    return CommandResult::Ok;
+}
+
+// Parses a hexadecimal number up to @p limit; prints why not.
+bool parseHex(shell::Shell& shell, const char* text, uint32_t limit, uint32_t& value)
+{
+    // parseUnsigned reads hexadecimal after "0x"; an identifier is written without it, as cansend takes it.
+    unsigned long parsed = 0;
+    char prefixed[2 + 8 + 1] = {'0', 'x'};
+    const size_t length = runtime::textLength(text);
+    for (size_t i = 0; i < length && i < 8; ++i) {
+        prefixed[2 + i] = text[i];
+    }
+    prefixed[2 + (length < 8 ? length : 8)] = '\0';
+    if (length == 0 || length > 8 || !shell::Shell::parseUnsigned(prefixed, parsed) || parsed > limit) {
+        shell.print("error: '%s' is not a hexadecimal number up to %lX\r\n", text, static_cast<unsigned long>(limit));
+        return false;
+    }
+    value = static_cast<uint32_t>(parsed);
+    return true;
+}
+
+CommandResult filter(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    const bool all = argc == 4 && runtime::textEquals(argv[3], "all");
+    const bool extendedOnly = argc == 6 && runtime::textEquals(argv[3], "ext");
+    const bool standardOnly = argc == 6 && runtime::textEquals(argv[3], "std");
+    if (!all && !extendedOnly && !standardOnly) {
+        shell.print("usage: can filter <channel> all | ext <id> <mask> | std <id> <mask>  (hexadecimal; a mask bit "
+                    "set must match)\r\n");
+        return CommandResult::Failed;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return CommandResult::Failed;
+    }
+    AcceptanceFilter wanted = AcceptanceFilter::all();
+    if (!all) {
+        const uint32_t limit = extendedOnly ? can::CanFrame::kMaxExtendedId : can::CanFrame::kMaxStandardId;
+        uint32_t id = 0;
+        uint32_t mask = 0;
+        if (!parseHex(shell, argv[4], limit, id) || !parseHex(shell, argv[5], limit, mask)) {
+            return CommandResult::Failed;
+        }
+        wanted = extendedOnly ? AcceptanceFilter::extended(id, mask) : AcceptanceFilter::standard(id, mask);
+    }
+    const Status set = systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kSetFilter, &wanted,
+                                           sizeof wanted);
+    if (set != Status::Ok) {
+        shell.print("error: cannot set the filter: %s\r\n", dcos::statusName(set));
+        return CommandResult::Failed;
+    }
+    shell.print("%s  filter %s\r\n", kNames[channel], all ? "takes every frame" : extendedOnly ? "extended only"
+                                                                                                 : "standard only");
+    return CommandResult::Ok;
+}
+
 void printState(shell::Shell& shell, unsigned channel)
 {
     if (!consoleChannels[channel].installed()) {
@@ -507,17 +703,20 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
     }
     ChannelStatistics s{};
     (void)systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kGetStatistics, &s, sizeof s);
-    shell.print("%s sent=%lu received=%lu rx_queue_overruns=%lu chip_overruns=%lu malformed=%lu bus_errors=%lu "
-                "ack_errors=%lu arbitration_lost=%lu warnings=%lu passives=%lu bus_offs=%lu restarts=%lu aborts=%lu "
-                "lone_node_holds=%lu interrupts=%lu interrupt_loop_limits=%lu\r\n",
+    shell.print("%s sent=%lu received=%lu rx_queue_overruns=%lu chip_overruns=%lu malformed=%lu bad_ids=%lu "
+                "bus_errors=%lu ack_errors=%lu arbitration_lost=%lu warnings=%lu passives=%lu bus_offs=%lu "
+                "restarts=%lu recoveries=%lu actives=%lu aborts=%lu lone_node_holds=%lu state_changes_lost=%lu "
+                "interrupts=%lu interrupt_loop_limits=%lu\r\n",
                 kNames[channel], static_cast<unsigned long>(s.framesSent),
                 static_cast<unsigned long>(s.framesReceived), static_cast<unsigned long>(s.receiveQueueOverruns),
                 static_cast<unsigned long>(s.chipOverruns), static_cast<unsigned long>(s.malformedFrames),
-                static_cast<unsigned long>(s.busErrors), static_cast<unsigned long>(s.acknowledgeErrors),
-                static_cast<unsigned long>(s.arbitrationLost), static_cast<unsigned long>(s.errorWarnings),
-                static_cast<unsigned long>(s.errorPassives), static_cast<unsigned long>(s.busOffs),
-                static_cast<unsigned long>(s.restarts), static_cast<unsigned long>(s.aborts),
-                static_cast<unsigned long>(s.loneNodeHolds), static_cast<unsigned long>(s.interrupts),
+                static_cast<unsigned long>(s.badIdentifiers), static_cast<unsigned long>(s.busErrors),
+                static_cast<unsigned long>(s.acknowledgeErrors), static_cast<unsigned long>(s.arbitrationLost),
+                static_cast<unsigned long>(s.errorWarnings), static_cast<unsigned long>(s.errorPassives),
+                static_cast<unsigned long>(s.busOffs), static_cast<unsigned long>(s.restarts),
+                static_cast<unsigned long>(s.recoveries), static_cast<unsigned long>(s.errorActives),
+                static_cast<unsigned long>(s.aborts), static_cast<unsigned long>(s.loneNodeHolds),
+                static_cast<unsigned long>(s.stateChangesLost), static_cast<unsigned long>(s.interrupts),
                 static_cast<unsigned long>(s.interruptLoopLimits));
     return CommandResult::Ok;
 }
@@ -525,6 +724,7 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
 constexpr shell::Subcommand kSubcommands[] = {
     {"up", up},       {"down", down},   {"send", send},           {"dump", dump},
     {"state", state}, {"stats", statistics}, {"isotp-send", isoTpSend}, {"isotp-recv", isoTpReceive},
+    {"queue", queue}, {"events", events}, {"policy", policy}, {"restart", restart}, {"filter", filter},
 };
 
 CommandResult canCommand(shell::Shell& shell, int argc, char** argv)
@@ -537,13 +737,18 @@ CommandResult canCommand(shell::Shell& shell, int argc, char** argv)
 DCOS_SHELL_COMMAND_DETAILED(canShellCommand, "can", "bring CAN channels up and down, send, dump, show their state",
                             "can up <channel> [bit rate] | down <channel> | send <channel> <id>#<data> [ms] | "
                             "dump <channel> [count] [ms] | state [channel] | stats <channel> | "
-                            "isotp-send <channel> <src> <dst> <hex> | isotp-recv <channel> <src> <dst> [ms]",
+                            "isotp-send <channel> <src> <dst> <hex> | isotp-recv <channel> <src> <dst> [ms] | "
+                            "queue <channel> <id>#<data>... | events <channel> [count] [ms] | "
+                            "policy <channel> auto|manual | restart <channel> | filter <channel> all|ext|std [id mask]",
                             "  channels: can0 (0x280, irq 10) and can1 (0x2a0, irq 11) of the ISA SJA1000 card\r\n"
                             "  frames: <id>#<data> as can-utils' cansend writes them: 3 hex digits for a standard\r\n"
                             "  identifier, 8 for an extended one; <id>#R[n] is a remote frame\r\n"
                             "  dump prints frames as candump does; send waits for the frame to be acknowledged\r\n"
                             "  isotp-send and isotp-recv move one ISO 15765-2 message, as can-utils' isotpsend\r\n"
-                            "  and isotprecv do: src is the identifier this end sends on, dst the one it receives on",
+                            "  and isotprecv do: src is the identifier this end sends on, dst the one it receives on\r\n"
+                            "  queue puts frames in the transmit queue without waiting; events shows the error-state\r\n"
+                            "  changes the driver reported to the console (and waits for count of them)\r\n"
+                            "  policy: after bus-off recover at once (auto, the default) or on 'can restart' (manual)",
                             canCommand);
 
 } // namespace sja1000

@@ -106,6 +106,9 @@ Result<dcos::ObjectId> Sja1000Controller::installController(const char* name, dc
     noAcknowledge_ = false;
     acknowledgeErrorsInARow_ = 0;
     errorState_ = ErrorState::Active;
+    stateLogHead_ = 0;
+    stateLogCount_ = 0;
+    stateLogLost_ = 0;
     return created;
 }
 
@@ -181,8 +184,19 @@ Status Sja1000Controller::startChip()
         return started;
     }
     started_ = true;
-    errorState_ = ErrorState::Active;
     acknowledgeErrorsInARow_ = 0;
+    // The counters were cleared: a channel that was not error-active is
+    // again, and its owner learns of it as of any other change.
+    const ErrorState previous = errorState_;
+    errorState_ = ErrorState::Active;
+    if (previous != ErrorState::Active) {
+        recordStateChange(previous, ErrorState::Active);
+        ++statistics_.errorActives;
+        if (previous == ErrorState::BusOff) {
+            ++statistics_.recoveries;
+        }
+        notify(notification_.stateEvent);
+    }
     loadNext();
     return Status::Ok;
 }
@@ -360,6 +374,11 @@ void Sja1000Controller::onReceive()
             ++statistics_.malformedFrames;
             continue;
         }
+        if (!filter_.takesFormat(frame.value().isExtended())) {
+            // The chip's filter cannot tell the formats apart (AcceptanceFilter).
+            ++statistics_.badIdentifiers;
+            continue;
+        }
         ++statistics_.framesReceived;
         received = true;
         if (receiveCount_ == kReceiveQueueLength) {
@@ -394,6 +413,7 @@ void Sja1000Controller::onBusError()
         if (!abortRequested_) {
             chip_.abortTransmission();
         }
+        recordStateChange(errorState_, errorState_, true);
         notify(notification_.stateEvent);
     }
 }
@@ -404,8 +424,16 @@ void Sja1000Controller::onStateChange()
     if (state == errorState_) {
         return;
     }
+    const ErrorState previous = errorState_;
     errorState_ = state;
-    if (state == ErrorState::Warning) {
+    recordStateChange(previous, state);
+    if (previous == ErrorState::BusOff) {
+        // The chip counted its 128 bus-free signals: it is on the bus again.
+        ++statistics_.recoveries;
+    }
+    if (state == ErrorState::Active) {
+        ++statistics_.errorActives;
+    } else if (state == ErrorState::Warning) {
         ++statistics_.errorWarnings;
     } else if (state == ErrorState::Passive) {
         ++statistics_.errorPassives;
@@ -422,10 +450,27 @@ void Sja1000Controller::onStateChange()
     notify(notification_.stateEvent);
 }
 
+void Sja1000Controller::recordStateChange(ErrorState from, ErrorState to, bool holdChanged)
+{
+    const ErrorCounters counters = chip_.errorCounters();
+    if (stateLogCount_ == StateChanges::kCapacity) {
+        // The owner has not read for a while: the oldest change goes, and it is counted.
+        stateLogHead_ = (stateLogHead_ + 1) % StateChanges::kCapacity;
+        --stateLogCount_;
+        ++stateLogLost_;
+        ++statistics_.stateChangesLost;
+    }
+    stateLog_[(stateLogHead_ + stateLogCount_) % StateChanges::kCapacity] =
+        StateChange{from, to, counters.receive, counters.transmit, static_cast<uint8_t>(holdChanged ? 1 : 0),
+                    static_cast<uint8_t>(noAcknowledge_ ? 1 : 0)};
+    ++stateLogCount_;
+}
+
 void Sja1000Controller::releaseHold()
 {
     noAcknowledge_ = false;
     acknowledgeErrorsInARow_ = 0;
+    recordStateChange(errorState_, errorState_, true);
     notify(notification_.stateEvent);
 }
 
@@ -457,11 +502,13 @@ void Sja1000Controller::handleInterrupt()
             (void)chip_.arbitrationLostBit(); // Frees ALC for the next loss.
             ++statistics_.arbitrationLost;
         }
-        if ((causes & reg::kInterruptBusError) != 0) {
-            onBusError();
-        }
+        // The state first: a bus error that begins the lone-node hold is
+        // then logged for the owner with the state it brought about.
         if ((causes & (reg::kInterruptErrorWarning | reg::kInterruptErrorPassive)) != 0) {
             onStateChange();
+        }
+        if ((causes & reg::kInterruptBusError) != 0) {
+            onBusError();
         }
         if ((causes & reg::kInterruptTransmit) != 0) {
             onTransmitDone();
@@ -490,7 +537,7 @@ Status Sja1000Controller::Control(uint32_t command, void* argument, size_t lengt
     }
     case kSetFilter: {
         const AcceptanceFilter* filter = argumentAs<AcceptanceFilter>(argument, length);
-        if (filter == nullptr) {
+        if (filter == nullptr || static_cast<uint8_t>(filter->formats) > static_cast<uint8_t>(FrameFormats::Standard)) {
             return Status::InvalidArgument;
         }
         filter_ = *filter;
@@ -547,16 +594,41 @@ Status Sja1000Controller::Control(uint32_t command, void* argument, size_t lengt
         busOffPolicy_ = static_cast<BusOffPolicy>(*policy);
         return Status::Ok;
     }
-    case kRestart:
+    case kRestart: {
         if (length != 0) {
             return Status::InvalidArgument;
         }
-        {
-            arch_x86::InterruptGuard guard;
-            noAcknowledge_ = false;
-            ++statistics_.restarts;
+        arch_x86::InterruptGuard guard;
+        if (noAcknowledge_) {
+            releaseHold();
+        }
+        ++statistics_.restarts;
+        if (started_ && errorState_ == ErrorState::BusOff && chip_.inReset()) {
+            // Leaving reset mode with the counters as the chip left them
+            // begins its own recovery: ISO 11898-1 lets a bus-off node back
+            // only after 128 times 11 recessive bits, and writing the
+            // counters now would cut that short (DS 6.4.11). The chip
+            // reports the end of it with EI, and the queue waits until then.
+            return chip_.start(busMode_);
         }
         return startChip();
+    }
+    case kReadStateChanges: {
+        StateChanges* out = argumentAs<StateChanges>(argument, length);
+        if (out == nullptr) {
+            return Status::InvalidArgument;
+        }
+        arch_x86::InterruptGuard guard;
+        out->count = static_cast<uint32_t>(stateLogCount_);
+        out->lost = stateLogLost_;
+        for (size_t i = 0; i < stateLogCount_; ++i) {
+            out->changes[i] = stateLog_[(stateLogHead_ + i) % StateChanges::kCapacity];
+        }
+        stateLogHead_ = 0;
+        stateLogCount_ = 0;
+        stateLogLost_ = 0;
+        return Status::Ok;
+    }
     case kFlushTransmit: {
         if (length != 0) {
             return Status::InvalidArgument;

@@ -371,6 +371,19 @@ TEST_F(Sja1000ControllerTest, ALoneNodeStopsRepeatingAndTriesAgainWhenItHearsAno
     const std::vector<CanFrame> sent = drainBus();
     ASSERT_EQ(sent.size(), 1u);
     EXPECT_EQ(sent[0], extended(0x42, {1}));
+    // The owner's log: warning, passive, then the hold (seen in the state
+    // it came in) and its release.
+    sja1000::StateChanges log{};
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kReadStateChanges, &log, sizeof log), Status::Ok);
+    ASSERT_EQ(log.count, 4u);
+    EXPECT_EQ(log.changes[0].to, sja1000::ErrorState::Warning);
+    EXPECT_EQ(log.changes[1].to, sja1000::ErrorState::Passive);
+    EXPECT_EQ(log.changes[2].holdChanged, 1);
+    EXPECT_EQ(log.changes[2].noAcknowledge, 1);
+    EXPECT_EQ(log.changes[2].from, log.changes[2].to) << "the error state did not change";
+    EXPECT_EQ(log.changes[3].holdChanged, 1);
+    EXPECT_EQ(log.changes[3].noAcknowledge, 0);
+    EXPECT_EQ(log.changes[0].holdChanged, 0);
 }
 
 TEST_F(Sja1000ControllerTest, ErrorStatesAreFollowedAndReportedToTheListener)
@@ -428,8 +441,100 @@ TEST_F(Sja1000ControllerTest, BusOffWaitsForRestartWhenThePolicySaysSo)
     EXPECT_EQ(send(id, {extended(0x20)}), 1u);
     EXPECT_FALSE(fake->transmitting()) << "nothing is sent while bus-off";
     ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kRestart, nullptr, 0), Status::Ok);
-    EXPECT_EQ(fake->txErrors, 0) << "the counters start afresh";
+    EXPECT_EQ(fake->mode & reg::kModeReset, 0) << "the chip left reset mode: its recovery has begun";
+    EXPECT_EQ(fake->txErrors, 127) << "the counters are the chip's: it counts the 128 bus-free signals itself";
+    EXPECT_FALSE(fake->transmitting()) << "nothing is sent before the recovery ends";
+    EXPECT_EQ(state(id).errorState, sja1000::ErrorState::BusOff);
+    // The chip counted 128 bus-free signals: BS clear, counters 0, EI.
+    fake->setCounters(0, 0);
+    fake->status = static_cast<uint8_t>(fake->status & ~(reg::kStatusBusOff | reg::kStatusError));
+    fake->interrupt = reg::kInterruptErrorWarning;
+    interrupt();
+    EXPECT_EQ(state(id).errorState, sja1000::ErrorState::Active);
+    EXPECT_EQ(statistics(id).recoveries, 1u);
     EXPECT_EQ(drainBus().size(), 2u);
+}
+
+TEST_F(Sja1000ControllerTest, TheOwnerReadsEveryStateChangeInOrder)
+{
+    const ObjectId id = open();
+    fake->setCounters(0, 130);
+    interrupt();
+    fake->busOff();
+    interrupt();
+    fake->setCounters(0, 0);
+    fake->status = static_cast<uint8_t>(fake->status & ~(reg::kStatusBusOff | reg::kStatusError));
+    fake->interrupt = reg::kInterruptErrorWarning;
+    interrupt();
+    sja1000::StateChanges log{};
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kReadStateChanges, &log, sizeof log), Status::Ok);
+    ASSERT_EQ(log.count, 3u);
+    EXPECT_EQ(log.lost, 0u);
+    EXPECT_EQ(log.changes[0].from, sja1000::ErrorState::Active);
+    EXPECT_EQ(log.changes[0].to, sja1000::ErrorState::Passive);
+    EXPECT_EQ(log.changes[0].transmitErrors, 130);
+    EXPECT_EQ(log.changes[1].to, sja1000::ErrorState::BusOff);
+    EXPECT_EQ(log.changes[1].transmitErrors, 127);
+    EXPECT_EQ(log.changes[2].from, sja1000::ErrorState::BusOff);
+    EXPECT_EQ(log.changes[2].to, sja1000::ErrorState::Active);
+    const sja1000::ChannelStatistics s = statistics(id);
+    EXPECT_EQ(s.recoveries, 1u);
+    EXPECT_EQ(s.errorActives, 1u);
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kReadStateChanges, &log, sizeof log), Status::Ok);
+    EXPECT_EQ(log.count, 0u) << "reading empties the log";
+}
+
+TEST_F(Sja1000ControllerTest, ARestartWithClearedCountersIsReportedAsAReturnToErrorActive)
+{
+    const ObjectId id = open();
+    fake->setCounters(0, 130);
+    interrupt();
+    uint32_t rate = 500'000;
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kSetBitRate, &rate, sizeof rate), Status::Ok);
+    EXPECT_EQ(state(id).errorState, sja1000::ErrorState::Active);
+    sja1000::StateChanges log{};
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kReadStateChanges, &log, sizeof log), Status::Ok);
+    ASSERT_EQ(log.count, 2u);
+    EXPECT_EQ(log.changes[1].from, sja1000::ErrorState::Passive);
+    EXPECT_EQ(log.changes[1].to, sja1000::ErrorState::Active);
+    EXPECT_EQ(log.changes[1].transmitErrors, 0) << "the counters were cleared";
+    EXPECT_EQ(statistics(id).errorActives, 1u);
+}
+
+TEST_F(Sja1000ControllerTest, AFullStateLogKeepsTheNewestAndCountsTheLost)
+{
+    const ObjectId id = open();
+    const size_t changes = sja1000::StateChanges::kCapacity + 4;
+    for (size_t i = 0; i < changes; ++i) {
+        fake->setCounters(0, i % 2 == 0 ? 130 : 10);
+        interrupt();
+    }
+    sja1000::StateChanges log{};
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kReadStateChanges, &log, sizeof log), Status::Ok);
+    EXPECT_EQ(log.count, sja1000::StateChanges::kCapacity);
+    EXPECT_EQ(log.lost, 4u);
+    EXPECT_EQ(statistics(id).stateChangesLost, 4u);
+    EXPECT_EQ(log.changes[log.count - 1].to, sja1000::ErrorState::Active) << "the newest change is kept";
+}
+
+TEST_F(Sja1000ControllerTest, FramesOfAFormatTheFilterExcludesAreDroppedAndCounted)
+{
+    const ObjectId id = open();
+    sja1000::AcceptanceFilter filter = sja1000::AcceptanceFilter::extended(0x1000000, 0x1000000);
+    ASSERT_EQ(systemAgent.Control(id, Sja1000Controller::kSetFilter, &filter, sizeof filter), Status::Ok);
+    // The fake takes every frame, as the chip takes a standard frame whose
+    // bits fall on the filter's positions.
+    fake->receive(standard(0x400, {1}));
+    fake->receive(extended(0x1000042, {2}));
+    interrupt();
+    const std::vector<CanFrame> frames = readAll(id);
+    ASSERT_EQ(frames.size(), 1u);
+    EXPECT_EQ(frames[0], extended(0x1000042, {2}));
+    EXPECT_EQ(statistics(id).badIdentifiers, 1u);
+    EXPECT_EQ(statistics(id).framesReceived, 1u);
+    sja1000::AcceptanceFilter bad = filter;
+    bad.formats = static_cast<sja1000::FrameFormats>(7);
+    EXPECT_EQ(systemAgent.Control(id, Sja1000Controller::kSetFilter, &bad, sizeof bad), Status::InvalidArgument);
 }
 
 TEST_F(Sja1000ControllerTest, ControlChecksItsArguments)

@@ -20,24 +20,51 @@
 
 namespace sja1000 {
 
+/// The identifier formats a channel takes, which the chip's filter alone
+/// cannot choose (see AcceptanceFilter).
+enum class FrameFormats : uint8_t {
+    Both = 0,     ///< Standard and extended frames.
+    Extended = 1, ///< Extended (29-bit) frames only, as DCOS sends them.
+    Standard = 2, ///< Standard (11-bit) frames only.
+};
+
 /// The single 32-bit acceptance filter (MOD.AFM set, DS 6.4.15): a received
 /// frame is taken when its bits equal `code` wherever `mask` has a 0. The
 /// layout is the chip's, left-aligned: an extended identifier in bits 31:3
 /// and the RTR bit in bit 2; a standard identifier in bits 31:21, RTR in
 /// bit 20, then its first two data bytes.
+///
+/// The chip compares every frame in the layout of its own format, so a
+/// filter written for extended identifiers also takes the standard frames
+/// whose 11 bits, RTR and first data bytes fall on the same positions: the
+/// chip has no format bit to compare. `formats` is that bit, checked by the
+/// driver: a frame of another format is an identifier the channel did not
+/// ask for, and is dropped and counted (ChannelStatistics::badIdentifiers).
 struct AcceptanceFilter {
     uint32_t code = 0;
     uint32_t mask = 0xFFFFFFFF; ///< Every bit "don't care": the default takes every frame.
+    FrameFormats formats = FrameFormats::Both;
 
     /// Takes every frame.
     static constexpr AcceptanceFilter all() { return {}; }
     /// Takes extended data and remote frames whose identifier matches
-    /// @p id in the bits set in @p idMask; standard frames whose 11 bits
-    /// fall on the same positions are taken alike, as the chip compares them.
+    /// @p id in the bits set in @p idMask, and no standard frame.
     static constexpr AcceptanceFilter extended(uint32_t id, uint32_t idMask)
     {
-        return {(id & can::CanFrame::kMaxExtendedId) << 3,
-                ~((idMask & can::CanFrame::kMaxExtendedId) << 3)};
+        return {(id & can::CanFrame::kMaxExtendedId) << 3, ~((idMask & can::CanFrame::kMaxExtendedId) << 3),
+                FrameFormats::Extended};
+    }
+    /// Takes standard data and remote frames whose identifier matches @p id
+    /// in the bits set in @p idMask, whatever their data, and no extended frame.
+    static constexpr AcceptanceFilter standard(uint32_t id, uint32_t idMask)
+    {
+        return {(id & can::CanFrame::kMaxStandardId) << 21, ~((idMask & can::CanFrame::kMaxStandardId) << 21),
+                FrameFormats::Standard};
+    }
+    /// Whether a frame's format is one the filter takes.
+    constexpr bool takesFormat(bool extendedFrame) const
+    {
+        return formats == FrameFormats::Both || (formats == FrameFormats::Extended) == extendedFrame;
     }
 };
 

@@ -71,13 +71,17 @@ struct ChannelStatistics {
     uint32_t receiveQueueOverruns = 0; ///< Frames lost because no task read them in time.
     uint32_t chipOverruns = 0;         ///< Frames lost in the chip's FIFO (DOI).
     uint32_t malformedFrames = 0;      ///< Received frames with a data length code above 8, dropped.
+    uint32_t badIdentifiers = 0;       ///< Received frames of a format the filter excludes, dropped.
     uint32_t busErrors = 0;            ///< BEI: every error the chip saw on the bus.
     uint32_t acknowledgeErrors = 0;    ///< Bus errors in the acknowledge slot of our own frames.
     uint32_t arbitrationLost = 0;      ///< ALI.
     uint32_t errorWarnings = 0;        ///< Entries into the warning state.
     uint32_t errorPassives = 0;        ///< Entries into error-passive.
     uint32_t busOffs = 0;
-    uint32_t restarts = 0;             ///< Restarts after bus-off.
+    uint32_t restarts = 0;             ///< Recoveries begun by the policy after bus-off, and every kRestart.
+    uint32_t recoveries = 0;           ///< Recoveries from bus-off completed: back on the bus, error-active.
+    uint32_t errorActives = 0;         ///< Returns to error-active from warning, passive or bus-off.
+    uint32_t stateChangesLost = 0;     ///< State changes the owner had not read when the log was full.
     uint32_t aborts = 0;               ///< Frames taken back from the chip for a more urgent one.
     uint32_t loneNodeHolds = 0;        ///< Times the queue was held for want of an acknowledge.
     uint32_t interrupts = 0;           ///< Calls of the interrupt service routine.
@@ -92,10 +96,30 @@ struct Notification {
     uint32_t sentEvent = 0;     ///< Posted when a frame has been sent.
 };
 
+/// One change of the error state or of the lone-node hold, as the driver
+/// saw it (kReadStateChanges): what the owner of the channel learns.
+struct StateChange {
+    ErrorState from = ErrorState::Active;
+    ErrorState to = ErrorState::Active; ///< Equal to from when only the hold changed.
+    uint8_t receiveErrors = 0;  ///< RXERR when the change was seen.
+    uint8_t transmitErrors = 0; ///< TXERR when the change was seen.
+    uint8_t holdChanged = 0;    ///< 1: this entry is the lone-node hold beginning or ending.
+    uint8_t noAcknowledge = 0;  ///< 1 while the queue is held for want of an acknowledge, after this change.
+};
+
+/// The state changes not yet read, oldest first (kReadStateChanges); reading
+/// them empties the channel's log.
+struct StateChanges {
+    static constexpr size_t kCapacity = 16;
+    uint32_t count = 0;   ///< Entries of changes filled in.
+    uint32_t lost = 0;    ///< Older changes overwritten since the last read.
+    StateChange changes[kCapacity]{};
+};
+
 /// After bus-off (kSetBusOffPolicy).
 enum class BusOffPolicy : uint32_t {
     RestartAtOnce = 0, ///< Leave reset mode at once; the chip waits 128 x 11 recessive bits.
-    WaitForRestart = 1, ///< Stay off the bus until Control kRestart.
+    WaitForRestart = 1, ///< Stay off the bus until Control kRestart, then recover as the chip does.
 };
 
 class Sja1000Controller : public dcos::Device {
@@ -109,8 +133,9 @@ public:
         kGetStatistics = 5,    ///< ChannelStatistics, filled in.
         kSetNotification = 6,  ///< Notification.
         kSetBusOffPolicy = 7,  ///< BusOffPolicy (uint32_t).
-        kRestart = 8,          ///< No argument: back onto the bus after bus-off, the counters cleared.
+        kRestart = 8,          ///< No argument: after bus-off begins the chip's recovery; else restarts it, counters cleared.
         kFlushTransmit = 9,    ///< No argument: drops every queued frame, the one in the chip too.
+        kReadStateChanges = 10, ///< StateChanges: the error-state changes since the last read, oldest first.
     };
 
     /// Frames the transmit queue holds, the one in the chip included.
@@ -179,6 +204,7 @@ private:
     void onStateChange();
     void notify(uint32_t events);
     void releaseHold();
+    void recordStateChange(ErrorState from, ErrorState to, bool holdChanged = false);
 
     const char* claimant_;
     Sja1000Chip chip_;
@@ -210,6 +236,12 @@ private:
     size_t receiveHead_ = 0;
     size_t receiveCount_ = 0;
     ChannelStatistics statistics_{};
+    // The state changes the owner has not read yet: a ring that keeps the
+    // newest, since the present state matters more than the oldest history.
+    StateChange stateLog_[StateChanges::kCapacity];
+    size_t stateLogHead_ = 0;
+    size_t stateLogCount_ = 0;
+    uint32_t stateLogLost_ = 0;
 };
 
 } // namespace sja1000
