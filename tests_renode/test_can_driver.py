@@ -310,18 +310,10 @@ def test_frames_with_a_bad_identifier_are_rejected_and_counted_and_the_next_good
     assert "can0  10000043   [1]  01" in other.command("can dump can0 1 5000")
 
 
-# The card model loses the framing of its receive FIFO after these frames,
-# so the frame after them is garbage or missing: the release of a message
-# (CMR.RRB, QEMU's core) frees 3 or 5 bytes plus the DLC for a data frame,
-# where the core stored at most 8 data bytes (the front end writes DLC 9-15
-# back into the frame information), and no data bytes for a remote frame,
-# where the core stored DLC of them. Fixing it means changing
-# tests_renode/models/isa_sja1000.c, which this branch must not touch; the
-# driver's side is tested on the host (AFrameWithALengthAboveEightIsDroppedAndCounted).
-# Strict: the test fails the suite as soon as the model is fixed, to be unmarked.
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
-    "card model defect: the receive FIFO loses its framing after a data frame with DLC 9-15 or a remote frame "
-    "with DLC above 0 (tests_renode/models/isa_sja1000.c and QEMU's can_sja1000.c)"))
+# A data frame of DLC 9-15 and a remote frame asking for data used to leave
+# the card's receive FIFO out of step (the model stored and released them
+# with different lengths), so the frame after them was garbage: the good
+# frame after each is the check.
 def test_frames_with_a_bad_length_are_rejected_and_counted_and_the_next_good_one_is_intact(canlab):
     lab = canlab({"can0": 500_000}, TWO_BOARDS, pace=PACE, kind="production")
     board, other = lab.board("board1"), lab.board("board2")
@@ -337,11 +329,7 @@ def test_frames_with_a_bad_length_are_rejected_and_counted_and_the_next_good_one
     assert (counters["received"], counters["malformed"], counters["chip_overruns"]) == (1, 8, 0), counters
 
 
-# The same card-model defect with ordinary traffic: a remote frame asking for
-# data (DLC above 0) leaves the receive FIFO out of step, so the frame after
-# it reads as a standard frame 000 with no data. Strict, like the one above.
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
-    "card model defect: QEMU's SJA1000 core stores DLC data bytes for a remote frame but releases none"))
+# The same with ordinary traffic: a remote frame asking for two bytes, then a data frame.
 def test_a_remote_frame_with_a_length_code_and_the_frame_after_it_arrive_intact(canlab):
     lab = canlab({"can0": 500_000}, TWO_BOARDS, pace=PACE, kind="production")
     board, other = lab.board("board1"), lab.board("board2")

@@ -1627,10 +1627,21 @@ static bool chan_single_filter_id_matches(Sja1000Channel *ch,
     return !((value ^ code) & ~mask & 0xfff);
 }
 
-/* Hands a received frame to the core, keeping the DLC as it was sent. */
-static void chan_deliver_frame(Sja1000Channel *ch, const qemu_can_frame *frame,
+/*
+ * Hands a received frame to the core, keeping the DLC as it was sent.
+ *
+ * The receive FIFO holds a PeliCAN remote frame's descriptor and no data
+ * bytes (DS 6.4.14): the core releases it so (can_sja_mem_write_pel, RRB)
+ * but stores DLC bytes of data for it, which would misalign every frame
+ * after it. Such a frame is therefore given to the core with no data and
+ * its DLC is written back into the stored frame information, as it is for
+ * a DLC of 9-15, which the core refuses to store.
+ */
+static void chan_deliver_frame(Sja1000Channel *ch, const qemu_can_frame *in,
                                uint8_t raw_dlc)
 {
+    qemu_can_frame stored = *in;
+    const qemu_can_frame *frame = &stored;
     uint8_t messages = ch->core.rxmsg_cnt;
     uint32_t start = ch->core.rx_ptr;
     bool single_standard = chan_pelican(ch) && (ch->core.mode & MOD_AFM) &&
@@ -1674,6 +1685,9 @@ static void chan_deliver_frame(Sja1000Channel *ch, const qemu_can_frame *frame,
         ch->core.code_mask[4] = 0xff;
         ch->core.code_mask[5] = 0xff;
     }
+    if (chan_pelican(ch) && (stored.can_id & QEMU_CAN_RTR_FLAG)) {
+        stored.can_dlc = 0;
+    }
     can_sja_receive(&ch->core.bus_client, frame, 1);
     if (single_standard) {
         ch->core.code_mask[0] = saved[0][0];
@@ -1681,8 +1695,8 @@ static void chan_deliver_frame(Sja1000Channel *ch, const qemu_can_frame *frame,
         ch->core.code_mask[4] = saved[1][0];
         ch->core.code_mask[5] = saved[1][1];
     }
-    if (ch->core.rxmsg_cnt != messages && raw_dlc > 8) {
-        /* The core stores at most DLC 8; the chip keeps the DLC received. */
+    if (ch->core.rxmsg_cnt != messages && raw_dlc != stored.can_dlc) {
+        /* The chip keeps the DLC received. */
         uint32_t at = chan_pelican(ch) ? start : start + 1;
 
         at %= SJA_RCV_BUF_LEN;
@@ -2096,6 +2110,26 @@ static void chan_write_control(Sja1000Channel *ch, uint8_t value)
     chan_normalise_rx_interrupts(ch);
 }
 
+/*
+ * RRB and CDO go to the core. The core releases a frame of DLC 9-15 as if
+ * it held that many data bytes, where it stored 8: for that one release
+ * the frame's stored DLC reads 8, and the frame is gone after it.
+ */
+static void chan_release_receive_buffer(Sja1000Channel *ch, uint8_t command)
+{
+    uint32_t at = ch->core.rxbuf_start;
+
+    if (!chan_pelican(ch)) {
+        at++;
+    }
+    at %= SJA_RCV_BUF_LEN;
+    if ((command & CMR_RRB) && ch->core.rxmsg_cnt > 0 &&
+        (ch->core.rx_buff[at] & FRAME_DLC_MASK) > 8) {
+        ch->core.rx_buff[at] = (ch->core.rx_buff[at] & ~FRAME_DLC_MASK) | 8;
+    }
+    can_sja_mem_write(&ch->core, SJA_CMR, command, 1);
+}
+
 static void chan_write_command(Sja1000Channel *ch, uint8_t value)
 {
     bool pelican = chan_pelican(ch);
@@ -2123,7 +2157,7 @@ static void chan_write_command(Sja1000Channel *ch, uint8_t value)
     }
     /* The core releases the receive buffer and clears the overrun. */
     if (value & (CMR_RRB | CMR_CDO)) {
-        can_sja_mem_write(&ch->core, SJA_CMR, value & (CMR_RRB | CMR_CDO), 1);
+        chan_release_receive_buffer(ch, value & (CMR_RRB | CMR_CDO));
         chan_normalise_rx_interrupts(ch);
     }
 }
