@@ -84,6 +84,16 @@ bool requireUp(shell::Shell& shell, unsigned channel)
     return false;
 }
 
+// The channel of a subcommand whose one argument is a channel that is up
+// ("can down can0"); false, with the usage or the error printed, otherwise.
+bool soleUpChannel(shell::Shell& shell, int argc, char** argv, const char* usage, unsigned& channel)
+{
+    if (argc != 3) {
+        shell.print("usage: %s\r\n", usage);
+        return false;
+    }
+    return parseChannel(shell, argv[2], channel) && requireUp(shell, channel);
+}
 // Points the driver's events at the task running the command (the shell
 // may have been restarted since the channel came up).
 void listenHere(unsigned channel)
@@ -171,11 +181,7 @@ CommandResult up(shell::Shell& shell, int argc, char** argv)
 CommandResult down(shell::Shell& shell, int argc, char** argv)
 {
     unsigned channel;
-    if (argc != 3) {
-        shell.print("usage: can down <channel>\r\n");
-        return CommandResult::Failed;
-    }
-    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+    if (!soleUpChannel(shell, argc, argv, "can down <channel>", channel)) {
         return CommandResult::Failed;
     }
     IsaSja1000Channel& driver = consoleChannels[channel];
@@ -590,11 +596,7 @@ CommandResult policy(shell::Shell& shell, int argc, char** argv)
 CommandResult restart(shell::Shell& shell, int argc, char** argv)
 {
     unsigned channel;
-    if (argc != 3) {
-        shell.print("usage: can restart <channel>\r\n");
-        return CommandResult::Failed;
-    }
-    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+    if (!soleUpChannel(shell, argc, argv, "can restart <channel>", channel)) {
         return CommandResult::Failed;
     }
     const Status restarted = systemAgent.Control(consoleChannels[channel].id(), Sja1000Controller::kRestart, nullptr, 0);
@@ -694,11 +696,7 @@ CommandResult state(shell::Shell& shell, int argc, char** argv)
 CommandResult statistics(shell::Shell& shell, int argc, char** argv)
 {
     unsigned channel;
-    if (argc != 3) {
-        shell.print("usage: can stats <channel>\r\n");
-        return CommandResult::Failed;
-    }
-    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+    if (!soleUpChannel(shell, argc, argv, "can stats <channel>", channel)) {
         return CommandResult::Failed;
     }
     ChannelStatistics s{};
