@@ -10,10 +10,10 @@ See docs/guide/lab-vm.md. The pieces:
 
 from .kernel import LabVMSetupError, obtain_kernel
 from .slcan import BITRATE_CODES, CanFrame, SlcanError, SlcanPort
-from .vm import (DEFAULT_QEMU, CheckResult, LabVM, LabVMError, Result, SlcanSetup, check_command, parse_checks,
-                 run)
+from .vm import (DEFAULT_QEMU, CheckResult, LabVM, LabVMError, Result, SlcanSetup, Sja1000Setup, built_qemu_x86_64,
+                 check_command, parse_checks, run)
 
 __all__ = [
     "BITRATE_CODES", "CanFrame", "CheckResult", "DEFAULT_QEMU", "LabVM", "LabVMError", "LabVMSetupError", "Result",
-    "SlcanError", "SlcanPort", "SlcanSetup", "check_command", "obtain_kernel", "parse_checks", "run",
+    "SlcanError", "SlcanPort", "SlcanSetup", "Sja1000Setup", "built_qemu_x86_64", "check_command", "obtain_kernel", "parse_checks", "run",
 ]
