@@ -44,10 +44,11 @@ LAST_FRAME = "124#BEEF"
 VM_SCRIPT = r"""
 . /run/labvm/lib.sh
 cd /tmp
-# Waits (at most $2 s) until can0's state is $1, as `ip -details link show` prints it.
+# Waits (at most $2 s) until can0's state is $1, as `ip -details link show` prints it (after the
+# control modes, e.g. "can <ONE-SHOT> state ERROR-PASSIVE").
 wait_state() {
     deadline=$(( $(labvm_uptime) + $2 ))
-    until ip -details link show can0 | grep -q "can state $1 "; do
+    until ip -details link show can0 | grep -Eq "can (<[^>]*> )?state $1 "; do
         if [ "$(labvm_uptime)" -ge "$deadline" ]; then
             echo "can0 did not reach state $1 within $2 s" >&2
             ip -details -statistics link show can0 >&2
@@ -81,6 +82,43 @@ wait $raw
 echo "@@RAW"; cut -d' ' -f2- /tmp/raw.log; echo "@@END RAW@@"
 link after-raw
 
+# -- error passive: nobody acknowledges (the lab drops the others' acknowledge); each one-shot frame is
+#    one ACK error, TEC + 8 --
+timeout 150 candump -n 1 can0,7F3:7FF >/dev/null &
+go=$!
+labvm_wait_receiver can0 raw 7f3 30
+echo "@@READY passive@@"
+wait $go
+# candump ends when its interface goes down: the session's trace goes on in a second one.
+ip link set can0 down
+kill -INT $trace 2>/dev/null
+wait $trace
+ip link set can0 type can bitrate 500000 one-shot on
+ip link set can0 up
+candump -L can0 >>/tmp/trace.log &
+trace=$!
+i=0
+while [ $i -lt __UNACKED__ ]; do
+    cansend can0 321#$(printf %02X $i)
+    i=$((i + 1))
+    # The driver counts a one-shot frame that failed at its TX interrupt: one frame at a time.
+    deadline=$(( $(labvm_uptime) + 30 ))
+    until [ "$(cat /sys/class/net/can0/statistics/tx_errors)" -ge $i ]; do
+        [ "$(labvm_uptime)" -lt "$deadline" ] || { echo "frame $i: no TX error counted in 30 s" >&2; break 2; }
+        sleep 0.05
+    done
+done
+wait_state ERROR-PASSIVE 60
+link passive
+timeout 150 candump -n 1 can0,7F4:7FF >/dev/null &
+go=$!
+labvm_wait_receiver can0 raw 7f4 30
+echo "@@READY acknowledged@@"
+wait $go
+cansend can0 322#AA
+wait_state ERROR-WARNING 60
+link warning
+
 # -- bus-off forced by the lab, seen by the driver; then a restart --
 echo "@@READY busoff@@"
 wait_state BUS-OFF 60
@@ -105,7 +143,8 @@ done
 kill -INT $trace
 wait $trace
 echo "@@TRACE"; cut -d' ' -f2- /tmp/trace.log; echo "@@END TRACE@@"
-""".replace("__LAST_FRAME__", LAST_FRAME)
+""".replace("__LAST_FRAME__", LAST_FRAME).replace("__UNACKED__", "16")
+UNACKED = 16  # one-shot frames nobody acknowledges: TEC 16 x 8 = 128, error passive
 
 
 class _Report:
@@ -217,7 +256,7 @@ def vm_frames(world, name):
 
 def can_state(link_text):
     """(state, tx errors, rx errors) from `ip -details link show`."""
-    match = re.search(r"can state (\S+) \(berr-counter tx (\d+) rx (\d+)\)", link_text)
+    match = re.search(r"can (?:<[^>]*> )?state (\S+) \(berr-counter tx (\d+) rx (\d+)\)", link_text)
     assert match, link_text
     return match.group(1), int(match.group(2)), int(match.group(3))
 
@@ -280,6 +319,41 @@ def test_frames_pass_both_ways_between_the_controller_and_the_kernels_driver(wor
     assert re.search(r"TX:\s+bytes\s+packets[^\n]*\n\s+8\s+2\s", text), text
 
 
+def test_unacknowledged_frames_make_the_chip_error_passive_for_the_kernel(world):
+    world.vm.expect(r"@@READY passive@@", timeout=STEP)
+    world.mark("passive: VM ready")
+    hub = world.lab.hub
+    hub.drop_ack("board1")
+    hub.drop_ack("hub.lab")
+    go(world, 0x7F3, 3)  # the card alone acknowledges it
+    text = vm_section(world, "LINK passive")
+    world.mark("passive: seen by the kernel")
+    # ACK errors of an error-active transmitter: TEC + 8 each (ISO 11898-1); ES (EI) at 96, EPI at 128.
+    assert can_state(text) == ("ERROR-PASSIVE", 8 * UNACKED, 0), text
+    statistics = can_statistics(text)
+    assert (statistics["error-warn"], statistics["error-pass"], statistics["bus-off"]) == (1, 1, 0), statistics
+    assert re.search(rf"TX:\s+bytes\s+packets\s+errors[^\n]*\n\s+\d+\s+\d+\s+{UNACKED}\s", text), text
+    failed = [record for record in hub.frames() if record.outcome != "ok"]
+    assert [(candump_form(r.frame), r.sender, r.outcome, r.ack) for r in failed] == [
+        (f"321#{i:02X}", "linux.0", "ack-error", ()) for i in range(UNACKED)], hub.log_text()
+    # Acknowledged again: one frame sent, TEC 127, EPI, and the kernel's state is error warning (TEC >= 96).
+    world.vm.expect(r"@@READY acknowledged@@", timeout=STEP)
+    hub.drop_ack("board1", False)
+    hub.drop_ack("hub.lab", False)
+    go(world, 0x7F4, 4)
+    text = vm_section(world, "LINK warning")
+    world.mark("passive: back to warning")
+    assert can_state(text) == ("ERROR-WARNING", 8 * UNACKED - 1, 0), text
+    record = hub.frames()[-1]
+    assert (candump_form(record.frame), record.outcome, record.ack) == ("322#AA", "ok", ("board1.0", "hub.lab")), \
+        hub.log_text()
+    # The controller received the go frames and the acknowledged frame; the unacknowledged ones were form
+    # errors for it (the sender's error flag), never frames.
+    output = world.board.command("can dump can0 3 60000", timeout=STEP)
+    assert re.findall(r"can0  (\S+) +\[\d\]  ([0-9A-F ]*?)\r?\n", output) == [
+        ("7F3", "03"), ("7F4", "04"), ("322", "AA")], output
+
+
 def test_a_bus_off_the_lab_forces_is_the_kernels_bus_off_and_a_restart_recovers(world):
     world.vm.expect(r"@@READY busoff@@", timeout=STEP)
     world.mark("busoff: VM ready")
@@ -317,6 +391,9 @@ def test_the_vms_whole_trace_is_the_bus_log(world):
     world.mark("VM finished")
     print(f"timings (s from the module's start): {world.timings}")
     assert result.status == 0, result.output
-    frames = [candump_form(record.frame) for record in world.lab.hub.frames()]
+    # Every frame that went through, and none of the unacknowledged ones (the driver echoes a frame only
+    # when it was sent).
+    frames = [candump_form(record.frame) for record in world.lab.hub.frames() if record.outcome == "ok"]
     assert trace == frames, f"VM trace:\n{trace}\nbus log:\n{world.lab.hub.log_text()}"
-    assert all(record.outcome == "ok" for record in world.lab.hub.frames()), world.lab.hub.log_text()
+    outcomes = [record.outcome for record in world.lab.hub.frames()]
+    assert outcomes.count("ack-error") == UNACKED and set(outcomes) == {"ok", "ack-error"}, world.lab.hub.log_text()
