@@ -371,6 +371,8 @@ def test_a_realtime_participant_is_a_chip_that_never_holds_the_boards(hub_factor
         request, "ok", ("tool.0", "vm.0"), ("tool.0", "vm.0"))
     rx = chip_events("RX")[0]
     assert rx[1:] == (1, request + completion_bits(record.frame) * T, "101", "SD", "2", "0203", "0")
+    # The board's own timing stays exact in emulated time: the real-time chip changes nothing in the lock-step.
+    assert board.of("TXOK")[-1][2] == request + completion_bits(record.frame) * T
     # Its request enters at the next boundary and one at a time, as a chip's single transmit buffer.
     chip.transmit(0, Frame.data_frame(0x102, b"\x04"))
     run([board], board.client.boundary + 8 * Q)
