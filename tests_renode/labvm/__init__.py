@@ -3,6 +3,7 @@
 See docs/guide/lab-vm.md. The pieces:
 - vm.py: LabVM, run() and Result: boot, run one command, collect its output;
 - slcan.py: SlcanPort and CanFrame, the host end of the VM's slcan serial port;
+- Sja1000Setup (vm.py): our ISA SJA1000 card in the VM on the lab CAN bus hub, for Linux's sja1000_isa;
 - kernel.py: fetching and unpacking Debian's kernel package;
 - initramfs.py and init.sh: the busybox initramfs and its /init;
 - labvm.py (cli.py): the command line, `labvm.py run -- candump ...`.
@@ -15,5 +16,6 @@ from .vm import (DEFAULT_QEMU, CheckResult, LabVM, LabVMError, Result, SlcanSetu
 
 __all__ = [
     "BITRATE_CODES", "CanFrame", "CheckResult", "DEFAULT_QEMU", "LabVM", "LabVMError", "LabVMSetupError", "Result",
-    "SlcanError", "SlcanPort", "SlcanSetup", "Sja1000Setup", "built_qemu_x86_64", "check_command", "obtain_kernel", "parse_checks", "run",
+    "SlcanError", "SlcanPort", "SlcanSetup", "Sja1000Setup", "built_qemu_x86_64", "check_command", "obtain_kernel",
+    "parse_checks", "run",
 ]
