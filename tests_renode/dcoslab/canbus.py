@@ -1479,7 +1479,9 @@ class Client:
     with the time "-" (they enter at the next boundary) and reads events as
     they come. Kind "emulated" is a participant with its own clock, which
     must call sync() at every boundary; the lab's tests use it to check the
-    hub without an emulator.
+    hub without an emulator. Kind "realtime" is a chip without such a clock
+    (the lab VM's card): it sends like a host tool and reports its states
+    like a board.
     """
 
     def __init__(self, socket_path, name, kind="host", timeout=10.0):
