@@ -26,6 +26,8 @@ libglib2.0-dev:GLib, which QEMU is built on
 libpixman-1-dev:pixman, which QEMU's display code needs even without a display
 zlib1g-dev:zlib, which QEMU needs
 libfdt-dev:the device-tree library QEMU links (--enable-fdt=system)
+libcap-ng-dev:lets that QEMU build virtfs (9p), through which the lab VM on the built qemu-system-x86_64 mounts the host's root
+libattr1-dev:the extended-attribute library QEMU's virtfs needs as well
 python3-pytest:runs the emulator regression suite
 python3-pytest-xdist:runs emulator tests side by side
 python3-pexpect:drives the make-run console in its test

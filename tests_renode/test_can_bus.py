@@ -24,7 +24,7 @@ import time
 import pytest
 
 from dcoslab.canbus import (
-    Client, Frame, Hub, RECOVERY_SIGNALS, completion_bits, crc_delimiter_index, frame_bits, parse_log,
+    BUS_FREE_BITS, Client, Frame, Hub, RECOVERY_SIGNALS, completion_bits, crc_delimiter_index, frame_bits, parse_log,
 )
 from dcoslab.target import run_target_test
 
@@ -392,6 +392,81 @@ def test_two_senders_of_one_identifier_with_different_data_collide(hub_factory):
     assert boards[1].of("ERR")[0][3:5] == ("tx", "0a") and boards[0].of("ERR")[0][3:5] == ("tx", "8a")
     assert boards[2].of("ERR")[0][3:5] == ("rx", "aa")
     assert len(hub.frames()) == 1  # single shots: no retransmission
+
+
+def test_a_realtime_participant_is_a_chip_that_never_holds_the_boards(hub_factory):
+    """The lab VM's card joins as kind "realtime" (docs/protocols/labbus.md, "Real-time participants")."""
+    hub = hub_factory({"can0": 500_000}, expect=["fake"])
+    T = 2000
+    Q = hub.quantum_ns
+    board = FakeBoard(hub.socket_path, "fake", "can0", T)
+    board.state("on", 0)
+    chip = Client(hub.socket_path, "vm", "realtime", timeout=TIMEOUT)
+    assert chip.attach(0, "can0") == T
+    tool = Client(hub.socket_path, "tool", "host", timeout=TIMEOUT)
+    tool.attach(0, "can0")
+    control = Client(hub.socket_path, "control", "host", timeout=TIMEOUT)  # no port: its only lines are answers
+
+    def wait_for_log(text):
+        """Runs the board until the hub has taken the chip's last message in (it comes when it comes)."""
+        deadline = time.monotonic() + TIMEOUT
+        while not any(text in line for line in hub.log_lines()):
+            assert time.monotonic() < deadline, hub.log_text()
+            run([board], board.client.boundary)
+
+    def chip_events(verb, count=1):
+        lines = chip.events(lambda lines: sum(line.startswith(verb + " ") for line in lines) >= count)
+        return [parse_event(line) for line in lines if line.startswith(verb + " ")]
+
+    # Like a board's chip it starts off the bus, in reset mode: it neither receives nor acknowledges.
+    board.transmit(Frame.data_frame(0x100, b"\x01"), board.client.boundary + 1)
+    run([board], board.client.boundary + 8 * Q)
+    first = hub.frames()[0]
+    assert (first.outcome, first.rx, first.ack) == ("ok", ("tool.0",), ("tool.0",))
+    # Out of reset mode it waits for a bus-free signal, which the hub counts for it from the boundary its
+    # STATE (time "-") took effect at, while the board runs on: the chip never sends SYNC.
+    chip.state(0, "wait", "-", 1, T, 875)
+    wait_for_log("vm.0 wait from")
+    run([board], board.client.boundary + 2 * Q)
+    # A bus-free signal is told at the boundary where it is certain (labbus.md, "Choice of the quantum").
+    join = chip_events("JOIN")[0]
+    assert join[1] == 1 and join[2] % Q == 0, join
+    chip.state(0, "on", "-", 1, T, 875)
+    # On the bus: it receives and acknowledges the board's frame, with the frame's exact emulated time.
+    request = board.client.boundary + 777
+    run([board], request - 1)
+    board.transmit(Frame.data_frame(0x101, b"\x02\x03"), request)
+    run([board], request + 8 * Q)
+    record = hub.frames()[-1]
+    assert (record.start, record.outcome, record.rx, record.ack) == (
+        request, "ok", ("tool.0", "vm.0"), ("tool.0", "vm.0"))
+    rx = chip_events("RX")[0]
+    assert rx[1:] == (1, request + completion_bits(record.frame) * T, "101", "SD", "2", "0203", "0")
+    # The board's own timing stays exact in emulated time: the real-time chip changes nothing in the lock-step.
+    assert board.of("TXOK")[-1][2] == request + completion_bits(record.frame) * T
+    # Its request enters at the next boundary and one at a time, as a chip's single transmit buffer.
+    chip.transmit(0, Frame.data_frame(0x102, b"\x04"))
+    run([board], board.client.boundary + 8 * Q)
+    assert board.of("RX")[-1][3:7] == ("102", "SD", "1", "04")
+    assert hub.frames()[-1].start % Q == 0 and hub.frames()[-1].sender == "vm.0"
+    assert chip_events("TXOK")
+    # Forced bus-off, refused for a host tool's port, which has no chip.
+    assert control.control("FAULT tool.0 busoff").startswith("NAK FAULT")
+    assert control.control("FAULT vm.0 busoff") == "DONE FAULT"
+    run([board], board.client.boundary + 2 * Q)
+    assert chip_events("FAULT")[0][3] == "busoff"
+    # The recovery: 128 bus-free signals, 11 bits apart, counted by the hub on the idle bus.
+    chip.state(0, "recover", "-", 2, T, 875)
+    wait_for_log("vm.0 recover from")
+    run([board], board.client.boundary + (RECOVERY_SIGNALS * BUS_FREE_BITS * T // Q + 4) * Q)
+    signals = chip_events("BUSFREE", RECOVERY_SIGNALS)
+    assert [int(event[3]) for event in signals] == list(range(1, RECOVERY_SIGNALS + 1))
+    # The first is told at the boundary after its 11 bits, the last 127 x 11 bits later, at most one quantum late.
+    span = signals[-1][2] - signals[0][2]
+    assert RECOVERY_SIGNALS * BUS_FREE_BITS * T - Q <= span <= RECOVERY_SIGNALS * BUS_FREE_BITS * T, span
+    chip.close()
+    tool.close()
+    control.close()
 
 
 def test_protocol_controls_inject_faults_and_a_babbler(hub_factory):

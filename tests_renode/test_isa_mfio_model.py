@@ -113,8 +113,8 @@ def test_make_run_boots_the_board_wired_in_loopback():
 
 
 def test_only_the_built_emulator_can_be_named_built():
-    with pytest.raises(EmulatorNotBuilt, match="the build makes only qemu-system-i386"):
-        built_emulator_path("qemu-system-x86_64")
+    with pytest.raises(EmulatorNotBuilt, match="the build makes only qemu-system-i386, qemu-system-x86_64"):
+        built_emulator_path("qemu-system-arm")
 
 
 @pytest.mark.parametrize("properties, message", [

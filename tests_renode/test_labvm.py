@@ -15,7 +15,7 @@ import pytest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from dcoslab.labvm import lab_vm  # noqa: E402,F401 (the fixture)
-from labvm import (CanFrame, LabVM, LabVMError, SlcanError, SlcanSetup, check_command,  # noqa: E402
+from labvm import (CanFrame, LabVM, LabVMError, SlcanError, SlcanSetup, Sja1000Setup, check_command,  # noqa: E402
                    parse_checks, run)
 
 # Bounds for a hung VM, not speed targets.
@@ -319,3 +319,26 @@ def test_lawicel_encoding(frame, line):
 def test_malformed_lawicel_lines_are_refused(line):
     with pytest.raises(SlcanError):
         CanFrame.from_lawicel(line)
+
+
+def test_the_sja1000_card_setup_gives_the_device_the_driver_and_the_interfaces():
+    card = Sja1000Setup("/tmp/lab/hub.sock", bus0="can0", name="linux", bitrate=250000)
+    assert card.device_argument() == ("isa-sja1000,iobase=0x280,irq0=5,irq1=7,hub=/tmp/lab/hub.sock,hub-name=linux,"
+                                      "hub-realtime=on,hub-timeout=60,bus0=can0")
+    assert card.load_line() == "sja1000_isa port=0x280 irq=5"
+    assert card.setup_lines() == ["ip link set can0 type can bitrate 250000", "ip link set can0 up"]
+    # Both channels: the driver's arrays get one entry per chip, and Linux names them can0, can1 in that order.
+    both = Sja1000Setup("/tmp/lab/hub.sock", bus0="can0", bus1="can1", bitrate=None)
+    assert both.load_line() == "sja1000_isa port=0x280,0x2a0 irq=5,7"
+    assert both.setup_lines() == [] and both.interface(1) == "can1"
+    # Channel 1 alone is can0 in the VM.
+    second = Sja1000Setup("/tmp/lab/hub.sock", bus0=None, bus1="can1")
+    assert second.load_line() == "sja1000_isa port=0x2a0 irq=7" and second.interface(1) == "can0"
+    assert second.device_argument().endswith(",bus1=can1")
+    for bad in ({"bus0": None}, {"name": "lin.ux"}, {"bus0": "can 0"}):
+        with pytest.raises(ValueError):
+            Sja1000Setup("/tmp/lab/hub.sock", **bad)
+    with pytest.raises(ValueError, match="comma"):
+        Sja1000Setup("/tmp/lab,x/hub.sock")
+    with pytest.raises(ValueError, match="both be can0"):
+        LabVM("true", slcan=SlcanSetup(), sja1000=card)

@@ -5,7 +5,10 @@ A board names its emulator either as a program on PATH or as
 device models (tests_renode/qemu/build_qemu.sh). Its binary lives in
 build/qemu-<key>/, where <key> hashes the build script and the models; the
 script itself says where (--print-path), so the key is computed in one place.
-An installed DCOS carries a copy of it in <prefix>/libexec/dcos/ instead.
+The build makes qemu-system-i386, which runs every board, and
+qemu-system-x86_64, which runs the lab VM with one of our cards
+(docs/guide/lab-vm.md). An installed DCOS carries a copy of
+qemu-system-i386 only, in <prefix>/libexec/dcos/.
 """
 
 import functools
@@ -18,7 +21,9 @@ REPOSITORY = layout.ROOT
 
 BUILD_SCRIPT = os.path.join(REPOSITORY, "tests_renode", "qemu", "build_qemu.sh")
 BUILT_PREFIX = "built:"
-BUILT_PROGRAMS = ("qemu-system-i386",)
+BUILT_PROGRAMS = ("qemu-system-i386", "qemu-system-x86_64")
+# What 'make install' copies (mk/install-sdk.sh): the boards' emulator.
+INSTALLED_PROGRAMS = ("qemu-system-i386",)
 
 
 class EmulatorNotBuilt(RuntimeError):
@@ -31,6 +36,9 @@ def built_emulator_path(program="qemu-system-i386"):
     if program not in BUILT_PROGRAMS:
         raise EmulatorNotBuilt(f"'{BUILT_PREFIX}{program}': the build makes only {', '.join(BUILT_PROGRAMS)}")
     if layout.INSTALLED:
+        if program not in INSTALLED_PROGRAMS:
+            raise EmulatorNotBuilt(f"an installed DCOS carries only {', '.join(INSTALLED_PROGRAMS)}; "
+                                   f"{program} is built in the source tree (tests_renode/qemu/build_qemu.sh)")
         candidate = os.path.join(layout.EMULATOR_DIRECTORY, program)
         if not os.access(candidate, os.X_OK):
             raise EmulatorNotBuilt(f"this installed DCOS has no {candidate}; reinstall it with 'make install'")

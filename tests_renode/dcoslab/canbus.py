@@ -77,6 +77,15 @@ SEG_ACK_DELIMITER = 0x1B
 
 MODES = ("off", "wait", "on", "recover", "sleep")
 
+# Participant kinds (HELLO): "emulated" has a clock the hub holds at every
+# boundary; "host" is a tool without a chip or a clock; "realtime" is a chip
+# on a machine that runs in real time (the lab VM's card): its port takes
+# part like a board's (states, fault confinement, bus-free signals, forced
+# faults) but, like a host tool, it is never held, its messages count from
+# the next boundary and it takes events as they come.
+KINDS = ("emulated", "host", "realtime")
+CHIP_KINDS = ("emulated", "realtime")
+
 # How long the hub waits for a participant that owes it a message.
 DEFAULT_TIMEOUT = 60.0
 
@@ -333,7 +342,7 @@ class Port:
         self.recover_key = None
         self.recover_signals = 0
         # A host tool or the hub's own node is always on, at the bus's rate.
-        if participant.kind != "emulated":
+        if participant.kind not in CHIP_KINDS:
             self.timeline.append(PortState(0, 0, "on", bus.bit_ns))
 
     def state_at(self, t):
@@ -684,7 +693,7 @@ class Hub:
         """With host tools and no board, time runs with the wall clock (unless boards are expected)."""
         if self.expect and not self.started:
             return False
-        return any(p.kind == "host" for p in self.participants.values()) or bool(self._babblers)
+        return any(p.kind in ("host", "realtime") for p in self.participants.values()) or bool(self._babblers)
 
     def _wall_deadline(self, boundary):
         pace = self.pace or 1.0
@@ -792,8 +801,9 @@ class Hub:
             raise ProtocolError(f"unknown message {verb}")
 
     def _hello(self, participant, words):
-        if len(words) != 4 or words[1] != str(PROTOCOL_VERSION) or words[3] not in ("emulated", "host"):
-            raise ProtocolError(f"HELLO must be 'HELLO {PROTOCOL_VERSION} <name> emulated|host', not {' '.join(words)!r}")
+        if len(words) != 4 or words[1] != str(PROTOCOL_VERSION) or words[3] not in KINDS:
+            raise ProtocolError(f"HELLO must be 'HELLO {PROTOCOL_VERSION} <name> {'|'.join(KINDS)}', "
+                                f"not {' '.join(words)!r}")
         name = words[2]
         if name in self.participants or name == "hub" or "." in name:
             raise ProtocolError(f"the name {name!r} is taken or not allowed (no dots, not 'hub')")
@@ -951,7 +961,7 @@ class Hub:
     def _fault_event(self, name, kind, boundary=None):
         boundary = self.boundary if boundary is None else boundary
         for port in self._find_ports(name):
-            if port.participant.kind != "emulated":
+            if port.participant.kind not in CHIP_KINDS:
                 raise HubError(f"{port.name} is not a board: only a board's chip can be forced {kind}")
             self._event(port, boundary, "FAULT", kind)
         self._comment(f"fault {name} {kind}", boundary)
@@ -1065,7 +1075,7 @@ class Hub:
             flags = set() if words[7] == "-" else set(words[7].split(","))
             state = PortState(t, int(words[3]), words[4], int(words[5]) or port.bus.bit_ns, int(words[6]),
                               "passive" in flags, "listen" in flags, "selftest" in flags)
-            if participant.kind != "emulated" and state.mode not in ("on", "off"):
+            if participant.kind == "host" and state.mode not in ("on", "off"):
                 raise ProtocolError("a host port is on or off")
             previous = port.state_at(t)
             port.insert_state(state)
@@ -1086,7 +1096,7 @@ class Hub:
             options = set() if words[7] == "-" else set(words[7].split(","))
             if options - {"once", "self"}:
                 raise ProtocolError(f"unknown TX options {','.join(sorted(options - {'once', 'self'}))}")
-            if participant.kind == "emulated" and port.pending:
+            if participant.kind in CHIP_KINDS and port.pending:
                 raise ProtocolError(f"{port.name} requested a transmission while one is pending (TBS is locked)")
             self._add_request(port, t, Frame.from_words(words[3:7]), "once" in options, "self" in options)
         elif verb == "ABORT":
@@ -1162,7 +1172,7 @@ class Hub:
         joined = False
         run_start = bus.recessive_from
         for port in bus.sorted_ports():
-            if port.participant.kind != "emulated":
+            if port.participant.kind not in CHIP_KINDS:
                 continue
             t = max(run_start, port.bf_cursor)
             while t < until:
@@ -1546,7 +1556,7 @@ class Hub:
             participant.queue(template.format(port=port_id, time=t))
         self._events.clear()
         for participant in self.participants.values():
-            if participant.kind == "host":
+            if participant.kind in ("host", "realtime"):
                 participant.flush()
 
 
@@ -1560,7 +1570,9 @@ class Client:
     with the time "-" (they enter at the next boundary) and reads events as
     they come. Kind "emulated" is a participant with its own clock, which
     must call sync() at every boundary; the lab's tests use it to check the
-    hub without an emulator.
+    hub without an emulator. Kind "realtime" is a chip without such a clock
+    (the lab VM's card): it sends like a host tool and reports its states
+    like a board.
     """
 
     def __init__(self, socket_path, name, kind="host", timeout=10.0):

@@ -20,7 +20,7 @@ from . import initramfs
 from .kernel import DEFAULT_CACHE, LabVMSetupError, obtain_kernel
 from .slcan import BITRATE_CODES
 from .vm import DEFAULT_9P_CACHE, DEFAULT_BOOT_TIMEOUT, DEFAULT_COMMAND_TIMEOUT, DEFAULT_QEMU, LabVM, LabVMError, \
-    SlcanSetup
+    SlcanSetup, Sja1000Setup
 
 VM_FAILED = 125
 
@@ -34,6 +34,16 @@ def _add_vm_options(parser):
     parser.add_argument("--slcan-interface", default="can0", metavar="NAME", help="slcan interface name (can0)")
     parser.add_argument("--slcan-bitrate", type=int, default=500000, choices=sorted(BITRATE_CODES),
                         metavar="BIT/S", help="slcan bit rate, sent as the Lawicel S code (500000 -> S6)")
+    parser.add_argument("--sja1000-hub", metavar="SOCKET",
+                        help="put our ISA SJA1000 card (isa-sja1000) in the VM, joined to the lab CAN bus hub at "
+                             "this unix socket, with Linux's sja1000_isa driver loaded for it; runs the VM on the "
+                             "QEMU built with the lab's models (tests_renode/qemu/build_qemu.sh)")
+    parser.add_argument("--sja1000-bus", default="can0", metavar="BUS",
+                        help="the hub's bus channel 0 is wired to (can0); it is can0 in the VM")
+    parser.add_argument("--sja1000-bitrate", type=int, default=500000, metavar="BIT/S",
+                        help="bit rate the setup gives can0 before bringing it up (500000; 0: leave it down)")
+    parser.add_argument("--sja1000-name", default="linux", metavar="NAME",
+                        help="the card's participant name at the hub (linux: its port is linux.0)")
     parser.add_argument("--setup", action="append", default=[], metavar="LINE",
                         help="a shell line run in the VM before the command (repeatable)")
     parser.add_argument("--load", action="append", default=[], metavar="'MODULE [OPTIONS]'",
@@ -45,7 +55,8 @@ def _add_vm_options(parser):
                         help=f"seconds the command may run (default {DEFAULT_COMMAND_TIMEOUT:.0f})")
     parser.add_argument("--boot-timeout", type=float, default=DEFAULT_BOOT_TIMEOUT, metavar="S",
                         help=f"seconds the VM may take to boot (default {DEFAULT_BOOT_TIMEOUT:.0f})")
-    parser.add_argument("--qemu", default=DEFAULT_QEMU, help=f"the QEMU binary (default {DEFAULT_QEMU})")
+    parser.add_argument("--qemu", default=None,
+                        help=f"the QEMU binary (default {DEFAULT_QEMU}, or the built one with --sja1000-hub)")
     parser.add_argument("--qemu-arg", action="append", default=[], metavar="ARG",
                         help="one more QEMU argument as it is (repeatable), e.g. --qemu-arg=-device ...")
     parser.add_argument("--memory", type=int, default=1024, metavar="MIB", help="guest memory (1024 MiB)")
@@ -60,7 +71,12 @@ def _add_vm_options(parser):
 
 def _vm(args, command, interactive=False, console_log=None):
     slcan = SlcanSetup(args.slcan_interface, args.slcan_bitrate) if args.slcan else None
-    return LabVM(command, cwd=os.getcwd(), vcan=args.vcan, slcan=slcan, setup=args.setup, load=args.load,
+    sja1000 = None
+    if args.sja1000_hub:
+        sja1000 = Sja1000Setup(os.path.abspath(args.sja1000_hub), bus0=args.sja1000_bus, name=args.sja1000_name,
+                               bitrate=args.sja1000_bitrate or None)
+    return LabVM(command, cwd=os.getcwd(), vcan=args.vcan, slcan=slcan, sja1000=sja1000, setup=args.setup,
+                 load=args.load,
                  modules=args.module,
                  timeout=args.timeout, boot_timeout=args.boot_timeout, qemu=args.qemu, qemu_args=args.qemu_arg,
                  memory_mib=args.memory, cpus=args.cpus, cpu=args.cpu, pvh=args.pvh, ninep_cache=args.ninep_cache,

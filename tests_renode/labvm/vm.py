@@ -34,6 +34,12 @@ from .kernel import DEFAULT_CACHE, LabVMSetupError, obtain_kernel
 from .slcan import BITRATE_CODES, SlcanPort
 
 DEFAULT_QEMU = "qemu-system-x86_64"
+# The lab's own QEMU build (our device models compiled in): the script says
+# where its binaries are for the current sources.
+BUILD_QEMU_SCRIPT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "qemu", "build_qemu.sh")
+# A QEMU run from its build folder finds no firmware of its own: Debian's
+# SeaBIOS and the option ROMs of qemu-system-data (PVH and Linux boot).
+BUILT_QEMU_FIRMWARE = ("-L", "/usr/share/seabios", "-L", "/usr/share/qemu")
 # Bounds for a hung VM, not measurements: a boot takes about 4 s on an idle
 # machine (8 s without PVH), several times that on a busy one.
 DEFAULT_BOOT_TIMEOUT = 180.0
@@ -75,6 +81,86 @@ class SlcanSetup:
             f"sleep 0.05; done",
             f"ip link set {name} up",
         ]
+
+
+def built_qemu_x86_64():
+    """The qemu-system-x86_64 built with the lab's device models for the current sources; LabVMError if not built."""
+    try:
+        printed = subprocess.run([BUILD_QEMU_SCRIPT, "--print-path"], capture_output=True, text=True, timeout=60,
+                                 check=True).stdout.strip()
+    except (OSError, subprocess.SubprocessError) as error:
+        raise LabVMError(f"cannot ask {BUILD_QEMU_SCRIPT} where the built QEMU is: {error}") from None
+    path = os.path.join(os.path.dirname(printed), "qemu-system-x86_64")
+    if not os.access(path, os.X_OK):
+        raise LabVMError(f"the QEMU with the lab's device models is not built for the current sources (expected "
+                         f"{path}); build it with 'make emulator' or {BUILD_QEMU_SCRIPT}")
+    return path
+
+
+class Sja1000Setup:
+    """Our ISA SJA1000 card (QEMU device isa-sja1000) in the VM, on buses of the lab CAN bus hub, driven by
+    Linux's own sja1000_isa driver (docs/guide/lab-vm.md, "The ISA SJA1000 card").
+
+    The card's link joins the hub as a real-time participant (hub-realtime=on): the VM runs without -icount,
+    so it cannot be held at the hub's boundaries; see docs/protocols/labbus.md. Channel 0 is wired to bus0,
+    channel 1 to bus1 (None: the channel is not used and gets no driver); Linux names them can0 and can1 in
+    that order. With a bitrate the setup configures and brings up each interface; with None it leaves that to
+    the command. The interrupt lines default to 5 and 7, which nothing in the VM uses: the PCI interrupt
+    links (virtio-9p) take 10 and 11 on QEMU's pc machine.
+    """
+
+    def __init__(self, hub, bus0="can0", bus1=None, name="linux", bitrate=500000, iobase=0x280, irq0=5, irq1=7,
+                 hub_timeout=60):
+        if not bus0 and not bus1:
+            raise ValueError("the card needs at least one channel on a bus")
+        for bus in (bus0, bus1):
+            if bus is not None and not re.match(r"^[A-Za-z0-9_-]{1,32}$", bus):
+                raise ValueError(f"{bus!r} is not a lab bus name")
+        if not re.match(r"^[A-Za-z0-9_-]{1,32}$", name):
+            raise ValueError(f"{name!r} is not a hub participant name (one word, no dots)")
+        if "," in hub:
+            raise ValueError(f"the hub's socket path {hub!r} may not contain a comma (a QEMU option separator)")
+        self.hub = hub
+        self.buses = (bus0, bus1)
+        self.name = name
+        self.bitrate = bitrate
+        self.iobase = iobase
+        self.irqs = (irq0, irq1)
+        self.hub_timeout = hub_timeout
+
+    @property
+    def channels(self):
+        """The channels wired to a bus: (channel, port, irq, interface name in the VM)."""
+        used = [index for index in (0, 1) if self.buses[index]]
+        return [(index, self.iobase + 0x20 * index, self.irqs[index], f"can{number}")
+                for number, index in enumerate(used)]
+
+    def interface(self, channel=0):
+        """The VM's interface name for a channel of the card."""
+        for index, _, _, name in self.channels:
+            if index == channel:
+                return name
+        raise ValueError(f"channel {channel} of the card is not wired to a bus")
+
+    def device_argument(self):
+        properties = [f"iobase={self.iobase:#x}", f"irq0={self.irqs[0]}", f"irq1={self.irqs[1]}", f"hub={self.hub}",
+                      f"hub-name={self.name}", "hub-realtime=on", f"hub-timeout={self.hub_timeout}"]
+        properties += [f"bus{index}={bus}" for index, bus in enumerate(self.buses) if bus]
+        return "isa-sja1000," + ",".join(properties)
+
+    def load_line(self):
+        """The modprobe line: sja1000_isa takes arrays, one entry per chip (its clk defaults to 16 MHz)."""
+        channels = self.channels
+        return (f"sja1000_isa port={','.join(f'{port:#x}' for _, port, _, _ in channels)} "
+                f"irq={','.join(str(irq) for _, _, irq, _ in channels)}")
+
+    def setup_lines(self):
+        if self.bitrate is None:
+            return []
+        lines = []
+        for _, _, _, name in self.channels:
+            lines += [f"ip link set {name} type can bitrate {int(self.bitrate)}", f"ip link set {name} up"]
+        return lines
 
 
 class Result:
@@ -122,6 +208,9 @@ class LabVM:
         host through the unix socket `slcan_socket_path`; `slcan` then is a
         connected SlcanPort unless connect_slcan=False (another program will).
     setup: more shell lines run before the command, in the chroot, with -e.
+    sja1000: a Sja1000Setup: our ISA SJA1000 card on the lab hub's buses, with Linux's sja1000_isa driver
+        loaded at boot (can0, can1); the VM then runs on the QEMU built with the lab's models unless qemu
+        names another. Not together with slcan (both would be can0).
     load: modprobe lines run at boot, e.g. "sja1000_isa port=0x2a0 irq=10".
     modules: more modules to put in the initramfs (loadable on demand).
     files: {relative name: str or bytes} placed under /run/labvm/files/.
@@ -140,8 +229,8 @@ class LabVM:
     log: a function for progress messages (kernel download, ...); default stderr.
     """
 
-    def __init__(self, command, *, vcan=(), slcan=None, setup=(), load=(), modules=(), files=None,
-                 timeout=DEFAULT_COMMAND_TIMEOUT, boot_timeout=DEFAULT_BOOT_TIMEOUT, qemu=DEFAULT_QEMU,
+    def __init__(self, command, *, vcan=(), slcan=None, sja1000=None, setup=(), load=(), modules=(), files=None,
+                 timeout=DEFAULT_COMMAND_TIMEOUT, boot_timeout=DEFAULT_BOOT_TIMEOUT, qemu=None,
                  qemu_args=(), memory_mib=1024, cpus=1, cpu="max", pvh=True, ninep_cache=DEFAULT_9P_CACHE,
                  kernel_arguments="", cwd=None, cache_dir=DEFAULT_CACHE, connect_slcan=True, interactive=False,
                  console_log=None, log=None):
@@ -163,13 +252,19 @@ class LabVM:
             if not re.match(r"^[A-Za-z0-9_.-]{1,15}$", name):
                 raise ValueError(f"{name!r} is not a network interface name")
         self.slcan_setup = SlcanSetup() if slcan is True else slcan
+        self.sja1000 = sja1000
+        if sja1000 is not None and self.slcan_setup is not None:
+            raise ValueError("slcan and the SJA1000 card would both be can0 in the VM; use one of them")
         self.setup = list(setup)
         load = [line.strip() for line in load if line.strip()]
+        if sja1000 is not None:
+            load.insert(0, sja1000.load_line())
         self.load = list(initramfs.DEFAULT_LOAD) + load
         self.modules = list(modules) + [line.split()[0] for line in load]
         self.files = dict(files or {})
         self.timeout = float(timeout)
         self.boot_timeout = float(boot_timeout)
+        # Resolved when the VM starts (the built QEMU is looked up then).
         self.qemu = qemu
         self.qemu_args = list(qemu_args)
         self.memory_mib = int(memory_mib)
@@ -230,6 +325,8 @@ class LabVM:
             lines += [f"ip link add dev {name} type vcan", f"ip link set {name} up"]
         if self.slcan_setup is not None:
             lines += self.slcan_setup.setup_lines()
+        if self.sja1000 is not None:
+            lines += self.sja1000.setup_lines()
         lines += self.setup
         return "".join(line + "\n" for line in lines)
 
@@ -239,6 +336,8 @@ class LabVM:
             raise RuntimeError("this LabVM was started already")
         if self._early_warning:
             self.log(self._early_warning)
+        if self.qemu is None:
+            self.qemu = built_qemu_x86_64() if self.sja1000 is not None else DEFAULT_QEMU
         try:
             self.kernel = obtain_kernel(self.cache_dir, log=self.log)
             self._kernel_image = (self.kernel.vmlinux() if self.pvh else None) or self.kernel.vmlinuz
@@ -285,6 +384,9 @@ class LabVM:
         if self.slcan_setup is not None:
             argv += ["-chardev", f"socket,id=s1,path={self.slcan_socket_path},server=on,wait=off",
                      "-serial", "chardev:s1"]
+        if self.sja1000 is not None:
+            # QEMU's default x86_64 machine is pc (i440FX with a PIIX3 ISA bridge), so an ISA card fits.
+            argv += ["-machine", "pc", *BUILT_QEMU_FIRMWARE, "-device", self.sja1000.device_argument()]
         return argv + self.qemu_args
 
     def _read_console(self):

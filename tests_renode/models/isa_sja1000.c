@@ -35,7 +35,12 @@
  * A channel named to a lab bus (bus0, bus1) joins the hub through the
  * card's link (properties hub and hub-name), a child object that holds the
  * board's emulated time at quantum boundaries so that every board on the
- * hub stays in step. (QEMU 7.2 creates with -object only the types its
+ * hub stays in step. A machine that runs in real time (no -icount, such as
+ * the lab VM's Linux) cannot be held that way, as its clock follows the
+ * host's; with hub-realtime=on its link joins the hub as a real-time
+ * participant instead, which never holds the boards, takes the hub's events
+ * as they arrive and lets its own requests count from the hub's next
+ * boundary. (QEMU 7.2 creates with -object only the types its
  * QAPI schema lists, so the link is made by the card rather than by the
  * user; one board has one link, so one card per board may use a hub.) The hub
  * is tests_renode/dcoslab/canbus.py; docs/protocols/labbus.md specifies the
@@ -108,6 +113,12 @@ struct LabBusLink {
     char *path;
     char *name;
     uint32_t timeout_s;
+    /*
+     * A real-time participant (docs/protocols/labbus.md, "Real-time
+     * participants"): no quantum boundaries, events applied on arrival,
+     * requests sent with the time "-".
+     */
+    bool realtime;
 
     int fd;
     uint64_t quantum_ns;
@@ -207,6 +218,39 @@ labbus_link_send(LabBusLink *link, const char *format, ...)
 }
 
 /*
+ * Takes the next whole line received from the hub out of the input buffer,
+ * without its newline; NULL when there is none yet, with *why set if the
+ * buffer is full without one or the line is too long. The line stays
+ * valid until the next call.
+ */
+static char *labbus_buffered_line(LabBusLink *link, const char **why)
+{
+    static char line[LABBUS_LINE_MAX];
+    char *newline = memchr(link->input, '\n', link->input_length);
+    size_t length;
+
+    if (!newline) {
+        if (link->input_length >= sizeof(link->input)) {
+            *why = "the hub sent a line that is too long";
+        }
+        return NULL;
+    }
+    length = newline - link->input;
+    if (length >= sizeof(line)) {
+        *why = "the hub sent a line that is too long";
+        return NULL;
+    }
+    memcpy(line, link->input, length);
+    line[length] = '\0';
+    if (length > 0 && line[length - 1] == '\r') {
+        line[length - 1] = '\0';
+    }
+    link->input_length -= length + 1;
+    memmove(link->input, newline + 1, link->input_length);
+    return line;
+}
+
+/*
  * Returns the next line from the hub without its newline, or NULL with
  * *why set when the hub closed the connection, sent a line that is too
  * long, or sent nothing for timeout_s seconds. The line stays valid until
@@ -214,33 +258,16 @@ labbus_link_send(LabBusLink *link, const char *format, ...)
  */
 static char *labbus_read_line(LabBusLink *link, const char **why)
 {
-    static char line[LABBUS_LINE_MAX];
     int64_t deadline_ms = qemu_clock_get_ms(QEMU_CLOCK_REALTIME) +
                           (int64_t)link->timeout_s * 1000;
 
+    *why = NULL;
     for (;;) {
-        char *newline = memchr(link->input, '\n', link->input_length);
+        char *line = labbus_buffered_line(link, why);
         ssize_t count;
 
-        if (newline) {
-            size_t length = newline - link->input;
-
-            if (length >= sizeof(line)) {
-                *why = "the hub sent a line that is too long";
-                return NULL;
-            }
-            memcpy(line, link->input, length);
-            line[length] = '\0';
-            if (length > 0 && line[length - 1] == '\r') {
-                line[length - 1] = '\0';
-            }
-            link->input_length -= length + 1;
-            memmove(link->input, newline + 1, link->input_length);
+        if (line || *why) {
             return line;
-        }
-        if (link->input_length >= sizeof(link->input)) {
-            *why = "the hub sent a line that is too long";
-            return NULL;
         }
         count = recv(link->fd, link->input + link->input_length,
                      sizeof(link->input) - link->input_length, MSG_DONTWAIT);
@@ -391,6 +418,59 @@ static void labbus_link_boundary(void *opaque)
 }
 
 /*
+ * A real-time link's socket has data: every whole line is applied at once.
+ * This runs in the main loop with the big lock held, like the card's
+ * timers and register accesses, so it needs no lock of its own. The link
+ * never waits for the hub here: nothing it does depends on an answer, and
+ * a real-time machine could not stand still for one anyway.
+ */
+static void labbus_link_readable(void *opaque)
+{
+    LabBusLink *link = opaque;
+    const char *why = NULL;
+
+    for (;;) {
+        char *line = labbus_buffered_line(link, &why);
+        ssize_t count;
+
+        if (line) {
+            labbus_dispatch(link, line);
+            continue;
+        }
+        if (why) {
+            labbus_link_fatal(link, "%s", why);
+        }
+        count = recv(link->fd, link->input + link->input_length,
+                     sizeof(link->input) - link->input_length, MSG_DONTWAIT);
+        if (count > 0) {
+            link->input_length += count;
+        } else if (count == 0) {
+            labbus_link_fatal(link, "the hub closed the connection");
+        } else if (errno == EAGAIN || errno == EWOULDBLOCK) {
+            return;
+        } else if (errno != EINTR) {
+            labbus_link_fatal(link, "reading from the hub failed (%s)",
+                              strerror(errno));
+        }
+    }
+}
+
+/*
+ * The time word of a message to the hub: the exact emulated time, or "-"
+ * from a real-time link, whose clock follows the host and means nothing to
+ * the hub (such a message counts from the next boundary the hub reaches).
+ */
+static const char *labbus_link_time(LabBusLink *link, int64_t now,
+                                    char *buffer, size_t size)
+{
+    if (link->realtime) {
+        return "-";
+    }
+    snprintf(buffer, size, "%" PRId64, now);
+    return buffer;
+}
+
+/*
  * Attaches one port to the named bus; called by a device at realize.
  * Returns the port number, or -1 with errp set.
  */
@@ -471,10 +551,11 @@ static void labbus_link_connect(LabBusLink *link, Error **errp)
         error_setg(errp, "isa-sja1000: hub-timeout must be at least 1 s");
         return;
     }
-    if (!icount_enabled()) {
+    if (!icount_enabled() && !link->realtime) {
         warn_report("labbus-link %s: without -icount the board's emulated "
-                    "time follows the host, so bus timing is not exact",
-                    link->name);
+                    "time follows the host, so bus timing is not exact "
+                    "(hub-realtime=on joins such a machine as a real-time "
+                    "participant)", link->name);
     }
 
     link->fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
@@ -490,8 +571,8 @@ static void labbus_link_connect(LabBusLink *link, Error **errp)
         link->fd = -1;
         return;
     }
-    labbus_link_send(link, "HELLO %d %s emulated", LABBUS_PROTOCOL_VERSION,
-                     link->name);
+    labbus_link_send(link, "HELLO %d %s %s", LABBUS_PROTOCOL_VERSION,
+                     link->name, link->realtime ? "realtime" : "emulated");
     line = labbus_read_line(link, &why);
     if (!line) {
         error_setg(errp, "labbus-link %s: no WELCOME from the hub: %s",
@@ -512,6 +593,14 @@ static void labbus_link_connect(LabBusLink *link, Error **errp)
         error_setg(errp, "labbus-link %s: the hub's greeting '%s' is not "
                    "protocol version %d", link->name, argv[0],
                    LABBUS_PROTOCOL_VERSION);
+        return;
+    }
+    if (link->realtime) {
+        /*
+         * Events arrive whenever the hub passes a boundary; the main loop
+         * hands them over as they come.
+         */
+        qemu_set_fd_handler(link->fd, labbus_link_readable, NULL, link);
         return;
     }
     /*
@@ -544,6 +633,9 @@ static void labbus_link_instance_finalize(Object *obj)
         timer_free(link->boundary_timer);
     }
     if (link->fd >= 0) {
+        if (link->realtime) {
+            qemu_set_fd_handler(link->fd, NULL, NULL, NULL);
+        }
         close(link->fd);
     }
     for (i = 0; i < link->port_count; i++) {
@@ -844,6 +936,7 @@ struct IsaSja1000State {
     char *hub_path;
     char *hub_name;
     uint32_t hub_timeout_s;
+    bool hub_realtime;
     char *bus_name[SJA_CARD_CHANNELS];
 
     Sja1000Channel chan[SJA_CARD_CHANNELS];
@@ -1048,8 +1141,12 @@ static void chan_update_mode(Sja1000Channel *ch)
             if (chan_self_test(ch)) {
                 g_strlcat(flags, ",selftest", sizeof(flags));
             }
-            labbus_link_send(card->link, "STATE %d %" PRId64 " %" PRIu32
-                             " %s %" PRIu64 " %u %s", ch->port, chan_now(),
+            char time_word[24];
+
+            labbus_link_send(card->link, "STATE %d %s %" PRIu32
+                             " %s %" PRIu64 " %u %s", ch->port,
+                             labbus_link_time(card->link, chan_now(),
+                                              time_word, sizeof(time_word)),
                              ch->epoch, bus_mode_names[mode], bit_ns,
                              chan_sample_permille(ch),
                              flags[0] ? flags + 1 : "-");
@@ -1495,6 +1592,7 @@ static void chan_request_transmission(Sja1000Channel *ch, bool single_shot,
     if (ch->port >= 0) {
         char frame[64];
         char options[16] = "";
+        char time_word[24];
 
         chan_frame_text(&ch->tx_frame, ch->tx_raw_dlc, frame, sizeof(frame));
         if (single_shot) {
@@ -1503,8 +1601,10 @@ static void chan_request_transmission(Sja1000Channel *ch, bool single_shot,
         if (self) {
             g_strlcat(options, ",self", sizeof(options));
         }
-        labbus_link_send(ch->card->link, "TX %d %" PRId64 " %s %s", ch->port,
-                         chan_now(), frame, options[0] ? options + 1 : "-");
+        labbus_link_send(ch->card->link, "TX %d %s %s %s", ch->port,
+                         labbus_link_time(ch->card->link, chan_now(),
+                                          time_word, sizeof(time_word)),
+                         frame, options[0] ? options + 1 : "-");
     } else {
         chan_lone_next_step(ch);
     }
@@ -1521,8 +1621,11 @@ static void chan_abort_transmission(Sja1000Channel *ch)
     }
     ch->tx_abort_requested = true;
     if (ch->port >= 0) {
-        labbus_link_send(ch->card->link, "ABORT %d %" PRId64, ch->port,
-                         chan_now());
+        char time_word[24];
+
+        labbus_link_send(ch->card->link, "ABORT %d %s", ch->port,
+                         labbus_link_time(ch->card->link, chan_now(),
+                                          time_word, sizeof(time_word)));
     } else if (!ch->lone_in_attempt) {
         /* Between attempts on the lone bus: nothing is under way. */
         chan_release_tx(ch, false);
@@ -1927,7 +2030,8 @@ static bool chan_has_flag(const char *list, const char *flag)
 /*
  * "<EVENT> <port> <epoch> <time> [arguments]" (docs/protocols/labbus.md,
  * "Events"): queued for its emulated time; the hub never announces an
- * event before the boundary it sends it at.
+ * event before the boundary it sends it at. A real-time link applies it on
+ * arrival instead.
  */
 static void chan_link_event(void *opaque, int argc, char **argv)
 {
@@ -1937,6 +2041,14 @@ static void chan_link_event(void *opaque, int argc, char **argv)
 
     event->epoch = chan_event_number(ch, argc, argv, 2, 10);
     event->time = chan_event_number(ch, argc, argv, 3, 10);
+    if (ch->card->link->realtime) {
+        /*
+         * The time is the hub's emulated time, which a real-time machine's
+         * clock does not share: the event happens now, as it arrives, and
+         * events keep the order the hub sent them in.
+         */
+        event->time = chan_now();
+    }
     if (!strcmp(verb, "SOF") && argc == 5) {
         event->kind = EV_SOF;
         if (!strcmp(argv[4], "tx")) {
@@ -2401,6 +2513,7 @@ static void sja_card_realize(DeviceState *dev, Error **errp)
         card->link->path = g_strdup(card->hub_path);
         card->link->name = g_strdup(card->hub_name);
         card->link->timeout_s = card->hub_timeout_s;
+        card->link->realtime = card->hub_realtime;
         object_property_add_child(OBJECT(card), "link", OBJECT(card->link));
         object_unref(OBJECT(card->link));
         labbus_link_connect(card->link, errp);
@@ -2470,6 +2583,7 @@ static Property sja_card_properties[] = {
     DEFINE_PROP_STRING("hub", IsaSja1000State, hub_path),
     DEFINE_PROP_STRING("hub-name", IsaSja1000State, hub_name),
     DEFINE_PROP_UINT32("hub-timeout", IsaSja1000State, hub_timeout_s, 60),
+    DEFINE_PROP_BOOL("hub-realtime", IsaSja1000State, hub_realtime, false),
     DEFINE_PROP_STRING("bus0", IsaSja1000State, bus_name[0]),
     DEFINE_PROP_STRING("bus1", IsaSja1000State, bus_name[1]),
     DEFINE_PROP_END_OF_LIST(),
@@ -2496,6 +2610,9 @@ static void sja_card_class_init(ObjectClass *klass, void *data)
         "this board's participant name at the hub, e.g. board1");
     object_class_property_set_description(klass, "hub-timeout",
         "seconds to wait for a silent hub before stopping the board");
+    object_class_property_set_description(klass, "hub-realtime",
+        "join the hub as a real-time participant, for a machine run without "
+        "-icount: never held at boundaries, events applied on arrival");
     object_class_property_set_description(klass, "bus0",
         "lab bus channel 0 is wired to (none: a bus without other nodes)");
     object_class_property_set_description(klass, "bus1",
