@@ -98,7 +98,7 @@ void closeContext(modbus_t* context)
 
 // Opens the port with the checked settings; a port that cannot be opened
 // or set up is "not available", the same status dcos-can gives.
-ModbusContext open(const Settings& s, char parity, uint8_t slave, Failure& failure)
+ModbusContext openPort(const Settings& s, char parity, uint8_t slave, Failure& failure)
 {
     ModbusContext context(modbus_new_rtu(s.device.c_str(), static_cast<int>(s.baud), parity, 8, s.stopBits),
                           closeContext);
@@ -479,7 +479,7 @@ int main(int argc, char** argv)
     }
 
     Failure failure;
-    const ModbusContext context = open(s, parity, slave, failure);
+    const ModbusContext context = openPort(s, parity, slave, failure);
     if (!context) {
         report(failure, s.json, app.get_subcommands().front()->get_name());
         return failure.status;
