@@ -27,12 +27,14 @@ No test needs the emulator. Every wait has a time-out.
 import json
 import os
 import queue
+import select
 import signal
 import subprocess
 import sys
 import tempfile
 import threading
 import time
+import tty
 
 import pytest
 
@@ -381,6 +383,40 @@ def test_dcos_modbus_drives_the_simulated_drive_through_its_ramp(link, drive):
     assert refused.returncode == 1 and "Illegal data address" in refused.stderr
     _, status = drive.stop()
     assert status["values"]["speed"] == 1000 and status["values"]["at_speed"] == 1
+
+
+def crc16(frame):
+    """The RTU CRC ([SL] 6.2.2), appended low byte first."""
+    crc = 0xFFFF
+    for byte in frame:
+        crc ^= byte
+        for _ in range(8):
+            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
+    return bytes(frame) + bytes([crc & 0xFF, crc >> 8])
+
+
+def test_simulator_drops_noise_and_refuses_unknown_functions(link, drive):
+    line = os.open(link.paths[0], os.O_RDWR | os.O_NOCTTY)
+    try:
+        tty.setraw(line)
+        os.write(line, b"\x41" * 300)                       # longer than any frame, no silence
+        time.sleep(0.1)
+        os.write(line, bytes([SLAVE, 3, 0, 0, 0, 1, 0, 0]))  # a wrong CRC
+        time.sleep(0.1)
+        os.write(line, crc16([SLAVE, 0x41, 0x22]))            # a function the simulator does not serve
+        answer = b""
+        deadline = time.monotonic() + TIMEOUT
+        while len(answer) < 5 and time.monotonic() < deadline:
+            if select.select([line], [], [], 0.5)[0]:
+                answer += os.read(line, 64)
+        assert answer == crc16([SLAVE, 0xC1, 0x01]), answer.hex()   # exception 01, illegal function
+    finally:
+        os.close(line)
+    assert values(tool(link.paths[0], "read-holding-registers", "1", parity="E")) == {1: 500}
+    requests, status = drive.stop()
+    # The noise is one bad frame, or two if a loaded machine delays its second half past the frame gap.
+    assert status["bad_frames"] in (2, 3) and status["exceptions"] == 1 and status["requests"] == 2
+    assert [r["function"] for r in requests] == [0x41, 3]
 
 
 def test_simulated_sensor_follows_its_sine(link, tmp_path):

@@ -58,6 +58,8 @@ constexpr int kTickMilliseconds = 50;
 // host sees a USB adapter's or a pseudo-terminal's bytes in bursts the
 // kernel and the scheduler time, so the host waits at least this long.
 constexpr auto kMinFrameGap = std::chrono::milliseconds(20);
+// The longest RTU frame ([SL] 2.5.1): address, 253 bytes of PDU, CRC.
+constexpr size_t kMaxAduSize = 256;
 
 Clock::duration frameGap(int baud)
 {
@@ -322,8 +324,10 @@ int main(int argc, char** argv)
                 length = scan.length;
             } else if (silent && scan.state == RequestScan::State::Unknown) {
                 length = pending.size();
-            } else if (silent) {
-                // A frame cut off by silence is noise, never a request.
+            } else if (silent || pending.size() > kMaxAduSize) {
+                // A frame cut off by silence is noise, never a request; so is
+                // a run of bytes longer than any frame, which would otherwise
+                // grow without bound on a line that never falls silent.
                 ++counts.badFrames;
                 pending.clear();
                 break;
