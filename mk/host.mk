@@ -3,7 +3,7 @@
 
 HOST_BUILD := $(BUILD)/host
 HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Wno-missing-field-initializers -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES) \
-	-Ihost_tools/can/include
+	-Ihost_tools/can/include $(HOSTMODBUS_CXXFLAGS)
 
 # Firmware sources with no hardware access of their own (chip drivers go
 # through the mocked port I/O).
@@ -22,7 +22,8 @@ HOST_PORTABLE_SRCS := \
 	$(CAN_PORTABLE_SRCS) \
 	$(MODBUS_PORTABLE_SRCS) \
 	$(CAN_DRIVER_PORTABLE_SRCS) \
-	$(HOSTCAN_SRCS)
+	$(HOSTCAN_SRCS) \
+	$(HOSTMODBUS_SRCS)
 
 HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp drivers/*/unit_tests/*.cpp fieldbus/*/unit_tests/*.cpp \
 	host_tools/*/unit_tests/*.cpp)

@@ -8,14 +8,34 @@ HOST_TOOLS_BIN := $(HOST_TOOLS_BUILD)/bin
 # The host CAN library: transports behind one interface (host_tools/can).
 HOSTCAN_SRCS := $(wildcard host_tools/can/src/*.cpp)
 HOSTCAN_TEST_SRCS := $(wildcard host_tools/can/unit_tests/*.cpp)
-HOST_TOOLS_LIBS := -lfmt
+# The host Modbus library (host_tools/modbus): argument and configuration
+# checks, device identification framing, the simulator's behaviours, on
+# Debian's libmodbus and toml++ (the shared library, hence the defines).
+HOSTMODBUS_SRCS := $(wildcard host_tools/modbus/src/*.cpp)
+HOSTMODBUS_CXXFLAGS := -Ihost_tools/modbus/include -I/usr/include/modbus -DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1
+HOST_TOOLS_LIBS := -lfmt -lmodbus -ltomlplusplus
 
 DCOS_CAN := $(HOST_TOOLS_BIN)/dcos-can
-HOST_TOOLS := $(DCOS_CAN)
+DCOS_MODBUS := $(HOST_TOOLS_BIN)/dcos-modbus
+DCOS_MODBUS_SIM := $(HOST_TOOLS_BIN)/dcos-modbus-sim
+HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM)
 
 host-tools: $(HOST_TOOLS)
 
 $(DCOS_CAN): $(BUILD)/host/host_tools/can/tools/dcos-can.cpp.o $(patsubst %,$(BUILD)/host/%.o,$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS)
+
+# The Modbus tools need only the stack's CRC from fieldbus/modbus.
+HOSTMODBUS_OBJS := $(patsubst %,$(BUILD)/host/%.o,$(HOSTMODBUS_SRCS) fieldbus/modbus/src/Crc16.cpp)
+
+$(DCOS_MODBUS): $(BUILD)/host/host_tools/modbus/tools/dcos-modbus.cpp.o $(HOSTMODBUS_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS)
+
+$(DCOS_MODBUS_SIM): $(BUILD)/host/host_tools/modbus/tools/dcos-modbus-sim.cpp.o $(HOSTMODBUS_OBJS)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS)

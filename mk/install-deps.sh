@@ -14,6 +14,8 @@ libgtest-dev:GoogleTest for the host unit tests
 libcli11-dev:parses the host tools' command lines (dcos-can)
 libfmt-dev:formats the host tools' output
 nlohmann-json3-dev:writes the host tools' --json output
+libmodbus-dev:the Modbus RTU master and slave of dcos-modbus and dcos-modbus-sim (host_tools/modbus)
+libtomlplusplus-dev:toml++, which parses dcos-modbus-sim's configuration files
 clang:compiles the CAN link layer's fuzz targets (make fuzz, run by make test)
 libclang-rt-14-dev:libFuzzer and the address and undefined-behaviour sanitizer runtimes those fuzz targets link (clang only recommends it)
 qemu-system-data:option ROMs the emulator loads (multiboot, linuxboot), from the -L path /usr/share/qemu
@@ -39,6 +41,8 @@ busybox-static:makes the lab VM's initramfs: its /init, modprobe and depmod
 iproute2:creates the lab VM's vcan and slcan interfaces (ip link)
 can-utils:candump, cansend, slcand, isotpsend and isotprecv, run in the lab VM against the Linux CAN stack (tests_renode/test_labvm.py)
 python3-can:python-can, tested in the lab VM against real SocketCAN (tests_renode/test_labvm.py)
+python3-pymodbus:a Modbus implementation we did not write, slave and master against dcos-modbus and dcos-modbus-sim (tests_renode/test_host_tools_modbus.py)
+python3-serial-asyncio:pymodbus's serial slave is built on it (pymodbus only recommends it)
 "
 
 missing=""

@@ -20,6 +20,9 @@
 #   bin/mfio_bringup.py          the I/O board bring-up tool (a relative link into share/dcos/tools)
 #   bin/plant_simulator.py       the plant simulator for the emulated I/O board (likewise)
 #   bin/dcos-can                 dump, send and measure CAN traffic (docs/guide/host-can.md)
+#   bin/dcos-modbus              read and write a Modbus RTU slave (docs/guide/modbus-host.md)
+#   bin/dcos-modbus-sim          a simulated Modbus RTU slave declared in a TOML file (likewise)
+#   share/dcos/modbus/           dcos-modbus-sim's example files: a drive, a sensor
 #   libexec/dcos/                the emulator built with the DCOS board models
 #
 # Nothing installed refers back to the source tree, and the paths inside are
@@ -84,9 +87,13 @@ put host_tools/bringup/bringup_report.py "$prefix/share/dcos/tools/bringup/bring
 put host_tools/plant_simulator/plant_simulator.py "$prefix/share/dcos/tools/plant_simulator.py" 755
 link ../share/dcos/tools/bringup/mfio_bringup.py "$prefix/bin/mfio_bringup.py"
 link ../share/dcos/tools/plant_simulator.py "$prefix/bin/plant_simulator.py"
-# The compiled host tools (docs/guide/host-can.md).
+# The compiled host tools (docs/guide/host-can.md, docs/guide/modbus-host.md),
+# and the simulated slaves the Modbus guide starts from.
 for tool in "$host_tools_bin"/*; do
     put "$tool" "$prefix/bin/$(basename "$tool")" 755
+done
+for example in host_tools/modbus/examples/*.toml; do
+    put "$example" "$prefix/share/dcos/modbus/$(basename "$example")"
 done
 put tests_renode/launch.py "$prefix/share/dcos/python/launch.py"
 for module in tests_renode/dcoslab/*.py; do
