@@ -22,6 +22,7 @@ HOST_PORTABLE_SRCS := \
 	$(CAN_PORTABLE_SRCS) \
 	$(MODBUS_PORTABLE_SRCS) \
 	$(CAN_DRIVER_PORTABLE_SRCS) \
+	$(MODBUS_DRIVER_PORTABLE_SRCS) \
 	$(HOSTCAN_SRCS)
 
 HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp drivers/*/unit_tests/*.cpp fieldbus/*/unit_tests/*.cpp \
