@@ -165,13 +165,26 @@ uint64_t LineRunner::service(uint64_t nowNs)
     }
     finishIfSent(nowNs);
     feedReceived();
+    // A byte is stamped when its stop bit has arrived, so at nowNs a
+    // character may still be coming in that began up to one character time
+    // ago; the line is known to have been silent only up to then. Polling
+    // at nowNs itself would take that character's own time for silence and
+    // could end a frame at a false t1.5 whenever the task wakes for another
+    // reason (a console command, the transmit interrupt) in mid-character.
+    const uint64_t silentUntilNs = nowNs > timing_.characterNs ? nowNs - timing_.characterNs : 0;
     if (role_ == Role::Slave) {
-        apply(slave_.poll(nowNs), nowNs);
+        apply(slave_.poll(silentUntilNs), nowNs);
     } else {
-        apply(master_.poll(nowNs), nowNs);
+        apply(master_.poll(silentUntilNs), nowNs);
     }
-    finishIfSent(nowNs);
+    // A transmit interrupt that comes after the check above posts the
+    // task's event, so the shift register is looked at again on that wake.
     uint64_t next = role_ == Role::Slave ? slave_.nextDeadlineNs() : master_.nextDeadlineNs();
+    if (next != ~0ull) {
+        // The station's deadline is in line time; it is reached when the
+        // line is known silent up to it, one character time later.
+        next += timing_.characterNs;
+    }
     if (transmitting_ && __atomic_load_n(&fifoEmptied_, __ATOMIC_ACQUIRE)) {
         // The shift register still holds the last byte: look again after it.
         const uint64_t again = nowNs + timing_.characterNs;
