@@ -37,6 +37,7 @@ busybox-static:makes the lab VM's initramfs: its /init, modprobe and depmod
 iproute2:creates the lab VM's vcan and slcan interfaces (ip link)
 can-utils:candump, cansend, slcand, isotpsend and isotprecv, run in the lab VM against the Linux CAN stack (tests_renode/test_labvm.py)
 python3-can:python-can, tested in the lab VM against real SocketCAN (tests_renode/test_labvm.py)
+python3-pymodbus:builds and checks the Modbus RTU frames the emulator tests exchange with the controller's RS-485 line, an implementation we did not write (tests_renode/test_modbus_rs485.py)
 "
 
 missing=""

@@ -293,6 +293,33 @@ bool parseLine(shell::Shell& shell, int argc, char** argv, int first, bsp::UartS
     return true;
 }
 
+// The receiver's state ([SL] Figure 14): a test waits for "idle" before it
+// puts a frame on the line, since a frame that starts before t3.5 of silence
+// is ignored; the console's time is the controller's, so that wait holds in
+// emulated time too.
+const char* receiverStateName(modbus::RtuReceiver::State state)
+{
+    switch (state) {
+    case modbus::RtuReceiver::State::Initial: return "initial";
+    case modbus::RtuReceiver::State::Idle: return "idle";
+    case modbus::RtuReceiver::State::Reception: return "reception";
+    case modbus::RtuReceiver::State::ControlAndWaiting: return "control";
+    }
+    return "?";
+}
+
+const char* masterStateName(modbus::Master::State state)
+{
+    switch (state) {
+    case modbus::Master::State::Idle: return "idle";
+    case modbus::Master::State::WaitingToSend: return "waiting-to-send";
+    case modbus::Master::State::Transmitting: return "transmitting";
+    case modbus::Master::State::WaitingReply: return "waiting-reply";
+    case modbus::Master::State::Turnaround: return "turnaround";
+    }
+    return "?";
+}
+
 char parityLetter(bsp::UartParity parity)
 {
     return parity == bsp::UartParity::None ? 'N' : parity == bsp::UartParity::Odd ? 'O' : 'E';
@@ -385,11 +412,12 @@ CommandResult state(shell::Shell& shell, int, char**)
                 static_cast<unsigned long>(errors.framingErrors));
     const modbus::RtuReceiver::Counters& r = runner.transport().receiver().counters();
     shell.print("frames: seen %lu delivered %lu crc-errors %lu gap-errors %lu overruns %lu short %lu lost %lu "
-                "ignored-characters %lu\r\n",
+                "ignored-characters %lu receiver %s\r\n",
                 static_cast<unsigned long>(r.busMessages), static_cast<unsigned long>(r.framesDelivered),
                 static_cast<unsigned long>(r.crcErrors), static_cast<unsigned long>(r.gapErrors),
                 static_cast<unsigned long>(r.overruns), static_cast<unsigned long>(r.shortFrames),
-                static_cast<unsigned long>(r.framesLost), static_cast<unsigned long>(r.ignoredCharacters));
+                static_cast<unsigned long>(r.framesLost), static_cast<unsigned long>(r.ignoredCharacters),
+                receiverStateName(runner.transport().receiver().state()));
     const modbus::Slave::Counters& s = runner.slave().counters();
     shell.print("slave: messages %lu exceptions %lu no-responses %lu other-addresses %lu dropped %lu\r\n",
                 static_cast<unsigned long>(s.messages), static_cast<unsigned long>(s.exceptions),
@@ -397,12 +425,22 @@ CommandResult state(shell::Shell& shell, int, char**)
                 static_cast<unsigned long>(s.droppedWhileSending));
     const modbus::Master::Counters& m = runner.master().counters();
     shell.print("master: transactions %lu transmissions %lu responses %lu exceptions %lu timeouts %lu "
-                "invalid %lu failures %lu foreign %lu\r\n",
+                "invalid %lu failures %lu foreign %lu state %s\r\n",
                 static_cast<unsigned long>(m.transactions), static_cast<unsigned long>(m.transmissions),
                 static_cast<unsigned long>(m.responses), static_cast<unsigned long>(m.exceptions),
                 static_cast<unsigned long>(m.timeouts), static_cast<unsigned long>(m.invalidResponses),
-                static_cast<unsigned long>(m.failures), static_cast<unsigned long>(m.foreignFrames));
+                static_cast<unsigned long>(m.failures), static_cast<unsigned long>(m.foreignFrames),
+                masterStateName(runner.master().state()));
     return CommandResult::Ok;
+}
+
+bool sameText(const char* a, const char* b)
+{
+    while (*a != '\0' && *a == *b) {
+        ++a;
+        ++b;
+    }
+    return *a == *b;
 }
 
 // The four tables by name, as the commands below take them.
@@ -434,17 +472,24 @@ bool parseTable(shell::Shell& shell, const char* text, Table& table)
     return false;
 }
 
-// Submits the mailbox's request and waits for the transaction to end.
-CommandResult transact(shell::Shell& shell)
+// Whether read and write only submit their request ('modbus submit') and
+// leave the wait for its end to 'modbus result'.
+bool submitOnly = false;
+
+// Hands the mailbox's request to the line's task.
+bool submitRequest(shell::Shell& shell)
 {
     if (runner.role() != Role::Master) {
         shell.print("error: the line is not a master; start one with 'modbus master'\r\n");
-        return CommandResult::Failed;
+        return false;
     }
     mailbox.kind = CommandKind::Submit;
-    if (!runCommand(shell)) {
-        return CommandResult::Failed;
-    }
+    return runCommand(shell);
+}
+
+// Waits for the submitted transaction to end and prints how it ended.
+CommandResult awaitCompletion(shell::Shell& shell)
+{
     const modbus::MasterConfig& config = runner.master().config();
     const uint64_t longest = (config.responseTimeoutNs + 100 * kMillisecond) * (config.retries + 1u)
                              + config.turnaroundDelayNs + kCommandTimeoutNs;
@@ -486,6 +531,20 @@ CommandResult transact(shell::Shell& shell)
     }
     shell.print("\r\n");
     return CommandResult::Ok;
+}
+
+// Submits the mailbox's request and, unless only submitting, waits for the
+// transaction to end.
+CommandResult transact(shell::Shell& shell)
+{
+    if (!submitRequest(shell)) {
+        return CommandResult::Failed;
+    }
+    if (submitOnly) {
+        shell.print("submitted %02x to %u\r\n", mailbox.request.function(), mailbox.request.unit);
+        return CommandResult::Ok;
+    }
+    return awaitCompletion(shell);
 }
 
 // read <unit> <table> <address> <count>
@@ -591,9 +650,39 @@ CommandResult data(shell::Shell& shell, int argc, char** argv)
     return CommandResult::Ok;
 }
 
+// submit read|write ...: the request of 'modbus read' or 'modbus write',
+// submitted without waiting, so that the console stays free while the
+// transaction runs (a test watches the line's state meanwhile).
+CommandResult submit(shell::Shell& shell, int argc, char** argv)
+{
+    if (argc < 3) {
+        return CommandResult::UsageError;
+    }
+    const bool isRead = sameText(argv[2], "read");
+    if (!isRead && !sameText(argv[2], "write")) {
+        shell.print("error: '%s' is not read or write\r\n", argv[2]);
+        return CommandResult::UsageError;
+    }
+    // The subcommands take their arguments from argv[2] on, as 'modbus read ...' has them.
+    submitOnly = true;
+    const CommandResult result = isRead ? read(shell, argc - 1, argv + 1) : write(shell, argc - 1, argv + 1);
+    submitOnly = false;
+    return result;
+}
+
+// result: waits for the transaction 'modbus submit' started to end.
+CommandResult result(shell::Shell& shell, int, char**)
+{
+    if (runner.role() != Role::Master) {
+        shell.print("error: the line is not a master\r\n");
+        return CommandResult::Failed;
+    }
+    return awaitCompletion(shell);
+}
+
 constexpr shell::Subcommand kSubcommands[] = {
     {"state", state}, {"slave", slave}, {"master", master}, {"off", off},
-    {"read", read},   {"write", write}, {"data", data},
+    {"read", read},   {"write", write}, {"data", data}, {"submit", submit}, {"result", result},
 };
 
 CommandResult modbusCommand(shell::Shell& shell, int argc, char** argv)
@@ -611,9 +700,11 @@ CommandResult modbusCommand(shell::Shell& shell, int argc, char** argv)
 DCOS_SHELL_COMMAND_DETAILED(modbusShellCommand, "modbus", "run the Modbus RTU line on the RS-485 port (COM2)",
                             "modbus [state] | slave <address> [baud] [n|e|o] | master [baud] [n|e|o] [time-out ms] "
                             "[retries] | off | read <unit> <table> <address> <count> | "
-                            "write <unit> <coils|holding> <address> <value>... | data <table> <address> <count>",
+                            "write <unit> <coils|holding> <address> <value>... | submit read|write ... | result | "
+                            "data <table> <address> <count>",
                             "  tables: coils, inputs, holding, input-registers; the line is 19200 baud 8E1 unless\r\n"
                             "  told; state shows the line's, the receiver's, the slave's and the master's counters;\r\n"
                             "  data shows what the console slave serves (input register n is 0x1000 + n,\r\n"
-                            "  discrete input n is on for multiples of 3)",
+                            "  discrete input n is on for multiples of 3); submit starts a read or write without\r\n"
+                            "  waiting for it, result waits for its end",
                             mbline::modbusCommand);
