@@ -320,6 +320,8 @@ def test_master_takes_correct_answers(master_line):
     seen = state(emulator)
     assert (seen["master.transactions"], seen["master.transmissions"], seen["master.responses"]) == (2, 2, 2)
     assert seen["master.timeouts"] == 0 and seen["master.state"] == "idle"
+    # Each end is shown once: a second result has no transaction to wait for.
+    assert "error: no transaction was submitted" in emulator.command("modbus result")
 
 
 def test_master_times_out_and_retries_when_no_answer_comes(master_line):

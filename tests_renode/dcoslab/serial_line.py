@@ -1,14 +1,14 @@
-"""A board's serial port (e.g. the isa486's RS-485 port, COM2) on a pty.
+"""A board's serial port (e.g. the isa486's RS-485 port, COM2) in a test's hands.
 
 The emulator serves the port on a Unix socket (Emulator(serial_sockets=
-["rs485"])); this bridge connects to it and copies bytes both ways to the
-master side of a pseudo-terminal, so that a host program that expects a
-serial device (pymodbus's serial client and server, libmodbus) opens
-`pty_path` as it would /dev/ttyUSB0. The emulator runs in real time for
-these tests (no -icount): the host program's inter-character timing is
-what the controller's t1.5/t3.5 timers see, give or take the host's
-scheduling, which is why exact emulated-time tests wait for the lab's
-RS-485 line.
+["rs485"])). With bridge=False the test writes and reads the line's bytes
+itself (write, read): tests_renode/test_modbus_rs485.py does, under exact
+emulated time, one frame per write. With bridge=True the bytes are copied
+both ways to the master side of a pseudo-terminal, so that a host program
+that expects a serial device (pymodbus's serial client, libmodbus) opens
+`pty_path` as it would /dev/ttyUSB0; such a program's timing between
+characters is the host's, not the emulated line's, so no test relies on
+the bridge for RTU framing until the lab's RS-485 line paces the bytes.
 """
 
 import os

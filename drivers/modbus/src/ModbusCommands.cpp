@@ -475,6 +475,9 @@ bool parseTable(shell::Shell& shell, const char* text, Table& table)
 // Whether read and write only submit their request ('modbus submit') and
 // leave the wait for its end to 'modbus result'.
 bool submitOnly = false;
+// A transaction 'modbus submit' started whose end 'modbus result' has not
+// yet shown: without one, result would wait for nothing or show an old end.
+bool resultPending = false;
 
 // Hands the mailbox's request to the line's task.
 bool submitRequest(shell::Shell& shell)
@@ -541,6 +544,7 @@ CommandResult transact(shell::Shell& shell)
         return CommandResult::Failed;
     }
     if (submitOnly) {
+        resultPending = true;
         shell.print("submitted %02x to %u\r\n", mailbox.request.function(), mailbox.request.unit);
         return CommandResult::Ok;
     }
@@ -677,6 +681,11 @@ CommandResult result(shell::Shell& shell, int, char**)
         shell.print("error: the line is not a master\r\n");
         return CommandResult::Failed;
     }
+    if (!resultPending) {
+        shell.print("error: no transaction was submitted; start one with 'modbus submit'\r\n");
+        return CommandResult::Failed;
+    }
+    resultPending = false;
     return awaitCompletion(shell);
 }
 
