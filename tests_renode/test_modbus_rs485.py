@@ -372,3 +372,7 @@ def test_master_ignores_an_answer_after_its_time_out(master_line):
     seen = wait_for(emulator, lambda s: s["frames.delivered"] == before["frames.delivered"] + 1, "late answer received")
     assert seen["master.foreign"] == before["master.foreign"] + 1
     assert seen["master.responses"] == 0 and seen["master.timeouts"] == 1
+    # A second transaction that times out reports its own transmissions, not the line's total.
+    submit(emulator, f"read {UNIT} holding 0 2")
+    take_request(line)
+    assert "error: response time-out after 1 transmissions" in emulator.command("modbus result")

@@ -84,6 +84,10 @@ struct Mailbox {
 Mailbox mailbox;
 ObjectId lineTask;
 Completion lastCompletion;
+// The master's transmissions before the last accepted transaction, taken by
+// the task as it submits, so that the transaction's end reports its own
+// count rather than the line's total.
+uint32_t transmissionsBefore = 0;
 volatile bool completionReady = false;
 ObjectId completionWaiter;
 
@@ -169,11 +173,16 @@ void serveMailbox()
         }
         break;
     }
-    case CommandKind::Submit:
+    case CommandKind::Submit: {
         completionReady = false;
         completionWaiter = mailbox.requester;
+        const uint32_t before = runner.master().counters().transmissions;
         mailbox.error = runner.submit(mailbox.request, now);
+        if (mailbox.error == ModbusError::Ok) {
+            transmissionsBefore = before;
+        }
         break;
+    }
     }
     mailbox.pending = false;
     (void)taskAgent.PostEvent(mailbox.requester, kAnswerEvent);
@@ -513,7 +522,7 @@ CommandResult awaitCompletion(shell::Shell& shell)
     }
     if (c.error != ModbusError::Ok) {
         shell.print("error: %s after %lu transmissions\r\n", modbus::modbusErrorName(c.error),
-                    static_cast<unsigned long>(runner.master().counters().transmissions));
+                    static_cast<unsigned long>(runner.master().counters().transmissions - transmissionsBefore));
         return CommandResult::Failed;
     }
     shell.print("ok %02x:", c.function);
