@@ -16,7 +16,8 @@ FW_INCLUDES := \
 	-Idrivers/iobus/include \
 	-Ifieldbus/can/include \
 	-Ifieldbus/modbus/include \
-	-Idrivers/can/include
+	-Idrivers/can/include \
+	-Idrivers/modbus/include
 
 FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
 # How every firmware object is compiled, the kernel's and an application's
@@ -38,6 +39,7 @@ include drivers/iobus/iobus.mk
 include fieldbus/can/can.mk
 include fieldbus/modbus/modbus.mk
 include drivers/can/can.mk
+include drivers/modbus/modbus.mk
 
 # Sources every image contains.
 FW_SRCS := \
@@ -53,7 +55,9 @@ FW_SRCS := \
 	$(CAN_PORTABLE_SRCS) \
 	$(MODBUS_PORTABLE_SRCS) \
 	$(CAN_DRIVER_PORTABLE_SRCS) \
-	$(CAN_DRIVER_TARGET_SRCS)
+	$(CAN_DRIVER_TARGET_SRCS) \
+	$(MODBUS_DRIVER_PORTABLE_SRCS) \
+	$(MODBUS_DRIVER_TARGET_SRCS)
 
 # The on-target test suite, linked only into the test image.
 FW_TARGET_TEST_SRCS := $(wildcard tests_renode/target/*.cpp)

@@ -38,18 +38,31 @@ def main():
                         help="leave a board device out for this run, e.g. isa-mfio (repeatable)")
     parser.add_argument("--emulator-arg", action="append", default=[], metavar="ARG",
                         help="pass an argument to the emulator as it is, e.g. a -chardev (repeatable)")
+    parser.add_argument("--serial", action="append", default=[], metavar="PORT=BACKEND",
+                        help="connect a serial port of the board other than the console, e.g. rs485=pty "
+                             "(QEMU -serial syntax; unconnected ports are null)")
     parser.add_argument("--print-command", action="store_true", help="print the emulator command and exit")
     arguments = parser.parse_args()
     properties = {}
     for driver, prop, value in arguments.set:
         properties.setdefault(driver, {})[prop] = value
 
+    backends = {"console": "mon:stdio"}
+    for text in arguments.serial:
+        port, equals, backend = text.partition("=")
+        if not equals or not port or not backend or port == "console":
+            sys.exit(f"error: --serial {text}: expected PORT=BACKEND for a port other than the console, e.g. rs485=pty")
+        backends[port] = backend
     board = load_board(arguments.board)
+    for port in backends:
+        if port not in board.serial_ports:
+            sys.exit(f"error: board {board.name} has no serial port '{port}'; its ports are: "
+                     f"{', '.join(board.serial_ports)}")
     image = arguments.image or board.image("production")
     if not os.path.exists(image):
         sys.exit(f"error: firmware image {image} does not exist; run 'make firmware'")
     try:
-        command = board.emulator_command(image, {"console": "mon:stdio"}, append=" ".join(arguments.append),
+        command = board.emulator_command(image, backends, append=" ".join(arguments.append),
                                          device_properties=properties, without_devices=arguments.without,
                                          extra_args=arguments.emulator_arg)
     except (EmulatorNotBuilt, ValueError) as error:

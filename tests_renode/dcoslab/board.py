@@ -61,8 +61,12 @@ class Board:
                          accel=None, device_properties=None, without_devices=(), extra_args=()):
         """The emulator argv for image, with one chardev argument per serial port.
 
-        serial_backends maps each name in serial_ports to a QEMU -serial value
-        (for example "mon:stdio" or "chardev:console"). cpu replaces the
+        serial_backends maps names in serial_ports to a QEMU -serial value
+        (for example "mon:stdio" or "chardev:console"); a port it does not
+        name is "null": the UART is on the board, its line goes nowhere (the
+        isa486's RS-485 port, COM2, unless a test joins it to a host
+        program). The order of serial_ports is the order of the -serial
+        arguments: COM1, COM2, ... on a PC. cpu replaces the
         board's CPU model (the bench image runs on benchmark_cpu), memory_mib
         the board's memory (the bench image runs with benchmark_memory()).
         accel names a QEMU accelerator, e.g. "kvm" (default: QEMU's, TCG);
@@ -108,7 +112,7 @@ class Board:
             command += ["-device", device["driver"] + properties]
         command += list(extra_args)
         for port in self.serial_ports:
-            command += ["-serial", serial_backends[port]]
+            command += ["-serial", serial_backends.get(port, "null")]
         return command
 
 

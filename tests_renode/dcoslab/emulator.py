@@ -26,7 +26,7 @@ class EmulatorError(AssertionError):
 
 class Emulator:
     def __init__(self, board, image, append="", icount=False, cpu=None, memory_mib=None, accel=None,
-                 device_properties=None, without_devices=(), extra_args=(), name=None):
+                 device_properties=None, without_devices=(), extra_args=(), name=None, serial_sockets=()):
         self.board = board
         # What failures call this emulator, e.g. "board2" among several boards.
         self.name = name or board.name
@@ -40,6 +40,10 @@ class Emulator:
         self.device_properties = device_properties or {}
         self.without_devices = tuple(without_devices)
         self.extra_args = tuple(extra_args)
+        # Serial ports of the board (names in its serial_ports, e.g. "rs485")
+        # joined to a Unix socket each, which a test connects to
+        # (serial_socket_path); the other ports but the console go nowhere.
+        self.serial_sockets = tuple(serial_sockets)
         self._workdir = tempfile.TemporaryDirectory(prefix="dcos-emulator-")
         self._socket_path = os.path.join(self._workdir.name, "console.sock")
         self._stderr_path = os.path.join(self._workdir.name, "emulator.stderr")
@@ -58,12 +62,22 @@ class Emulator:
         if not os.path.exists(self.image):
             raise EmulatorError(f"firmware image {self.image} does not exist; run 'make firmware'")
         backend = f"socket,id=console,path={self._socket_path},server=on,wait=on"
+        backends = {"console": "chardev:console"}
+        chardevs = []
+        for port in self.serial_sockets:
+            if port not in self.board.serial_ports or port == "console":
+                raise EmulatorError(f"board {self.board.name} has no serial port '{port}' besides the console; "
+                                    f"its ports are: {', '.join(self.board.serial_ports)}")
+            # wait=off: the board runs before the test connects; what it sends
+            # until then is lost, as on an unconnected line.
+            chardevs += ["-chardev", f"socket,id={port},path={self.serial_socket_path(port)},server=on,wait=off"]
+            backends[port] = f"chardev:{port}"
         command = self.board.emulator_command(
-            self.image, {"console": "chardev:console"}, append=self.append, icount=self.icount, cpu=self.cpu,
+            self.image, backends, append=self.append, icount=self.icount, cpu=self.cpu,
             memory_mib=self.memory_mib, accel=self.accel, device_properties=self.device_properties,
             without_devices=self.without_devices, extra_args=self.extra_args,
         )
-        command[1:1] = ["-chardev", backend]
+        command[1:1] = ["-chardev", backend] + chardevs
         self.argv = command
         with open(self._stderr_path, "wb") as stderr:
             self._process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=stderr, stderr=stderr)
@@ -85,6 +99,10 @@ class Emulator:
         self._reader = threading.Thread(target=self._read_console, daemon=True)
         self._reader.start()
         return self
+
+    def serial_socket_path(self, port):
+        """The Unix socket the emulator serves serial port @p port on (see serial_sockets)."""
+        return os.path.join(self._workdir.name, f"{port}.sock")
 
     def _read_console(self):
         while True:

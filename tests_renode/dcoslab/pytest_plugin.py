@@ -65,16 +65,18 @@ def boot(request):
     path of an image file. Optional, per test: device_properties={"isa-mfio":
     {"no-irq": "on"}} adds or replaces device properties, without_devices=
     ["isa-mfio"] leaves devices out, extra_args=[...] go to the emulator as
-    they are.
+    they are, serial_sockets=["rs485"] joins serial ports to Unix sockets
+    (Emulator.serial_socket_path).
     """
     started = []
     request.node.dcos_emulators = started
 
     def start(board, kind="production", append="", icount=False, device_properties=None, without_devices=(),
-              extra_args=(), name=None):
+              extra_args=(), name=None, serial_sockets=()):
         image = kind if os.path.sep in kind else board.image(kind)
         emulator = Emulator(board, image, append=append, icount=icount, device_properties=device_properties,
-                            without_devices=without_devices, extra_args=extra_args, name=name)
+                            without_devices=without_devices, extra_args=extra_args, name=name,
+                            serial_sockets=serial_sockets)
         started.append(emulator)
         return emulator.start()
 

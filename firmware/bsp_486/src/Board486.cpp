@@ -1,6 +1,6 @@
 // Board support for the ISA i486 single-board controller (seed 9.2,
-// controller node 1): an 8259A pair, an 8254 and a 16550 on COM1, at their
-// PC/AT addresses.
+// controller node 1): an 8259A pair, an 8254, a 16550 on COM1 (the console)
+// and a second one on COM2 (the RS-485 port), at their PC/AT addresses.
 #include <bsp/Board.hpp>
 #include <bsp/Pic8259.hpp>
 #include <bsp/Rtc146818.hpp>
@@ -20,6 +20,9 @@ constexpr uint16_t masterPicPort = 0x20;
 constexpr uint16_t slavePicPort = 0xA0;
 constexpr uint16_t pitPort = 0x40;
 constexpr uint16_t com1Port = 0x3F8;
+// COM2: the same chip core as the console, with the RS-485 port's settings
+// given by its user when the line comes up (bsp::rs485Uart()).
+static_assert(rs485PortAddress == 0x2F8 && rs485Line == 3, "COM2 is at 0x2F8, IRQ 3 on a PC/AT");
 
 Pic8259 pic(arch_x86::IoWindow::ports(masterPicPort, 2), arch_x86::IoWindow::ports(slavePicPort, 2));
 // The PC/AT's CMOS real-time clock: index port 0x70, data port 0x71.
@@ -27,6 +30,7 @@ constexpr uint16_t rtcPort = 0x70;
 const Rtc146818 rtc(arch_x86::IoWindow::ports(rtcPort, 2));
 Pit8254 pit(arch_x86::IoWindow::ports(pitPort, 4));
 Uart16550 uart(arch_x86::IoWindow::ports(com1Port, 8));
+Uart16550 rs485(arch_x86::IoWindow::ports(rs485PortAddress, 8));
 
 struct Attachment {
     InterruptHandler handler;
@@ -266,6 +270,8 @@ bool consoleRead(char& character) { return uart.read(character); }
 bool consoleHasInput() { return uart.hasInput(); }
 
 void consoleFlush() { uart.flush(); }
+
+Uart16550& rs485Uart() { return rs485; }
 
 void setConsoleInputNotifier(InterruptHandler notifier, void* context) { uart.setReceiveNotifier(notifier, context); }
 

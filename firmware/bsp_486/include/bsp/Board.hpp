@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include <boot/BootInfo.hpp>
+#include <bsp/Uart16550.hpp>
 #include <dcos/DateTime.hpp>
 #include <dcos/Status.hpp>
 #include <runtime/Format.hpp>
@@ -29,6 +30,11 @@ constexpr unsigned interruptLineCount = 16;
 constexpr unsigned systemTickLine = 0;
 /// The line of the console UART.
 constexpr unsigned consoleLine = 4;
+
+/// The line of the RS-485 port's UART (COM2).
+constexpr unsigned rs485Line = 3;
+/// The RS-485 port's UART: its I/O address, for messages.
+constexpr uint16_t rs485PortAddress = 0x2F8;
 
 /// The default system tick rate; "tick_hz=N" on the command line changes it.
 constexpr uint32_t defaultTickRateHz = 1000;
@@ -111,6 +117,13 @@ bool consoleHasInput();
 
 /// Waits until everything queued for the console has left the UART.
 void consoleFlush();
+
+/// The board's RS-485 port: COM2, a 16550 whose RTS drives the
+/// transceiver's driver enable (half duplex). The board leaves it
+/// uninitialised and its line unattached: its user (the Modbus line,
+/// drivers/modbus) initialises it with DriverEnable::Rts settings and
+/// attaches rs485Line when it brings the line up.
+Uart16550& rs485Uart();
 
 /// Called from the console interrupt after bytes arrive, so a task can
 /// sleep until there is input instead of polling.

@@ -1,0 +1,196 @@
+#include <mbline/LineRunner.hpp>
+
+namespace mbline {
+
+using modbus::ModbusError;
+
+const char* roleName(Role role)
+{
+    switch (role) {
+    case Role::Off: return "off";
+    case Role::Slave: return "slave";
+    case Role::Master: return "master";
+    }
+    return "?";
+}
+
+ModbusError LineRunner::startSlave(const modbus::RtuTiming& timing, modbus::DataModel& model,
+                                   const modbus::DeviceIdentification& identification, uint8_t address,
+                                   uint64_t nowNs)
+{
+    stop();
+    modbus::ModbusResult<modbus::Server> server = modbus::Server::create(model, identification);
+    if (!server.ok()) {
+        return server.error();
+    }
+    server_ = server.value();
+    timing_ = timing;
+    transport_ = modbus::RtuTransport(timing);
+    transport_.onTransmitDone(nowNs); // The line must be silent for t3.5 before the first frame.
+    modbus::ModbusResult<modbus::Slave> slave = modbus::Slave::create(transport_, server_, address);
+    if (!slave.ok()) {
+        return slave.error();
+    }
+    slave_ = slave.value();
+    role_ = Role::Slave;
+    return ModbusError::Ok;
+}
+
+ModbusError LineRunner::startMaster(const modbus::RtuTiming& timing, const modbus::MasterConfig& config,
+                                    uint64_t nowNs)
+{
+    stop();
+    timing_ = timing;
+    transport_ = modbus::RtuTransport(timing);
+    transport_.onTransmitDone(nowNs);
+    modbus::ModbusResult<modbus::Master> master = modbus::Master::create(transport_, config);
+    if (!master.ok()) {
+        return master.error();
+    }
+    master_ = master.value();
+    role_ = Role::Master;
+    return ModbusError::Ok;
+}
+
+void LineRunner::stop()
+{
+    role_ = Role::Off;
+    transmitting_ = false;
+    fifoEmptied_ = false;
+    completed_ = false;
+    queue_.clear();
+}
+
+ModbusError LineRunner::submit(const modbus::Request& request, uint64_t nowNs)
+{
+    if (role_ != Role::Master) {
+        return ModbusError::NotExpected;
+    }
+    completed_ = false;
+    const modbus::StationStep step = master_.submit(request, nowNs);
+    if (step.rejected != ModbusError::Ok) {
+        return step.rejected;
+    }
+    apply(step, nowNs);
+    return ModbusError::Ok;
+}
+
+bool LineRunner::takeCompletion(Completion& completion)
+{
+    if (!completed_) {
+        return false;
+    }
+    completion = completion_;
+    completed_ = false;
+    return true;
+}
+
+void LineRunner::apply(const modbus::StationStep& step, uint64_t nowNs)
+{
+    if (step.transmit != nullptr && step.transmitLength != 0) {
+        if (port_.transmit(step.transmit, step.transmitLength) == dcos::Status::Ok) {
+            transmitting_ = true;
+            ++counters_.framesSent;
+        } else {
+            // The station waits for a transmit-done that will not come for
+            // this frame; tell it the frame is gone so that it goes on (a
+            // master times out and retries, a slave serves the next request).
+            ++counters_.transmitRefused;
+            if (role_ == Role::Slave) {
+                (void)slave_.onTransmitDone(nowNs);
+            } else if (role_ == Role::Master) {
+                apply(master_.onTransmitDone(nowNs), nowNs);
+            }
+        }
+    }
+    if (step.completed && role_ == Role::Master) {
+        completion_.error = step.error;
+        completion_.exception = step.exception;
+        const modbus::ResponseView response = master_.response();
+        completion_.function = response.function();
+        completion_.length = step.error == ModbusError::Ok || step.error == ModbusError::ExceptionResponse
+                                 ? response.length()
+                                 : 0;
+        for (size_t i = 0; i < completion_.length; ++i) {
+            completion_.pdu[i] = response.pdu()[i];
+        }
+        completed_ = true;
+    }
+}
+
+void LineRunner::finishIfSent(uint64_t nowNs)
+{
+    if (!transmitting_ || !__atomic_load_n(&fifoEmptied_, __ATOMIC_ACQUIRE)) {
+        return;
+    }
+    if (!port_.finishTransmission()) {
+        ++counters_.temtPolls;
+        return;
+    }
+    // The last stop bit left at most one character time after the FIFO ran
+    // dry; that, not the moment this task noticed, is when the line fell
+    // silent, so a fast answer's first byte is not taken for an echo.
+    uint64_t doneNs = fifoEmptiedAtNs_ + timing_.characterNs;
+    doneNs = doneNs < nowNs ? doneNs : nowNs;
+    transmitting_ = false;
+    fifoEmptied_ = false;
+    if (role_ == Role::Slave) {
+        (void)slave_.onTransmitDone(doneNs);
+    } else if (role_ == Role::Master) {
+        apply(master_.onTransmitDone(doneNs), nowNs);
+    }
+}
+
+void LineRunner::feedReceived()
+{
+    // Bytes are fed one by one with their own times; a run of bytes with
+    // one time (a FIFO burst) would do as well, but one at a time keeps
+    // the receiver's silence arithmetic exact for every byte.
+    TimedByte received;
+    for (size_t i = 0; i < kQueueCapacity && queue_.pop(received); ++i) {
+        ++counters_.charactersReceived;
+        if (role_ == Role::Slave) {
+            apply(slave_.onBytes(&received.byte, 1, received.timeNs), received.timeNs);
+        } else if (role_ == Role::Master) {
+            apply(master_.onBytes(&received.byte, 1, received.timeNs), received.timeNs);
+        }
+    }
+}
+
+uint64_t LineRunner::service(uint64_t nowNs)
+{
+    if (role_ == Role::Off) {
+        queue_.clear();
+        return ~0ull;
+    }
+    finishIfSent(nowNs);
+    feedReceived();
+    // A byte is stamped when its stop bit has arrived, so at nowNs a
+    // character may still be coming in that began up to one character time
+    // ago; the line is known to have been silent only up to then. Polling
+    // at nowNs itself would take that character's own time for silence and
+    // could end a frame at a false t1.5 whenever the task wakes for another
+    // reason (a console command, the transmit interrupt) in mid-character.
+    const uint64_t silentUntilNs = nowNs > timing_.characterNs ? nowNs - timing_.characterNs : 0;
+    if (role_ == Role::Slave) {
+        apply(slave_.poll(silentUntilNs), nowNs);
+    } else {
+        apply(master_.poll(silentUntilNs), nowNs);
+    }
+    // A transmit interrupt that comes after the check above posts the
+    // task's event, so the shift register is looked at again on that wake.
+    uint64_t next = role_ == Role::Slave ? slave_.nextDeadlineNs() : master_.nextDeadlineNs();
+    if (next != ~0ull) {
+        // The station's deadline is in line time; it is reached when the
+        // line is known silent up to it, one character time later.
+        next += timing_.characterNs;
+    }
+    if (transmitting_ && __atomic_load_n(&fifoEmptied_, __ATOMIC_ACQUIRE)) {
+        // The shift register still holds the last byte: look again after it.
+        const uint64_t again = nowNs + timing_.characterNs;
+        next = again < next ? again : next;
+    }
+    return next;
+}
+
+} // namespace mbline
