@@ -104,6 +104,17 @@ TEST(ModbusSimulatorConfig, RefusalsNameTheLine)
               "test.toml:6:11: not TOML: Error while parsing key-value pair: expected value, saw '\\n'");
 }
 
+// toml++ reaches __builtin_unreachable() on some non-ASCII characters where
+// it looks for white space (U+011A in a key, found by the fuzzer), so such a
+// file is refused before toml++ sees it, with the line of the first byte.
+TEST(ModbusSimulatorConfig, OnlyAsciiIsAccepted)
+{
+    EXPECT_EQ(refusal(std::string(kDevice) + "[[coil]]\nr\xc4\x9avision = 1\n"),
+              "test.toml:6: only ASCII characters are accepted (the TOML library fails on some others)");
+    EXPECT_EQ(refusal("# Gr\xc3\xbc\xc3\x9f\n"), "test.toml:1: only ASCII characters are accepted (the TOML library "
+                                                  "fails on some others)");
+}
+
 TEST(ModbusSimulatorConfig, BehavioursMayNameLaterEntries)
 {
     const SimulatorConfig config = parsed("[[input_register]]\nname = \"speed\"\naddress = 0\n"
