@@ -263,8 +263,13 @@ CommandResult dump(shell::Shell& shell, int argc, char** argv)
     const uint64_t deadline = dcos::timerAgent.Uptime() + timeoutMs * kMillisecond;
     unsigned long shown = 0;
     while (shown < count) {
+        // No more frames than are still to be shown: the driver hands over
+        // what fits, and a frame taken past the count would be lost to the
+        // next reader.
         can::CanFrame frames[8];
-        const dcos::Result<size_t> read = systemAgent.Read(consoleChannels[channel].id(), 0, frames, sizeof frames);
+        const size_t wanted = count - shown < 8 ? count - shown : 8;
+        const dcos::Result<size_t> read =
+            systemAgent.Read(consoleChannels[channel].id(), 0, frames, wanted * sizeof(can::CanFrame));
         if (!read.ok()) {
             shell.print("error: cannot read %s: %s\r\n", kNames[channel], dcos::statusName(read.status()));
             return CommandResult::Failed;
