@@ -907,6 +907,7 @@ class Hub:
     def _advance(self):
         if not self._ready():
             return False
+        self._skip_idle_quanta()
         boundary = self.boundary
         if not self.started:
             self.started = True
@@ -931,6 +932,27 @@ class Hub:
             if participant.closed:
                 self._drop(participant, "connection lost")
         return True
+
+    def _skip_idle_quanta(self):
+        """With no board, an idle hub that fell behind the wall clock catches up at once.
+
+        Host tools alone tick one quantum at a time with the wall clock; on a
+        busy machine the hub thread can fall seconds behind, and a tool's
+        frame would wait for every quantum in between. While nothing is
+        pending (no request, command, event or babbler) a quantum decides
+        nothing but bus-free signals, which are counted by time over any
+        stretch, so the hub moves to the wall clock's last boundary.
+        """
+        if self._emulated() or self._commands or self._events or self._babblers or self._wall_origin is None:
+            return
+        if any(port.pending for bus in self.buses.values() for port in bus.ports.values()):
+            return
+        pace = self.pace or 1.0
+        behind = int((time.monotonic() - self._wall_origin) * 1e9 * pace) // self.quantum_ns * self.quantum_ns
+        if behind > self.boundary:
+            with self._progress:
+                self.boundary = behind
+                self._progress.notify_all()
 
     def _apply_commands(self, boundary):
         while True:
