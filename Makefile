@@ -49,7 +49,7 @@ endif
 # Every suite runs even when an earlier one fails; the summary line counts
 # them all and the exit status says whether anything failed.
 test: deps
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory -j$(JOBS) all
 	@mkdir -p $(BUILD)/reports
 	@rm -f $(BUILD)/reports/*.xml
 	@status=0; \
