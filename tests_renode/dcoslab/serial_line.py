@@ -6,9 +6,12 @@ itself (write, read): tests_renode/test_modbus_rs485.py does, under exact
 emulated time, one frame per write. With bridge=True the bytes are copied
 both ways to the master side of a pseudo-terminal, so that a host program
 that expects a serial device (pymodbus's serial client, libmodbus) opens
-`pty_path` as it would /dev/ttyUSB0; such a program's timing between
-characters is the host's, not the emulated line's, so no test relies on
-the bridge for RTU framing until the lab's RS-485 line paces the bytes.
+`pty_path` as it would /dev/ttyUSB0. Such a program's timing between
+characters is the host's, not the emulated line's: one that writes each
+frame in one write(), as libmodbus does, reaches the controller as one
+frame (test_libmodbus_master_reads_and_writes_the_controllers_slave), but
+nothing at the emulated line's exact timing comes through the bridge; that
+waits for the lab's RS-485 line, which paces the bytes.
 """
 
 import os
