@@ -69,6 +69,25 @@ echo "__MESSAGE__" | timeout 30 isotpsend -s 7E0 -d 7E8 -p CC vcan0
 wait $receiver
 echo "received: $(cat /tmp/received)"
 """.replace("__MESSAGE__", MESSAGE),
+    # The kernel's ISO-TP socket (dcos-can --kernel) sends, our own state machines receive.
+    "kernel_isotp_to_ours": PRELUDE + r"""
+timeout 30 /tmp/dcos-can -i vcan0 isotp-recv -s 7E8 -d 7E0 -t 20000 >/tmp/received &
+receiver=$!
+labvm_wait_receiver vcan0 raw
+/tmp/dcos-can -i vcan0 isotp-send --kernel -s 7E0 -d 7E8 "__MESSAGE__"
+echo "sent: $?"
+wait $receiver
+echo "received: $(cat /tmp/received)"
+""".replace("__MESSAGE__", MESSAGE),
+    # Our own state machines send, the kernel's ISO-TP socket (dcos-can --kernel) receives.
+    "ours_to_kernel_isotp": PRELUDE + r"""
+timeout 30 /tmp/dcos-can -i vcan0 --json isotp-recv --kernel -s 7E8 -d 7E0 -t 20000 >/tmp/received &
+receiver=$!
+labvm_wait_receiver vcan0 isotp 7e0
+/tmp/dcos-can -i vcan0 isotp-send -s 7E0 -d 7E8 "__MESSAGE__"
+wait $receiver
+cat /tmp/received
+""".replace("__MESSAGE__", MESSAGE),
     # Counting: five frames of 8 bytes in a listening window.
     "stats": PRELUDE + r"""
 timeout 30 /tmp/dcos-can -i vcan0 --json stats -s 4 --bitrate 500000 >/tmp/stats.json &
@@ -127,6 +146,18 @@ def test_our_isotp_sender_is_understood_by_the_kernel(outcome):
 def test_our_isotp_receiver_understands_the_kernel(outcome):
     received = [line for line in check(outcome, "isotp_from_kernel").splitlines() if line.startswith("received:")]
     assert received and received[0].split()[1:] == MESSAGE.split(), received
+
+
+def test_the_kernels_isotp_socket_through_dcos_can_talks_to_our_own_isotp(outcome):
+    output = check(outcome, "kernel_isotp_to_ours")
+    assert "sent: 0" in output, output
+    received = [line for line in output.splitlines() if line.startswith("received:")]
+    assert received and received[0].split()[1:] == MESSAGE.split(), output
+
+
+def test_our_own_isotp_reaches_the_kernels_isotp_socket_through_dcos_can(outcome):
+    [answer] = [json.loads(line) for line in check(outcome, "ours_to_kernel_isotp").splitlines() if line.startswith("{")]
+    assert answer["length"] == 100 and answer["data"].split() == MESSAGE.split(), answer
 
 
 def test_stats_counts_frames_and_bus_load(outcome):

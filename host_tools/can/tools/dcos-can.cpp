@@ -7,12 +7,14 @@
 //     dcos-can -i can0 stats [-s SECONDS] [--bitrate B] [--json]
 //     dcos-can -i can0 isotp-send -s 7E0 -d 7E8 "01 02 03 ..."   (as can-utils' isotpsend)
 //     dcos-can -i can0 isotp-recv -s 7E8 -d 7E0 [-t MS]          (as isotprecv)
+//     ... isotp-send/isotp-recv --kernel: through the kernel's ISO-TP socket
 //
 // Exit status: 0 done; 1 dump ended before -n frames, or send was refused;
 // 2 bad arguments; 3 the interface kind is not available here (no
 // SocketCAN in this kernel, no such device); 4 the interface failed
 // (open, I/O, the other end went away).
 #include <hostcan/IsoTpEndpoint.hpp>
+#include <hostcan/KernelIsoTp.hpp>
 #include <hostcan/Transport.hpp>
 
 #include <can/FrameText.hpp>
@@ -286,6 +288,7 @@ struct IsoTpOptions {
     std::string data;
     long timeoutMs = 10'000;
     bool padding = false;
+    bool kernel = false; // through the kernel's ISO-TP sockets rather than our own state machines
 };
 
 bool isoTpConfig(const IsoTpOptions& options, can::IsoTpConfig& config)
@@ -315,21 +318,24 @@ int isoTpResult(const hostcan::IsoTpOutcome& outcome)
     return kExitOk;
 }
 
-int isoTpSend(hostcan::Transport& transport, const can::IsoTpConfig& config, const std::vector<uint8_t>& message,
+int isoTpSent(const hostcan::IsoTpOutcome& outcome, const std::string& interface, const std::vector<uint8_t>& message,
               bool json)
 {
-    const hostcan::IsoTpOutcome outcome = hostcan::isoTpSend(transport, config, message);
     const int status = isoTpResult(outcome);
     if (status == kExitOk && json) {
-        fmt::print("{}\n", nlohmann::json{{"interface", transport.name()}, {"sent_bytes", message.size()}}.dump());
+        fmt::print("{}\n", nlohmann::json{{"interface", interface}, {"sent_bytes", message.size()}}.dump());
     }
     return status;
 }
 
-int isoTpReceive(hostcan::Transport& transport, const can::IsoTpConfig& config, long timeoutMs, bool json)
+int isoTpSend(hostcan::Transport& transport, const can::IsoTpConfig& config, const std::vector<uint8_t>& message,
+              bool json)
 {
-    const hostcan::IsoTpOutcome outcome =
-        hostcan::isoTpReceive(transport, config, std::chrono::milliseconds(timeoutMs));
+    return isoTpSent(hostcan::isoTpSend(transport, config, message), transport.name(), message, json);
+}
+
+int isoTpReceived(const hostcan::IsoTpOutcome& outcome, const std::string& interface, bool json)
+{
     const int status = isoTpResult(outcome);
     if (status != kExitOk) {
         return status;
@@ -339,12 +345,18 @@ int isoTpReceive(hostcan::Transport& transport, const can::IsoTpConfig& config, 
         text += fmt::format("{}{:02X}", text.empty() ? "" : " ", byte);
     }
     if (json) {
-        fmt::print("{}\n", nlohmann::json{{"interface", transport.name()}, {"length", outcome.message.size()},
+        fmt::print("{}\n", nlohmann::json{{"interface", interface}, {"length", outcome.message.size()},
                                           {"data", text}}.dump());
     } else {
         fmt::print("{} \n", text); // isotprecv's form: bytes, then a space before the line end.
     }
     return kExitOk;
+}
+
+int isoTpReceive(hostcan::Transport& transport, const can::IsoTpConfig& config, long timeoutMs, bool json)
+{
+    return isoTpReceived(hostcan::isoTpReceive(transport, config, std::chrono::milliseconds(timeoutMs)),
+                         transport.name(), json);
 }
 
 // "01 02 ff" or "0102ff" into bytes; false for anything else.
@@ -416,6 +428,8 @@ int main(int argc, char** argv)
         ->required();
     isoTpSendCommand->add_option("data", isoTp.data, "1 to 4095 bytes in hexadecimal, e.g. \"01 02 03\"")->required();
     isoTpSendCommand->add_flag("-p,--padding", isoTp.padding, "pad every frame to 8 bytes with 0xCC");
+    isoTpSendCommand->add_flag("--kernel", isoTp.kernel,
+                               "segment with the kernel's ISO-TP socket (can-isotp), not our own; SocketCAN only");
     CLI::App* isoTpReceiveCommand =
         app.add_subcommand("isotp-recv", "receive one ISO 15765-2 message and print it, as isotprecv does");
     isoTpReceiveCommand->add_option("-s,--source", isoTp.source, "the identifier of the flow control this end sends (hex)")
@@ -425,6 +439,8 @@ int main(int argc, char** argv)
     isoTpReceiveCommand->add_option("-t,--timeout-ms", isoTp.timeoutMs, "how long to wait for the message to begin")
         ->check(CLI::Range(1L, 86'400'000L));
     isoTpReceiveCommand->add_flag("-p,--padding", isoTp.padding, "pad the flow control to 8 bytes with 0xCC");
+    isoTpReceiveCommand->add_flag("--kernel", isoTp.kernel,
+                                  "reassemble with the kernel's ISO-TP socket (can-isotp), not our own; SocketCAN only");
 
     try {
         app.parse(argc, argv);
@@ -446,6 +462,21 @@ int main(int argc, char** argv)
     if (*isoTpSendCommand && !parseBytes(isoTp.data, message)) {
         fmt::print(stderr, "dcos-can: '{}' is not 1 to 4095 bytes in hexadecimal\n", isoTp.data);
         return kExitUsage;
+    }
+    if ((*isoTpSendCommand || *isoTpReceiveCommand) && isoTp.kernel) {
+        // The kernel's sockets exist on SocketCAN interfaces only, named
+        // plainly (can0), never behind a transport prefix (lab:, slcan:).
+        if (interface.find(':') != std::string::npos) {
+            fmt::print(stderr, "dcos-can: --kernel needs a SocketCAN interface such as can0, not '{}'\n", interface);
+            return kExitUsage;
+        }
+        const hostcan::IsoTpOutcome outcome =
+            *isoTpSendCommand ? hostcan::kernelIsoTpSend(interface, isoTpSettings, message,
+                                                         std::chrono::milliseconds(isoTp.timeoutMs))
+                              : hostcan::kernelIsoTpReceive(interface, isoTpSettings,
+                                                            std::chrono::milliseconds(isoTp.timeoutMs));
+        return *isoTpSendCommand ? isoTpSent(outcome, interface, message, json)
+                                 : isoTpReceived(outcome, interface, json);
     }
     TransportError error;
     const std::unique_ptr<hostcan::Transport> transport = hostcan::openTransport(interface, error);
