@@ -40,9 +40,10 @@ import pytest
 from dcoslab.board import REPOSITORY, load_board
 from dcoslab.canbus import Client, Frame, Hub
 from dcoslab.canlab import CanLab
-from dcoslab.emulator import Emulator
+from dcoslab import vmworld
 from dcoslab.labvm import LabVM, SlcanSetup
 from dcoslab.slcan_bridge import SlcanBridge, parse_lawicel, to_lawicel
+from dcoslab.vmworld import Report, World, attach_reports
 
 BITRATE = 500_000
 PACE = 1.0  # emulated time runs no faster than wall time while the slow VM works
@@ -167,64 +168,24 @@ echo "@@QDISC $(tc -s qdisc show dev can0 | tr '\n' ' ')@@"
 """.replace("__MESSAGE__", " ".join(f"{byte:02X}" for byte in MESSAGE)).replace("__LAST_FRAME__", LAST_FRAME)
 
 
-class _Report:
-    """Something with a name and a transcript, for the lab plugin's failure report."""
-
-    def __init__(self, name, text, argv=()):
-        self.name = name
-        self._text = text
-        self.argv = list(argv)
-
-    @property
-    def transcript(self):
-        return self._text()
-
-
-class World:
-    """The board, the hub, the lab VM and the bridge, shared by the module's tests."""
+class BridgedWorld(World):
+    """The board, the hub and the lab VM, joined by the slcan bridge."""
 
     def __init__(self):
-        self.lab = None
-        self.board = None
-        self.vm = None
+        super().__init__()
         self.bridge = None
-        self.started = time.monotonic()
-        self.timings = {}
 
     def reports(self):
-        reports = []
-        if self.board is not None:
-            reports.append(self.board.emulator)
-        if self.vm is not None:
-            reports.append(_Report("lab VM", lambda: self.vm.transcript, self.vm.argv))
+        reports = super().reports()
         if self.bridge is not None:
-            reports.append(_Report("slcan bridge", lambda: f"counts {dict(self.bridge.counts)}, error "
-                                   f"{self.bridge.error}\n{self.bridge.log_text()}"))
+            reports.append(Report("slcan bridge", lambda: f"counts {dict(self.bridge.counts)}, error "
+                                  f"{self.bridge.error}\n{self.bridge.log_text()}"))
         return reports
-
-    def mark(self, name):
-        self.timings[name] = round(time.monotonic() - self.started, 1)
 
     def close(self):
         if self.bridge is not None:
             self.bridge.stop()
-        if self.vm is not None:
-            self.vm.close()
-        for emulator in _boot.started:
-            emulator.close()
-        if self.lab is not None:
-            self.lab.close()
-
-
-def _boot(board, kind, icount=False, name=None, device_properties=None, extra_args=()):
-    """The lab plugin's boot fixture, for a module-scoped lab."""
-    emulator = Emulator(board, board.image(kind), icount=icount, device_properties=device_properties,
-                        extra_args=extra_args, name=name)
-    _boot.started.append(emulator)
-    return emulator.start()
-
-
-_boot.started = []
+        super().close()
 
 
 def _dcos_can_binary():
@@ -238,11 +199,10 @@ def _dcos_can_binary():
 
 @pytest.fixture(scope="module")
 def world():
-    world = World()
+    world = BridgedWorld()
     try:
         # canlab({"can0": 500_000}, {"board1": {"bus0": "can0"}}, pace=1.0, kind="production"), for the module.
-        _boot.started.clear()
-        world.lab = CanLab(_boot, load_board("isa486"), {"can0": BITRATE}, {"board1": {"bus0": "can0"}},
+        world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BITRATE}, {"board1": {"bus0": "can0"}},
                            pace=PACE, kind="production")
         world.board = world.lab.board("board1")
         world.mark("board booted")
@@ -266,33 +226,19 @@ def world():
 @pytest.fixture(autouse=True)
 def _reports(request):
     """Puts the board's and the VM's consoles, the bridge's log and the bus log into a failing test's report."""
-    request.node.dcos_emulators = []
-    request.node.dcos_canlabs = []
-    if "world" in request.fixturenames:
-        shared = request.getfixturevalue("world")
-        request.node.dcos_emulators.extend(shared.reports())  # read when the report is made
-        request.node.dcos_canlabs.append(shared.lab)
-
-
-def candump_form(frame):
-    """A frame as `candump -L` writes it after the interface: 123#11223344, 1ABCDEF0#0102, 7FF#R."""
-    identifier = f"{frame.id:08X}" if frame.extended else f"{frame.id:03X}"
-    return f"{identifier}#R" if frame.remote else f"{identifier}#{frame.data.hex().upper()}"
+    attach_reports(request)
 
 
 def bus_frames(world):
-    """The frames that went through on can0, in order, as candump -L writes them."""
-    return [candump_form(record.frame) for record in world.lab.hub.frames() if record.outcome == "ok"]
+    return vmworld.bus_frames(world.lab)
 
 
 def go(world, can_id, phase):
-    """A hub node puts the go frame for a phase on the bus."""
-    world.lab.hub.inject("can0", "lab", Frame.data_frame(can_id, bytes([phase])))
+    vmworld.go(world.lab, can_id, phase)
 
 
 def vm_section(world, name):
-    match = world.vm.expect(rf"@@{name}\r?\n([\s\S]*?)@@END {name}@@", timeout=STEP)
-    return [line.split(" ", 1)[-1].strip() for line in match.group(1).decode("latin-1").splitlines() if line.strip()]
+    return vmworld.vm_frames(world.vm, name, STEP)
 
 
 # -- the bridge alone (no VM, no board) ------------------------------------------

@@ -25,15 +25,14 @@ report carries the board's console, the VM's console and the bus log.
 """
 
 import re
-import time
 
 import pytest
 
 from dcoslab.board import load_board
-from dcoslab.canbus import Frame
 from dcoslab.canlab import CanLab
-from dcoslab.emulator import Emulator
+from dcoslab import vmworld
 from dcoslab.labvm import LabVM, Sja1000Setup
+from dcoslab.vmworld import World, attach_reports, candump_form
 
 BITRATE = 500_000
 PACE = 1.0  # emulated time runs no faster than wall time while the slow VM works
@@ -147,66 +146,11 @@ echo "@@TRACE"; cut -d' ' -f2- /tmp/trace.log; echo "@@END TRACE@@"
 UNACKED = 16  # one-shot frames nobody acknowledges: TEC 16 x 8 = 128, error passive
 
 
-class _Report:
-    """Something with a name and a transcript, for the lab plugin's failure report."""
-
-    def __init__(self, name, text, argv=()):
-        self.name = name
-        self._text = text
-        self.argv = list(argv)
-
-    @property
-    def transcript(self):
-        return self._text()
-
-
-class World:
-    """The board, the hub and the lab VM with the card, shared by the module's tests."""
-
-    def __init__(self):
-        self.lab = None
-        self.board = None
-        self.vm = None
-        self.started = time.monotonic()
-        self.timings = {}
-
-    def reports(self):
-        reports = []
-        if self.board is not None:
-            reports.append(self.board.emulator)
-        if self.vm is not None:
-            reports.append(_Report("lab VM", lambda: self.vm.transcript, self.vm.argv))
-        return reports
-
-    def mark(self, name):
-        self.timings[name] = round(time.monotonic() - self.started, 1)
-
-    def close(self):
-        if self.vm is not None:
-            self.vm.close()
-        for emulator in _boot.started:
-            emulator.close()
-        if self.lab is not None:
-            self.lab.close()
-
-
-def _boot(board, kind, icount=False, name=None, device_properties=None, extra_args=()):
-    """The lab plugin's boot fixture, for a module-scoped lab."""
-    emulator = Emulator(board, board.image(kind), icount=icount, device_properties=device_properties,
-                        extra_args=extra_args, name=name)
-    _boot.started.append(emulator)
-    return emulator.start()
-
-
-_boot.started = []
-
-
 @pytest.fixture(scope="module")
 def world():
     world = World()
     try:
-        _boot.started.clear()
-        world.lab = CanLab(_boot, load_board("isa486"), {"can0": BITRATE}, {"board1": {"bus0": "can0"}},
+        world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BITRATE}, {"board1": {"bus0": "can0"}},
                            pace=PACE, kind="production")
         world.board = world.lab.board("board1")
         output = world.board.command(f"can up can0 {BITRATE}")
@@ -226,32 +170,19 @@ def world():
 @pytest.fixture(autouse=True)
 def _reports(request):
     """Puts the board's and the VM's consoles and the bus log into a failing test's report."""
-    request.node.dcos_emulators = []
-    request.node.dcos_canlabs = []
-    if "world" in request.fixturenames:
-        shared = request.getfixturevalue("world")
-        request.node.dcos_emulators.extend(shared.reports())  # read when the report is made
-        request.node.dcos_canlabs.append(shared.lab)
-
-
-def candump_form(frame):
-    """A frame as `candump -L` writes it after the interface: 123#11223344, 1ABCDEF0#0102, 7FF#R."""
-    identifier = f"{frame.id:08X}" if frame.extended else f"{frame.id:03X}"
-    return f"{identifier}#R" if frame.remote else f"{identifier}#{frame.data.hex().upper()}"
+    attach_reports(request)
 
 
 def go(world, can_id, phase):
-    """A hub node puts the go frame for a phase on the bus."""
-    world.lab.hub.inject("can0", "lab", Frame.data_frame(can_id, bytes([phase])))
+    vmworld.go(world.lab, can_id, phase)
 
 
 def vm_section(world, name):
-    match = world.vm.expect(rf"@@{name}\r?\n([\s\S]*?)@@END {name}@@", timeout=STEP)
-    return match.group(1).decode("latin-1").replace("\r", "")
+    return vmworld.vm_section(world.vm, name, STEP)
 
 
 def vm_frames(world, name):
-    return [line.split(" ", 1)[-1].strip() for line in vm_section(world, name).splitlines() if line.strip()]
+    return vmworld.vm_frames(world.vm, name, STEP)
 
 
 def can_state(link_text):

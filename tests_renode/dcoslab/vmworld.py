@@ -1,0 +1,104 @@
+"""A module-scoped lab of one or more boards on a hub and the lab VM, for tests that run one VM script in phases.
+
+The lab VM boots in tens of seconds, so a module boots it once, with its
+boards and hub, and its tests take the script's phases in turn
+(test_can_linux_interop.py, test_can_sja1000_linux.py). World holds the
+pieces, closes them whatever happened, and hands the lab plugin what a
+failing test's report shows: every console, the VM's, and the bus log.
+The helpers below are the phases' common words: the frames as candump -L
+writes them, the hub's "go" frames, and the VM's marked output sections.
+"""
+
+import time
+
+from .canbus import Frame
+from .emulator import Emulator
+
+
+class Report:
+    """Something with a name and a transcript, for the lab plugin's failure report."""
+
+    def __init__(self, name, text, argv=()):
+        self.name = name
+        self._text = text
+        self.argv = list(argv)
+
+    @property
+    def transcript(self):
+        return self._text()
+
+
+class World:
+    """The boards, the hub and the VM of a module; subclasses add what they join them with."""
+
+    def __init__(self):
+        self.lab = None
+        self.board = None
+        self.vm = None
+        self.started = time.monotonic()
+        self.timings = {}
+        self._emulators = []
+
+    def boot(self, board, kind, icount=False, name=None, device_properties=None, extra_args=()):
+        """The lab plugin's boot fixture, for a module-scoped CanLab; the emulators close with the world."""
+        emulator = Emulator(board, board.image(kind), icount=icount, device_properties=device_properties,
+                            extra_args=extra_args, name=name)
+        self._emulators.append(emulator)
+        return emulator.start()
+
+    def reports(self):
+        reports = []
+        if self.board is not None:
+            reports.append(self.board.emulator)
+        if self.vm is not None:
+            reports.append(Report("lab VM", lambda: self.vm.transcript, self.vm.argv))
+        return reports
+
+    def mark(self, name):
+        """Notes when a phase got somewhere, in seconds from the module's start (printed by the last test)."""
+        self.timings[name] = round(time.monotonic() - self.started, 1)
+
+    def close(self):
+        if self.vm is not None:
+            self.vm.close()
+        for emulator in self._emulators:
+            emulator.close()
+        if self.lab is not None:
+            self.lab.close()
+
+
+def attach_reports(request, name="world"):
+    """For an autouse fixture: puts the world's consoles and bus log into a failing test's report."""
+    request.node.dcos_emulators = []
+    request.node.dcos_canlabs = []
+    if name in request.fixturenames:
+        shared = request.getfixturevalue(name)
+        request.node.dcos_emulators.extend(shared.reports())  # read when the report is made
+        request.node.dcos_canlabs.append(shared.lab)
+
+
+def candump_form(frame):
+    """A frame as `candump -L` writes it after the interface: 123#11223344, 1ABCDEF0#0102, 7FF#R."""
+    identifier = f"{frame.id:08X}" if frame.extended else f"{frame.id:03X}"
+    return f"{identifier}#R" if frame.remote else f"{identifier}#{frame.data.hex().upper()}"
+
+
+def bus_frames(lab, bus="can0"):
+    """The frames that went through on the bus, in order, as candump -L writes them."""
+    return [candump_form(record.frame) for record in lab.hub.frames() if record.outcome == "ok" and record.bus == bus]
+
+
+def go(lab, can_id, phase, bus="can0"):
+    """A hub node puts the go frame for a phase on the bus."""
+    lab.hub.inject(bus, "lab", Frame.data_frame(can_id, bytes([phase])))
+
+
+def vm_section(vm, name, timeout):
+    """The text the VM printed between `@@<name>` and `@@END <name>@@`."""
+    match = vm.expect(rf"@@{name}\r?\n([\s\S]*?)@@END {name}@@", timeout=timeout)
+    return match.group(1).decode("latin-1").replace("\r", "")
+
+
+def vm_frames(vm, name, timeout):
+    """A section of candump -L lines, without their timestamps: 123#11223344 ..."""
+    return [line.split(" ", 1)[-1].strip() for line in vm_section(vm, name, timeout).splitlines() if line.strip()]
