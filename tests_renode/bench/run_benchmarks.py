@@ -18,6 +18,11 @@ writes two JSON reports:
   can.json         instructions per received and per sent CAN frame through
                    the SJA1000 driver and the link layer (the Can.* pieces
                    added up) and the CPU share at 7,407 frames/s.
+  modbus.json      instructions per received character and per handled
+                   Modbus request (read and write 10 holding registers)
+                   through the 16550 driver and the RTU stack, the line's
+                   transactions per second at 115200 baud and the CPU share
+                   there.
 
 n is the smallest instruction count of one call with that many objects (null
 when setup failed). Where /dev/kvm is usable and the bench image runs under
@@ -360,6 +365,88 @@ def print_can_summary(summary):
               "18 port accesses per frame (docs/performance.md)")
 
 
+# The Modbus RTU line (tests_renode/bench/ModbusBench.cpp): the pieces of a
+# received character and the two handled requests, and the line's own limit
+# at 115200 baud. A character is 11 bits ([SL] 2.5.1: start, 8 data, parity,
+# stop); above 19200 baud t3.5 is the fixed 1.75 ms ([SL] 2.5.1.1). A
+# transaction holds the line for the request, the t3.5 that ends it, the
+# response and the t3.5 that ends that before the master's next request.
+MODBUS_CHARACTER_PIECES = ("Modbus.ReceiveInterrupt", "Modbus.ReceiveCharacter")
+MODBUS_BAUD = 115200
+MODBUS_CHARACTER_BITS = 11
+MODBUS_T35_SECONDS = 1.75e-3
+# name: (what it is, request characters, response characters): read 10
+# registers is 8 bytes in, 3 + 20 + 2 out; write 10 is 9 + 20 in, 8 out.
+MODBUS_REQUESTS = {
+    "Modbus.ReadHoldingRegisters": ("read 10 holding registers (03)", 8, 25),
+    "Modbus.WriteMultipleRegisters": ("write 10 holding registers (10)", 29, 8),
+}
+
+
+def modbus_summary(results):
+    """Instructions per received character and per transaction of the two
+    requests, the line's transaction limit at MODBUS_BAUD and the CPU share
+    there; None when the Modbus benchmarks did not all run."""
+    def figure(name):
+        entry = results.get(name)
+        return smallest(entry, 8) if entry is not None else None
+
+    pieces = {name: figure(name) for name in MODBUS_CHARACTER_PIECES + tuple(MODBUS_REQUESTS)}
+    if any(value is None for value in pieces.values()):
+        return None
+    per_character = sum(pieces[name] for name in MODBUS_CHARACTER_PIECES)
+    character_seconds = MODBUS_CHARACTER_BITS / MODBUS_BAUD
+    summary = {"baud": MODBUS_BAUD, "character_bits": MODBUS_CHARACTER_BITS, "t35_seconds": MODBUS_T35_SECONDS,
+               "pieces": pieces, "instructions_per_character": per_character,
+               "interrupt_entry_instructions": figure("Kernel.InterruptLatency"), "requests": {}}
+    for name, (title, request_characters, response_characters) in MODBUS_REQUESTS.items():
+        line_seconds = (request_characters + response_characters) * character_seconds + 2 * MODBUS_T35_SECONDS
+        limit = 1 / line_seconds
+        # Every request character costs the interrupt and a wake-up of the
+        # task; the request's figure takes the characters through the
+        # receiver again, so this is an upper bound (docs/performance.md).
+        per_transaction = request_characters * per_character + pieces[name]
+        per_second = per_transaction * limit
+        summary["requests"][name] = {
+            "title": title,
+            "request_characters": request_characters,
+            "response_characters": response_characters,
+            "instructions_per_request": pieces[name],
+            "instructions_per_transaction": per_transaction,
+            "line_limit_transactions_per_second": limit,
+            # The response leaves only once the request is served: the answer's
+            # instructions add to the line's time per transaction.
+            "transactions_per_second_emulated_cpu": 1 / (line_seconds + pieces[name] / EMULATED_INSTRUCTION_RATE),
+            "transactions_per_second_reference_486":
+                1 / (line_seconds + pieces[name] / REFERENCE_486_INSTRUCTION_RATE),
+            "instructions_per_second": per_second,
+            "share_of_emulated_cpu": per_second / EMULATED_INSTRUCTION_RATE,
+            "share_of_reference_486": per_second / REFERENCE_486_INSTRUCTION_RATE,
+        }
+    return summary
+
+
+def print_modbus_summary(summary):
+    print()
+    print(f"Modbus RTU line through the 16550 driver, drivers/modbus and fieldbus/modbus, at {summary['baud']} baud "
+          f"({summary['character_bits']}-bit characters, t3.5 {summary['t35_seconds'] * 1e3:g} ms)")
+    parts = " + ".join(f"{name} {summary['pieces'][name]}" for name in MODBUS_CHARACTER_PIECES)
+    print(f"  per received character: {summary['instructions_per_character']} instructions ({parts})")
+    for name, figures in summary["requests"].items():
+        print(f"  {figures['title']}: {name} {figures['instructions_per_request']} instructions; "
+              f"{figures['request_characters']} + {figures['response_characters']} characters: line limit "
+              f"{figures['line_limit_transactions_per_second']:.1f} transactions/s, reached "
+              f"{figures['transactions_per_second_emulated_cpu']:.1f} (emulated CPU) / "
+              f"{figures['transactions_per_second_reference_486']:.1f} (486 at 33 million/s); at the limit "
+              f"{figures['instructions_per_transaction']} instructions per transaction, "
+              f"{100 * figures['share_of_emulated_cpu']:.3f} % of the emulated CPU, "
+              f"{100 * figures['share_of_reference_486']:.2f} % of the 486")
+    if summary["interrupt_entry_instructions"] is not None:
+        print(f"  not included: the kernel's interrupt entry per character (Kernel.InterruptLatency "
+              f"{summary['interrupt_entry_instructions']}) and exit, the task's wake-up, the response's transmission "
+              "(16550 transmit, its interrupts, the driver enable), the ISA bus's wait states (docs/performance.md)")
+
+
 def write_json(path, report):
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w", encoding="utf-8") as handle:
@@ -386,6 +473,8 @@ def main():
     parser.add_argument("--strict", action="store_true", help="exit 1 when an O(1) benchmark is NOT FLAT")
     parser.add_argument("--can", default=os.path.join(REPOSITORY, "build", "bench", "can.json"),
                         help="JSON report of the CAN frame costs to write (when the CAN benchmarks ran)")
+    parser.add_argument("--modbus", default=os.path.join(REPOSITORY, "build", "bench", "modbus.json"),
+                        help="JSON report of the Modbus line's costs to write (when the Modbus benchmarks ran)")
     arguments = parser.parse_args()
 
     board = load_board(arguments.board)
@@ -419,6 +508,9 @@ def main():
     can = can_summary(results)
     if can is not None:
         print_can_summary(can)
+    modbus = modbus_summary(results)
+    if modbus is not None:
+        print_modbus_summary(modbus)
     if kvm_results is None:
         print(f"KVM not available: real cycle figures not reported ({kvm_reason}). "
               "Every figure above is an exact instruction count under QEMU TCG with -icount.")
@@ -430,6 +522,8 @@ def main():
         for name in sorted(results)})
     if can is not None:
         write_json(arguments.can, can)
+    if modbus is not None:
+        write_json(arguments.modbus, modbus)
     if arguments.strict and any(order_check(entry) == "NOT FLAT" for entry in results.values()):
         return 1
     return 0

@@ -10,6 +10,7 @@
 // the single-master rule of [SL] 2.1. The console changes the role and
 // submits a master's requests through a one-slot mailbox the task takes;
 // every wait of the console has a time-out.
+#include <mbline/LineInterrupt.hpp>
 #include <mbline/LineRunner.hpp>
 
 #include <bsp/Board.hpp>
@@ -101,11 +102,6 @@ void fillPattern()
     }
 }
 
-void onReceivedByte(void*, uint8_t byte)
-{
-    (void)runner.queue().push(byte, timerAgent.Uptime());
-}
-
 void onFifoEmptied(void*) { runner.fifoEmptied(timerAgent.Uptime()); }
 
 void lineInterrupt(void*)
@@ -130,7 +126,7 @@ Status startPort(const bsp::UartSettings& settings)
     if (status != Status::Ok) {
         return status;
     }
-    uart.setReceiveSink(onReceivedByte, nullptr);
+    uart.setReceiveSink(stampReceivedByte, &runner);
     uart.setTransmitNotifier(onFifoEmptied, nullptr);
     return bsp::attachInterrupt(bsp::rs485Line, lineInterrupt, nullptr);
 }
@@ -712,6 +708,13 @@ CommandResult modbusCommand(shell::Shell& shell, int argc, char** argv)
 }
 
 } // namespace
+
+void stampReceivedByte(void* runner, uint8_t byte)
+{
+    // A full queue counts the byte as lost (TimedByteQueue::push); the
+    // frame it belonged to then fails its CRC and is discarded.
+    (void)static_cast<LineRunner*>(runner)->queue().push(byte, timerAgent.Uptime());
+}
 
 } // namespace mbline
 
