@@ -152,6 +152,71 @@ def test_configuration_errors_name_the_object_at_compile_time(tmp_path, change, 
     assert not os.path.exists(os.path.join(application, "build", "hello-486.elf"))
 
 
+MAP_SOURCE = """\
+#include <dcos/Application.hpp>
+
+namespace {{
+void control(uintptr_t) {{}}
+
+constexpr dcos::app::TaskDeclaration tasks[] = {{{{.name = "control", .entry = control}}}};
+constexpr dcos::app::PublisherDeclaration publishers[] = {{
+    {{.name = "setpoint"}},
+    {{.name = "measured", .writer = "control"}},
+}};
+using dcos::app::ModbusTable;
+constexpr dcos::app::ModbusMapEntry map[] = {{
+    {{.name = "setpoint", .table = ModbusTable::HoldingRegisters, .address = 0, .count = 4, .object = "setpoint"}},
+    {{.name = "speed", .table = ModbusTable::{speed_table}, .address = {speed_address}, .count = {speed_count},
+     .object = "{speed_object}", .offset = {speed_offset}}},
+}};
+}} // namespace
+
+DCOS_APPLICATION(mapped, {{.name = "mapped", .tasks = tasks, .publishers = publishers, .modbusMap = map}});
+"""
+
+
+def write_map(directory, speed_table="HoldingRegisters", speed_address=4, speed_count=2, speed_object="setpoint",
+              speed_offset=8):
+    os.makedirs(directory, exist_ok=True)
+    with open(os.path.join(directory, "mapped.cpp"), "w", encoding="utf-8") as handle:
+        handle.write(MAP_SOURCE.format(speed_table=speed_table, speed_address=speed_address,
+                                       speed_count=speed_count, speed_object=speed_object,
+                                       speed_offset=speed_offset))
+    return directory
+
+
+def test_a_valid_modbus_map_compiles(tmp_path):
+    """The map the failures below break one rule of builds, so each failure is the rule's own."""
+    application = write_map(str(tmp_path / "mapped"))
+    result = build_with_staged_sdk(application)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+@pytest.mark.parametrize("change, phrases", [
+    (dict(speed_address=3), ['ObjectName{"speed"}', "MapOverlap, 3, 3",
+                             "configuration error: Modbus map entry 'speed': the Modbus map entry overlaps an "
+                             "earlier entry of its table (value: the first shared address, limit: the last) "
+                             "(value 3, limit 3)"]),
+    (dict(speed_object="pressure"), ['ObjectName{"speed"}', "MapObjectNotDeclared",
+                                     "configuration error: Modbus map entry 'speed': the Modbus map entry's object "
+                                     "is not a declared publisher"]),
+    (dict(speed_offset=14), ['ObjectName{"speed"}', "MapTooLarge, 18, 16",
+                             "configuration error: Modbus map entry 'speed': the Modbus map entry does not fit its "
+                             "source", "(value 18, limit 16)"]),
+    (dict(speed_address=65535), ['ObjectName{"speed"}', "MapAddressPastEnd, 65536, 65535",
+                                 "configuration error: Modbus map entry 'speed': the Modbus map entry runs past "
+                                 "address 65535", "(value 65536, limit 65535)"]),
+    (dict(speed_object="measured"), ['ObjectName{"speed"}', "MapWritesReadOnly",
+                                     "configuration error: Modbus map entry 'speed': a coil or holding register "
+                                     "entry is bound to something read-only"]),
+])
+def test_modbus_map_errors_name_the_entry_at_compile_time(tmp_path, change, phrases):
+    application = write_map(str(tmp_path / "mapped"), **change)
+    output = expect_build_failure(application, *phrases)
+    assert "DCOS_APPLICATION: the configuration breaks the rule named above" in output
+    assert not os.path.exists(os.path.join(application, "build", "mapped-486.elf"))
+
+
 def test_an_unchecked_status_does_not_compile(tmp_path):
     """Status and Result are [[nodiscard]], and an application build refuses a dropped one."""
     application = write_hello(str(tmp_path / "hello"))

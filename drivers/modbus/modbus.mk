@@ -3,6 +3,7 @@
 
 # Sources with no hardware access of their own: built for the host tests and the firmware.
 MODBUS_DRIVER_PORTABLE_SRCS := \
+	drivers/modbus/src/ApplicationMapModel.cpp \
 	drivers/modbus/src/LineRunner.cpp
 
 # Sources that run only on the target: the line's task and the console command.

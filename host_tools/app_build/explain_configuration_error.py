@@ -43,10 +43,12 @@ KIND_NAMES = {
     "Publisher": "publisher",
     "BufferPool": "buffer pool",
     "Heap": "heap",
+    "ModbusMapEntry": "Modbus map entry",
 }
 # Rules whose value and limit mean something (ConfigurationReport.cpp shows the same ones).
 RULES_WITH_VALUES = {"NameTooLong", "PriorityOutOfRange", "StackTooSmall", "StacksExceedArena", "TooManyObjects",
-                     "InitialCountTooLarge", "TickRateOutOfRange", "AreaTooSmall", "BufferTooSmall"}
+                     "InitialCountTooLarge", "TickRateOutOfRange", "AreaTooSmall", "BufferTooSmall",
+                     "MapAddressPastEnd", "MapTooLarge", "MapOverlap"}
 # The summary is one line: a name or rule text longer than this is cut.
 MAX_PART = 200
 

@@ -19,6 +19,9 @@ using dcos::app::ConfigurationRule;
 using dcos::app::findConfigurationError;
 using dcos::app::HeapDeclaration;
 using dcos::app::MessagePortDeclaration;
+using dcos::app::ModbusMapEntry;
+using dcos::app::ModbusSource;
+using dcos::app::ModbusTable;
 using dcos::app::ObjectKind;
 using dcos::app::PublisherDeclaration;
 using dcos::app::SemaphoreDeclaration;
@@ -74,6 +77,7 @@ struct Configuration {
     std::vector<PublisherDeclaration> publishers;
     std::vector<BufferPoolDeclaration> pools;
     std::vector<HeapDeclaration> heaps;
+    std::vector<ModbusMapEntry> map;
     const char* name = "demo";
     uint32_t tickRateHz = 0;
 
@@ -86,6 +90,7 @@ struct Configuration {
                                 .publishers = {publishers.data(), publishers.size()},
                                 .bufferPools = {pools.data(), pools.size()},
                                 .heaps = {heaps.data(), heaps.size()},
+                                .modbusMap = {map.data(), map.size()},
                                 .tickRateHz = tickRateHz};
         return findConfigurationError(application);
     }
@@ -161,8 +166,7 @@ TEST(ConfigurationRulesTest, KernelTaskNamesAreReserved)
 TEST(ConfigurationRulesTest, TooManyTasksNamesTheFirstThatDoesNotFit)
 {
     Configuration configuration;
-    static std::vector<std::string> names;
-    names.clear();
+    std::vector<std::string> names;
     const size_t fit = dcos::internal::kTaskCapacity - dcos::app::kKernelTaskCount;
     names.reserve(fit + 2);
     for (size_t i = 1; i <= fit; ++i) {
@@ -324,4 +328,179 @@ TEST(ConfigurationRulesTest, LoaderErrorsAreWorded)
                                      static_cast<size_t>(dcos::Status::AlreadyExists), 0};
     EXPECT_EQ(message("demo", refused),
               "application 'demo' not started: heap 'work' was refused by its agent (already exists)");
+}
+
+// A map that keeps every rule, checked by the compiler too: a setpoint the
+// master writes (a publisher with no writer), a measurement the application
+// publishes, the I/O board's analog inputs and digital outputs, and one
+// address used in two different tables.
+constexpr TaskDeclaration mapTasks[] = {{.name = "control", .entry = entry}};
+constexpr PublisherDeclaration mapPublishers[] = {{.name = "setpoint"}, {.name = "measured", .writer = "control"}};
+constexpr ModbusMapEntry validMap[] = {
+    {.name = "setpoint", .table = ModbusTable::HoldingRegisters, .address = 0, .count = 8, .object = "setpoint"},
+    {.name = "enable", .table = ModbusTable::Coils, .address = 0, .count = 16, .object = "setpoint", .offset = 14},
+    {.name = "measured", .table = ModbusTable::InputRegisters, .address = 0, .count = 8, .object = "measured"},
+    {.name = "ai", .table = ModbusTable::InputRegisters, .address = 100, .count = 8,
+     .source = ModbusSource::AnalogInput},
+    {.name = "do", .table = ModbusTable::Coils, .address = 100, .count = 16, .source = ModbusSource::DigitalOutput},
+    {.name = "top", .table = ModbusTable::DiscreteInputs, .address = 65535, .count = 1, .object = "measured",
+     .offset = 15},
+};
+constexpr Application mapped{.name = "mapped", .tasks = mapTasks, .publishers = mapPublishers, .modbusMap = validMap};
+static_assert(findConfigurationError(mapped).ok());
+static_assert(dcos::internal::ConfigurationCheck<mapped>::passed);
+
+namespace {
+
+// The valid map above as a run-time configuration, to break one rule at a time.
+Configuration mappedConfiguration()
+{
+    Configuration configuration;
+    configuration.tasks.assign(std::begin(mapTasks), std::end(mapTasks));
+    configuration.publishers.assign(std::begin(mapPublishers), std::end(mapPublishers));
+    configuration.map.assign(std::begin(validMap), std::end(validMap));
+    return configuration;
+}
+
+} // namespace
+
+TEST(ConfigurationRulesTest, AValidModbusMapPasses)
+{
+    EXPECT_TRUE(findConfigurationError(mapped).ok());
+    EXPECT_TRUE(mappedConfiguration().check().ok());
+}
+
+TEST(ConfigurationRulesTest, OverlappingMapEntriesNameTheLaterAndTheSharedAddresses)
+{
+    Configuration configuration = mappedConfiguration();
+    // Holding registers 0 to 7 are "setpoint"; 5 to 9 share 5 to 7.
+    configuration.map.push_back({.name = "speed", .table = ModbusTable::HoldingRegisters, .address = 5, .count = 5,
+                                 .object = "setpoint", .offset = 6});
+    const ConfigurationError error = configuration.check();
+    expectBroken(error, ConfigurationRule::MapOverlap, ObjectKind::ModbusMapEntry, "speed");
+    EXPECT_EQ(error.value, 5u);
+    EXPECT_EQ(error.limit, 7u);
+    EXPECT_EQ(message("demo", error), "application 'demo' not started: Modbus map entry 'speed' overlaps an earlier "
+                                      "entry of its table (5, limit 7)");
+    // Touching is not overlapping, and another table's addresses are its own.
+    configuration.map.back().address = 8;
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.map.back().address = 7;
+    EXPECT_EQ(configuration.check().rule, ConfigurationRule::MapOverlap);
+    // Discrete inputs 7 to 11 are free (the valid map has only 65535 there).
+    configuration.map.back().table = ModbusTable::DiscreteInputs;
+    EXPECT_TRUE(configuration.check().ok());
+}
+
+TEST(ConfigurationRulesTest, AMapEntryEndsAtTheLastModbusAddress)
+{
+    Configuration configuration = mappedConfiguration();
+    configuration.map.push_back({.name = "tail", .table = ModbusTable::Coils, .address = 65530, .count = 6,
+                                 .source = ModbusSource::DigitalOutput});
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.map.back().count = 7;
+    const ConfigurationError error = configuration.check();
+    expectBroken(error, ConfigurationRule::MapAddressPastEnd, ObjectKind::ModbusMapEntry, "tail");
+    EXPECT_EQ(error.value, 65536u);
+    EXPECT_EQ(error.limit, 65535u);
+    // A count near 2^32 does not wrap around into a fit.
+    configuration.map.back().count = 0xFFFFFFFF;
+    EXPECT_EQ(configuration.check().rule, ConfigurationRule::MapAddressPastEnd);
+    configuration.map.back().count = 0;
+    expectBroken(configuration.check(), ConfigurationRule::MapRangeEmpty, ObjectKind::ModbusMapEntry, "tail");
+}
+
+TEST(ConfigurationRulesTest, AMapEntryNamesADeclaredPublisher)
+{
+    Configuration configuration = mappedConfiguration();
+    configuration.map.push_back({.name = "ghost", .table = ModbusTable::InputRegisters, .address = 200,
+                                 .object = "pressure"});
+    expectBroken(configuration.check(), ConfigurationRule::MapObjectNotDeclared, ObjectKind::ModbusMapEntry, "ghost");
+    configuration.map.back().object = nullptr;
+    expectBroken(configuration.check(), ConfigurationRule::MapObjectNotDeclared, ObjectKind::ModbusMapEntry, "ghost");
+}
+
+TEST(ConfigurationRulesTest, AMapEntryFitsItsPageOrTheBoardsPoints)
+{
+    Configuration page = mappedConfiguration();
+    // Eight registers are the whole sixteen-byte page; from byte 2 on they need 18.
+    page.map[0].offset = 2;
+    ConfigurationError error = page.check();
+    expectBroken(error, ConfigurationRule::MapTooLarge, ObjectKind::ModbusMapEntry, "setpoint");
+    EXPECT_EQ(error.value, 18u);
+    EXPECT_EQ(error.limit, 16u);
+    // Sixteen coils are two bytes: from byte 14 they fit, from 15 they do not.
+    Configuration bits = mappedConfiguration();
+    bits.map[1].offset = 15;
+    error = bits.check();
+    expectBroken(error, ConfigurationRule::MapTooLarge, ObjectKind::ModbusMapEntry, "enable");
+    EXPECT_EQ(error.value, 17u);
+    // An offset near 2^32 does not wrap around into a fit.
+    bits.map[1].offset = 0xFFFFFFFF;
+    EXPECT_EQ(bits.check().rule, ConfigurationRule::MapTooLarge);
+
+    Configuration board = mappedConfiguration();
+    board.map[3].offset = 1; // AI1 to AI8: the board has AI0 to AI7.
+    error = board.check();
+    expectBroken(error, ConfigurationRule::MapTooLarge, ObjectKind::ModbusMapEntry, "ai");
+    EXPECT_EQ(error.value, 9u);
+    EXPECT_EQ(error.limit, 8u);
+    board = mappedConfiguration();
+    board.map[4].count = 17;
+    error = board.check();
+    expectBroken(error, ConfigurationRule::MapTooLarge, ObjectKind::ModbusMapEntry, "do");
+    EXPECT_EQ(error.limit, 16u);
+}
+
+TEST(ConfigurationRulesTest, TheMasterWritesOnlyWhatModbusOwns)
+{
+    // The application's own publication cannot be a holding register or a coil.
+    Configuration published = mappedConfiguration();
+    published.map[2].table = ModbusTable::HoldingRegisters;
+    published.map[2].address = 50;
+    const ConfigurationError error = published.check();
+    expectBroken(error, ConfigurationRule::MapWritesReadOnly, ObjectKind::ModbusMapEntry, "measured");
+    EXPECT_EQ(message("demo", error), "application 'demo' not started: Modbus map entry 'measured' is writable "
+                                      "(coils, holding registers) but bound to something read-only");
+    // Nor can an analog input.
+    Configuration analog = mappedConfiguration();
+    analog.map[3].table = ModbusTable::HoldingRegisters;
+    expectBroken(analog.check(), ConfigurationRule::MapWritesReadOnly, ObjectKind::ModbusMapEntry, "ai");
+    // The master's setpoint is also readable as input registers.
+    Configuration readBack = mappedConfiguration();
+    readBack.map.push_back({.name = "echo", .table = ModbusTable::InputRegisters, .address = 20, .count = 8,
+                            .object = "setpoint"});
+    EXPECT_TRUE(readBack.check().ok());
+}
+
+TEST(ConfigurationRulesTest, BoardPointsGoInTheirTables)
+{
+    Configuration analog = mappedConfiguration();
+    analog.map[3].table = ModbusTable::DiscreteInputs;
+    expectBroken(analog.check(), ConfigurationRule::MapSourceWrongTable, ObjectKind::ModbusMapEntry, "ai");
+    Configuration digital = mappedConfiguration();
+    digital.map[4].table = ModbusTable::HoldingRegisters;
+    expectBroken(digital.check(), ConfigurationRule::MapSourceWrongTable, ObjectKind::ModbusMapEntry, "do");
+}
+
+TEST(ConfigurationRulesTest, MapEntriesHaveUniqueNamesAndAreCounted)
+{
+    Configuration twice = mappedConfiguration();
+    twice.map.push_back(twice.map[0]);
+    twice.map.back().address = 300;
+    expectBroken(twice.check(), ConfigurationRule::DuplicateName, ObjectKind::ModbusMapEntry, "setpoint");
+
+    Configuration crowd = mappedConfiguration();
+    std::vector<std::string> names;
+    for (size_t i = crowd.map.size(); i <= dcos::app::kMaximumModbusMapEntries; ++i) {
+        names.push_back("di" + std::to_string(i));
+    }
+    for (size_t i = 0; i < names.size(); ++i) {
+        crowd.map.push_back({.name = names[i].c_str(), .table = ModbusTable::DiscreteInputs,
+                             .address = static_cast<uint32_t>(1000 + i), .object = "measured"});
+    }
+    const ConfigurationError error = crowd.check();
+    EXPECT_EQ(error.rule, ConfigurationRule::TooManyObjects);
+    EXPECT_EQ(error.value, dcos::app::kMaximumModbusMapEntries + 1);
+    EXPECT_EQ(error.limit, dcos::app::kMaximumModbusMapEntries);
 }

@@ -37,6 +37,7 @@
 #include <iobus/IsaResourceManager.hpp>
 #include <iobus/MfioChip.hpp>
 
+#include <dcos/ApplicationDeclarations.hpp>
 #include <dcos/Device.hpp>
 #include <dcos/ObjectId.hpp>
 #include <dcos/Visibility.hpp>
@@ -55,6 +56,11 @@ constexpr uint32_t kDigitalInputs = 16;  ///< DI, the 16 inputs as one word.
 constexpr uint32_t kDigitalOutputs = 17; ///< DO, the 16 outputs as one word.
 constexpr uint32_t kCount = 18;          ///< Channels 0 to kCount - 1 exist.
 } // namespace channel
+
+// An application's Modbus register map is checked against the board's points
+// by the kernel's configuration rules, which cannot include this driver.
+static_assert(dcos::app::kModbusAnalogInputPoints == mfio::kAnalogInputs, "the map's analog inputs are the board's");
+static_assert(dcos::app::kModbusDigitalOutputPoints == mfio::kDigitalBits, "the map's digital outputs are the board's");
 
 /// How conversions complete (Control kSetMode / kGetMode).
 enum class ConversionMode : uint32_t {

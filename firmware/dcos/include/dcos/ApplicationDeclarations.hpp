@@ -81,6 +81,51 @@ struct HeapDeclaration {
     ObjectId* id = nullptr;
 };
 
+/// The four tables a Modbus slave serves ([AP] 4.3). Coils and holding
+/// registers are written by the master; discrete inputs and input registers
+/// only read.
+enum class ModbusTable : uint8_t {
+    Coils,
+    DiscreteInputs,
+    HoldingRegisters,
+    InputRegisters,
+};
+
+/// What a Modbus register map entry serves.
+enum class ModbusSource : uint8_t {
+    /// Bytes of a declared DSM publisher's page, from `offset` on: registers
+    /// two bytes each, high byte first as on the wire; bits packed from bit 0
+    /// of byte `offset`. A publisher with no writer is written by the
+    /// Modbus line (the application subscribes to it and reads what the
+    /// master wrote); a publisher with a writer task is the application's,
+    /// which Modbus only reads.
+    Publisher,
+    /// Analog input channels of the I/O board in raw counts, from channel
+    /// `offset` on, one register each. Read-only.
+    AnalogInput,
+    /// Digital outputs of the I/O board, from output `offset` on, one bit
+    /// each. Written by the master through coils.
+    DigitalOutput,
+};
+
+/// The I/O board's points a map can reach (drivers/iobus: MfioRegisters.hpp's
+/// kAnalogInputs and kDigitalBits, checked equal in MfioBoard.hpp).
+constexpr uint32_t kModbusAnalogInputPoints = 8;
+constexpr uint32_t kModbusDigitalOutputPoints = 16;
+
+/// One range of a Modbus slave's addresses bound to a DCOS object; the
+/// application's `modbusMap` lists them, and the controller's `modbus slave`
+/// line serves them instead of the console's data model.
+struct ModbusMapEntry {
+    const char* name = nullptr;    ///< Required, 1 to 15 characters, unique in the map; errors name it.
+    ModbusTable table = ModbusTable::HoldingRegisters;
+    uint32_t address = 0;          ///< The first address, 0 to 65535.
+    uint32_t count = 1;            ///< Registers or bits; address + count - 1 at most 65535.
+    ModbusSource source = ModbusSource::Publisher;
+    const char* object = nullptr;  ///< Publisher: the declared publisher's name; unused for the I/O board.
+    uint32_t offset = 0;           ///< Publisher: the first byte in its page; I/O board: the first channel.
+};
+
 /// The declared task an object is handed to: its owner, a port's receiver,
 /// a publisher's writer. Null: the object stays the system's. (The loader
 /// never hands a task over.)
@@ -118,6 +163,9 @@ struct Application {
     DeclarationList<PublisherDeclaration> publishers;
     DeclarationList<BufferPoolDeclaration> bufferPools;
     DeclarationList<HeapDeclaration> heaps;
+    /// The Modbus register map the controller's slave serves (empty: the
+    /// console's data model).
+    DeclarationList<ModbusMapEntry> modbusMap;
     /// The system tick the application needs, in Hz (timer resolution is one
     /// tick); 0 keeps the board's default. A tick_hz= on the kernel command
     /// line still wins.

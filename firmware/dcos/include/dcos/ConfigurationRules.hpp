@@ -6,11 +6,13 @@
 // and the application loader, which runs it again at boot on the linked
 // configuration before it creates anything. Rules are checked in declaration
 // order: the application, then tasks, semaphores, ports, publishers, pools
-// and heaps, then the totals; the first broken rule is reported.
+// and heaps, then the totals, then the Modbus register map; the first broken
+// rule is reported.
 #pragma once
 
 #include <dcos/ApplicationDeclarations.hpp>
 #include <dcos/BufferPoolAgent.hpp>
+#include <dcos/DsmAgent.hpp>
 #include <dcos/HeapAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/StackArena.hpp>
@@ -30,6 +32,7 @@ enum class ObjectKind : uint8_t {
     Publisher,
     BufferPool,
     Heap,
+    ModbusMapEntry,
 };
 
 /// The rule a configuration breaks.
@@ -52,6 +55,13 @@ enum class ConfigurationRule : uint8_t {
     AreaMissing,
     AreaTooSmall,         ///< value: areaBytes; limit: the least that holds one buffer or segment.
     BufferTooSmall,       ///< value: bufferSize; limit: kMinimumBufferSize.
+    MapRangeEmpty,        ///< A Modbus map entry of count 0.
+    MapAddressPastEnd,    ///< value: its last address (address + count - 1); limit: 65535.
+    MapSourceWrongTable,  ///< Analog inputs in a bit table, digital outputs in a register table.
+    MapObjectNotDeclared, ///< The entry's publisher is not a declared publisher.
+    MapTooLarge,          ///< value: page bytes or I/O points it needs (offset + size); limit: what there is.
+    MapWritesReadOnly,    ///< A coil or holding register entry bound to something Modbus may not write.
+    MapOverlap,           ///< value: the first address it shares with an earlier entry of its table; limit: the last.
     // Rules only the running node can check (application loader).
     NameInUse,            ///< An object of the node already has the name.
     CreateFailed,         ///< The agent refused; the loader prints its status.
@@ -77,6 +87,11 @@ constexpr size_t kMaximumApplicationName = 31;
 /// Longest object name (every agent's name field holds 15 characters).
 constexpr size_t kMaximumObjectName = 15;
 
+/// Most entries in an application's Modbus register map.
+constexpr size_t kMaximumModbusMapEntries = 32;
+/// The last Modbus address of every table ([AP] 4.4: addresses 0 to 65535).
+constexpr uint32_t kLastModbusAddress = 0xFFFF;
+
 /// Tasks the kernel itself runs on every node (idle, the root task and the console shell).
 constexpr const char* kKernelTaskNames[] = {internal::kIdleTaskName, internal::kRootTaskName,
                                             internal::kShellTaskName};
@@ -100,6 +115,7 @@ constexpr const char* objectKindName(ObjectKind kind)
     case ObjectKind::Publisher: return "publisher";
     case ObjectKind::BufferPool: return "buffer pool";
     case ObjectKind::Heap: return "heap";
+    case ObjectKind::ModbusMapEntry: return "Modbus map entry";
     }
     return "object";
 }
@@ -126,6 +142,15 @@ constexpr const char* ruleText(ConfigurationRule rule)
     case ConfigurationRule::AreaMissing: return "has no memory area";
     case ConfigurationRule::AreaTooSmall: return "has an area too small for one buffer or segment";
     case ConfigurationRule::BufferTooSmall: return "has buffers smaller than kMinimumBufferSize";
+    case ConfigurationRule::MapRangeEmpty: return "has a count of 0";
+    case ConfigurationRule::MapAddressPastEnd: return "runs past the last Modbus address";
+    case ConfigurationRule::MapSourceWrongTable:
+        return "puts its source in the wrong table (analog inputs are registers, digital outputs bits)";
+    case ConfigurationRule::MapObjectNotDeclared: return "names an object that is not a declared publisher";
+    case ConfigurationRule::MapTooLarge: return "does not fit its source (a DSM page, or the I/O board's points)";
+    case ConfigurationRule::MapWritesReadOnly:
+        return "is writable (coils, holding registers) but bound to something read-only";
+    case ConfigurationRule::MapOverlap: return "overlaps an earlier entry of its table";
     case ConfigurationRule::NameInUse: return "has a name another object of the node already uses";
     case ConfigurationRule::CreateFailed: return "was refused by its agent";
     }
@@ -331,6 +356,120 @@ constexpr ConfigurationError checkTotals(const Application& application)
     return {};
 }
 
+constexpr bool isWritable(ModbusTable table)
+{
+    return table == ModbusTable::Coils || table == ModbusTable::HoldingRegisters;
+}
+
+constexpr bool isBitTable(ModbusTable table)
+{
+    return table == ModbusTable::Coils || table == ModbusTable::DiscreteInputs;
+}
+
+constexpr const PublisherDeclaration* findPublisher(const Application& application, const char* name)
+{
+    if (name == nullptr) {
+        return nullptr;
+    }
+    for (const PublisherDeclaration& publisher : application.publishers) {
+        if (textEquals(publisher.name, name)) {
+            return &publisher;
+        }
+    }
+    return nullptr;
+}
+
+/// Page bytes a publisher entry takes: two per register, eight bits a byte.
+constexpr uint64_t pageBytesOf(const ModbusMapEntry& entry)
+{
+    return isBitTable(entry.table) ? (uint64_t{entry.count} + 7) / 8 : uint64_t{entry.count} * 2;
+}
+
+/// The rules one entry keeps on its own; the sizes are summed in 64 bits,
+/// so that no offset or count near 2^32 can wrap around into a fit.
+constexpr ConfigurationError checkMapEntry(const Application& application, const ModbusMapEntry& entry)
+{
+    constexpr ObjectKind kind = ObjectKind::ModbusMapEntry;
+    if (entry.count == 0) {
+        return broken(ConfigurationRule::MapRangeEmpty, kind, entry.name);
+    }
+    const uint64_t last = uint64_t{entry.address} + entry.count - 1;
+    if (last > kLastModbusAddress) {
+        return broken(ConfigurationRule::MapAddressPastEnd, kind, entry.name,
+                      last > SIZE_MAX ? SIZE_MAX : static_cast<size_t>(last), kLastModbusAddress);
+    }
+    uint64_t needed = 0;
+    uint64_t available = 0;
+    bool readOnly = false;
+    switch (entry.source) {
+    case ModbusSource::Publisher: {
+        const PublisherDeclaration* publisher = findPublisher(application, entry.object);
+        if (publisher == nullptr) {
+            return broken(ConfigurationRule::MapObjectNotDeclared, kind, entry.name);
+        }
+        needed = uint64_t{entry.offset} + pageBytesOf(entry);
+        available = kDsmPageSize;
+        // A publisher has one writer: the task declared as its writer, or,
+        // when none is, the Modbus line. The master may only write the latter.
+        readOnly = publisher->writer != nullptr;
+        break;
+    }
+    case ModbusSource::AnalogInput:
+        if (isBitTable(entry.table)) {
+            return broken(ConfigurationRule::MapSourceWrongTable, kind, entry.name);
+        }
+        needed = uint64_t{entry.offset} + entry.count;
+        available = kModbusAnalogInputPoints;
+        readOnly = true;
+        break;
+    case ModbusSource::DigitalOutput:
+        if (!isBitTable(entry.table)) {
+            return broken(ConfigurationRule::MapSourceWrongTable, kind, entry.name);
+        }
+        needed = uint64_t{entry.offset} + entry.count;
+        available = kModbusDigitalOutputPoints;
+        break;
+    }
+    if (needed > available) {
+        return broken(ConfigurationRule::MapTooLarge, kind, entry.name,
+                      needed > SIZE_MAX ? SIZE_MAX : static_cast<size_t>(needed), static_cast<size_t>(available));
+    }
+    if (readOnly && isWritable(entry.table)) {
+        return broken(ConfigurationRule::MapWritesReadOnly, kind, entry.name);
+    }
+    return {};
+}
+
+constexpr ConfigurationError checkModbusMap(const Application& application)
+{
+    const DeclarationList<ModbusMapEntry>& map = application.modbusMap;
+    if (ConfigurationError names = checkNames(map, ObjectKind::ModbusMapEntry); !names.ok()) {
+        return names;
+    }
+    if (ConfigurationError count = checkCount(map, ObjectKind::ModbusMapEntry, kMaximumModbusMapEntries);
+        !count.ok()) {
+        return count;
+    }
+    for (size_t i = 0; i < map.count; ++i) {
+        const ModbusMapEntry& entry = map[i];
+        if (ConfigurationError error = checkMapEntry(application, entry); !error.ok()) {
+            return error;
+        }
+        // Every entry before this one has passed, so no sum below wraps.
+        const uint32_t last = entry.address + entry.count - 1;
+        for (size_t j = 0; j < i; ++j) {
+            const ModbusMapEntry& earlier = map[j];
+            const uint32_t earlierLast = earlier.address + earlier.count - 1;
+            if (earlier.table == entry.table && entry.address <= earlierLast && earlier.address <= last) {
+                const uint32_t first = entry.address > earlier.address ? entry.address : earlier.address;
+                const uint32_t shared = last < earlierLast ? last : earlierLast;
+                return broken(ConfigurationRule::MapOverlap, ObjectKind::ModbusMapEntry, entry.name, first, shared);
+            }
+        }
+    }
+    return {};
+}
+
 } // namespace rules
 
 /// The first rule @p application breaks, or an error with rule None.
@@ -355,6 +494,7 @@ constexpr ConfigurationError findConfigurationError(const Application& applicati
     if (error.ok()) error = rules::checkPortsAndPublishers(application);
     if (error.ok()) error = rules::checkMemoryAreas(application);
     if (error.ok()) error = rules::checkTotals(application);
+    if (error.ok()) error = rules::checkModbusMap(application);
     return error;
 }
 

@@ -324,7 +324,8 @@ Result<ObjectId> ApplicationLoader::find(app::ObjectKind kind, const char* name)
     case ObjectKind::Publisher: return kindServices<app::PublisherDeclaration>.nameToObject(name);
     case ObjectKind::BufferPool: return kindServices<app::BufferPoolDeclaration>.nameToObject(name);
     case ObjectKind::Heap: return kindServices<app::HeapDeclaration>.nameToObject(name);
-    case ObjectKind::Application: break;
+    case ObjectKind::Application:
+    case ObjectKind::ModbusMapEntry: break; // Neither is an object of the node.
     }
     return Status::InvalidArgument;
 }

@@ -20,6 +20,9 @@ bool showsValueAndLimit(ConfigurationRule rule)
     case ConfigurationRule::TickRateOutOfRange:
     case ConfigurationRule::AreaTooSmall:
     case ConfigurationRule::BufferTooSmall:
+    case ConfigurationRule::MapAddressPastEnd:
+    case ConfigurationRule::MapTooLarge:
+    case ConfigurationRule::MapOverlap:
         return true;
     default:
         return false;

@@ -58,6 +58,21 @@ struct ConfigurationRejected {
     static_assert(rule != Rule::AreaMissing, "the pool or heap has no memory area");
     static_assert(rule != Rule::AreaTooSmall, "the area holds not even one buffer or segment (limit: the least)");
     static_assert(rule != Rule::BufferTooSmall, "buffers must be at least BufferPoolAgent::kMinimumBufferSize");
+    static_assert(rule != Rule::MapRangeEmpty, "a Modbus map entry needs a count of at least 1");
+    static_assert(rule != Rule::MapAddressPastEnd,
+                  "the Modbus map entry runs past address 65535 (value: its last address, limit: 65535)");
+    static_assert(rule != Rule::MapSourceWrongTable,
+                  "analog inputs map to registers and digital outputs to coils or discrete inputs");
+    static_assert(rule != Rule::MapObjectNotDeclared, "the Modbus map entry's object is not a declared publisher");
+    static_assert(rule != Rule::MapTooLarge,
+                  "the Modbus map entry does not fit its source (value: the page bytes or I/O points it needs, "
+                  "limit: what there is)");
+    static_assert(rule != Rule::MapWritesReadOnly,
+                  "a coil or holding register entry is bound to something read-only (an analog input, or a "
+                  "publisher with a writer task)");
+    static_assert(rule != Rule::MapOverlap,
+                  "the Modbus map entry overlaps an earlier entry of its table (value: the first shared address, "
+                  "limit: the last)");
     // NameInUse and CreateFailed come from the running node only.
     static constexpr bool passed = rule == Rule::None;
 };
