@@ -185,11 +185,21 @@ def write_map(directory, speed_table="HoldingRegisters", speed_address=4, speed_
     return directory
 
 
-def test_a_valid_modbus_map_compiles(tmp_path):
-    """The map the failures below break one rule of builds, so each failure is the rule's own."""
+def test_a_valid_modbus_map_compiles(tmp_path, boot, isa486):
+    """The map the failures below break one rule of builds, so each failure is the rule's own.
+
+    It boots, and `app` lists the map with the notice that the line does not serve it yet.
+    """
     application = write_map(str(tmp_path / "mapped"))
     result = build_with_staged_sdk(application)
     assert result.returncode == 0, result.stdout + result.stderr
+    emulator = boot(isa486, os.path.join(application, "build", "mapped-486.elf"))
+    emulator.expect(r"dcos> ")
+    output = emulator.command("app")
+    assert "application 'mapped': running" in output, output
+    assert "modbus map, 2 entries, checked; not served yet" in output, output
+    assert re.search(r"setpoint +holding +0-3 +publisher setpoint byte 0", output), output
+    assert re.search(r"speed +holding +4-5 +publisher setpoint byte \d+", output), output
 
 
 @pytest.mark.parametrize("change, phrases", [

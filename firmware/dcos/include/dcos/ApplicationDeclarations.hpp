@@ -114,8 +114,9 @@ constexpr uint32_t kModbusAnalogInputPoints = 8;
 constexpr uint32_t kModbusDigitalOutputPoints = 16;
 
 /// One range of a Modbus slave's addresses bound to a DCOS object; the
-/// application's `modbusMap` lists them, and the controller's `modbus slave`
-/// line serves them instead of the console's data model.
+/// application's `modbusMap` lists them. The compiler and the loader check
+/// them; the controller's `modbus slave` line does not serve them yet (it
+/// serves the console's data model), which the `app` command says.
 struct ModbusMapEntry {
     const char* name = nullptr;    ///< Required, 1 to 15 characters, unique in the map; errors name it.
     ModbusTable table = ModbusTable::HoldingRegisters;
