@@ -35,7 +35,8 @@ bool ApplicationMapModel::covered(ModbusTable table, uint16_t address, uint16_t 
     return true;
 }
 
-ExceptionCode ApplicationMapModel::readBits(ModbusTable table, uint16_t address, uint16_t quantity, uint8_t* bits)
+template <class Each>
+ExceptionCode ApplicationMapModel::forEachEntry(ModbusTable table, uint16_t address, uint16_t quantity, Each each)
 {
     if (!covered(table, address, quantity)) {
         return ExceptionCode::IllegalDataAddress;
@@ -44,8 +45,20 @@ ExceptionCode ApplicationMapModel::readBits(ModbusTable table, uint16_t address,
     while (done < quantity) {
         const uint32_t at = uint32_t{address} + done;
         const ModbusMapEntry& entry = *find(table, at);
-        const uint32_t first = at - entry.address; // The entry's bit the chunk starts at.
+        const uint32_t first = at - entry.address;
         const uint32_t chunk = entry.count - first < quantity - done ? entry.count - first : quantity - done;
+        if (const ExceptionCode code = each(entry, first, done, chunk); code != ExceptionCode::None) {
+            return code;
+        }
+        done += chunk;
+    }
+    return ExceptionCode::None;
+}
+
+ExceptionCode ApplicationMapModel::readBits(ModbusTable table, uint16_t address, uint16_t quantity, uint8_t* bits)
+{
+    return forEachEntry(table, address, quantity,
+                        [&](const ModbusMapEntry& entry, uint32_t first, uint32_t done, uint32_t chunk) {
         if (entry.source == ModbusSource::Publisher) {
             dcos::DsmPage page{};
             if (const ExceptionCode code = backend_.readPage(entry.object, page); code != ExceptionCode::None) {
@@ -64,23 +77,15 @@ ExceptionCode ApplicationMapModel::readBits(ModbusTable table, uint16_t address,
                 modbus::setBit(bits, done + i, ((outputs >> (entry.offset + first + i)) & 1) != 0);
             }
         }
-        done += chunk;
-    }
-    return ExceptionCode::None;
+        return ExceptionCode::None;
+    });
 }
 
 ExceptionCode ApplicationMapModel::readRegisters(ModbusTable table, uint16_t address, uint16_t quantity,
                                                  uint16_t* values)
 {
-    if (!covered(table, address, quantity)) {
-        return ExceptionCode::IllegalDataAddress;
-    }
-    uint32_t done = 0;
-    while (done < quantity) {
-        const uint32_t at = uint32_t{address} + done;
-        const ModbusMapEntry& entry = *find(table, at);
-        const uint32_t first = at - entry.address;
-        const uint32_t chunk = entry.count - first < quantity - done ? entry.count - first : quantity - done;
+    return forEachEntry(table, address, quantity,
+                        [&](const ModbusMapEntry& entry, uint32_t first, uint32_t done, uint32_t chunk) {
         if (entry.source == ModbusSource::Publisher) {
             dcos::DsmPage page{};
             if (const ExceptionCode code = backend_.readPage(entry.object, page); code != ExceptionCode::None) {
@@ -99,9 +104,8 @@ ExceptionCode ApplicationMapModel::readRegisters(ModbusTable table, uint16_t add
                 }
             }
         }
-        done += chunk;
-    }
-    return ExceptionCode::None;
+        return ExceptionCode::None;
+    });
 }
 
 ExceptionCode ApplicationMapModel::readCoils(uint16_t address, uint16_t quantity, uint8_t* bits)
@@ -126,15 +130,8 @@ ExceptionCode ApplicationMapModel::readInputRegisters(uint16_t address, uint16_t
 
 ExceptionCode ApplicationMapModel::writeCoils(uint16_t address, uint16_t quantity, const uint8_t* bits)
 {
-    if (!covered(ModbusTable::Coils, address, quantity)) {
-        return ExceptionCode::IllegalDataAddress;
-    }
-    uint32_t done = 0;
-    while (done < quantity) {
-        const uint32_t at = uint32_t{address} + done;
-        const ModbusMapEntry& entry = *find(ModbusTable::Coils, at);
-        const uint32_t first = at - entry.address;
-        const uint32_t chunk = entry.count - first < quantity - done ? entry.count - first : quantity - done;
+    return forEachEntry(ModbusTable::Coils, address, quantity,
+                        [&](const ModbusMapEntry& entry, uint32_t first, uint32_t done, uint32_t chunk) {
         if (entry.source == ModbusSource::Publisher) {
             dcos::DsmPage page{};
             if (const ExceptionCode code = backend_.readPage(entry.object, page); code != ExceptionCode::None) {
@@ -160,22 +157,14 @@ ExceptionCode ApplicationMapModel::writeCoils(uint16_t address, uint16_t quantit
                 return code;
             }
         }
-        done += chunk;
-    }
-    return ExceptionCode::None;
+        return ExceptionCode::None;
+    });
 }
 
 ExceptionCode ApplicationMapModel::writeHoldingRegisters(uint16_t address, uint16_t quantity, const uint16_t* values)
 {
-    if (!covered(ModbusTable::HoldingRegisters, address, quantity)) {
-        return ExceptionCode::IllegalDataAddress;
-    }
-    uint32_t done = 0;
-    while (done < quantity) {
-        const uint32_t at = uint32_t{address} + done;
-        const ModbusMapEntry& entry = *find(ModbusTable::HoldingRegisters, at);
-        const uint32_t first = at - entry.address;
-        const uint32_t chunk = entry.count - first < quantity - done ? entry.count - first : quantity - done;
+    return forEachEntry(ModbusTable::HoldingRegisters, address, quantity,
+                        [&](const ModbusMapEntry& entry, uint32_t first, uint32_t done, uint32_t chunk) {
         // The configuration rules allow only writable publishers here.
         dcos::DsmPage page{};
         if (const ExceptionCode code = backend_.readPage(entry.object, page); code != ExceptionCode::None) {
@@ -189,9 +178,8 @@ ExceptionCode ApplicationMapModel::writeHoldingRegisters(uint16_t address, uint1
         if (const ExceptionCode code = backend_.writePage(entry.object, page); code != ExceptionCode::None) {
             return code;
         }
-        done += chunk;
-    }
-    return ExceptionCode::None;
+        return ExceptionCode::None;
+    });
 }
 
 } // namespace mbline

@@ -68,6 +68,14 @@ private:
     const dcos::app::ModbusMapEntry* find(dcos::app::ModbusTable table, uint32_t address) const;
     /// Whether every address of the range is in some entry of @p table.
     bool covered(dcos::app::ModbusTable table, uint16_t address, uint16_t quantity) const;
+    /// Refuses a range with an unmapped address (IllegalDataAddress) before
+    /// anything is read or written, then calls @p each(entry, first, done,
+    /// chunk) for every entry the range crosses, in address order: the
+    /// entry's item the chunk starts at, the request's items before it, and
+    /// how many of the entry's items the request takes. Stops at the first
+    /// exception @p each returns.
+    template <class Each>
+    modbus::ExceptionCode forEachEntry(dcos::app::ModbusTable table, uint16_t address, uint16_t quantity, Each each);
     modbus::ExceptionCode readBits(dcos::app::ModbusTable table, uint16_t address, uint16_t quantity, uint8_t* bits);
     modbus::ExceptionCode readRegisters(dcos::app::ModbusTable table, uint16_t address, uint16_t quantity,
                                         uint16_t* values);
