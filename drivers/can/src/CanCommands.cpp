@@ -240,23 +240,32 @@ CommandResult send(shell::Shell& shell, int argc, char** argv)
     return CommandResult::Ok;
 }
 
+// The arguments of a subcommand that waits on a channel: "<channel>
+// [count] [time-out ms]", the channel up, the count from @p leastCount to
+// 10000. False, with the usage or the error printed, otherwise.
+bool channelCountTimeout(shell::Shell& shell, int argc, char** argv, const char* usage, unsigned long leastCount,
+                         unsigned& channel, unsigned long& count, unsigned long& timeoutMs)
+{
+    if (argc < 3 || argc > 5) {
+        shell.print("usage: %s <channel> [count] [time-out ms]\r\n", usage);
+        return false;
+    }
+    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
+        return false;
+    }
+    if (argc >= 4 && (!shell::Shell::parseUnsigned(argv[3], count) || count < leastCount || count > 10000)) {
+        shell.print("error: count '%s' is not a number from %lu to 10000\r\n", argv[3], leastCount);
+        return false;
+    }
+    return argc != 5 || parseMilliseconds(shell, argv[4], timeoutMs);
+}
+
 CommandResult dump(shell::Shell& shell, int argc, char** argv)
 {
     unsigned channel;
     unsigned long count = 1;
     unsigned long timeoutMs = kDefaultDumpTimeoutMs;
-    if (argc < 3 || argc > 5) {
-        shell.print("usage: can dump <channel> [count] [time-out ms]\r\n");
-        return CommandResult::Failed;
-    }
-    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
-        return CommandResult::Failed;
-    }
-    if (argc >= 4 && (!shell::Shell::parseUnsigned(argv[3], count) || count == 0 || count > 10000)) {
-        shell.print("error: count '%s' is not a number from 1 to 10000\r\n", argv[3]);
-        return CommandResult::Failed;
-    }
-    if (argc == 5 && !parseMilliseconds(shell, argv[4], timeoutMs)) {
+    if (!channelCountTimeout(shell, argc, argv, "can dump", 1, channel, count, timeoutMs)) {
         return CommandResult::Failed;
     }
     listenHere(channel);
@@ -524,18 +533,7 @@ CommandResult events(shell::Shell& shell, int argc, char** argv)
     unsigned channel;
     unsigned long wanted = 0;
     unsigned long timeoutMs = kDefaultDumpTimeoutMs;
-    if (argc < 3 || argc > 5) {
-        shell.print("usage: can events <channel> [count] [time-out ms]\r\n");
-        return CommandResult::Failed;
-    }
-    if (!parseChannel(shell, argv[2], channel) || !requireUp(shell, channel)) {
-        return CommandResult::Failed;
-    }
-    if (argc >= 4 && (!shell::Shell::parseUnsigned(argv[3], wanted) || wanted > 10000)) {
-        shell.print("error: count '%s' is not a number from 0 to 10000\r\n", argv[3]);
-        return CommandResult::Failed;
-    }
-    if (argc == 5 && !parseMilliseconds(shell, argv[4], timeoutMs)) {
+    if (!channelCountTimeout(shell, argc, argv, "can events", 0, channel, wanted, timeoutMs)) {
         return CommandResult::Failed;
     }
     listenHere(channel);

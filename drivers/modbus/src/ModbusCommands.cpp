@@ -541,10 +541,15 @@ CommandResult awaitCompletion(shell::Shell& shell)
     return CommandResult::Ok;
 }
 
-// Submits the mailbox's request and, unless only submitting, waits for the
-// transaction to end.
-CommandResult transact(shell::Shell& shell)
+// Submits the request the console built (or says why it could not be
+// built) and, unless only submitting, waits for the transaction to end.
+CommandResult transactRequest(shell::Shell& shell, const modbus::ModbusResult<modbus::Request>& request)
 {
+    if (!request.ok()) {
+        shell.print("error: %s\r\n", modbus::modbusErrorName(request.error()));
+        return CommandResult::Failed;
+    }
+    mailbox.request = request.value();
     if (!submitRequest(shell)) {
         return CommandResult::Failed;
     }
@@ -576,12 +581,7 @@ CommandResult read(shell::Shell& shell, int argc, char** argv)
         : table == Table::Inputs   ? modbus::Request::readDiscreteInputs(u, a, n)
         : table == Table::Holding  ? modbus::Request::readHoldingRegisters(u, a, n)
                                    : modbus::Request::readInputRegisters(u, a, n);
-    if (!request.ok()) {
-        shell.print("error: %s\r\n", modbus::modbusErrorName(request.error()));
-        return CommandResult::Failed;
-    }
-    mailbox.request = request.value();
-    return transact(shell);
+    return transactRequest(shell, request);
 }
 
 // write <unit> <coils|holding> <address> <value>...: one value is function
@@ -619,12 +619,7 @@ CommandResult write(shell::Shell& shell, int argc, char** argv)
                                             : modbus::Request::writeMultipleCoils(u, a, n, bits))
                               : (count == 1 ? modbus::Request::writeSingleRegister(u, a, values[0])
                                             : modbus::Request::writeMultipleRegisters(u, a, n, values));
-    if (!request.ok()) {
-        shell.print("error: %s\r\n", modbus::modbusErrorName(request.error()));
-        return CommandResult::Failed;
-    }
-    mailbox.request = request.value();
-    return transact(shell);
+    return transactRequest(shell, request);
 }
 
 // data <table> <address> <count>: the console slave's own data, read here.
