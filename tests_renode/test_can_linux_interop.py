@@ -45,6 +45,11 @@ from dcoslab.labvm import LabVM, SlcanSetup
 from dcoslab.slcan_bridge import SlcanBridge, parse_lawicel, to_lawicel
 from dcoslab.vmworld import Report, World, attach_reports
 
+# The module's tests share a module-scoped lab VM: xdist (--dist loadgroup in
+# pytest.ini) keeps them on one worker, in order: the VM runs one script in phases
+# that the tests follow in order.
+pytestmark = pytest.mark.xdist_group("test_can_linux_interop")
+
 BITRATE = 500_000
 PACE = 1.0  # emulated time runs no faster than wall time while the slow VM works
 BOOT_TIMEOUT = 240  # the VM's boot; generous, it bounds a hang

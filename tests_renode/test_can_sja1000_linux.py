@@ -34,6 +34,11 @@ from dcoslab import vmworld
 from dcoslab.labvm import LabVM, Sja1000Setup
 from dcoslab.vmworld import World, attach_reports, candump_form
 
+# The module's tests share a module-scoped lab VM: xdist (--dist loadgroup in
+# pytest.ini) keeps them on one worker, in order: the VM runs one script in phases
+# that the tests follow in order.
+pytestmark = pytest.mark.xdist_group("test_can_sja1000_linux")
+
 BITRATE = 500_000
 PACE = 1.0  # emulated time runs no faster than wall time while the slow VM works
 BOOT_TIMEOUT = 240  # the VM's boot; generous, it bounds a hang

@@ -20,6 +20,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from dcoslab.board import REPOSITORY  # noqa: E402
 from labvm import LabVMError, check_command, parse_checks, run  # noqa: E402
 
+# The module's tests share a module-scoped lab VM: xdist (--dist loadgroup in
+# pytest.ini) keeps them on one worker, in order: one VM runs every check the tests read.
+pytestmark = pytest.mark.xdist_group("test_dcos_can_labvm")
+
 DCOS_CAN = os.path.join(REPOSITORY, "build", "host_tools", "bin", "dcos-can")
 BOOT_TIMEOUT = 240
 CHECK_TIMEOUT = 60

@@ -12,6 +12,10 @@ import sys
 
 import pytest
 
+# The module's tests share a module-scoped lab VM: xdist (--dist loadgroup in
+# pytest.ini) keeps them on one worker, so that each VM fixture boots once.
+pytestmark = pytest.mark.xdist_group("test_labvm")
+
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from dcoslab.labvm import lab_vm  # noqa: E402,F401 (the fixture)

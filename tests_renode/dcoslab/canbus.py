@@ -597,6 +597,15 @@ class Hub:
         """Waits until every board has passed emulated time ns."""
         self.wait_for(lambda: self.boundary - self.quantum_ns >= ns, timeout, f"emulated time {ns} ns")
 
+    def wait_on_bus(self, port_names, timeout):
+        """Waits until every named port is on the bus (it has counted the 11
+        recessive bits by which a starting node integrates, ISO 11898-1):
+        a node still waiting neither receives nor acknowledges a frame."""
+        def joined():
+            now = self.boundary - self.quantum_ns
+            return all(port.state_at(now).mode == "on" for name in port_names for port in self._find_ports(name))
+        self.wait_for(joined, timeout, f"{', '.join(port_names)} to join the bus")
+
     def wait_for_records(self, predicate, timeout, what="the frames asked for"):
         """Waits until predicate(records) is true; returns the records."""
         self.wait_for(lambda: predicate(self.records), timeout, what)

@@ -95,15 +95,21 @@ def _parse_entry(channel, uptime, kind, rest):
 class LabBoard:
     """One booted board of the lab: its emulator and the `canlab` command."""
 
-    def __init__(self, name, emulator):
+    def __init__(self, name, emulator, hub=None):
         self.name = name
         self.emulator = emulator
+        self.hub = hub
 
     def command(self, line, timeout=DEFAULT_TIMEOUT):
         return self.emulator.command(line, timeout=timeout)
 
-    def init(self, channel, bitrate=None, btr=None, listen=False, selftest=False):
-        """Resets the channel, sets PeliCAN mode, the bit rate and every interrupt, and starts it."""
+    def init(self, channel, bitrate=None, btr=None, listen=False, selftest=False, join=True, timeout=DEFAULT_TIMEOUT):
+        """Resets the channel, sets PeliCAN mode, the bit rate and every
+        interrupt, and starts it; with join, waits until the hub has it on the
+        bus. A chip that has just left reset mode counts 11 recessive bits
+        before it takes part (1.1 ms at 10 kbit/s), and a frame sent meanwhile
+        is neither received nor acknowledged by it: without the wait, a test's
+        first frame would depend on how fast the host typed the commands."""
         btr0, btr1 = btr if btr is not None else CIA_BIT_TIMING[bitrate]
         words = [f"canlab init {channel} {btr0:#04x} {btr1:#04x}"]
         if listen:
@@ -113,6 +119,8 @@ class LabBoard:
         output = self.command(" ".join(words))
         if f"CANINIT {channel}" not in output:
             raise AssertionError(f"{self.name}: canlab init failed:\n{output}")
+        if join and self.hub is not None:
+            self.hub.wait_on_bus([f"{self.name}.{channel}"], timeout)
 
     def send(self, channel, id, data=b"", extended=False, remote=False, dlc=None, once=False, self_rx=False,
              at_ms=None, count=1, timeout=DEFAULT_TIMEOUT):
@@ -233,7 +241,7 @@ class CanLab:
                 emulator = boot(board_definition, kind, icount=True, name=name,
                                 device_properties={"isa-sja1000": properties},
                                 extra_args=["-rtc", f"base={RTC_BASE}"])
-                self.boards[name] = LabBoard(name, emulator)
+                self.boards[name] = LabBoard(name, emulator, self.hub)
             for board in self.boards.values():
                 board.emulator.expect(r"dcos> ", timeout=timeout)
         except BaseException:
