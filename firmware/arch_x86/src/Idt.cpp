@@ -41,9 +41,9 @@ Idt::Handler exceptionHandler = unhandled;
 Idt::Handler interruptHandler = unhandled;
 Idt::Handler trapHandler = unhandled;
 Idt::Handler outermostExitHook = unchanged;
-volatile unsigned depth = 0;
-
 } // namespace
+
+volatile unsigned Idt::depth_ = 0;
 
 void Idt::install()
 {
@@ -72,15 +72,12 @@ InterruptFrame* Idt::dispatchInterrupt(InterruptFrame* frame) { return interrupt
 
 void Idt::setOutermostExitHook(Handler hook) { outermostExitHook = hook; }
 
-unsigned Idt::nestingDepth() { return depth; }
-
 } // namespace arch_x86
 
-/// The single C++ entry for every vector, called from interrupt_common.
 extern "C" arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame)
 {
     using namespace arch_x86;
-    depth = depth + 1;
+    Idt::depth_ = Idt::depth_ + 1;
     const uint32_t vector = frame->vector;
     InterruptFrame* resume;
     if (vector < exceptionVectorCount) {
@@ -90,9 +87,9 @@ extern "C" arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* fr
     } else {
         resume = interruptHandler(frame);
     }
-    if (depth == 1) {
+    if (Idt::depth_ == 1) {
         resume = outermostExitHook(resume);
     }
-    depth = depth - 1;
+    Idt::depth_ = Idt::depth_ - 1;
     return resume;
 }

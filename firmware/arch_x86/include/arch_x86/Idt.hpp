@@ -9,6 +9,9 @@
 
 #include <arch_x86/InterruptFrame.hpp>
 
+/// The single C++ entry for every vector, called from interrupt_common.
+extern "C" arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame);
+
 namespace arch_x86 {
 
 class Idt {
@@ -49,7 +52,14 @@ public:
     static void setOutermostExitHook(Handler hook);
 
     /// The current nesting depth of interrupt handlers (0 in task context).
-    static unsigned nestingDepth();
+    /// Inline: every blocking service asks, on its fast path.
+    static unsigned nestingDepth() { return depth_; }
+
+private:
+    friend arch_x86::InterruptFrame* (::interruptEntry)(arch_x86::InterruptFrame* frame);
+
+    // Raised and lowered by interruptEntry around each handler.
+    static volatile unsigned depth_;
 };
 
 } // namespace arch_x86

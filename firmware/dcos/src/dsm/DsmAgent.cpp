@@ -210,18 +210,30 @@ Status DsmAgent::Delete(ObjectId id) const
 Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page) const
 {
     arch_x86::InterruptGuard guard;
-    start();
-    const Result<PublisherObject*> resolved = resolvePublisher(id);
-    if (!resolved.ok()) {
-        return resolved.status();
-    }
-    if (!internal::inInterruptContext()) {
-        const Status owner = publisherTable.checkOwner(id, internal::currentTaskId());
-        if (owner != Status::Ok) {
-            return owner; // Single writer: the owner, super user or not.
+    // The fast path: the table's inline lookup, with the owner, for a live
+    // publisher written by its owner (or by an interrupt handler).
+    ObjectId owner;
+    PublisherObject* const* found = publisherTable.find(id, owner);
+    PublisherObject* writable = nullptr;
+    if (found != nullptr && !(*found)->dying
+        && (internal::inInterruptContext()
+            || (internal::Scheduler::started() && owner == internal::Scheduler::current().id))) [[likely]] {
+        writable = *found;
+    } else {
+        start();
+        const Result<PublisherObject*> resolved = resolvePublisher(id);
+        if (!resolved.ok()) {
+            return resolved.status();
         }
+        if (!internal::inInterruptContext()) {
+            const Status ownerCheck = publisherTable.checkOwner(id, internal::currentTaskId());
+            if (ownerCheck != Status::Ok) {
+                return ownerCheck; // Single writer: the owner, super user or not.
+            }
+        }
+        writable = resolved.value();
     }
-    PublisherObject& publisher = *resolved.value();
+    PublisherObject& publisher = *writable;
     publisher.page = page;
     publisher.dataId = publisher.dataId + 1 == kNoDsmData ? publisher.dataId + 2 : publisher.dataId + 1;
     const uint32_t written = publisher.dataId;
@@ -283,17 +295,25 @@ Status DsmAgent::Close(ObjectId id) const
 Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& page, uint64_t timeoutNs) const
 {
     arch_x86::InterruptGuard guard;
-    start();
-    const Result<SubscriptionObject*> subscription = resolveSubscription(id);
-    if (!subscription.ok()) {
-        return subscription.status();
+    // The fast path: the table's inline lookup, with the owner, for the
+    // subscription's owner; anything else is resolved and checked in full.
+    ObjectId owner;
+    SubscriptionObject* subscription = subscriptionTable.find(id, owner);
+    if (subscription == nullptr || !internal::Scheduler::started() || owner != internal::Scheduler::current().id)
+        [[unlikely]] {
+        start();
+        const Result<SubscriptionObject*> resolved = resolveSubscription(id);
+        if (!resolved.ok()) {
+            return resolved.status();
+        }
+        const Status ownerCheck = subscriptionTable.checkOwner(id, internal::currentTaskId());
+        if (ownerCheck != Status::Ok) {
+            return ownerCheck;
+        }
+        subscription = resolved.value();
     }
-    const Status owner = subscriptionTable.checkOwner(id, internal::currentTaskId());
-    if (owner != Status::Ok) {
-        return owner;
-    }
-    PublisherObject& publisher = internal::publishers[internal::publisherSlotOf(subscription.value()->publisher)];
-    if (publisher.incarnation != subscription.value()->incarnation) {
+    PublisherObject& publisher = internal::publishers[internal::publisherSlotOf(subscription->publisher)];
+    if (publisher.incarnation != subscription->incarnation) {
         return Status::Deleted;
     }
     if (publisher.dataId != kNoDsmData && publisher.dataId != lastSeenDataId) {

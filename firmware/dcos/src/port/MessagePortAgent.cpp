@@ -167,6 +167,69 @@ using internal::resolvePort;
 using internal::start;
 using internal::TaskManager;
 
+namespace {
+
+// The complete Send and Receive: every case, from a resolved id. The
+// agent's fast paths (below) come here for all they do not handle.
+[[gnu::noinline]] Status sendFull(ObjectId id, const Message& message, int priority)
+{
+    if (!MessageQueue::isValidPriority(priority)) {
+        return Status::InvalidArgument;
+    }
+    arch_x86::InterruptGuard guard;
+    start();
+    const Result<PortObject*> resolved = resolvePort(id);
+    if (!resolved.ok()) {
+        return resolved.status();
+    }
+    PortObject& port = *resolved.value();
+    if (!port.receivers.isEmpty()) {
+        // A receiver waits only while the queue is empty, so this message is
+        // the one it gets: hand it over without taking a buffer.
+        internal::Task& receiver = port.receivers.first();
+        *reinterpret_cast<Message*>(receiver.waitData) = message;
+        TaskManager::wakeFirst(port.receivers, Status::Ok);
+        return Status::Ok;
+    }
+    MessageBuffer* buffer = bufferPool.take();
+    if (buffer == nullptr) {
+        return Status::NoMemory; // Refused, not dropped: the sender decides.
+    }
+    buffer->message = message;
+    port.queue.post(*buffer, priority);
+    return Status::Ok;
+}
+
+[[gnu::noinline]] Status receiveFull(ObjectId id, Message& message, uint64_t timeoutNs)
+{
+    arch_x86::InterruptGuard guard;
+    start();
+    const Result<PortObject*> resolved = resolvePort(id);
+    if (!resolved.ok()) {
+        return resolved.status();
+    }
+    const Status owner = portTable.checkOwner(id, internal::currentTaskId());
+    if (owner != Status::Ok) {
+        return owner; // N-to-1: the owner is the only receiver, super user or not.
+    }
+    PortObject& port = *resolved.value();
+    if (MessageBuffer* buffer = port.queue.takeFirst()) {
+        message = buffer->message;
+        bufferPool.give(*buffer);
+        return Status::Ok;
+    }
+    if (timeoutNs == kPoll) {
+        return Status::WouldBlock;
+    }
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    internal::Scheduler::current().waitData = reinterpret_cast<uintptr_t>(&message);
+    return TaskManager::blockOn(port.receivers, timeoutNs);
+}
+
+} // namespace
+
 Result<ObjectId> MessagePortAgent::Create(const char* name, Visibility visibility, PortOrder order) const
 {
     if (order != PortOrder::Priority && order != PortOrder::Fifo) {
@@ -207,59 +270,40 @@ Status MessagePortAgent::Delete(ObjectId id) const
 
 Status MessagePortAgent::Send(ObjectId id, const Message& message, int priority) const
 {
-    if (!MessageQueue::isValidPriority(priority)) {
-        return Status::InvalidArgument;
+    // The fast path queues a message on a live port no receiver waits at;
+    // a hand-over to a waiting receiver, an error or a wrong id goes the full way.
+    if (MessageQueue::isValidPriority(priority)) [[likely]] {
+        arch_x86::InterruptGuard guard;
+        PortObject* const* found = portTable.find(id);
+        if (found != nullptr && !(*found)->dying && (*found)->receivers.isEmpty()) [[likely]] {
+            if (MessageBuffer* buffer = bufferPool.take()) [[likely]] {
+                buffer->message = message;
+                (*found)->queue.post(*buffer, priority);
+                return Status::Ok;
+            }
+        }
     }
-    arch_x86::InterruptGuard guard;
-    start();
-    const Result<PortObject*> resolved = resolvePort(id);
-    if (!resolved.ok()) {
-        return resolved.status();
-    }
-    PortObject& port = *resolved.value();
-    if (!port.receivers.isEmpty()) {
-        // A receiver waits only while the queue is empty, so this message is
-        // the one it gets: hand it over without taking a buffer.
-        internal::Task& receiver = port.receivers.first();
-        *reinterpret_cast<Message*>(receiver.waitData) = message;
-        TaskManager::wakeFirst(port.receivers, Status::Ok);
-        return Status::Ok;
-    }
-    MessageBuffer* buffer = bufferPool.take();
-    if (buffer == nullptr) {
-        return Status::NoMemory; // Refused, not dropped: the sender decides.
-    }
-    buffer->message = message;
-    port.queue.post(*buffer, priority);
-    return Status::Ok;
+    return sendFull(id, message, priority);
 }
 
 Status MessagePortAgent::Receive(ObjectId id, Message& message, uint64_t timeoutNs) const
 {
-    arch_x86::InterruptGuard guard;
-    start();
-    const Result<PortObject*> resolved = resolvePort(id);
-    if (!resolved.ok()) {
-        return resolved.status();
+    // The fast path takes a queued message for the port's owner; an empty
+    // queue (a wait), an error or a wrong id goes the full way.
+    {
+        arch_x86::InterruptGuard guard;
+        ObjectId owner;
+        PortObject* const* found = portTable.find(id, owner);
+        if (found != nullptr && !(*found)->dying && internal::Scheduler::started()
+            && owner == internal::Scheduler::current().id) [[likely]] {
+            if (MessageBuffer* buffer = (*found)->queue.takeFirst()) {
+                message = buffer->message;
+                bufferPool.give(*buffer);
+                return Status::Ok;
+            }
+        }
     }
-    const Status owner = portTable.checkOwner(id, internal::currentTaskId());
-    if (owner != Status::Ok) {
-        return owner; // N-to-1: the owner is the only receiver, super user or not.
-    }
-    PortObject& port = *resolved.value();
-    if (MessageBuffer* buffer = port.queue.takeFirst()) {
-        message = buffer->message;
-        bufferPool.give(*buffer);
-        return Status::Ok;
-    }
-    if (timeoutNs == kPoll) {
-        return Status::WouldBlock;
-    }
-    if (internal::inInterruptContext()) {
-        return Status::InInterrupt;
-    }
-    internal::Scheduler::current().waitData = reinterpret_cast<uintptr_t>(&message);
-    return TaskManager::blockOn(port.receivers, timeoutNs);
+    return receiveFull(id, message, timeoutNs);
 }
 
 Status MessagePortAgent::AddMsgBufs(size_t count) const

@@ -146,6 +146,96 @@ size_t semaphoreCount()
     return table.usedCount();
 }
 
+// The complete Acquire and Release: every case, from a resolved id.
+// The agent's fast paths (below) come here for all they do not handle.
+[[gnu::noinline]] Status acquireFull(ObjectId id, uint64_t timeout)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> resolved = resolve(id);
+    if (!resolved.ok()) {
+        return resolved.status();
+    }
+    Semaphore& semaphore = *resolved.value();
+    const bool inInterrupt = inInterruptContext();
+    if (semaphore.kind == SemaphoreKind::Binary) {
+        if (semaphore.count == 1) {
+            if (inInterrupt) {
+                return Status::InInterrupt; // A handler cannot hold a semaphore.
+            }
+            semaphore.count = 0;
+            takeHold(semaphore, Scheduler::current());
+            return Status::Ok;
+        }
+        if (!inInterrupt && semaphore.holder == &Scheduler::current()) {
+            return Status::Deadlock;
+        }
+    } else if (semaphore.count > 0) {
+        semaphore.count = semaphore.count - 1;
+        return Status::Ok;
+    }
+    if (timeout == kPoll) {
+        return Status::WouldBlock;
+    }
+    if (inInterrupt) {
+        return Status::InInterrupt;
+    }
+    Task& self = Scheduler::current();
+    // The unit is handed over by Release, so success needs no retry.
+    semaphore.waiters.add(self);
+    self.waitingOn = &semaphore.waiters;
+    if (semaphore.inheritance && semaphore.holder != nullptr) {
+        TaskManager::recomputePriority(*semaphore.holder);
+    }
+    return TaskManager::blockCurrent(WaitReason::Object, timeout);
+}
+
+[[gnu::noinline]] Status releaseFull(ObjectId id)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> resolved = resolve(id);
+    if (!resolved.ok()) {
+        return resolved.status();
+    }
+    Semaphore& semaphore = *resolved.value();
+    if (semaphore.kind == SemaphoreKind::Binary) {
+        if (inInterruptContext() || semaphore.holder != &Scheduler::current()) {
+            return Status::NotOwner;
+        }
+        Task& self = Scheduler::current();
+        if (semaphore.waiters.isEmpty()) {
+            dropHold(semaphore);
+            semaphore.count = 1;
+            return Status::Ok;
+        }
+        // Hand the semaphore straight to the first waiter, so no other task
+        // can slip in between and the waiter's wait always succeeds. The
+        // waiter is readied before this task drops back from the priority
+        // it inherited: dropping first would let a task of middling
+        // priority run before the waiter (the very inversion inheritance
+        // exists to prevent).
+        self.heldSources.remove(semaphore);
+        semaphore.holder = nullptr;
+        Task& next = semaphore.waiters.first();
+        semaphore.waiters.remove(next);
+        next.waitingOn = nullptr;
+        takeHold(semaphore, next);
+        TaskManager::wake(next, Status::Ok);
+        if (semaphore.inheritance) {
+            TaskManager::recomputePriority(self);
+        }
+        return Status::Ok;
+    }
+    if (!semaphore.waiters.isEmpty()) {
+        TaskManager::wakeFirst(semaphore.waiters, Status::Ok);
+        return Status::Ok;
+    }
+    if (semaphore.count == semaphore.maximum) {
+        return Status::InvalidArgument; // The count would exceed its maximum.
+    }
+    semaphore.count = semaphore.count + 1;
+    return Status::Ok;
+}
+
 } // namespace internal
 
 using internal::Scheduler;
@@ -213,90 +303,52 @@ Status SemaphoreAgent::Delete(ObjectId id) const
 
 Status SemaphoreAgent::Acquire(ObjectId id, uint64_t timeout) const
 {
-    arch_x86::InterruptGuard guard;
-    const Result<Semaphore*> resolved = internal::resolve(id);
-    if (!resolved.ok()) {
-        return resolved.status();
-    }
-    Semaphore& semaphore = *resolved.value();
-    const bool inInterrupt = internal::inInterruptContext();
-    if (semaphore.kind == SemaphoreKind::Binary) {
-        if (semaphore.count == 1) {
-            if (inInterrupt) {
-                return Status::InInterrupt; // A handler cannot hold a semaphore.
+    // The fast path takes a free semaphore (or a unit of a counting one)
+    // from a task; everything else, a wrong id included, goes the full way.
+    {
+        arch_x86::InterruptGuard guard;
+        Semaphore* const* found = internal::table.find(id);
+        if (found != nullptr) [[likely]] {
+            Semaphore& semaphore = **found;
+            if (semaphore.kind == SemaphoreKind::Binary) {
+                if (semaphore.count == 1 && !internal::inInterruptContext()) {
+                    semaphore.count = 0;
+                    internal::takeHold(semaphore, Scheduler::current());
+                    return Status::Ok;
+                }
+            } else if (semaphore.count > 0) {
+                semaphore.count = semaphore.count - 1;
+                return Status::Ok;
             }
-            semaphore.count = 0;
-            internal::takeHold(semaphore, Scheduler::current());
-            return Status::Ok;
         }
-        if (!inInterrupt && semaphore.holder == &Scheduler::current()) {
-            return Status::Deadlock;
-        }
-    } else if (semaphore.count > 0) {
-        semaphore.count = semaphore.count - 1;
-        return Status::Ok;
     }
-    if (timeout == kPoll) {
-        return Status::WouldBlock;
-    }
-    if (inInterrupt) {
-        return Status::InInterrupt;
-    }
-    Task& self = Scheduler::current();
-    // The unit is handed over by Release, so success needs no retry.
-    semaphore.waiters.add(self);
-    self.waitingOn = &semaphore.waiters;
-    if (semaphore.inheritance && semaphore.holder != nullptr) {
-        TaskManager::recomputePriority(*semaphore.holder);
-    }
-    return TaskManager::blockCurrent(internal::WaitReason::Object, timeout);
+    return internal::acquireFull(id, timeout);
 }
 
 Status SemaphoreAgent::Release(ObjectId id) const
 {
-    arch_x86::InterruptGuard guard;
-    const Result<Semaphore*> resolved = internal::resolve(id);
-    if (!resolved.ok()) {
-        return resolved.status();
-    }
-    Semaphore& semaphore = *resolved.value();
-    if (semaphore.kind == SemaphoreKind::Binary) {
-        if (internal::inInterruptContext() || semaphore.holder != &Scheduler::current()) {
-            return Status::NotOwner;
+    // The fast path gives back what no task waits for; a hand-over to a
+    // waiter, an error or a wrong id goes the full way.
+    {
+        arch_x86::InterruptGuard guard;
+        Semaphore* const* found = internal::table.find(id);
+        if (found != nullptr) [[likely]] {
+            Semaphore& semaphore = **found;
+            if (semaphore.waiters.isEmpty()) {
+                if (semaphore.kind == SemaphoreKind::Binary) {
+                    if (semaphore.holder == &Scheduler::current() && !internal::inInterruptContext()) {
+                        internal::dropHold(semaphore);
+                        semaphore.count = 1;
+                        return Status::Ok;
+                    }
+                } else if (semaphore.count != semaphore.maximum) {
+                    semaphore.count = semaphore.count + 1;
+                    return Status::Ok;
+                }
+            }
         }
-        Task& self = Scheduler::current();
-        if (semaphore.waiters.isEmpty()) {
-            internal::dropHold(semaphore);
-            semaphore.count = 1;
-            return Status::Ok;
-        }
-        // Hand the semaphore straight to the first waiter, so no other task
-        // can slip in between and the waiter's wait always succeeds. The
-        // waiter is readied before this task drops back from the priority
-        // it inherited: dropping first would let a task of middling
-        // priority run before the waiter (the very inversion inheritance
-        // exists to prevent).
-        self.heldSources.remove(semaphore);
-        semaphore.holder = nullptr;
-        Task& next = semaphore.waiters.first();
-        semaphore.waiters.remove(next);
-        next.waitingOn = nullptr;
-        internal::takeHold(semaphore, next);
-        TaskManager::wake(next, Status::Ok);
-        if (semaphore.inheritance) {
-            TaskManager::recomputePriority(self);
-        }
-        return Status::Ok;
     }
-    if (!semaphore.waiters.isEmpty()) {
-        TaskManager::wakeFirst(semaphore.waiters, Status::Ok);
-        return Status::Ok;
-    }
-    if (semaphore.count == semaphore.maximum) {
-        return Status::InvalidArgument; // The count would exceed its maximum.
-    }
-    semaphore.count = semaphore.count + 1;
-    return Status::Ok;
+    return internal::releaseFull(id);
 }
 
 Result<uint32_t> SemaphoreAgent::GetCount(ObjectId id) const

@@ -132,12 +132,7 @@ Status TaskAgent::PostEvent(ObjectId id, uint32_t events) const
     if (events == 0) {
         return Status::InvalidArgument;
     }
-    const Result<Task*> task = TaskManager::resolve(id);
-    if (!task.ok()) {
-        return task.status();
-    }
-    TaskManager::postEvent(*task.value(), events);
-    return Status::Ok;
+    return TaskManager::postEvent(id, events);
 }
 
 Result<uint32_t> TaskAgent::ReceiveEvent(uint32_t events, EventWait mode, uint64_t timeout) const

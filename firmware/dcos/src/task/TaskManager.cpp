@@ -598,9 +598,9 @@ void TaskManager::wake(Task& task, Status result)
     Scheduler::makeReady(task);
 }
 
-void TaskManager::postEvent(Task& task, uint32_t events)
+// Posts with interrupts already off; both PostEvent paths share it.
+[[gnu::always_inline]] inline void TaskManager::postEventLocked(Task& task, uint32_t events)
 {
-    arch_x86::InterruptGuard guard;
     task.events |= events;
     if (task.state != TaskState::Blocked || task.waitReason != WaitReason::Events) {
         return;
@@ -612,6 +612,28 @@ void TaskManager::postEvent(Task& task, uint32_t events)
         task.receivedEvents = present;
         wake(task, Status::Ok);
     }
+}
+
+void TaskManager::postEvent(Task& task, uint32_t events)
+{
+    arch_x86::InterruptGuard guard;
+    postEventLocked(task, events);
+}
+
+Status TaskManager::postEvent(ObjectId id, uint32_t events)
+{
+    arch_x86::InterruptGuard guard;
+    Task* const* found = table.find(id);
+    if (found != nullptr) [[likely]] {
+        postEventLocked(**found, events);
+        return Status::Ok;
+    }
+    const Result<Task*> task = resolve(id);
+    if (!task.ok()) {
+        return task.status();
+    }
+    postEventLocked(*task.value(), events);
+    return Status::Ok;
 }
 
 void TaskManager::sendSignal(Task& task, unsigned signal)
@@ -854,8 +876,6 @@ size_t TaskManager::taskArraySize() { return kTaskCapacity; }
 ObjectId currentTaskId() { return Scheduler::started() ? Scheduler::current().id : ObjectId::null(); }
 
 bool currentTaskIsSuperUser() { return !Scheduler::started() || Scheduler::current().superUser; }
-
-bool inInterruptContext() { return inInterrupt(); }
 
 uint16_t localNode() { return bsp::nodeId(); }
 

@@ -61,6 +61,9 @@ public:
     static void recomputePriority(Task& task);
 
     static void postEvent(Task& task, uint32_t events);
+    /// PostEvent's path: looks the task up and posts under one interrupt
+    /// guard, with the table's inline lookup; fails as resolve() does. O(1).
+    static Status postEvent(ObjectId id, uint32_t events);
     static void sendSignal(Task& task, unsigned signal);
     /// Marks an exception for delivery to task when it next runs.
     static void raiseException(Task& task, const ExceptionInfo& info);
@@ -93,6 +96,10 @@ public:
     /// The task array, for forEachTask.
     static Task* taskArray();
     static size_t taskArraySize();
+
+private:
+    // Posts with interrupts already off; both postEvent paths share it.
+    static void postEventLocked(Task& task, uint32_t events);
 };
 
 template <typename Visitor>
