@@ -287,7 +287,7 @@ def summary_text(rows):
     parts = [f"{counts[key]} {key}" for key in (WITHIN, OVER, NO_COUNT, MISSING, NOT_MEASURED_YET) if key in counts]
     if differ:
         parts.append(f"{differ} not flat")
-    return "; ".join(parts) + f"; {sum(len(row['offences']) for row in rows)} offences"
+    return "; ".join(parts) + f"; {sum(len(row['offences']) for row in rows)} offenders"
 
 
 def read_json(path):
