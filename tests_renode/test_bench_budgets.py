@@ -76,6 +76,13 @@ def test_a_flat_budget_fails_when_8_and_4096_objects_differ_even_by_one():
     assert verdict_of(rows, "Port.Send")["offences"] == []
 
 
+def test_a_fixed_cost_benchmark_must_be_flat_even_where_its_budget_does_not_ask():
+    fixture = small_budgets(**{"Dsm.Open": {"budget": 300}})
+    rows = budgets.check_primitives(fixture, {"Dsm.Open": entry(207, 209)})
+    assert rows[0]["verdict"] == budgets.WITHIN and rows[0]["flat_agrees"] is False
+    assert rows[0]["offences"] == ["Dsm.Open: 207 with 8 objects, 209 with 4096: must be flat"]
+
+
 def test_an_unbudgeted_fixed_cost_benchmark_that_is_not_flat_is_an_offender_and_a_variable_one_is_not():
     fixture = small_budgets()
     rows = budgets.check_primitives(fixture, {"Dsm.Close": entry(125, 124), "Dsm.Read": entry(160, 160),
@@ -121,6 +128,10 @@ def test_thread_metric_figures_are_held_against_half_of_freertos():
     assert within[0]["verdict"] == budgets.WITHIN and within[0]["offences"] == []
     over = budgets.check_thread_metric(fixture, {"synchronization_processing": {"instructions_per_iteration": 66.6}})
     assert over[0]["verdict"] == budgets.OVER and len(over[0]["offences"]) == 1
+    # The exact quotient decides, not the figure rounded to two decimals.
+    edge = budgets.check_thread_metric(fixture, {"synchronization_processing": {
+        "iterations": 2000, "instructions": 133001, "instructions_per_iteration": 66.5}})
+    assert edge[0]["verdict"] == budgets.OVER
     missing = budgets.check_thread_metric(fixture, {})
     assert missing[0]["verdict"] == budgets.MISSING and missing[0]["offences"]
 

@@ -137,7 +137,10 @@ def check_primitive(name, budget, report_entry):
             row["offences"].append(f"{name}: {worst} instructions, over its budget of {budget['budget']}")
     else:
         row["verdict"] = NO_COUNT
-    if budget["flat"]:
+    # A benchmark declared O(1) must be flat whatever its budget says: the
+    # budget file cannot excuse the design's own claim.
+    if budget["flat"] or report_entry.get("cost") == "constant":
+        row["flat"] = True
         row["flat_agrees"] = small == large
         if not row["flat_agrees"]:
             row["offences"].append(f"{name}: {small} with 8 objects, {large} with 4096: must be flat")
@@ -176,6 +179,10 @@ def check_thread_metric(budgets, results):
     for name, budget in budgets["thread_metric"].items():
         entry = results.get(name)
         figure = entry.get("instructions_per_iteration") if entry else None
+        # The exact quotient where the totals are there: the printed figure
+        # is rounded to two decimals, which could decide a verdict at the edge.
+        if entry and entry.get("iterations") and entry.get("instructions") is not None:
+            figure = entry["instructions"] / entry["iterations"]
         row = {"name": name, "budget": budget["budget"], "freertos": budget.get("freertos"),
                "now": budget.get("now"), "note": budget["note"], "measured": budget["measured"],
                "instructions_per_iteration": figure, "offences": []}
@@ -287,7 +294,8 @@ def summary_text(rows):
     parts = [f"{counts[key]} {key}" for key in (WITHIN, OVER, NO_COUNT, MISSING, NOT_MEASURED_YET) if key in counts]
     if differ:
         parts.append(f"{differ} not flat")
-    return "; ".join(parts) + f"; {sum(len(row['offences']) for row in rows)} offenders"
+    found = sum(len(row["offences"]) for row in rows)
+    return "; ".join(parts) + f"; {found} offender{'' if found == 1 else 's'}"
 
 
 def read_json(path):
@@ -334,7 +342,7 @@ def main():
         handle.write("\n")
 
     print()
-    print(f"Budget verdict: {len(found)} offenders; primitives: {summary_text(primitives)}; "
+    print(f"Budget verdict: {len(found)} offender{'' if len(found) == 1 else 's'}; primitives: {summary_text(primitives)}; "
           f"Thread-Metric: {summary_text(thread_metric)}; footprint: {summary_text(footprint)}")
     if not_measured:
         print(f"not measured yet (budget recorded, no benchmark or image yet): {', '.join(not_measured)}")
