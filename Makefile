@@ -8,7 +8,7 @@
 #   make app APP=<dir>       build an application kept outside the tree
 #   make test-app APP=<dir>  run an application's own emulator tests
 #   make install PREFIX=<path>  install DCOS to build applications against
-#   make bench    benchmarks
+#   make bench    benchmarks, footprint and their budgets (STRICT=1: fail on any offender)
 #   make emulator build the emulator with our board models (done by run, test and bench)
 #   make clean    remove build/
 #
@@ -71,11 +71,19 @@ test-emulator: firmware sdk
 
 # Builds the bench image and runs every benchmark on the board's benchmark CPU
 # with exact instruction counting, and under KVM where it works; prints the
-# seed's Tables 9.2-9.11 for DCOS and writes $(PRIMITIVES_REPORT) and $(BENCH_REPORT).
+# seed's Tables 9.2-9.11 for DCOS and writes $(PRIMITIVES_REPORT) and $(BENCH_REPORT);
+# runs Thread-Metric; reports the production image's footprint by component;
+# and prints every figure against its budget in $(BENCH_BUDGETS). STRICT=1
+# fails when any figure offends its budget (docs/performance.md, "Budgets").
+# The reports of the last run are removed first, so that the verdict never
+# reads a figure a failed step left behind.
 bench: deps
-	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH)
-	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board isa486 --output $(BENCH_REPORT) --primitives $(PRIMITIVES_REPORT)
-	@$(PYTHON) tests_renode/thread_metric/run_thread_metric.py --board isa486 --output $(THREAD_METRIC_REPORT)
+	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH) $(IMAGE_486) $(FOOTPRINT_MAP)
+	@rm -f $(PRIMITIVES_REPORT) $(THREAD_METRIC_REPORT) $(FOOTPRINT_REPORT) $(BUDGET_REPORT)
+	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board isa486 --output $(BENCH_REPORT) --primitives $(PRIMITIVES_REPORT) --budgets $(BENCH_BUDGETS)
+	@$(PYTHON) tests_renode/thread_metric/run_thread_metric.py --board isa486 --output $(THREAD_METRIC_REPORT) --budgets $(BENCH_BUDGETS)
+	@$(PYTHON) tests_renode/bench/footprint.py --map $(FOOTPRINT_MAP) --build-directory $(FW_BUILD) --output $(FOOTPRINT_REPORT) --budgets $(BENCH_BUDGETS)
+	@$(PYTHON) tests_renode/bench/budgets.py --budgets $(BENCH_BUDGETS) --primitives $(PRIMITIVES_REPORT) --thread-metric $(THREAD_METRIC_REPORT) --footprint $(FOOTPRINT_REPORT) --output $(BUDGET_REPORT) $(BENCH_STRICT)
 
 clean:
 	rm -rf $(BUILD)

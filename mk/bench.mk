@@ -65,6 +65,24 @@ IMAGE_486_BENCH := $(BUILD)/486/dcos486-bench.elf
 BENCH_REPORT := $(BUILD)/bench/kernel.json
 PRIMITIVES_REPORT := $(BUILD)/bench/primitives.json
 THREAD_METRIC_REPORT := $(BUILD)/bench/thread_metric.json
+FOOTPRINT_REPORT := $(BUILD)/bench/footprint.json
+BUDGET_REPORT := $(BUILD)/bench/budgets.json
+BENCH_BUDGETS := tests_renode/bench/budgets.toml
+# STRICT=1 makes 'make bench' fail on every figure that offends its budget
+# (tests_renode/bench/budgets.py); without it the verdict is only printed.
+BENCH_STRICT := $(if $(filter 1,$(STRICT)),--strict)
+
+# The production image's linker map, for the footprint report
+# (tests_renode/bench/footprint.py). It is linked here, from the same objects
+# and linker script, rather than by the production image's own rule, so that
+# the image's build stays as it is; footprint.py checks that the map's
+# sections add up to the image's.
+FOOTPRINT_MAP := $(BUILD)/bench/dcos486.map
+$(FOOTPRINT_MAP): $(FW_OBJS) firmware/boot/link.ld
+	@mkdir -p $(dir $@)
+	@echo "  MAP     $@"
+	$(Q)ld $(FW_LDFLAGS) -Map=$@ -o $(@:.map=-map.elf) $(FW_OBJS)
+	$(Q)rm -f $(@:.map=-map.elf)
 
 # Built with the other images, so the emulator suite can check the framework.
 firmware: $(IMAGE_486_BENCH)

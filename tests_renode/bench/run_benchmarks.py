@@ -12,7 +12,10 @@ writes two JSON reports:
        "cost": "constant" | "log" | "variable", "seed_table": "9.x",
        "seed_microseconds": x | null,
        "cycles_median_8": n, "cycles_median_4096": n,        (KVM pass only)
-       "cycles_min_8": n, "cycles_max_8": n, "cycles_min_4096": n, "cycles_max_4096": n}
+       "cycles_min_8": n, "cycles_max_8": n, "cycles_min_4096": n, "cycles_max_4096": n,
+       "budget": null | {"instructions": n | null, "flat": bool, "now": n | null,
+                         "bound": text | null, "verdict": "within" | "over" | "no count" | "missing",
+                         "flat_agrees": bool | null, "offences": [text]}}
   kernel.json      the kernel core's subset (Kernel, Task, Scheduler, Timer,
                    System) with the instruction fields only.
   can.json         instructions per received and per sent CAN frame through
@@ -29,8 +32,12 @@ when setup failed). Where /dev/kvm is usable and the bench image runs under
 KVM, a second pass boots it with -accel kvm, where rdtsc counts real cycles of
 the host CPU, runs every benchmark --kvm-repeat times and reports the median
 (and min and max) of each; otherwise it says plainly that no real cycle
-figures are reported. Real-time figures are reported, never asserted. See
-docs/performance.md.
+figures are reported. Real-time figures are reported, never asserted.
+
+After the tables it prints every benchmark that has a budget in
+tests_renode/bench/budgets.toml against that budget, and every fixed-cost
+benchmark that is NOT FLAT (budgets.py decides; `make bench STRICT=1` fails
+on them, this script only with --strict). See docs/performance.md.
 """
 
 import argparse
@@ -47,6 +54,7 @@ sys.path.insert(0, HERE)
 from dcoslab.board import REPOSITORY, load_board  # noqa: E402
 from dcoslab.emulator import Emulator, EmulatorError  # noqa: E402
 from seed_figures import SEED_FIGURES, SEED_PROCESSOR, SEED_TABLES, seed_text, table_of  # noqa: E402
+import budgets as budget_file  # noqa: E402
 
 OBJECT_COUNTS = (8, 4096)
 PROMPT = r"dcos> "
@@ -447,6 +455,24 @@ def print_modbus_summary(summary):
               "(16550 transmit, its interrupts, the driver enable), the ISA bus's wait states (docs/performance.md)")
 
 
+def budget_rows(budgets, report, selection):
+    """budgets.py's rows for this run's primitives.json entries."""
+    return budget_file.check_primitives(budgets, report, selection)
+
+
+def attach_budgets(report, rows):
+    """Puts each row's verdict into its benchmark's primitives.json entry ("budget", null when it has none)."""
+    for entry in report.values():
+        entry["budget"] = None
+    for row in rows:
+        if row["name"] in report:
+            report[row["name"]]["budget"] = {
+                "instructions": row["budget"], "flat": row["flat"], "now": row["now"], "bound": row["bound"],
+                "note": row["note"], "verdict": row["verdict"], "flat_agrees": row["flat_agrees"],
+                "offences": row["offences"]}
+    return report
+
+
 def write_json(path, report):
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w", encoding="utf-8") as handle:
@@ -470,13 +496,20 @@ def main():
     parser.add_argument("--kvm-repeat", type=int, default=201,
                         help="measured calls per object count in the KVM pass, whose median is reported")
     parser.add_argument("--timeout", type=float, default=120.0, help="seconds for each wait on the emulator")
-    parser.add_argument("--strict", action="store_true", help="exit 1 when an O(1) benchmark is NOT FLAT")
+    parser.add_argument("--strict", action="store_true",
+                        help="exit 1 when a figure offends its budget or an O(1) benchmark is NOT FLAT")
+    parser.add_argument("--budgets", default=budget_file.DEFAULT_BUDGETS, help="the budget file (budgets.toml)")
     parser.add_argument("--can", default=os.path.join(REPOSITORY, "build", "bench", "can.json"),
                         help="JSON report of the CAN frame costs to write (when the CAN benchmarks ran)")
     parser.add_argument("--modbus", default=os.path.join(REPOSITORY, "build", "bench", "modbus.json"),
                         help="JSON report of the Modbus line's costs to write (when the Modbus benchmarks ran)")
     arguments = parser.parse_args()
 
+    try:
+        budgets = budget_file.load_budgets(arguments.budgets)
+    except budget_file.BudgetFileError as error:
+        print(f"make bench: {error}", file=sys.stderr)
+        return 2
     board = load_board(arguments.board)
     if not board.benchmark_cpu:
         print(f"board {board.name} names no benchmark_cpu; the bench image needs a CPU with rdtsc", file=sys.stderr)
@@ -514,17 +547,25 @@ def main():
     if kvm_results is None:
         print(f"KVM not available: real cycle figures not reported ({kvm_reason}). "
               "Every figure above is an exact instruction count under QEMU TCG with -icount.")
+    primitives = {
+        name: primitive_entry(name, results[name], kvm_results.get(name) if kvm_results is not None else None)
+        for name in sorted(results)}
+    rows = budget_rows(budgets, primitives, arguments.select)
+    print()
+    print("\n".join(budget_file.primitive_lines(rows, arguments.budgets)))
 
     write_json(arguments.output, {name: report_entry(results[name]) for name in sorted(results)
                                   if name.split(".", 1)[0] in KERNEL_AGENTS})
-    write_json(arguments.primitives, {
-        name: primitive_entry(name, results[name], kvm_results.get(name) if kvm_results is not None else None)
-        for name in sorted(results)})
+    write_json(arguments.primitives, attach_budgets(primitives, rows))
     if can is not None:
         write_json(arguments.can, can)
     if modbus is not None:
         write_json(arguments.modbus, modbus)
-    if arguments.strict and any(order_check(entry) == "NOT FLAT" for entry in results.values()):
+    found = budget_file.offenders(rows)
+    if arguments.strict and (found or any(order_check(entry) == "NOT FLAT" for entry in results.values())):
+        print(f"run_benchmarks.py --strict: {len(found)} offenders:", file=sys.stderr)
+        for offence in found:
+            print(f"  {offence}", file=sys.stderr)
         return 1
     return 0
 

@@ -5,7 +5,11 @@ The bench image runs on the board's benchmark CPU (a Pentium model) under
 -icount, where the time-stamp counter counts retired instructions, so every
 figure is exact and the same on every run and every machine. Writes
 build/bench/thread_metric.json as {"<test>": {"iterations": n,
-"instructions": n, "instructions_per_iteration": x}, ...} and prints a table.
+"instructions": n, "instructions_per_iteration": x, "budget": null | {...}}, ...}
+and prints a table, each test beside its budget in
+tests_renode/bench/budgets.toml (at most half of FreeRTOS's figure) where it
+has one. --strict exits 1 when a test is over its budget; `make bench`
+leaves that verdict to tests_renode/bench/budgets.py.
 """
 
 import argparse
@@ -15,9 +19,11 @@ import re
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "bench"))
 
 from dcoslab.board import load_board  # noqa: E402
 from dcoslab.emulator import Emulator  # noqa: E402
+import budgets as budget_file  # noqa: E402
 
 LINE = re.compile(r"TM (\w+) iterations=(\d+) instructions=(\d+) per_iteration=([\d.]+)")
 EXPECTED = [
@@ -60,8 +66,22 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--board", default="isa486")
     parser.add_argument("--output", default="build/bench/thread_metric.json")
+    parser.add_argument("--budgets", default=budget_file.DEFAULT_BUDGETS, help="the budget file (budgets.toml)")
+    parser.add_argument("--strict", action="store_true", help="exit 1 when a test is over its budget")
     arguments = parser.parse_args()
+    try:
+        budgets = budget_file.load_budgets(arguments.budgets)
+    except budget_file.BudgetFileError as error:
+        print(f"make bench: {error}", file=sys.stderr)
+        return 2
     results = run(arguments.board)
+    rows = budget_file.check_thread_metric(budgets, results)
+    for entry in results.values():
+        entry["budget"] = None
+    for row in rows:
+        if row["name"] in results:
+            results[row["name"]]["budget"] = {key: row[key] for key in ("budget", "freertos", "now", "verdict",
+                                                                       "offences")}
     os.makedirs(os.path.dirname(arguments.output), exist_ok=True)
     with open(arguments.output, "w", encoding="utf-8") as handle:
         json.dump(results, handle, indent=2, sort_keys=True)
@@ -70,8 +90,16 @@ def main():
     for name in EXPECTED:
         entry = results[name]
         print(f"{name:36} {entry['iterations']:>10} {entry['instructions_per_iteration']:>14.2f}")
+    print("\n".join(budget_file.thread_metric_lines(rows)))
     print(f"written to {arguments.output}")
+    found = budget_file.offenders(rows)
+    if arguments.strict and found:
+        print(f"run_thread_metric.py --strict: {len(found)} offenders:", file=sys.stderr)
+        for offence in found:
+            print(f"  {offence}", file=sys.stderr)
+        return 1
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
