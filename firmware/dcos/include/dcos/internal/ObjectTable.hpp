@@ -396,25 +396,27 @@ private:
     // The key of the list of objects the system owns (the null owner).
     static constexpr size_t kSystemOwnerKey = OwnerKeys::kCount;
 
+    // resolve() reads only object, index and used. The entry keeps the
+    // layout it had before the chains came (the owner key sits where the
+    // free-list link was), so that its size, a power of two for a pointer
+    // T, still makes the fast paths' slot-to-entry arithmetic one shift.
     struct Entry {
         T object{};
         ObjectId owner{};
         uint16_t index = 0; ///< The id's index field while the slot is used.
+        uint16_t ownerKey = 0; ///< The owner list the object is on.
         bool used = false;
         Visibility visibility = Visibility::Local;
         char name[kNameCapacity] = {};
     };
 
-    // The lists a used slot is on. They are kept apart from Entry so that
-    // the entry that resolve() reads keeps its size (a power of two for a
-    // pointer T), and the fast paths their address arithmetic.
+    // The links of a used slot, kept apart from Entry for the reason above.
     struct Chain {
         uint32_t nameHash = 0; ///< Hash of the name; meaningful only for a named object.
         Link nameNext = kNoLink; ///< Next object in the same name bucket.
         Link namePrev = kNoLink; ///< Previous one; none for the bucket's first.
         Link ownerNext = kNoLink; ///< Next object on the same owner list.
         Link ownerPrev = kNoLink; ///< Previous one; none for the list's first.
-        uint16_t ownerKey = 0; ///< The owner list the object is on.
     };
 
     struct NameScan {
@@ -480,7 +482,7 @@ private:
     {
         Chain& chain = chains_[slot];
         Link& head = ownerHeads_[key];
-        chain.ownerKey = static_cast<uint16_t>(key);
+        entries_[slot].ownerKey = static_cast<uint16_t>(key);
         chain.ownerPrev = kNoLink;
         chain.ownerNext = head;
         if (head != kNoLink) {
@@ -500,7 +502,7 @@ private:
         if (chain.ownerPrev != kNoLink) {
             chains_[slotOfLink(chain.ownerPrev)].ownerNext = chain.ownerNext;
         } else {
-            ownerHeads_[chain.ownerKey] = chain.ownerNext;
+            ownerHeads_[entries_[slot].ownerKey] = chain.ownerNext;
         }
         chain.ownerNext = chain.ownerPrev = kNoLink;
     }
