@@ -3,6 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <deque>
+#include <iterator>
+#include <map>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
@@ -353,4 +358,391 @@ TEST(ObjectTableTest, SetNodeOnlyWhileEmpty)
     EXPECT_EQ(table.setNode(8), Status::Busy);
     ASSERT_EQ(table.Delete(id), Status::Ok);
     EXPECT_EQ(table.setNode(8), Status::Ok);
+}
+
+TEST(ObjectTableTest, RenameMovesTheNameAndKeepsTheRules)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId id = create(table, "before");
+    EXPECT_EQ(table.rename(id, "0123456789abcdef"), Status::InvalidArgument);
+    EXPECT_STREQ(table.nameOf(id).value(), "before");
+    EXPECT_EQ(table.rename(id, "after"), Status::Ok);
+    EXPECT_EQ(table.NameToObject("before", Visibility::Local).status(), Status::NotFound);
+    EXPECT_EQ(table.NameToObject("after", Visibility::Local).value(), id);
+    EXPECT_EQ(table.rename(id, nullptr), Status::Ok);
+    EXPECT_EQ(table.NameToObject("after", Visibility::Local).status(), Status::NotFound);
+    EXPECT_STREQ(table.nameOf(id).value(), "");
+    ASSERT_EQ(table.Delete(id), Status::Ok);
+    EXPECT_EQ(table.rename(id, "again"), Status::StaleId);
+}
+
+TEST(ObjectTableTest, DuplicateNamesResolveToTheLowestSlotAndSurviveDeletes)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(16), Status::Ok);
+    std::vector<ObjectId> twins;
+    for (int i = 0; i < 4; ++i) {
+        create(table, "other");
+        twins.push_back(create(table, "twin"));
+    }
+    // Create fills slots in order, so the first twin holds the lowest slot.
+    EXPECT_EQ(table.NameToObject("twin", Visibility::Local).value(), twins[0]);
+    ASSERT_EQ(table.Delete(twins[0]), Status::Ok);
+    EXPECT_EQ(table.NameToObject("twin", Visibility::Local).value(), twins[1]);
+    ASSERT_EQ(table.Delete(twins[2]), Status::Ok);
+    EXPECT_EQ(table.NameToObject("twin", Visibility::Local).value(), twins[1]);
+    ASSERT_EQ(table.Delete(twins[1]), Status::Ok);
+    EXPECT_EQ(table.NameToObject("twin", Visibility::Local).value(), twins[3]);
+    ASSERT_EQ(table.Delete(twins[3]), Status::Ok);
+    EXPECT_EQ(table.NameToObject("twin", Visibility::Local).status(), Status::NotFound);
+    EXPECT_TRUE(table.NameToObject("other", Visibility::Local).ok());
+}
+
+TEST(ObjectTableTest, SystemObjectsHaveAnOwnerListOfTheirOwn)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId system = create(table, nullptr, ObjectId::null());
+    create(table, nullptr, kTaskA);
+    std::vector<ObjectId> visited;
+    EXPECT_EQ(table.forEachOwnedBy(ObjectId::null(), [&](ObjectId id, Semaphore&) { visited.push_back(id); }), 1u);
+    EXPECT_EQ(visited, std::vector<ObjectId>{system});
+}
+
+namespace {
+
+// Owner keys that make owners share lists, to prove a shared list still
+// yields exactly each owner's objects.
+struct FewOwnerKeys {
+    static constexpr size_t kCount = 3;
+    static size_t keyOf(ObjectId owner) { return owner.index() % kCount; }
+};
+
+// A reference model of a table: what every name lookup and owner walk must
+// answer after any sequence of operations. Slots are modelled too (a FIFO of
+// free slots), because duplicate names resolve to the lowest slot.
+struct ModelObject {
+    ObjectId owner;
+    std::string name;
+    Visibility visibility;
+    size_t slot;
+};
+
+template <typename Table>
+class ObjectTableModelTest {
+public:
+    // A recovery empties one owner's lists, so its rate sets how full the
+    // table gets: creations outnumber deletions otherwise.
+    ObjectTableModelTest(Table& table, uint32_t seed, unsigned recoverPerMille = 50)
+        : table_(table), random_(seed), recoverPerMille_(recoverPerMille)
+    {
+    }
+
+    // Checks every lookup and walk against the model after every
+    // checkInterval operations and after the last.
+    void run(int operations, int checkInterval = 7)
+    {
+        for (int step = 0; step < operations; ++step) {
+            const unsigned choice = pick(1000);
+            if (choice < 30) {
+                addObjects();
+            } else if (choice < 450) {
+                createOne();
+            } else if (choice < 700) {
+                deleteOne();
+            } else if (choice < 800) {
+                renameOne();
+            } else if (choice < 1000 - recoverPerMille_) {
+                transferOne();
+            } else {
+                recoverOne();
+            }
+            ASSERT_EQ(table_.usedCount(), objects_.size());
+            if (step % checkInterval == 0 || step + 1 == operations) {
+                checkEverything();
+                if (::testing::Test::HasFailure()) {
+                    return;
+                }
+            }
+        }
+    }
+
+    size_t maxLive() const { return maxLive_; }
+
+private:
+    unsigned pick(unsigned bound) { return static_cast<unsigned>(random_() % bound); }
+
+    template <typename Container>
+    const auto& pickFrom(const Container& items)
+    {
+        return items[pick(static_cast<unsigned>(items.size()))];
+    }
+
+    // A few names, so that duplicates and shared buckets are common; the
+    // empty name stands for an unnamed object.
+    std::string randomName()
+    {
+        static const std::vector<std::string> names = {"",      "",       "a",    "b",     "sem",  "port",
+                                                       "twin",  "twin",   "x1",   "x2",    "x3",   "target",
+                                                       "abcdefghijklmno", "node.task", "Z"};
+        return pickFrom(names);
+    }
+
+    // Owners include the system (null), two tasks that share an index on
+    // different nodes, and a few more.
+    ObjectId randomOwner()
+    {
+        static const std::vector<ObjectId> owners = {
+            ObjectId::null(),
+            ObjectId(kNode, ObjectType::Task, 1),
+            ObjectId(kNode, ObjectType::Task, 2),
+            ObjectId(kNode, ObjectType::Task, 3),
+            ObjectId(kNode, ObjectType::Task, 4095),
+            ObjectId(kNode + 1, ObjectType::Task, 1),
+        };
+        return pickFrom(owners);
+    }
+
+    Visibility randomVisibility() { return static_cast<Visibility>(pick(3)); }
+
+    ObjectId randomLive()
+    {
+        auto it = objects_.begin();
+        std::advance(it, pick(static_cast<unsigned>(objects_.size())));
+        return ObjectId::fromRaw(it->first);
+    }
+
+    void addObjects()
+    {
+        const size_t room = Table::capacity() - table_.activeCount();
+        if (room == 0) {
+            EXPECT_EQ(table_.AddObjects(Table::kGroupSize), Status::TableFull);
+            return;
+        }
+        const size_t count = Table::kGroupSize * (1 + pick(static_cast<unsigned>(room / Table::kGroupSize)));
+        const size_t first = table_.activeCount();
+        ASSERT_EQ(table_.AddObjects(count), Status::Ok);
+        for (size_t i = 0; i < count; ++i) {
+            freeSlots_.push_back(first + i);
+        }
+    }
+
+    void createOne()
+    {
+        const ObjectId owner = randomOwner();
+        const std::string name = randomName();
+        const Visibility visibility = randomVisibility();
+        const char* text = name.empty() && pick(2) == 0 ? nullptr : name.c_str();
+        const auto result = table_.Create(owner, text, visibility);
+        if (freeSlots_.empty()) {
+            EXPECT_EQ(result.status(), Status::TableFull);
+            return;
+        }
+        ASSERT_TRUE(result.ok()) << dcos::statusName(result.status());
+        const size_t slot = freeSlots_.front();
+        freeSlots_.pop_front();
+        ASSERT_EQ(table_.slotNumber(result.value()), slot) << "slots are reused oldest freed first";
+        ASSERT_EQ(objects_.count(result.value().raw()), 0u);
+        objects_[result.value().raw()] = ModelObject{owner, name, visibility, slot};
+        maxLive_ = std::max(maxLive_, objects_.size());
+    }
+
+    void forget(ObjectId id)
+    {
+        freeSlots_.push_back(objects_.at(id.raw()).slot);
+        objects_.erase(id.raw());
+        deleted_.push_back(id);
+    }
+
+    void deleteOne()
+    {
+        if (objects_.empty()) {
+            if (!deleted_.empty()) {
+                EXPECT_EQ(table_.Delete(pickFrom(deleted_)), Status::StaleId);
+            }
+            return;
+        }
+        const ObjectId id = randomLive();
+        ASSERT_EQ(table_.Delete(id), Status::Ok);
+        forget(id);
+        EXPECT_EQ(table_.resolve(id).status(), Status::StaleId);
+    }
+
+    void renameOne()
+    {
+        if (objects_.empty()) {
+            return;
+        }
+        const ObjectId id = randomLive();
+        const std::string name = randomName();
+        ASSERT_EQ(table_.rename(id, name.c_str()), Status::Ok);
+        objects_.at(id.raw()).name = name;
+    }
+
+    void transferOne()
+    {
+        if (objects_.empty()) {
+            return;
+        }
+        const ObjectId id = randomLive();
+        ModelObject& object = objects_.at(id.raw());
+        const ObjectId newOwner = randomOwner();
+        if (pick(5) == 0) {
+            // From a task that does not own it: refused, nothing moves.
+            const ObjectId wrong = object.owner.isNull() ? ObjectId(kNode, ObjectType::Task, 7) : ObjectId::null();
+            EXPECT_EQ(table_.XferOwnership(id, wrong, newOwner), Status::NotOwner);
+            return;
+        }
+        ASSERT_EQ(table_.XferOwnership(id, object.owner, newOwner), Status::Ok);
+        object.owner = newOwner;
+    }
+
+    // What resource recovery does: delete everything one owner holds, from
+    // inside the walk.
+    void recoverOne()
+    {
+        const ObjectId owner = randomOwner();
+        std::set<uint32_t> expected;
+        for (const auto& [raw, object] : objects_) {
+            if (object.owner == owner) {
+                expected.insert(raw);
+            }
+        }
+        std::set<uint32_t> visited;
+        std::vector<ObjectId> order;
+        const size_t count = table_.forEachOwnedBy(owner, [&](ObjectId id, auto&) {
+            visited.insert(id.raw());
+            order.push_back(id);
+            EXPECT_EQ(table_.Delete(id), Status::Ok);
+        });
+        EXPECT_EQ(count, expected.size());
+        ASSERT_EQ(visited, expected);
+        for (const ObjectId id : order) {
+            forget(id);
+        }
+    }
+
+    void checkEverything()
+    {
+        static const std::vector<std::string> probes = {"a",    "b",      "sem",  "port",  "twin", "x1",
+                                                        "x2",   "x3",     "target", "abcdefghijklmno",
+                                                        "node.task", "Z", "missing", "abcdefghijklmnop", ""};
+        for (const std::string& name : probes) {
+            for (unsigned scope = 0; scope < 3; ++scope) {
+                const Visibility asking = static_cast<Visibility>(scope);
+                // The model's answer: the lowest slot among visible objects of that name.
+                const ModelObject* best = nullptr;
+                uint32_t bestRaw = 0;
+                for (const auto& [raw, object] : objects_) {
+                    if (!name.empty() && object.name == name && dcos::isVisibleFrom(object.visibility, asking)
+                        && (best == nullptr || object.slot < best->slot)) {
+                        best = &object;
+                        bestRaw = raw;
+                    }
+                }
+                const auto found = table_.NameToObject(name.c_str(), asking);
+                if (best == nullptr) {
+                    ASSERT_EQ(found.status(), Status::NotFound) << "name '" << name << "' scope " << scope;
+                } else {
+                    ASSERT_TRUE(found.ok()) << "name '" << name << "' scope " << scope;
+                    ASSERT_EQ(found.value().raw(), bestRaw) << "name '" << name << "' scope " << scope;
+                }
+            }
+        }
+        static const std::vector<ObjectId> owners = {
+            ObjectId::null(),
+            ObjectId(kNode, ObjectType::Task, 1),
+            ObjectId(kNode, ObjectType::Task, 2),
+            ObjectId(kNode, ObjectType::Task, 3),
+            ObjectId(kNode, ObjectType::Task, 4095),
+            ObjectId(kNode + 1, ObjectType::Task, 1),
+            ObjectId(kNode, ObjectType::Task, 7),
+        };
+        for (const ObjectId owner : owners) {
+            std::set<uint32_t> expected;
+            for (const auto& [raw, object] : objects_) {
+                if (object.owner == owner) {
+                    expected.insert(raw);
+                }
+            }
+            std::multiset<uint32_t> visited;
+            const size_t count = table_.forEachOwnedBy(owner, [&](ObjectId id, auto&) { visited.insert(id.raw()); });
+            ASSERT_EQ(count, expected.size());
+            ASSERT_EQ(std::set<uint32_t>(visited.begin(), visited.end()), expected);
+            ASSERT_EQ(visited.size(), expected.size()) << "an object was visited twice";
+        }
+        for (const auto& [raw, object] : objects_) {
+            const ObjectId id = ObjectId::fromRaw(raw);
+            ASSERT_EQ(table_.ownerOf(id).value(), object.owner);
+            ASSERT_EQ(std::string(table_.nameOf(id).value()), object.name);
+            ASSERT_EQ(table_.slotNumber(id), object.slot);
+            // The fast paths' inline lookup finds what resolve finds, with the owner.
+            ObjectId owner;
+            ASSERT_EQ(table_.find(id), table_.resolve(id).value());
+            ASSERT_EQ(table_.find(id, owner), table_.resolve(id).value());
+            ASSERT_EQ(owner, object.owner);
+        }
+        // And misses wherever resolve fails: deleted ids, ids never handed
+        // out, and ids of another type or node whose index is live.
+        std::vector<ObjectId> misses(deleted_.begin(), deleted_.end());
+        for (unsigned i = 0; i < 16; ++i) {
+            const uint16_t index = static_cast<uint16_t>(pick(ObjectId::kMaxIndex + 1));
+            misses.push_back(ObjectId(kNode, ObjectType::Semaphore, index));
+            misses.push_back(ObjectId(kNode + 1, ObjectType::Semaphore, index));
+            misses.push_back(ObjectId(kNode, ObjectType::MessagePort, index));
+        }
+        misses.push_back(ObjectId::null());
+        for (const ObjectId id : misses) {
+            const auto resolved = table_.resolve(id);
+            ObjectId owner = ObjectId(kNode, ObjectType::Task, 9);
+            ASSERT_EQ(table_.find(id), resolved.ok() ? resolved.value() : nullptr) << std::hex << id.raw();
+            ASSERT_EQ(table_.find(id, owner), resolved.ok() ? resolved.value() : nullptr) << std::hex << id.raw();
+            if (!resolved.ok()) {
+                ASSERT_EQ(owner, ObjectId(kNode, ObjectType::Task, 9)) << "a miss leaves the owner alone";
+            }
+        }
+    }
+
+    Table& table_;
+    std::mt19937 random_;
+    unsigned recoverPerMille_;
+    std::map<uint32_t, ModelObject> objects_;
+    std::deque<size_t> freeSlots_;
+    std::vector<ObjectId> deleted_;
+    size_t maxLive_ = 0;
+};
+
+} // namespace
+
+TEST(ObjectTableTest, RandomOperationsAgreeWithAModelInASmallTable)
+{
+    // Eight slots share eight buckets: names collide in nearly every lookup.
+    for (uint32_t seed = 1; seed <= 20; ++seed) {
+        SCOPED_TRACE(seed);
+        ObjectTable<Semaphore, 8> table(ObjectType::Semaphore, kNode);
+        ObjectTableModelTest<ObjectTable<Semaphore, 8>> model(table, seed);
+        model.run(2000);
+        ASSERT_FALSE(::testing::Test::HasFailure());
+    }
+}
+
+TEST(ObjectTableTest, RandomOperationsAgreeWithAModelWhenOwnersShareLists)
+{
+    for (uint32_t seed = 100; seed <= 110; ++seed) {
+        SCOPED_TRACE(seed);
+        ObjectTable<Semaphore, 64, FewOwnerKeys> table(ObjectType::Semaphore, kNode);
+        ObjectTableModelTest<ObjectTable<Semaphore, 64, FewOwnerKeys>> model(table, seed);
+        model.run(3000);
+        ASSERT_FALSE(::testing::Test::HasFailure());
+    }
+}
+
+TEST(ObjectTableTest, RandomOperationsAgreeWithAModelInAFullSizeTable)
+{
+    using Table = ObjectTable<Semaphore, 4096>;
+    static Table table(ObjectType::Semaphore, kNode);
+    ObjectTableModelTest<Table> model(table, 4096, 1);
+    model.run(30000, 97);
+    EXPECT_GT(model.maxLive(), 1000u);
 }

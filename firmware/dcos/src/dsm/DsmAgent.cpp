@@ -67,9 +67,9 @@ struct ReadRequest {
     uint32_t dataId;    ///< The identifier of the page handed over.
 };
 
-ObjectTable<PublisherObject*, kPublisherCapacity> publisherTable(ObjectType::DsmPublisher, 0);
+ObjectTable<PublisherObject*, kPublisherCapacity, TaskOwnerKeys> publisherTable(ObjectType::DsmPublisher, 0);
 PublisherObject publishers[kPublisherCapacity];
-ObjectTable<SubscriptionObject, kSubscriptionCapacity> subscriptionTable(ObjectType::DsmSubscription, 0);
+ObjectTable<SubscriptionObject, kSubscriptionCapacity, TaskOwnerKeys> subscriptionTable(ObjectType::DsmSubscription, 0);
 bool started = false;
 
 size_t publisherSlotOf(ObjectId id) { return publisherTable.slotNumber(id); }

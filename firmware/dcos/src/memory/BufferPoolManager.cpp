@@ -30,7 +30,7 @@ struct PoolObject {
     bool inUse = false;
 };
 
-using PoolTable = ObjectTable<PoolObject*, kPoolCapacity>;
+using PoolTable = ObjectTable<PoolObject*, kPoolCapacity, TaskOwnerKeys>;
 
 constinit PoolTable poolTable(ObjectType::BufferPool, 0);
 constinit PoolObject pools[kPoolCapacity];

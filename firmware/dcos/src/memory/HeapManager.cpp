@@ -28,7 +28,7 @@ struct HeapObject {
     bool inUse = false;
 };
 
-using HeapTable = ObjectTable<HeapObject*, kHeapCapacity>;
+using HeapTable = ObjectTable<HeapObject*, kHeapCapacity, TaskOwnerKeys>;
 
 constinit HeapTable heapTable(ObjectType::Heap, 0);
 constinit HeapObject heaps[kHeapCapacity];

@@ -43,7 +43,7 @@ struct PortObject {
     WaitQueue receivers{WaitQueue::Order::Priority};
 };
 
-ObjectTable<PortObject*, kPortCapacity> portTable(ObjectType::MessagePort, 0);
+ObjectTable<PortObject*, kPortCapacity, TaskOwnerKeys> portTable(ObjectType::MessagePort, 0);
 PortObject ports[kPortCapacity];
 MessageBuffer bufferReserve[kMessageBufferCapacity];
 MessageBufferPool bufferPool(bufferReserve, kMessageBufferCapacity);

@@ -41,7 +41,7 @@ struct Semaphore : InheritanceSource {
     // InheritanceSource::holder is the holding task of a binary semaphore.
 };
 
-ObjectTable<Semaphore*, kSemaphoreCapacity> table(ObjectType::Semaphore, 0);
+ObjectTable<Semaphore*, kSemaphoreCapacity, TaskOwnerKeys> table(ObjectType::Semaphore, 0);
 Semaphore semaphores[kSemaphoreCapacity];
 bool tableReady = false;
 

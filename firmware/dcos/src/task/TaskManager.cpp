@@ -37,7 +37,7 @@ constexpr uint32_t kStackPaint = 0xDC05DC05u;
 // A handler frame is refused when it would leave less than this below it.
 constexpr size_t kHandlerStackReserve = 512;
 
-ObjectTable<Task*, kTaskCapacity> table(ObjectType::Task, 0);
+ObjectTable<Task*, kTaskCapacity, TaskOwnerKeys> table(ObjectType::Task, 0);
 Task tasks[kTaskCapacity];
 // Tasks that ended while running; their stack and slot are freed once
 // another task runs (the dying task's own stack is in use until then).
@@ -878,6 +878,8 @@ ObjectId currentTaskId() { return Scheduler::started() ? Scheduler::current().id
 bool currentTaskIsSuperUser() { return !Scheduler::started() || Scheduler::current().superUser; }
 
 uint16_t localNode() { return bsp::nodeId(); }
+
+size_t taskSlotOf(ObjectId task) { return table.slotNumber(task); }
 
 } // namespace dcos::internal
 

@@ -35,7 +35,7 @@ volatile uint64_t tickCount = 0;
 volatile uint64_t incrementNs = 0; // Nanoseconds ticked since the tick started.
 uint64_t baseNs = 0;               // Time of day, in ns since 1970, when the tick started.
 
-ObjectTable<TimerObject*, kTimerCapacity> timerTable(ObjectType::Timer, 0);
+ObjectTable<TimerObject*, kTimerCapacity, TaskOwnerKeys> timerTable(ObjectType::Timer, 0);
 TimerObject timers[kTimerCapacity];
 
 size_t timerSlotOf(ObjectId id) { return timerTable.slotNumber(id); }

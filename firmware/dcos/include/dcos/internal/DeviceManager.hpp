@@ -25,6 +25,7 @@
 #include <dcos/Status.hpp>
 #include <dcos/Visibility.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
 
 #include <stddef.h>
@@ -43,7 +44,7 @@ struct DeviceEntry {
 };
 
 /// The object table type that holds the installed devices.
-using DeviceTable = ObjectTable<DeviceEntry, kDeviceCapacity>;
+using DeviceTable = ObjectTable<DeviceEntry, kDeviceCapacity, TaskOwnerKeys>;
 
 /// A consistent copy of one device's state, for listings such as the console.
 struct DeviceInfo {

@@ -6,11 +6,13 @@
 #pragma once
 
 #include <dcos/ObjectId.hpp>
+#include <dcos/internal/KernelConfig.hpp>
 
 #ifndef DCOS_HOST_BUILD
 #include <arch_x86/Idt.hpp>
 #endif
 
+#include <stddef.h>
 #include <stdint.h>
 
 namespace dcos::internal {
@@ -35,5 +37,17 @@ inline bool inInterruptContext() { return arch_x86::Idt::nestingDepth() != 0; }
 
 /// The node id of this controller, stamped into every object id it issues.
 uint16_t localNode();
+
+/// The slot a task id names in the task table, below kTaskCapacity for any
+/// task id (for a stale or remote one, the slot its index last named).
+size_t taskSlotOf(ObjectId task);
+
+/// The owner keys of the kernel's object tables (see ObjectTable.hpp): a
+/// task's slot, so that each table keeps one owner list per task slot, a
+/// few hundred bytes, rather than one per 12-bit index.
+struct TaskOwnerKeys {
+    static constexpr size_t kCount = kTaskCapacity;
+    static size_t keyOf(ObjectId owner) { return taskSlotOf(owner); }
+};
 
 } // namespace dcos::internal

@@ -4,9 +4,24 @@
 // Capacity is reserved at build time, but only the first activeCount() slots
 // take part in allocation; the AddObjects configuration service activates
 // further slots in groups of eight, as the seed prescribes. The real-time
-// services (Create, Delete, resolve, ownership checks) cost O(1); the
-// configuration services (AddObjects, NameToObject, enumeration by owner)
-// cost O(N), which the seed accepts for configuration-class services.
+// services (Create, Delete, resolve, ownership checks) cost O(1) and the
+// same number of instructions whatever the table holds.
+//
+// Names: every named object is chained, through its slot, into one of
+// Capacity hash buckets, so NameToObject hashes the name once and compares
+// names only with the objects whose hash matches. Its cost depends on how
+// many names share a bucket, about one with a fair hash, never on how many
+// objects the table holds. Unnamed objects are in no bucket.
+//
+// Ownership: every object is chained, through its slot, into the list of
+// its owner (one list per owner key, see OwnerKeysByIndex), so forEachOwnedBy
+// costs in proportion to what the owner holds, which is what lets a task's
+// death be recovered without a walk over every table.
+//
+// The chains cost, per slot, a 32-bit hash and four links of one byte (a
+// table of at most 128 slots) or two, plus one link per bucket and one per
+// owner key, and the free-slot ring: about 4 KiB for a kernel table of 256
+// slots.
 //
 // Stale id detection: the 12-bit index field of an ObjectId is not a slot
 // number. Every table hands out all 4096 index values, each naming at most
@@ -34,6 +49,20 @@
 
 namespace dcos::internal {
 
+/// The owner keys a table uses when nothing better is known: an owner's
+/// 12-bit index, so 4096 owner lists per table. The kernel's tables key
+/// owners by their task slot instead (TaskOwnerKeys), which needs only as
+/// many lists as there are task slots.
+///
+/// An owner-key policy has kCount and keyOf(owner), which maps every task id
+/// to a key below kCount. Two owners may share a key (a stale or remote task
+/// id, say): the walk compares owners exactly, so sharing costs time, never
+/// correctness.
+struct OwnerKeysByIndex {
+    static constexpr size_t kCount = size_t{1} << ObjectId::kIndexBits;
+    static size_t keyOf(ObjectId owner) { return owner.index(); }
+};
+
 /// A static table of objects of one type, addressed by ObjectId.
 ///
 /// T must be default constructible and copy-assignable: every slot holds a
@@ -43,11 +72,12 @@ namespace dcos::internal {
 /// Services that implement a primitive of the seed keep its name
 /// (AddObjects, Create, Delete, NameToObject, XferOwnership); kernel-internal
 /// helpers use lower camel case.
-template <typename T, size_t Capacity>
+template <typename T, size_t Capacity, typename OwnerKeys = OwnerKeysByIndex>
 class ObjectTable {
     static_assert(Capacity >= 8 && Capacity <= 4096, "a table holds 8 to 4096 objects (12-bit index)");
     static_assert(std::has_single_bit(Capacity), "Capacity is a power of two, as the kernel configuration sizes it");
     static_assert(Capacity % 8 == 0, "objects are added in groups of eight");
+    static_assert(OwnerKeys::kCount >= 1 && OwnerKeys::kCount < UINT16_MAX, "owner keys fit 16 bits with one to spare");
 
 public:
     /// Objects are activated by AddObjects in multiples of this count.
@@ -109,9 +139,9 @@ public:
             return Status::TableFull;
         }
         for (size_t i = 0; i < count; ++i) {
-            pushFree(static_cast<uint16_t>(active_ + i));
+            pushFree(static_cast<uint16_t>(active_));
+            ++active_;
         }
-        active_ += count;
         return Status::Ok;
     }
 
@@ -121,15 +151,18 @@ public:
     /// owned by the system, which resource recovery never reclaims. @p name
     /// may be null or empty for an unnamed object, otherwise at most
     /// kMaxNameLength characters. The seed leaves unique naming to the user,
-    /// so duplicates are not searched for, which keeps Create O(1).
-    /// Fails with InvalidArgument or TableFull.
+    /// so duplicates are not searched for. Fails with InvalidArgument or
+    /// TableFull. Cost O(1): the name's hash is taken in the same pass that
+    /// measures it, and the object joins the front of its bucket and of its
+    /// owner's list.
     Result<ObjectId> Create(ObjectId owner, const char* name, Visibility visibility)
     {
-        if (!isValidOwner(owner) || nameLength(name) > kMaxNameLength
+        const NameScan scan = scanName(name);
+        if (!isValidOwner(owner) || scan.length > kMaxNameLength
             || static_cast<uint8_t>(visibility) > static_cast<uint8_t>(Visibility::Global)) {
             return Status::InvalidArgument;
         }
-        if (freeHead_ == kNoSlot) {
+        if (used_ == active_) {
             return Status::TableFull;
         }
         const uint16_t slot = popFree();
@@ -141,14 +174,21 @@ public:
         entry.visibility = visibility;
         copyName(entry.name, name);
         ++used_;
+        Chain& chain = chains_[slot];
+        chain.nameHash = scan.hash;
+        if (scan.length != 0) {
+            linkName(slot);
+        }
+        linkOwner(slot, ownerKey(owner));
         return idOf(slot);
     }
 
     /// Deletes the object named by @p id and frees its slot.
     ///
     /// The object is reset to T{} and its index goes to the back of the free
-    /// indices, so every copy of @p id turns stale for 4096 - N Creates. Ownership is checked by the agent before,
-    /// because some primitives (KillTask by a super user) bypass it. Cost O(1).
+    /// indices, so every copy of @p id turns stale for 4096 - N Creates.
+    /// Ownership is checked by the agent before, because some primitives
+    /// (KillTask by a super user) bypass it. Cost O(1).
     Status Delete(ObjectId id)
     {
         const Result<uint16_t> slot = slotOf(id);
@@ -156,13 +196,17 @@ public:
             return slot.status();
         }
         Entry& entry = entries_[slot.value()];
+        if (entry.name[0] != '\0') {
+            unlinkName(slot.value());
+        }
+        unlinkOwner(slot.value());
         entry.object = T{};
         entry.used = false;
         entry.owner = ObjectId::null();
         entry.name[0] = '\0';
         giveBackIndex(entry.index);
-        --used_;
         pushFree(slot.value());
+        --used_;
         return Status::Ok;
     }
 
@@ -271,11 +315,38 @@ public:
         return static_cast<const char*>(entries_[slot.value()].name);
     }
 
+    /// Gives @p id the name @p name (null or empty: unnamed), with Create's
+    /// rules: at most kMaxNameLength characters, else InvalidArgument and no
+    /// change; duplicates are not searched for. Cost O(1): the object moves
+    /// to the new name's bucket.
+    Status rename(ObjectId id, const char* name)
+    {
+        const Result<uint16_t> slot = slotOf(id);
+        if (!slot.ok()) {
+            return slot.status();
+        }
+        const NameScan scan = scanName(name);
+        if (scan.length > kMaxNameLength) {
+            return Status::InvalidArgument;
+        }
+        Entry& entry = entries_[slot.value()];
+        if (entry.name[0] != '\0') {
+            unlinkName(slot.value());
+        }
+        copyName(entry.name, name);
+        chains_[slot.value()].nameHash = scan.hash;
+        if (scan.length != 0) {
+            linkName(slot.value());
+        }
+        return Status::Ok;
+    }
+
     /// Transfers ownership of @p id from @p currentOwner to @p newOwner.
     ///
     /// Fails with NotOwner unless @p currentOwner owns the object, which
     /// stops a task from giving away objects it does not hold, and with
-    /// InvalidArgument when @p newOwner is neither a task id nor null. Cost O(1).
+    /// InvalidArgument when @p newOwner is neither a task id nor null. Cost
+    /// O(1): the object moves from its owner's list to the new owner's.
     Status XferOwnership(ObjectId id, ObjectId currentOwner, ObjectId newOwner)
     {
         const Result<uint16_t> slot = slotOf(id);
@@ -289,7 +360,9 @@ public:
         if (!isValidOwner(newOwner)) {
             return Status::InvalidArgument;
         }
+        unlinkOwner(slot.value());
         entry.owner = newOwner;
+        linkOwner(slot.value(), ownerKey(newOwner));
         return Status::Ok;
     }
 
@@ -299,36 +372,54 @@ public:
     /// forwarded from a remote node never finds a local object. When the
     /// user broke the uniqueness rule the lowest slot wins. An empty or null
     /// name never matches, because unnamed objects must not be findable.
-    /// Fails with NotFound. Cost O(N) in the active count.
+    /// Fails with NotFound. Cost: one pass over @p name for its hash, then
+    /// one step per object in its bucket, names compared only where the
+    /// hashes match; independent of how many objects the table holds.
     Result<ObjectId> NameToObject(const char* name, Visibility askingScope) const
     {
-        if (nameLength(name) == 0 || nameLength(name) > kMaxNameLength) {
+        const NameScan scan = scanName(name);
+        if (scan.length == 0 || scan.length > kMaxNameLength) {
             return Status::NotFound;
         }
-        for (size_t slot = 0; slot < active_; ++slot) {
-            const Entry& entry = entries_[slot];
-            if (entry.used && isVisibleFrom(entry.visibility, askingScope) && namesEqual(entry.name, name)) {
-                return idOf(static_cast<uint16_t>(slot));
+        // The whole bucket is walked, because a duplicate name may sit in a
+        // lower slot than the first match and the lowest slot must win.
+        uint16_t found = kNoSlot;
+        for (Link link = buckets_[bucketOf(scan.hash)]; link != kNoLink; link = chains_[slotOfLink(link)].nameNext) {
+            const uint16_t slot = slotOfLink(link);
+            if (chains_[slot].nameHash == scan.hash && slot < found) {
+                const Entry& entry = entries_[slot];
+                if (isVisibleFrom(entry.visibility, askingScope) && namesEqual(entry.name, name)) {
+                    found = slot;
+                }
             }
         }
-        return Status::NotFound;
+        if (found == kNoSlot) {
+            return Status::NotFound;
+        }
+        return idOf(found);
     }
 
     /// Calls @p visit(ObjectId, T&) for every object owned by @p owner.
     ///
     /// Resource recovery uses this when a task dies. The visitor may Delete
-    /// the object it is given, because the walk re-reads each slot's state
-    /// and a Delete touches only its own slot. Returns the number of objects
-    /// visited. Cost O(N) in the active count.
+    /// the object it is given or transfer it to another owner, because the
+    /// walk reads the next object of the list before the visit; it must not
+    /// delete any other object of this table. Objects are visited newest
+    /// owned first. Returns the number of objects visited. Cost O(objects on
+    /// the owner's list): only owners that share its key (a stale or remote
+    /// task id) lengthen the walk, and their objects are not visited.
     template <typename Visitor>
     size_t forEachOwnedBy(ObjectId owner, Visitor&& visit)
     {
         size_t visited = 0;
-        for (size_t slot = 0; slot < active_; ++slot) {
+        Link link = ownerHeads_[ownerKey(owner)];
+        while (link != kNoLink) {
+            const uint16_t slot = slotOfLink(link);
+            link = chains_[slot].ownerNext;
             Entry& entry = entries_[slot];
-            if (entry.used && entry.owner == owner) {
+            if (entry.owner == owner) {
                 ++visited;
-                visit(idOf(static_cast<uint16_t>(slot)), entry.object);
+                visit(idOf(slot), entry.object);
             }
         }
         return visited;
@@ -338,36 +429,145 @@ private:
     static constexpr uint16_t kNoSlot = 0xFFFF;
     // The smallest type that numbers every slot.
     using SlotNumber = std::conditional_t<(Capacity <= 256), uint8_t, uint16_t>;
+    // A slot number plus one, zero meaning none, so that every list starts
+    // empty in zero-initialised storage; the smallest type that holds it.
+    using Link = std::conditional_t<(Capacity < 256), uint8_t, uint16_t>;
+    static constexpr Link kNoLink = 0;
+    // The key of the list of objects the system owns (the null owner).
+    static constexpr size_t kSystemOwnerKey = OwnerKeys::kCount;
 
+    // resolve() reads only object, index and used. The entry keeps the
+    // layout it had before the chains came (the owner key sits where the
+    // free-list link was), so that its size, a power of two for a pointer
+    // T, still makes the fast paths' slot-to-entry arithmetic one shift.
     struct Entry {
         T object{};
         ObjectId owner{};
         uint16_t index = 0; ///< The id's index field while the slot is used.
-        uint16_t nextFree = kNoSlot;
+        uint16_t ownerKey = 0; ///< The owner list the object is on.
         bool used = false;
         Visibility visibility = Visibility::Local;
         char name[kNameCapacity] = {};
     };
 
+    // The links of a used slot, kept apart from Entry for the reason above.
+    struct Chain {
+        uint32_t nameHash = 0; ///< Hash of the name; meaningful only for a named object.
+        Link nameNext = kNoLink; ///< Next object in the same name bucket.
+        Link namePrev = kNoLink; ///< Previous one; none for the bucket's first.
+        Link ownerNext = kNoLink; ///< Next object on the same owner list.
+        Link ownerPrev = kNoLink; ///< Previous one; none for the list's first.
+    };
+
+    struct NameScan {
+        size_t length; ///< At most kNameCapacity, which marks a name too long.
+        uint32_t hash;
+    };
+
+    static Link linkOf(uint16_t slot) { return static_cast<Link>(slot + 1); }
+    static uint16_t slotOfLink(Link link) { return static_cast<uint16_t>(link - 1); }
+
     ObjectId idOf(uint16_t slot) const { return ObjectId(node_, type_, entries_[slot].index); }
 
+    // The null owner has a list of its own, so that a walk for it finds the
+    // system's objects as the slot-by-slot walk did.
+    static size_t ownerKey(ObjectId owner) { return owner.isNull() ? kSystemOwnerKey : OwnerKeys::keyOf(owner); }
+
+    // FNV-1a over at most kNameCapacity characters, in the pass that measures
+    // the name, so that an unterminated name cannot run away.
+    static NameScan scanName(const char* name)
+    {
+        uint32_t hash = 2166136261u;
+        size_t length = 0;
+        if (name != nullptr) {
+            while (length < kNameCapacity && name[length] != '\0') {
+                hash = (hash ^ static_cast<uint8_t>(name[length])) * 16777619u;
+                ++length;
+            }
+        }
+        return NameScan{length, hash};
+    }
+
+    // FNV-1a's low bits mix poorly for short names, so the high half is
+    // folded in before the mask.
+    static size_t bucketOf(uint32_t hash) { return (hash ^ (hash >> 16)) & (Capacity - 1); }
+
+    void linkName(uint16_t slot)
+    {
+        Chain& chain = chains_[slot];
+        Link& head = buckets_[bucketOf(chain.nameHash)];
+        chain.namePrev = kNoLink;
+        chain.nameNext = head;
+        if (head != kNoLink) {
+            chains_[slotOfLink(head)].namePrev = linkOf(slot);
+        }
+        head = linkOf(slot);
+    }
+
+    void unlinkName(uint16_t slot)
+    {
+        Chain& chain = chains_[slot];
+        if (chain.nameNext != kNoLink) {
+            chains_[slotOfLink(chain.nameNext)].namePrev = chain.namePrev;
+        }
+        if (chain.namePrev != kNoLink) {
+            chains_[slotOfLink(chain.namePrev)].nameNext = chain.nameNext;
+        } else {
+            buckets_[bucketOf(chain.nameHash)] = chain.nameNext;
+        }
+        chain.nameNext = chain.namePrev = kNoLink;
+    }
+
+    void linkOwner(uint16_t slot, size_t key)
+    {
+        Chain& chain = chains_[slot];
+        Link& head = ownerHeads_[key];
+        entries_[slot].ownerKey = static_cast<uint16_t>(key);
+        chain.ownerPrev = kNoLink;
+        chain.ownerNext = head;
+        if (head != kNoLink) {
+            chains_[slotOfLink(head)].ownerPrev = linkOf(slot);
+        }
+        head = linkOf(slot);
+    }
+
+    // Uses the key stored at link time, not the owner's key now: the key of
+    // a stale owner id may have changed since.
+    void unlinkOwner(uint16_t slot)
+    {
+        Chain& chain = chains_[slot];
+        if (chain.ownerNext != kNoLink) {
+            chains_[slotOfLink(chain.ownerNext)].ownerPrev = chain.ownerPrev;
+        }
+        if (chain.ownerPrev != kNoLink) {
+            chains_[slotOfLink(chain.ownerPrev)].ownerNext = chain.ownerNext;
+        } else {
+            ownerHeads_[entries_[slot].ownerKey] = chain.ownerNext;
+        }
+        chain.ownerNext = chain.ownerPrev = kNoLink;
+    }
+
     // The index freed longest ago; indices never handed out count as freed
-    // before any other. There is always one: at most Capacity objects live,
-    // and Capacity <= 4096.
+    // before any other. The ring starts full with every index in order, each
+    // stored as index ^ position so that zero-initialised storage holds it;
+    // Create thus takes the same path whether or not fresh indices remain,
+    // which keeps its cost flat. There is always one: at most Capacity
+    // objects live, and Capacity <= 4096.
     uint16_t takeIndex()
     {
-        if (freshIndices_ < kIndexCount) {
-            return static_cast<uint16_t>(freshIndices_++);
-        }
-        const uint16_t index = freedIndices_[freedHead_];
-        freedHead_ = (freedHead_ + 1) % kIndexCount;
+        const uint16_t index = static_cast<uint16_t>(freedIndices_[freedHead_] ^ freedHead_);
+        freedHead_ = (freedHead_ + 1) & (kIndexCount - 1);
         --freedCount_;
+        // Indices come out of the ring in order until each was handed out
+        // once, so issued_ counts them; a comparison, not a branch.
+        issued_ += static_cast<size_t>(issued_ == index);
         return index;
     }
 
     void giveBackIndex(uint16_t index)
     {
-        freedIndices_[(freedHead_ + freedCount_) % kIndexCount] = index;
+        const size_t position = (freedHead_ + freedCount_) & (kIndexCount - 1);
+        freedIndices_[position] = static_cast<uint16_t>(index ^ position);
         ++freedCount_;
     }
 
@@ -386,7 +586,7 @@ private:
             // the object is unreachable.
             return Status::Remote;
         }
-        if (id.index() >= freshIndices_) {
+        if (id.index() >= issued_) {
             return Status::InvalidId; // Never handed out: forged.
         }
         const uint16_t slot = indexSlot_[id.index()];
@@ -397,43 +597,25 @@ private:
         return slot;
     }
 
-    // Freed slots join the tail so that the slot freed longest ago is reused
-    // first, which spreads wear of the slots' storage evenly.
+    // Free slots wait in a ring, so that the slot freed longest ago is
+    // reused first, which spreads wear of the slots' storage evenly. A ring,
+    // unlike a list, has no empty case to treat apart, so Create and Delete
+    // cost the same whether the table is nearly empty or nearly full.
+    // The ring holds freeCount() slots, so the caller counts the slot it
+    // adds (active_ or used_) only after the push.
     void pushFree(uint16_t slot)
     {
-        entries_[slot].nextFree = kNoSlot;
-        if (freeTail_ == kNoSlot) {
-            freeHead_ = slot;
-        } else {
-            entries_[freeTail_].nextFree = slot;
-        }
-        freeTail_ = slot;
+        freeSlots_[(freeHead_ + active_ - used_) & (Capacity - 1)] = static_cast<SlotNumber>(slot);
     }
 
     uint16_t popFree()
     {
-        const uint16_t slot = freeHead_;
-        freeHead_ = entries_[slot].nextFree;
-        if (freeHead_ == kNoSlot) {
-            freeTail_ = kNoSlot;
-        }
-        entries_[slot].nextFree = kNoSlot;
+        const uint16_t slot = freeSlots_[freeHead_];
+        freeHead_ = (freeHead_ + 1) & (Capacity - 1);
         return slot;
     }
 
     static bool isValidOwner(ObjectId owner) { return owner.isNull() || owner.type() == ObjectType::Task; }
-
-    // Counts at most kNameCapacity characters so an unterminated name cannot run away.
-    static size_t nameLength(const char* name)
-    {
-        size_t length = 0;
-        if (name != nullptr) {
-            while (length < kNameCapacity && name[length] != '\0') {
-                ++length;
-            }
-        }
-        return length;
-    }
 
     static void copyName(char (&destination)[kNameCapacity], const char* source)
     {
@@ -458,14 +640,23 @@ private:
     }
 
     Entry entries_[Capacity] = {};
+    Chain chains_[Capacity] = {};
+    // Name hash buckets: the first object of each chain, as a Link.
+    Link buckets_[Capacity] = {};
+    // Owner lists: the first object of each, as a Link; the last is the system's.
+    Link ownerHeads_[OwnerKeys::kCount + 1] = {};
+    // Free slots, oldest first: a ring of active_ - used_ entries at freeHead_.
+    SlotNumber freeSlots_[Capacity] = {};
+    size_t freeHead_ = 0;
     // Index -> slot, for every index handed out (the slot it last named).
     SlotNumber indexSlot_[kIndexCount] = {};
-    // Freed indices, oldest first: a ring of freedCount_ entries at freedHead_.
+    // Freed indices, oldest first: a ring of freedCount_ entries at
+    // freedHead_, each stored as index ^ position (see takeIndex).
     uint16_t freedIndices_[kIndexCount] = {};
     size_t freedHead_ = 0;
-    size_t freedCount_ = 0;
-    // Indices [freshIndices_, 4096) were never handed out.
-    size_t freshIndices_ = 0;
+    size_t freedCount_ = kIndexCount;
+    // Indices [issued_, 4096) were never handed out.
+    size_t issued_ = 0;
     ObjectType type_;
     uint16_t node_;
     // The upper 20 bits (node and type) of every id this table issues.
@@ -477,8 +668,6 @@ private:
     }
     size_t active_ = 0;
     size_t used_ = 0;
-    uint16_t freeHead_ = kNoSlot;
-    uint16_t freeTail_ = kNoSlot;
 };
 
 } // namespace dcos::internal
