@@ -432,7 +432,7 @@ inline bool SegmentedHeap::checkAllocatedFrame(uint32_t offset, uint32_t previou
            && size <= size_ - offset;
 }
 
-bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) const
+inline bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) const
 {
     const uint32_t first = word(offset);
     const uint32_t second = word(offset + 4);
@@ -443,7 +443,7 @@ bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) const
            && header.size <= size_ - offset && (second >> 16) == seal(offset, first, header.holder);
 }
 
-bool SegmentedHeap::checkListNeighbours(uint32_t offset, SizeClass sizeClass) const
+inline bool SegmentedHeap::checkListNeighbours(uint32_t offset, SizeClass sizeClass) const
 {
     // Called after checkLinks(), which checked that both links are offsets in the heap.
     const uint32_t previous = word(offset + 4);
@@ -458,7 +458,7 @@ bool SegmentedHeap::checkListNeighbours(uint32_t offset, SizeClass sizeClass) co
     return previousOk && (next == kNone || word(next + 4) == offset);
 }
 
-void SegmentedHeap::writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder)
+inline void SegmentedHeap::writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder)
 {
     const uint32_t first = size | kAllocatedFlag | (previousFree ? kPreviousFreeFlag : 0);
     setWord(offset, first);

@@ -165,10 +165,10 @@ private:
     [[gnu::always_inline]] bool isLink(uint32_t link) const;
     [[gnu::always_inline]] bool checkFree(uint32_t offset, uint32_t& size) const;
     [[gnu::always_inline]] bool checkLinks(uint32_t offset) const;
-    bool checkAllocated(uint32_t offset, Allocated& header) const;
+    [[gnu::always_inline]] bool checkAllocated(uint32_t offset, Allocated& header) const;
     [[gnu::always_inline]] bool checkAllocatedFrame(uint32_t offset, uint32_t previousFreeFlag) const;
-    bool checkListNeighbours(uint32_t offset, SizeClass sizeClass) const;
-    void writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder);
+    [[gnu::always_inline]] bool checkListNeighbours(uint32_t offset, SizeClass sizeClass) const;
+    [[gnu::always_inline]] void writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder);
     [[gnu::always_inline]] void insert(uint32_t offset, uint32_t size);
     [[gnu::always_inline]] void unlink(uint32_t offset, SizeClass sizeClass);
     // Moves @p sizeClass to the smallest non-empty class at or above it; false when none.
