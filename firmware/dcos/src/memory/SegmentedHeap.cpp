@@ -465,7 +465,7 @@ inline void SegmentedHeap::writeAllocated(uint32_t offset, uint32_t size, bool p
     setWord(offset + 4, (static_cast<uint32_t>(seal(offset, first, holder)) << 16) | holder);
 }
 
-Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header)
+inline Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header)
 {
     const uintptr_t address = reinterpret_cast<uintptr_t>(segment);
     const uintptr_t base = reinterpret_cast<uintptr_t>(base_);

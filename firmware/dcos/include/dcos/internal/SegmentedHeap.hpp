@@ -178,7 +178,7 @@ private:
     // Clears the bits of the class whose list just became empty.
     [[gnu::always_inline]] void emptied(SizeClass sizeClass);
     // Finds the offset of an allocated segment for release() and transfer().
-    Result<uint32_t> allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header);
+    [[gnu::always_inline]] Result<uint32_t> allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header);
     // Frees the checked allocated segment at @p offset and merges it; sets
     // @p freedEnd to the end of the resulting free segment.
     Status releaseAt(uint32_t offset, const Allocated& header, uint32_t& freedEnd);
