@@ -196,8 +196,10 @@ private:
     uint32_t failedAllocations_ = 0;
     uint32_t returns_ = 0;
     uint32_t salt_ = 0;
-    // Odd, derived from the salt: the factor of the seals and tags.
-    uint32_t multiplier_ = 1;
+    // Odd, derived from the salt by initialise(): the factor of the seals and
+    // tags. Zero until then, so that a table of unused heaps is all zero and
+    // lives in .bss, not in the image.
+    uint32_t multiplier_ = 0;
     // Bit k: levelMaps_[k] is not zero.
     uint32_t levelMap_ = 0;
     // Bit i of levelMaps_[k]: the list heads_[k][i] is not empty. A head is
