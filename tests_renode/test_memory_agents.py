@@ -14,7 +14,7 @@ from dcoslab.target import run_target_test
 
 MEMORY_TARGET_TESTS = [
     "pools",        # Create/Delete/Allocate/Return/GetStatistics/NameToObject/XferOwnership, holders, id errors
-    "heaps",        # the same for heaps, with the header, alignment, minimum, first fit and merging
+    "heaps",        # the same for heaps, with the header, alignment, minimum, segregated fit and merging
     "memtables",    # full pool and heap tables, AddObjects
     "poolcorrupt",  # double return, overwritten free list, wild pointer: Corrupted until Delete
     "heapcorrupt",  # double return, overrun into a header, overwritten link: Corrupted until Delete

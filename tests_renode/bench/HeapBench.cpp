@@ -5,17 +5,17 @@
 // covers a 4 KiB area and has a defined free-list shape for each benchmark:
 //
 //   Heap.Allocate, Heap.GetUsageInfo: a fresh heap, one free segment (the
-//     whole heap). First fit succeeds at the first free segment.
+//     whole heap), split by the allocation.
 //   Heap.Return: [free][b][free] with b allocated: returning b merges it
 //     with both neighbours (the most work a Return does).
 //
-// First fit costs O(free segments), so Allocate (and GetUsageInfo, the
-// seed's name for GetStatistics, which walks and checks the free list) are
-// Cost::Variable, as the seed marks Allocate. Their growth is measured by
-// the "...Fragmented" benchmarks, where the object count is not heaps but
-// free segments: one heap whose free list holds that many 16-byte free
-// segments, every one too small for the request, ahead of the one that fits.
-// Heap.AddObjects is in ConfigurationBench.cpp.
+// The seed's Allocate was first fit, O(free segments), and marked Variable;
+// DCOS's two-level segregated fit makes Allocate and GetUsageInfo (the
+// seed's name for GetStatistics) O(1), so they are Cost::Constant, and the
+// "...Fragmented" benchmarks show it: there the object count is not heaps
+// but free segments, one heap holding that many 16-byte free segments, every
+// one too small for the request, besides the one that fits. First fit
+// walked them all. Heap.AddObjects is in ConfigurationBench.cpp.
 #include "BenchSupport.hpp"
 
 #include <dcos/HeapAgent.hpp>
@@ -121,8 +121,9 @@ void recreateTarget()
     heaps[heapCount - 1] = target;
 }
 
-// --- Heap.Allocate on the fresh target: the first free segment fits; the
-// segment is cut from its end. Returned unmeasured, which merges it back.
+// --- Heap.Allocate on the fresh target: its one free segment fits; the
+// segment is cut from its start and the rest goes to its size class.
+// Returned unmeasured, which merges it back.
 
 void allocate()
 {
@@ -138,10 +139,10 @@ void returnFirst()
 }
 
 // --- Heap.Return with a free segment on both sides. Allocation cuts from
-// the end of the free segment, so three allocations give [free][c][b][a];
-// returning c and a leaves [free][b][free]. After b's return merges all
-// three, allocating a, b and c again and returning c and a rebuilds exactly
-// that shape, with b at the same address.
+// the start of the free segment, so three allocations give [a][b][c][free];
+// returning c (merged into the free rest) and a leaves [free][b][free].
+// After b's return merges all three, allocating a, b and c again and
+// returning c and a rebuilds exactly that shape, with b at the same address.
 
 void buildMergeShape()
 {
@@ -171,7 +172,8 @@ void returnBetweenFree()
     segments[1] = nullptr;
 }
 
-// --- Heap.GetUsageInfo (GetStatistics) of the fresh target: one free segment.
+// --- Heap.GetUsageInfo (GetStatistics) of the fresh target: counters and
+// the first segment of the highest non-empty class, checked.
 
 void getStatistics()
 {
@@ -193,17 +195,16 @@ void nameToObject()
     lastValue = id.ok() ? id.value().raw() : 0;
 }
 
-// --- Heap.AllocateFragmented, Heap.GetUsageInfoFragmented: one heap whose
-// free list holds count 16-byte free segments (8 usable bytes each, too
-// small for the 64-byte request) ahead of one large free segment.
+// --- Heap.AllocateFragmented, Heap.GetUsageInfoFragmented: one heap that
+// holds count 16-byte free segments (8 usable bytes each, too small for the
+// 64-byte request) besides one large free segment.
 //
-// Fresh, the heap is one free segment R at its start. 2 * count allocations
-// of 8 bytes are cut from R's end: s1 at the very end, s2 before it, ...
-// Returning s1, s3, s5, ... (each between two allocated segments, s1 at the
-// end) pushes each on the head of the free list, so the list is
-// s(2count-1), ..., s3, s1, R: count small segments, then R. Allocate(64)
-// walks all of them, and its segment is cut from R's end; returning it
-// merges it back into R, which keeps its place at the end of the list.
+// Fresh, the heap is one free segment R. 2 * count allocations of 8 bytes
+// are cut from R's start: s1 first, s2 after it, ... Returning s1, s3, s5,
+// ... (each before an allocated segment) leaves count small free segments,
+// all in the 16-byte class, and R. First fit had to walk the small ones;
+// the segregated fit goes straight to R's class. The allocation is cut from
+// R's start, and returning it merges it back into R.
 
 constexpr size_t kFragmentBytes = HeapAgent::SegmentBytes(8); // 16
 constexpr size_t kLargeBytes = 512;
@@ -283,16 +284,16 @@ DCOS_BENCHMARK(heapCreateBench, "Heap.Create", populateButOne, createHeap, Cost:
                .teardown = clearAll);
 DCOS_BENCHMARK(heapDeleteBench, "Heap.Delete", populate, deleteTarget, Cost::Constant, .restore = recreateTarget,
                .teardown = clearAll);
-DCOS_BENCHMARK(heapAllocateBench, "Heap.Allocate", populate, allocate, Cost::Variable, .restore = returnFirst,
+DCOS_BENCHMARK(heapAllocateBench, "Heap.Allocate", populate, allocate, Cost::Constant, .restore = returnFirst,
                .teardown = clearAll);
 DCOS_BENCHMARK(heapAllocateFragmentedBench, "Heap.AllocateFragmented", populateFragmented, allocateFragmented,
-               Cost::Variable, .restore = returnFragmented, .teardown = clearFragmented);
+               Cost::Constant, .restore = returnFragmented, .teardown = clearFragmented);
 DCOS_BENCHMARK(heapReturnBench, "Heap.Return", populateForReturn, returnBetweenFree, Cost::Constant,
                .restore = buildMergeShape, .teardown = clearAll);
-DCOS_BENCHMARK(heapGetUsageInfoBench, "Heap.GetUsageInfo", populate, getStatistics, Cost::Variable,
+DCOS_BENCHMARK(heapGetUsageInfoBench, "Heap.GetUsageInfo", populate, getStatistics, Cost::Constant,
                .teardown = clearAll);
 DCOS_BENCHMARK(heapGetUsageInfoFragmentedBench, "Heap.GetUsageInfoFragmented", populateFragmented,
-               getFragmentedStatistics, Cost::Variable, .teardown = clearFragmented);
+               getFragmentedStatistics, Cost::Constant, .teardown = clearFragmented);
 DCOS_BENCHMARK(heapXferOwnershipBench, "Heap.XferOwnership", populate, transferOwnership, Cost::Constant,
                .teardown = clearAll);
 DCOS_BENCHMARK(heapNameToObjectBench, "Heap.NameToObject", populate, nameToObject, Cost::Variable,

@@ -293,7 +293,7 @@ bool heaps(shell::Shell& shell)
         static_cast<uint8_t*>(b)[i] = 0xB0;
     }
 
-    // First fit and merging on both sides.
+    // Reuse of a free segment of the right size class, and merging on both sides.
     ok = checkStatus(shell, heapAgent.Return(heap, a), Status::Ok, "Return a") && ok;
     ok = checkStatus(shell, heapAgent.Return(heap, c), Status::Ok, "Return c") && ok;
     statistics = heapStatistics(heap);
@@ -302,7 +302,7 @@ bool heaps(shell::Shell& shell)
                 static_cast<unsigned long>(statistics.largestFreeSegment));
     ok = check(shell, statistics.freeSegments == 3, "a and c are separate free segments") && ok;
     const dcos::Result<void*> fits = heapAgent.Allocate(heap, 200);
-    ok = check(shell, fits.ok() && fits.value() == c, "first fit reuses c's segment for the same size") && ok;
+    ok = check(shell, fits.ok() && fits.value() == c, "the size class of c's segment gives it back for the same size") && ok;
     ok = checkStatus(shell, heapAgent.Return(heap, c), Status::Ok, "Return c again") && ok;
     ok = checkStatus(shell, heapAgent.Return(heap, b), Status::Ok, "Return b, between two free segments") && ok;
     ok = check(shell, heapStatistics(heap).freeSegments == 2, "b merged with both neighbours") && ok;
@@ -352,7 +352,7 @@ bool heaps(shell::Shell& shell)
     return ok;
 }
 
-DCOS_TARGET_TEST(heapsTest, "heaps", "segmented heap primitives, first fit, merging, holders and errors", heaps);
+DCOS_TARGET_TEST(heapsTest, "heaps", "segmented heap primitives, segregated fit, merging, holders and errors", heaps);
 
 bool tables(shell::Shell& shell)
 {
@@ -468,9 +468,9 @@ bool heapCorruption(shell::Shell& shell)
 
     // A task writes past the end of its segment into the next one's header.
     const ObjectId second = heapAgent.Create(otherHeapArea, sizeof otherHeapArea, nullptr, Visibility::Local).value();
-    uint8_t* upper = static_cast<uint8_t*>(heapAgent.Allocate(second, 24).value());
     uint8_t* lower = static_cast<uint8_t*>(heapAgent.Allocate(second, 24).value());
-    ok = check(shell, lower + 32 == upper, "segments are cut from the end of the free segment") && ok;
+    uint8_t* upper = static_cast<uint8_t*>(heapAgent.Allocate(second, 24).value());
+    ok = check(shell, lower + 32 == upper, "segments are cut from the start of the free segment") && ok;
     for (size_t i = 0; i < 24 + 8; ++i) {
         static_cast<volatile uint8_t*>(lower)[i] = 0x55;
     }
@@ -483,8 +483,9 @@ bool heapCorruption(shell::Shell& shell)
     void* freed = heapAgent.Allocate(third, 40).value();
     (void)heapAgent.Allocate(third, 40);
     ok = checkStatus(shell, heapAgent.Return(third, freed), Status::Ok, "Return") && ok;
-    static_cast<volatile uint32_t*>(freed)[0] = 0x00000010; // Its next link, now naming the middle of free space.
-    ok = checkStatus(shell, heapAgent.Allocate(third, 800).status(), Status::Corrupted,
+    static_cast<volatile uint32_t*>(freed)[0] = 0x00000010; // Its next link, now naming the middle of a segment.
+    // A request of the same size takes the first segment of that size class: the freed one.
+    ok = checkStatus(shell, heapAgent.Allocate(third, 40).status(), Status::Corrupted,
                      "Allocate over an overwritten link") && ok;
     ok = checkStatus(shell, heapAgent.Return(third, kept), Status::Corrupted, "and every later call") && ok;
     ok = checkStatus(shell, heapAgent.Delete(third), Status::Ok, "Delete") && ok;

@@ -1,7 +1,8 @@
 // Host tests of the segmented heap algorithm (seed 7.8): header, alignment
-// and minimum size, first fit, merging on both sides, holders, long
-// randomized sequences checked against an independent model of the address
-// space, and detection of corruption.
+// and minimum size, two-level segregated fit, merging on both sides, holders,
+// long randomized sequences checked against an independent model of the
+// address space (with bad returns that must be refused without a write),
+// and detection of corruption.
 #include <dcos/internal/SegmentedHeap.hpp>
 
 #include "GuardedArea.hpp"
@@ -128,23 +129,68 @@ TEST(SegmentedHeapTest, ReturnMergesWithBothNeighbours)
     EXPECT_EQ(heap.audit(), Status::Ok);
 }
 
-TEST(SegmentedHeapTest, FirstFitTakesTheFirstListedSegmentThatIsLargeEnough)
+TEST(SegmentedHeapTest, AllocationIsCutFromTheStartOfTheChosenSegment)
 {
     Area area(1024);
     SegmentedHeap heap;
     ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
-    void* small = heap.allocate(16, kTaskA).value();
+    void* first = heap.allocate(16, kTaskA).value();
+    void* second = heap.allocate(100, kTaskA).value();
+    EXPECT_EQ(first, area.data() + 8);
+    EXPECT_EQ(second, area.data() + 24 + 8);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+}
+
+TEST(SegmentedHeapTest, SmallFreeSegmentsAreNotSearched)
+{
+    // Many free 16-byte segments and one large one: the request goes straight
+    // to the large one's class, whatever the number of small ones.
+    Area area(16 * 2 * 64 + 512);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
+    std::vector<void*> small;
+    for (int i = 0; i < 2 * 64; ++i) {
+        small.push_back(heap.allocate(8, kTaskA).value());
+    }
+    for (int i = 0; i < 2 * 64; i += 2) {
+        ASSERT_EQ(heap.release(small[static_cast<size_t>(i)], kTaskA), Status::Ok);
+    }
+    EXPECT_EQ(statisticsOf(heap).freeSegments, 65u);
+    uint8_t* large = static_cast<uint8_t*>(heap.allocate(64, kTaskB).value());
+    EXPECT_EQ(large, area.data() + 16 * 2 * 64 + 8);
+    // A 16-byte request takes one of the small ones.
+    uint8_t* fits = static_cast<uint8_t*>(heap.allocate(8, kTaskB).value());
+    EXPECT_LT(fits, area.data() + 16 * 2 * 64);
+    EXPECT_EQ(heap.audit(), Status::Ok);
+}
+
+TEST(SegmentedHeapTest, TheLargestFreeSegmentReportedIsTheLargestRequestThatSucceeds)
+{
+    Area area(4096);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
+    // Free segments of 1,000 and 1,016 bytes (one class, [960, 1024)), kept
+    // apart by allocated ones, and the remainder allocated.
+    void* a = heap.allocate(992, kTaskA).value();
     void* keep1 = heap.allocate(8, kTaskA).value();
-    void* large = heap.allocate(200, kTaskA).value();
+    void* b = heap.allocate(1008, kTaskA).value();
     void* keep2 = heap.allocate(8, kTaskA).value();
-    ASSERT_EQ(heap.release(large, kTaskA), Status::Ok);
-    ASSERT_EQ(heap.release(small, kTaskA), Status::Ok); // The list: small, large, remainder.
-    // 16 bytes fit the first listed segment exactly.
-    EXPECT_EQ(heap.allocate(16, kTaskB).value(), small);
-    // 100 bytes skip nothing suitable: the large one is next, cut from its end.
-    void* cut = heap.allocate(100, kTaskB).value();
-    EXPECT_GT(cut, large);
-    EXPECT_LT(static_cast<uint8_t*>(cut), static_cast<uint8_t*>(large) + 200);
+    const size_t rest = statisticsOf(heap).largestFreeSegment;
+    void* keep3 = heap.allocate(rest, kTaskA).value();
+    ASSERT_NE(keep3, nullptr);
+    ASSERT_EQ(heap.release(b, kTaskA), Status::Ok);
+    ASSERT_EQ(heap.release(a, kTaskA), Status::Ok); // First in the class list now.
+    const HeapStatistics statistics = statisticsOf(heap);
+    EXPECT_EQ(statistics.freeSegments, 2u);
+    EXPECT_EQ(statistics.largestFreeSegment, 992u); // The class's first segment.
+    // The rounded request for 1,000 bytes finds no higher class; its own
+    // class's first segment (992) is too small, so it fails, as reported.
+    EXPECT_EQ(heap.allocate(993, kTaskB).status(), Status::NoMemory);
+    // 992 bytes fit the first segment of their own class.
+    EXPECT_EQ(heap.allocate(992, kTaskB).value(), a);
+    EXPECT_EQ(statisticsOf(heap).largestFreeSegment, 1008u);
+    EXPECT_EQ(heap.allocate(1008, kTaskB).value(), b);
+    EXPECT_EQ(statisticsOf(heap).largestFreeSegment, 0u);
     EXPECT_EQ(heap.audit(), Status::Ok);
     (void)keep1;
     (void)keep2;
@@ -180,6 +226,21 @@ struct Model {
     std::map<uint8_t*, Segment> allocated; // By data address.
 };
 
+// The smallest size of the size class of @p bytes: classes are 8 bytes wide
+// below 64 bytes, and each power of two above is cut into eight.
+size_t classFloor(size_t bytes)
+{
+    if (bytes < 64) {
+        return bytes;
+    }
+    size_t power = 64;
+    while (power * 2 <= bytes) {
+        power *= 2;
+    }
+    const size_t width = power / 8;
+    return bytes / width * width;
+}
+
 void checkAgainstModel(SegmentedHeap& heap, const Model& model, uint8_t* base, size_t heapBytes)
 {
     size_t gaps = 0;
@@ -213,13 +274,34 @@ void checkAgainstModel(SegmentedHeap& heap, const Model& model, uint8_t* base, s
     EXPECT_EQ(statistics.freeBytes, gapBytes);
     EXPECT_EQ(statistics.usedBytes + statistics.freeBytes, heapBytes);
     EXPECT_EQ(statistics.allocatedSegments, model.allocated.size());
-    EXPECT_EQ(statistics.largestFreeSegment, largestGap == 0 ? 0 : largestGap - 8);
+    // The largest request that can succeed is the first segment of the
+    // highest non-empty class: a whole gap, in the largest gap's class.
+    if (largestGap == 0) {
+        EXPECT_EQ(statistics.largestFreeSegment, 0u);
+    } else {
+        EXPECT_LE(statistics.largestFreeSegment + 8, largestGap);
+        EXPECT_EQ(classFloor(statistics.largestFreeSegment + 8), classFloor(largestGap));
+    }
+}
+
+// Tries a return that must be refused, then puts the heap back as it was.
+// The refusal must come before any write: the area is byte for byte what it
+// was. A refusal that disables the heap (Corrupted) is undone from a copy
+// of the heap object, so the sequence can go on.
+void expectRefusedWithoutAWrite(SegmentedHeap& heap, Area& area, void* pointer, uint16_t holder, Status expected)
+{
+    const std::vector<uint8_t> before(area.data(), area.data() + area.size());
+    const SegmentedHeap saved = heap;
+    ASSERT_EQ(heap.release(pointer, holder), expected);
+    ASSERT_TRUE(std::equal(before.begin(), before.end(), area.data())) << "a refused return wrote into the heap";
+    ASSERT_EQ(heap.isCorrupted(), expected == Status::Corrupted);
+    heap = saved;
 }
 
 TEST(SegmentedHeapTest, RandomizedSequencesMatchTheModel)
 {
     std::mt19937 random(19870615);
-    for (int round = 0; round < 12; ++round) {
+    for (int round = 0; round < 16; ++round) {
         const size_t heapBytes = 512 + 8 * (random() % 1024);
         Area area(heapBytes);
         SegmentedHeap heap;
@@ -229,8 +311,9 @@ TEST(SegmentedHeapTest, RandomizedSequencesMatchTheModel)
         uint32_t failed = 0;
         uint32_t returns = 0;
         uint32_t lowWater = static_cast<uint32_t>(heapBytes);
+        std::vector<uint8_t*> returned; // Data addresses returned before; some are allocated again.
         // Small, medium and occasional large requests, as a real mix would be.
-        const size_t maxRequest = round % 3 == 0 ? 24 : round % 3 == 1 ? 200 : heapBytes / 3;
+        const size_t maxRequest = round % 4 == 0 ? 24 : round % 4 == 1 ? 200 : round % 4 == 2 ? heapBytes / 3 : 2000;
         for (int step = 0; step < 6000; ++step) {
             const uint16_t holder = static_cast<uint16_t>(random() % 4);
             const unsigned action = random() % 20;
@@ -266,8 +349,38 @@ TEST(SegmentedHeapTest, RandomizedSequencesMatchTheModel)
                     it->second.holder = other;
                 }
                 ASSERT_EQ(heap.release(it->first, it->second.holder), Status::Ok);
+                returned.push_back(it->first);
                 model.allocated.erase(it);
                 ++returns;
+            } else if (action == 19 && random() % 2 == 0) {
+                // A bad return: a double return, a pointer inside a segment
+                // or misaligned, or one outside the heap.
+                const unsigned kind = random() % 4;
+                if (kind == 0 && !returned.empty()) {
+                    uint8_t* stale = returned[random() % returned.size()];
+                    if (model.allocated.count(stale) == 0) {
+                        expectRefusedWithoutAWrite(heap, area, stale, holder, Status::Corrupted);
+                    }
+                } else if (kind == 1 && !model.allocated.empty()) {
+                    auto it = model.allocated.begin();
+                    std::advance(it, static_cast<long>(random() % model.allocated.size()));
+                    const size_t inside = HeapAgent::SegmentBytes(it->second.requested) - 8;
+                    if (inside > 8) {
+                        uint8_t* pointer = it->first + 8 * (1 + random() % ((inside - 8) / 8 + 1));
+                        if (pointer < it->first + inside) {
+                            expectRefusedWithoutAWrite(heap, area, pointer, it->second.holder, Status::Corrupted);
+                        }
+                    }
+                } else if (kind == 2 && !model.allocated.empty()) {
+                    auto it = model.allocated.begin();
+                    std::advance(it, static_cast<long>(random() % model.allocated.size()));
+                    expectRefusedWithoutAWrite(heap, area, it->first + 1 + random() % 7, it->second.holder,
+                                               Status::Corrupted);
+                } else if (kind == 3) {
+                    uint8_t outside[16];
+                    expectRefusedWithoutAWrite(heap, area, outside, holder, Status::InvalidArgument);
+                    expectRefusedWithoutAWrite(heap, area, area.data() + heapBytes, holder, Status::InvalidArgument);
+                }
             } else if (!model.allocated.empty()) {
                 size_t expected = 0;
                 for (auto it = model.allocated.begin(); it != model.allocated.end();) {
@@ -325,7 +438,8 @@ protected:
         for (uint8_t*& segment : segments) {
             segment = static_cast<uint8_t*>(heap.allocate(24, kTaskA).value());
         }
-        // Segments are cut from the end: segments[0] is highest. Free one in the middle.
+        // Segments are cut from the start: segments[0] is lowest, at offset 0,
+        // each 32 bytes. Free one in the middle.
         ASSERT_EQ(heap.release(segments[2], kTaskA), Status::Ok);
     }
 
@@ -345,11 +459,11 @@ TEST_F(SegmentedHeapCorruptionTest, DoubleReturnDisablesTheHeap)
 
 TEST_F(SegmentedHeapCorruptionTest, DoubleReturnOfAMergedSegmentIsDetected)
 {
-    // segments[1] sits just above segments[2] (free): it merges into it, and
+    // segments[3] sits just above segments[2] (free): it merges into it, and
     // its header is cleared, so a second return cannot pass for a live one.
-    ASSERT_EQ(heap.release(segments[1], kTaskA), Status::Ok);
+    ASSERT_EQ(heap.release(segments[3], kTaskA), Status::Ok);
     EXPECT_EQ(heap.audit(), Status::Ok);
-    EXPECT_EQ(heap.release(segments[1], kTaskA), Status::Corrupted);
+    EXPECT_EQ(heap.release(segments[3], kTaskA), Status::Corrupted);
     expectDisabled(heap, segments[0]);
 }
 
@@ -378,10 +492,10 @@ TEST_F(SegmentedHeapCorruptionTest, ForeignPointerIsRefusedAndTheHeapStaysInServ
 
 TEST_F(SegmentedHeapCorruptionTest, OverrunIntoTheNextHeaderIsDetectedByBothSegments)
 {
-    // segments[4] is lowest; writing past its end hits segments[3]'s header.
-    std::memset(segments[4], 0x11, 24 + 8);
-    EXPECT_EQ(heap.release(segments[4], kTaskA), Status::Corrupted); // Its successor's header fails.
-    expectDisabled(heap, segments[3]);
+    // segments[0] is lowest; writing past its end hits segments[1]'s header.
+    std::memset(segments[0], 0x11, 24 + 8);
+    EXPECT_EQ(heap.release(segments[0], kTaskA), Status::Corrupted); // Its successor's header fails.
+    expectDisabled(heap, segments[1]);
 }
 
 TEST_F(SegmentedHeapCorruptionTest, OverwrittenHolderIsCorruptionNotAnotherOwner)
@@ -409,29 +523,52 @@ TEST_F(SegmentedHeapCorruptionTest, WriteAfterReturnIntoTheLinksIsCaughtByAlloca
 TEST_F(SegmentedHeapCorruptionTest, OverwrittenBoundaryTagIsCaughtWhenTheSuccessorReturns)
 {
     std::memset(segments[2] + 16 + 4, 0x33, 4); // Last word of the free 32-byte segment.
-    EXPECT_EQ(heap.release(segments[1], kTaskA), Status::Corrupted); // segments[1] follows it.
+    EXPECT_EQ(heap.release(segments[3], kTaskA), Status::Corrupted); // segments[3] follows it.
     expectDisabled(heap, segments[0]);
 }
 
-TEST_F(SegmentedHeapCorruptionTest, OverwrittenBoundaryTagIsCaughtByTheStatistics)
+TEST_F(SegmentedHeapCorruptionTest, OverwrittenBoundaryTagIsCaughtByTheAudit)
 {
     std::memset(segments[2] + 16 + 4, 0x33, 4);
+    EXPECT_EQ(heap.audit(), Status::Corrupted);
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, OverwrittenTagOfTheLargestFreeSegmentIsCaughtByTheStatistics)
+{
+    // The free remainder above segments[4] is the largest; its tag is the area's last word.
+    std::memset(area.data() + area.size() - 4, 0x33, 4);
     EXPECT_EQ(heap.statistics().status(), Status::Corrupted);
     expectDisabled(heap, segments[0]);
 }
 
 TEST_F(SegmentedHeapCorruptionTest, FreeListLoopIsCaught)
 {
-    // Point the free segment's next link at itself.
+    // Point the free segment's next link at itself: Allocate takes it first
+    // from its class list, and its successor's back link does not point back.
     const uint32_t self = static_cast<uint32_t>(headerOf(segments[2]) - area.data());
     std::memcpy(segments[2], &self, 4);
-    EXPECT_EQ(heap.allocate(900, kTaskA).status(), Status::Corrupted); // Fits nowhere: walks the whole list.
+    EXPECT_EQ(heap.allocate(16, kTaskA).status(), Status::Corrupted);
+    expectDisabled(heap, segments[0]);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, FreeListLoopIsCaughtByTheAudit)
+{
+    const uint32_t self = static_cast<uint32_t>(headerOf(segments[2]) - area.data());
+    std::memcpy(segments[2], &self, 4);
+    EXPECT_EQ(heap.audit(), Status::Corrupted);
+}
+
+TEST_F(SegmentedHeapCorruptionTest, OverwrittenSizeOfAFreeSegmentIsCaughtByAllocate)
+{
+    headerOf(segments[2])[1] ^= 0x01; // Size + 256: the end tag no longer matches.
+    EXPECT_EQ(heap.allocate(16, kTaskA).status(), Status::Corrupted);
     expectDisabled(heap, segments[0]);
 }
 
 TEST_F(SegmentedHeapCorruptionTest, ClearedPreviousFreeFlagIsCaughtByAudit)
 {
-    headerOf(segments[1])[0] &= static_cast<uint8_t>(~2u); // segments[1] follows the free segment.
+    headerOf(segments[3])[0] &= static_cast<uint8_t>(~2u); // segments[3] follows the free segment.
     EXPECT_EQ(heap.audit(), Status::Corrupted);
 }
 

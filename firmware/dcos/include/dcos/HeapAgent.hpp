@@ -1,12 +1,15 @@
 // The segmented heap memory agent's application interface (seed 7.8).
 //
 // A heap is a physically contiguous area from which segments of any size are
-// allocated first-fit. Every segment carries an 8-byte header, starts on an
-// 8-byte boundary and holds at least 8 bytes; a returned segment is merged
-// with its free neighbours on both sides, so two free segments are never
-// adjacent. The heap is more flexible than a buffer pool but costlier:
-// Allocate walks the free list (cost variable, bounded by the number of free
-// segments), so control loops with hard deadlines should prefer pools.
+// allocated. Every segment carries an 8-byte header, starts on an 8-byte
+// boundary and holds at least 8 bytes; a returned segment is merged with its
+// free neighbours on both sides, so two free segments are never adjacent.
+// Where the seed allocated first fit, walking the free list, DCOS keeps the
+// free segments in size classes (a two-level segregated fit): Allocate and
+// Return cost O(1) however fragmented the heap is. The price is that a
+// request may fail while a free segment less than an eighth larger than it
+// exists; GetStatistics reports exactly the largest request that succeeds.
+// A heap is still costlier than a buffer pool, whose buffers are all alike.
 //
 // Where the memory comes from: as for pools, the application owns the area,
 // typically a static array, and passes it to Create; the heap keeps all its
@@ -59,7 +62,9 @@ struct HeapStatistics {
     uint32_t allocatedSegments = 0;
     /// Number of free segments (fragments).
     uint32_t freeSegments = 0;
-    /// The largest request Allocate can satisfy now: the largest free segment less its header; 0 when none.
+    /// The largest request Allocate can satisfy now: the first free segment
+    /// of the highest non-empty size class less its header (another segment
+    /// of that class may be up to an eighth larger); 0 when none.
     uint32_t largestFreeSegment = 0;
     /// The fewest free bytes there have been since Create (low-water mark).
     uint32_t lowWaterFreeBytes = 0;
@@ -73,10 +78,9 @@ struct HeapStatistics {
 
 /// The segmented heap memory agent interface object (seed 7.8, Table 9.7).
 ///
-/// The class has no state; use the object heapAgent. Return and the segment
-/// form of XferOwnership cost O(1); Allocate and GetStatistics cost O(free
-/// segments); Create and the configuration services cost O(N) in the number
-/// of pool and heap slots.
+/// The class has no state; use the object heapAgent. Allocate, Return,
+/// GetStatistics and the segment form of XferOwnership cost O(1); Create and
+/// the configuration services cost O(N) in the number of pool and heap slots.
 class HeapAgent {
 public:
     /// Bytes of the header in front of every segment (seed 7.8).
@@ -112,14 +116,14 @@ public:
     /// corrupted. Also fails with InInterrupt and the id errors.
     Status Delete(ObjectId heap) const;
 
-    /// Allocates a segment of at least @p bytes, first fit, held by the
-    /// calling task (by the system in an interrupt handler). O(free segments); never blocks.
+    /// Allocates a segment of at least @p bytes, held by the calling task
+    /// (by the system in an interrupt handler). O(1); never blocks.
     ///
     /// The segment is 8-byte aligned and holds SegmentBytes(bytes) - 8 bytes
     /// or, when the rest of the free segment would be too small to use, up
-    /// to 8 more. Fails with InvalidArgument for 0 bytes, NoMemory when no
-    /// free segment is large enough (counted in the statistics), Corrupted,
-    /// and the id errors.
+    /// to 8 more. Fails with InvalidArgument for 0 bytes, NoMemory when
+    /// @p bytes is more than GetStatistics' largestFreeSegment (counted in
+    /// the statistics), Corrupted, and the id errors.
     Result<void*> Allocate(ObjectId heap, size_t bytes) const;
 
     /// Returns the segment @p segment to the heap and merges it with its free neighbours. O(1).
@@ -131,8 +135,9 @@ public:
     /// bookkeeping; and the id errors.
     Status Return(ObjectId heap, void* segment) const;
 
-    /// Reports the heap's usage, including the largest free segment (the
-    /// seed's GetUsageInfo). O(free segments), since it walks and checks the free list.
+    /// Reports the heap's usage, including the largest request that can
+    /// succeed (the seed's GetUsageInfo). O(1): Allocate and Return keep the
+    /// counters.
     ///
     /// Fails with Corrupted for a corrupted heap, and the id errors.
     Result<HeapStatistics> GetStatistics(ObjectId heap) const;

@@ -71,7 +71,10 @@ Status checkOwnerOrSuperUser(ObjectId id)
 void remove(ObjectId id, HeapObject& object)
 {
     (void)heapTable.Delete(id);
-    object = HeapObject{};
+    // Only the slot's flag and id are cleared: the heap's class heads make
+    // the object close to a kilobyte, which Create lays out anew anyway.
+    object.inUse = false;
+    object.id = ObjectId::null();
 }
 
 unsigned recoverHeaps(ObjectId deadTask) { return HeapManager::recoverResourcesOf(deadTask); }

@@ -5,10 +5,13 @@ namespace dcos::internal {
 
 namespace {
 
-constexpr uint32_t kSegmentKind = 0x5345474Du; // "SEGM"
-constexpr uint32_t kTagKind = 0x54414753u;     // "TAGS"
+constexpr uint32_t kTagKind = 0x54414753u; // "TAGS"
 
 constexpr uintptr_t roundUp8(uintptr_t value) { return (value + 7) & ~uintptr_t{7}; }
+
+// The index of the highest set bit of a non-zero value. Written with XOR,
+// not as 31 - clz, so that GCC emits a lone BSR.
+inline uint32_t highestBit(uint32_t value) { return static_cast<uint32_t>(__builtin_clz(value)) ^ 31; }
 
 } // namespace
 
@@ -32,11 +35,11 @@ Status SegmentedHeap::initialise(void* area, size_t areaBytes, uint32_t salt)
     areaEnd_ = begin + areaBytes;
     size_ = static_cast<uint32_t>(usable);
     salt_ = salt;
+    multiplier_ = mixBits(salt ^ 0x9E3779B9u) | 1;
     // One free segment spans the heap.
-    writeFreeSize(0, size_);
-    setWord(4, kNone);
-    setWord(8, kNone);
-    head_ = 0;
+    setWord(0, size_);
+    setWord(size_ - 4, endTag(size_, size_));
+    insert(0, size_);
     freeSegments_ = 1;
     freeBytes_ = size_;
     lowWater_ = size_;
@@ -57,70 +60,69 @@ Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
     }
     const uint32_t needed = static_cast<uint32_t>(HeapAgent::SegmentBytes(bytes));
 
-    // First fit: check each free segment and its back link on the way.
-    uint32_t previous = kNone;
-    uint32_t current = head_;
-    uint32_t currentSize = 0;
-    uint32_t steps = 0;
-    while (current != kNone) {
-        if (++steps > freeSegments_ || !isLink(current) || !checkFree(current, currentSize)
-            || word(current + 4) != previous) {
-            return fail();
-        }
-        if (currentSize >= needed) {
-            break;
-        }
-        previous = current;
-        current = word(current + 8);
+    // Round the request up to a class boundary: every segment of the class
+    // found then fits, and the first one is taken without a search.
+    uint32_t rounded = needed;
+    if (needed >= 8 * kAlignment) {
+        rounded += (uint32_t{1} << (highestBit(needed) - kClassBits)) - 1;
     }
-    if (current == kNone) {
-        if (steps != freeSegments_) {
-            return fail(); // Free segments the list no longer reaches.
+    SizeClass found = classOf(rounded);
+    if (!findFrom(found)) {
+        // The request's own class may still hold a segment that fits: try its first.
+        found = classOf(needed);
+        if ((levelMaps_[found.level] & (1u << found.index)) == 0) {
+            ++failedAllocations_;
+            return Status::NoMemory;
         }
-        ++failedAllocations_;
-        return Status::NoMemory;
+        const uint32_t first = heads_[found.level][found.index];
+        if (isLink(first) && (word(first) & ~kFlagMask) < needed) {
+            ++failedAllocations_;
+            return Status::NoMemory;
+        }
     }
+    const uint32_t current = heads_[found.level][found.index];
 
-    // The segment after a free one must be allocated and know its predecessor is free.
-    const uint32_t after = current + currentSize;
-    Allocated afterHeader{};
-    if (after < size_ && (!checkAllocated(after, afterHeader) || !afterHeader.previousFree)) {
+    // A listed segment is free, starts its list and fits; its successor in the list points back.
+    uint32_t currentSize;
+    if (!isLink(current) || !checkFree(current, currentSize) || word(current + 4) != kNone || currentSize < needed) {
         return fail();
     }
     const uint32_t next = word(current + 8);
     if (next != kNone && word(next + 4) != current) {
         return fail();
     }
-
-    // Every word involved was checked; now the heap changes.
-    uint32_t segment;
-    uint32_t segmentSize;
-    bool previousFree;
-    if (currentSize - needed >= kSmallestSegment) {
-        // Cut the allocation from the end: the remainder keeps its list place.
-        const uint32_t remainder = currentSize - needed;
-        writeFreeSize(current, remainder);
-        segment = current + remainder;
+    uint32_t segmentSize = currentSize;
+    const uint32_t remainder = currentSize - needed;
+    if (remainder >= kSmallestSegment) {
+        // Cut the allocation from the start: the remainder keeps the segment's
+        // end, so its successor's P flag and the end tag's position stay.
+        removeFirst(found, next);
+        const uint32_t rest = current + needed;
+        setWord(rest, remainder);
+        const uint32_t tagOffset = current + currentSize - 4;
+        setWord(tagOffset, word(tagOffset) ^ currentSize ^ remainder); // Same end, new size.
+        insert(rest, remainder);
         segmentSize = needed;
-        previousFree = true;
     } else {
-        unlink(current);
+        // The whole segment goes: its successor, allocated, no longer follows a free one.
+        const uint32_t after = current + currentSize;
+        if (after < size_ && !checkAllocatedFrame(after, kPreviousFreeFlag)) {
+            return fail();
+        }
+        removeFirst(found, next);
         --freeSegments_;
-        segment = current;
-        segmentSize = currentSize;
-        previousFree = false; // A free segment never follows another free one.
+        if (after < size_) {
+            setWord(after, word(after) & ~kPreviousFreeFlag); // The seal leaves P out.
+        }
     }
-    writeAllocated(segment, segmentSize, previousFree, holder);
-    if (after < size_) {
-        writeAllocated(after, afterHeader.size, false, afterHeader.holder);
-    }
+    writeAllocated(current, segmentSize, false, holder); // A free segment never follows another free one.
     freeBytes_ -= segmentSize;
     if (freeBytes_ < lowWater_) {
         lowWater_ = freeBytes_;
     }
     ++allocatedSegments_;
     ++allocations_;
-    return static_cast<void*>(base_ + segment + kHeaderBytes);
+    return static_cast<void*>(base_ + current + kHeaderBytes);
 }
 
 Status SegmentedHeap::release(void* segment, uint16_t holder)
@@ -191,22 +193,16 @@ Result<HeapStatistics> SegmentedHeap::statistics()
     if (corrupted_) {
         return Status::Corrupted;
     }
+    // The largest request that can succeed is the first segment of the
+    // highest non-empty class (see allocate()); the counters give the rest.
     uint32_t largest = 0;
-    uint32_t total = 0;
-    uint32_t steps = 0;
-    uint32_t previous = kNone;
-    for (uint32_t current = head_; current != kNone; current = word(current + 8)) {
-        uint32_t size;
-        if (++steps > freeSegments_ || !isLink(current) || !checkFree(current, size)
-            || word(current + 4) != previous) {
+    if (levelMap_ != 0) {
+        const uint32_t level = highestBit(levelMap_);
+        const uint32_t index = highestBit(levelMaps_[level]);
+        const uint32_t first = heads_[level][index];
+        if (!isLink(first) || !checkFree(first, largest)) {
             return fail();
         }
-        largest = size > largest ? size : largest;
-        total += size;
-        previous = current;
-    }
-    if (steps != freeSegments_ || total != freeBytes_) {
-        return fail();
     }
     HeapStatistics statistics;
     statistics.heapBytes = size_;
@@ -256,21 +252,122 @@ Status SegmentedHeap::audit()
         || freeTotal != freeBytes_) {
         return fail();
     }
-    // Every listed segment was just seen free; a list of freeCount steps
-    // with consistent back links visits each free segment exactly once.
+    // Every listed segment was just seen free; lists of freeCount steps in
+    // all, each segment in its own class and with consistent back links,
+    // visit each free segment exactly once.
     uint32_t steps = 0;
-    uint32_t previous = kNone;
-    for (uint32_t current = head_; current != kNone; current = word(current + 8)) {
-        uint32_t size;
-        if (++steps > freeCount || !isLink(current) || !checkFree(current, size) || word(current + 4) != previous) {
+    for (uint32_t level = 0; level < kLevels; ++level) {
+        if (((levelMap_ >> level) & 1) != (levelMaps_[level] != 0 ? 1u : 0u)) {
             return fail();
         }
-        previous = current;
+        for (uint32_t index = 0; index < kClasses; ++index) {
+            if ((levelMaps_[level] & (1u << index)) == 0) {
+                continue;
+            }
+            uint32_t previous = kNone;
+            uint32_t current = heads_[level][index];
+            do {
+                uint32_t size;
+                if (++steps > freeCount || !isLink(current) || !checkFree(current, size)
+                    || word(current + 4) != previous) {
+                    return fail();
+                }
+                const SizeClass sizeClass = classOf(size);
+                if (sizeClass.level != level || sizeClass.index != index) {
+                    return fail();
+                }
+                previous = current;
+                current = word(current + 8);
+            } while (current != kNone);
+        }
     }
-    return steps == freeCount ? Status::Ok : fail();
+    return steps == freeCount && (levelMap_ >> kLevels) == 0 ? Status::Ok : fail();
 }
 
-uint32_t SegmentedHeap::word(uint32_t offset) const
+inline SegmentedHeap::SizeClass SegmentedHeap::classOf(uint32_t size)
+{
+    const uint32_t units = size / kAlignment;
+    if (units < kClasses) {
+        return {0, units};
+    }
+    const uint32_t power = highestBit(units);
+    return {power - kClassBits + 1, (units >> (power - kClassBits)) & (kClasses - 1)};
+}
+
+inline bool SegmentedHeap::findFrom(SizeClass& sizeClass) const
+{
+    if (sizeClass.level >= kLevels) {
+        return false;
+    }
+    uint32_t classes = levelMaps_[sizeClass.level] & (0xFFu << sizeClass.index);
+    if (classes == 0) {
+        // Any class of a higher level fits: the lowest one with a segment.
+        const uint32_t levels = levelMap_ & (~uint32_t{1} << sizeClass.level);
+        if (levels == 0) {
+            return false;
+        }
+        sizeClass.level = static_cast<uint32_t>(__builtin_ctz(levels));
+        classes = levelMaps_[sizeClass.level];
+    }
+    sizeClass.index = static_cast<uint32_t>(__builtin_ctz(classes));
+    return true;
+}
+
+inline void SegmentedHeap::removeFirst(SizeClass sizeClass, uint32_t next)
+{
+    heads_[sizeClass.level][sizeClass.index] = next;
+    if (next != kNone) {
+        setWord(next + 4, kNone);
+        return;
+    }
+    emptied(sizeClass);
+}
+
+inline void SegmentedHeap::emptied(SizeClass sizeClass)
+{
+    const uint32_t classes = levelMaps_[sizeClass.level] & ~(1u << sizeClass.index);
+    levelMaps_[sizeClass.level] = static_cast<uint8_t>(classes);
+    if (classes == 0) {
+        levelMap_ &= ~(1u << sizeClass.level);
+    }
+}
+
+inline void SegmentedHeap::insert(uint32_t offset, uint32_t size)
+{
+    const SizeClass sizeClass = classOf(size);
+    uint32_t& head = heads_[sizeClass.level][sizeClass.index];
+    const uint32_t bit = 1u << sizeClass.index;
+    uint32_t next = kNone;
+    if ((levelMaps_[sizeClass.level] & bit) != 0) {
+        next = head;
+        setWord(next + 4, offset);
+    } else {
+        levelMaps_[sizeClass.level] = static_cast<uint8_t>(levelMaps_[sizeClass.level] | bit);
+        levelMap_ |= 1u << sizeClass.level;
+    }
+    setWord(offset + 4, kNone);
+    setWord(offset + 8, next);
+    head = offset;
+}
+
+inline void SegmentedHeap::unlink(uint32_t offset, SizeClass sizeClass)
+{
+    const uint32_t previous = word(offset + 4);
+    const uint32_t next = word(offset + 8);
+    if (next != kNone) {
+        setWord(next + 4, previous);
+    }
+    if (previous != kNone) {
+        setWord(previous + 8, next);
+        return;
+    }
+    heads_[sizeClass.level][sizeClass.index] = next;
+    if (next == kNone) {
+        emptied(sizeClass);
+    }
+}
+
+inline uint32_t SegmentedHeap::word(uint32_t offset) const
 {
     // The area belongs to the application and may be declared with any
     // type; memcpy is a single load whatever that type is.
@@ -279,26 +376,35 @@ uint32_t SegmentedHeap::word(uint32_t offset) const
     return value;
 }
 
-void SegmentedHeap::setWord(uint32_t offset, uint32_t value) { __builtin_memcpy(base_ + offset, &value, sizeof value); }
+inline void SegmentedHeap::setWord(uint32_t offset, uint32_t value) { __builtin_memcpy(base_ + offset, &value, sizeof value); }
 
-uint16_t SegmentedHeap::seal(uint32_t offset, uint32_t first, uint16_t holder) const
+inline uint16_t SegmentedHeap::seal(uint32_t offset, uint32_t first, uint16_t holder) const
 {
-    return static_cast<uint16_t>(
-        mixBits(salt_ ^ kSegmentKind ^ (offset * 0x9E3779B1u) ^ (first * 0x85EBCA77u) ^ (holder * 0xC2B2AE3Du)) >> 16);
+    // Multiplying by the heap's odd multiplier carries every input bit into
+    // the top half, which the seal keeps. The multiplier is a variable, so
+    // it is one IMUL: a constant would be expanded into a long shift-and-add
+    // chain under -mtune=i486. P is left out: a neighbour's allocation or
+    // return flips it with one write instead of a new seal. A wrong P is
+    // caught by the boundary tag it makes Return read, or by audit(); it
+    // cannot make a segment pass for another.
+    uint32_t value = (salt_ ^ offset) * multiplier_;
+    value = (value ^ (first & ~kPreviousFreeFlag)) * multiplier_;
+    value = (value ^ holder) * multiplier_;
+    return static_cast<uint16_t>(value >> 16);
 }
 
-uint32_t SegmentedHeap::endTag(uint32_t size, uint32_t end) const
+inline uint32_t SegmentedHeap::endTag(uint32_t size, uint32_t end) const
 {
-    return size ^ mixBits(salt_ ^ kTagKind ^ (end * 0x9E3779B1u));
+    return size ^ ((salt_ ^ kTagKind ^ end) * multiplier_);
 }
 
-bool SegmentedHeap::isLink(uint32_t link) const
+inline bool SegmentedHeap::isLink(uint32_t link) const
 {
     // Room for a whole smallest segment, so that its links can be read.
     return (link & kFlagMask) == 0 && link <= size_ - kSmallestSegment;
 }
 
-bool SegmentedHeap::checkFree(uint32_t offset, uint32_t& size) const
+inline bool SegmentedHeap::checkFree(uint32_t offset, uint32_t& size) const
 {
     const uint32_t first = word(offset);
     size = first & ~kFlagMask;
@@ -306,13 +412,27 @@ bool SegmentedHeap::checkFree(uint32_t offset, uint32_t& size) const
     if ((first & kFlagMask) != 0 || size < kSmallestSegment || size > size_ - offset) {
         return false;
     }
-    const uint32_t previous = word(offset + 4);
-    const uint32_t next = word(offset + 8);
-    return word(offset + size - 4) == endTag(size, offset + size) && (previous == kNone || isLink(previous))
-           && (next == kNone || isLink(next));
+    return word(offset + size - 4) == endTag(size, offset + size) && checkLinks(offset);
 }
 
-bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) const
+inline bool SegmentedHeap::checkLinks(uint32_t offset) const
+{
+    const uint32_t previous = word(offset + 4);
+    const uint32_t next = word(offset + 8);
+    return (previous == kNone || isLink(previous)) && (next == kNone || isLink(next));
+}
+
+inline bool SegmentedHeap::checkAllocatedFrame(uint32_t offset, uint32_t previousFreeFlag) const
+{
+    // Allocate and Return write only a neighbour's P flag, so they check its
+    // frame, not its seal: allocated, P as expected, a size that fits.
+    const uint32_t first = word(offset);
+    const uint32_t size = first & ~kFlagMask;
+    return (first & kFlagMask) == (kAllocatedFlag | previousFreeFlag) && size >= kSmallestSegment
+           && size <= size_ - offset;
+}
+
+inline bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) const
 {
     const uint32_t first = word(offset);
     const uint32_t second = word(offset + 4);
@@ -323,42 +443,29 @@ bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) const
            && header.size <= size_ - offset && (second >> 16) == seal(offset, first, header.holder);
 }
 
-bool SegmentedHeap::checkListNeighbours(uint32_t offset) const
+inline bool SegmentedHeap::checkListNeighbours(uint32_t offset, SizeClass sizeClass) const
 {
+    // Called after checkLinks(), which checked that both links are offsets in the heap.
     const uint32_t previous = word(offset + 4);
     const uint32_t next = word(offset + 8);
-    const bool previousOk = previous == kNone ? head_ == offset : word(previous + 8) == offset;
+    bool previousOk;
+    if (previous == kNone) {
+        previousOk = (levelMaps_[sizeClass.level] & (1u << sizeClass.index)) != 0
+                     && heads_[sizeClass.level][sizeClass.index] == offset;
+    } else {
+        previousOk = word(previous + 8) == offset;
+    }
     return previousOk && (next == kNone || word(next + 4) == offset);
 }
 
-void SegmentedHeap::writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder)
+inline void SegmentedHeap::writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder)
 {
     const uint32_t first = size | kAllocatedFlag | (previousFree ? kPreviousFreeFlag : 0);
     setWord(offset, first);
     setWord(offset + 4, (static_cast<uint32_t>(seal(offset, first, holder)) << 16) | holder);
 }
 
-void SegmentedHeap::writeFreeSize(uint32_t offset, uint32_t size)
-{
-    setWord(offset, size);
-    setWord(offset + size - 4, endTag(size, offset + size));
-}
-
-void SegmentedHeap::unlink(uint32_t offset)
-{
-    const uint32_t previous = word(offset + 4);
-    const uint32_t next = word(offset + 8);
-    if (previous == kNone) {
-        head_ = next;
-    } else {
-        setWord(previous + 8, next);
-    }
-    if (next != kNone) {
-        setWord(next + 4, previous);
-    }
-}
-
-Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header)
+inline Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header)
 {
     const uintptr_t address = reinterpret_cast<uintptr_t>(segment);
     const uintptr_t base = reinterpret_cast<uintptr_t>(base_);
@@ -385,63 +492,76 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
     const uint32_t nextOffset = offset + header.size;
     bool mergeNext = false;
     uint32_t nextSize = 0;
-    Allocated nextHeader{};
+    SizeClass nextClass{};
     if (nextOffset < size_) {
-        if ((word(nextOffset) & kAllocatedFlag) == 0) {
-            if (!checkFree(nextOffset, nextSize) || !checkListNeighbours(nextOffset)) {
+        const uint32_t nextFirst = word(nextOffset);
+        if ((nextFirst & kAllocatedFlag) == 0) {
+            if (!checkFree(nextOffset, nextSize)) {
+                return fail();
+            }
+            nextClass = classOf(nextSize);
+            if (!checkListNeighbours(nextOffset, nextClass)) {
                 return fail();
             }
             mergeNext = true;
-        } else if (!checkAllocated(nextOffset, nextHeader) || nextHeader.previousFree) {
+        } else if (!checkAllocatedFrame(nextOffset, 0)) {
             return fail();
         }
     }
     uint32_t previousOffset = 0;
     uint32_t previousSize = 0;
+    SizeClass previousClass{};
     if (header.previousFree) {
         if (offset < kSmallestSegment) {
             return fail();
         }
-        previousSize = word(offset - 4) ^ endTag(0, offset); // The tag ends where this segment starts.
-        uint32_t checkedSize;
-        if (previousSize > offset || (previousSize & kFlagMask) != 0
-            || !checkFree(offset - previousSize, checkedSize) || checkedSize != previousSize) {
+        // The tag ends where this segment starts; unscrambled, it gives the
+        // predecessor's size, which its header (no flags) must repeat. That
+        // is checkFree() without computing the same scramble twice.
+        previousSize = word(offset - 4) ^ endTag(0, offset);
+        if (previousSize > offset || previousSize < kSmallestSegment || (previousSize & kFlagMask) != 0) {
             return fail();
         }
         previousOffset = offset - previousSize;
+        if (word(previousOffset) != previousSize || !checkLinks(previousOffset)) {
+            return fail();
+        }
+        previousClass = classOf(previousSize);
+        if (!checkListNeighbours(previousOffset, previousClass)) {
+            return fail();
+        }
     }
 
     // Merge. An obsolete header is cleared so an old pointer to it reads as a double return.
     uint32_t start = offset;
     uint32_t total = header.size;
+    uint32_t tag;
     if (mergeNext) {
-        unlink(nextOffset);
+        unlink(nextOffset, nextClass);
         setWord(nextOffset, 0);
         setWord(nextOffset + 4, 0);
         total += nextSize;
         --freeSegments_;
+        // The merged segment ends where the successor did: its tag changes size only.
+        tag = word(nextOffset + nextSize - 4) ^ nextSize;
+    } else {
+        tag = endTag(0, nextOffset);
+        if (nextOffset < size_) {
+            setWord(nextOffset, word(nextOffset) | kPreviousFreeFlag); // The seal leaves P out.
+        }
     }
     if (header.previousFree) {
+        unlink(previousOffset, previousClass);
         setWord(offset, 0);
         setWord(offset + 4, 0);
         start = previousOffset;
         total += previousSize;
-        writeFreeSize(start, total); // Already on the free list.
     } else {
-        writeFreeSize(start, total);
-        setWord(start + 4, kNone);
-        setWord(start + 8, head_);
-        if (head_ != kNone) {
-            setWord(head_ + 4, start);
-        }
-        head_ = start;
         ++freeSegments_;
     }
-    // The segment after the merged one is allocated; it now follows a free one.
-    // After a merge with the successor it already had the flag set.
-    if (!mergeNext && nextOffset < size_) {
-        writeAllocated(nextOffset, nextHeader.size, true, nextHeader.holder);
-    }
+    setWord(start, total);
+    setWord(start + total - 4, tag ^ total);
+    insert(start, total);
     freeBytes_ += header.size;
     --allocatedSegments_;
     ++returns_;

@@ -7,11 +7,10 @@
 // the manager adds ids, ownership, the holder of each segment, serialisation
 // and resource recovery.
 //
-// Serialisation: every step runs with interrupts disabled. Return costs
-// O(1); Allocate and GetStatistics walk the free list, so they hold
-// interrupts off for a time proportional to the number of free segments.
-// This is the price of first fit that the seed states; code with hard
-// deadlines uses buffer pools.
+// Serialisation: every step runs with interrupts disabled. Allocate, Return
+// and GetStatistics cost O(1) (internal::SegmentedHeap is a two-level
+// segregated fit, not the seed's first fit), so they hold interrupts off for
+// a bounded time whatever the fragmentation.
 #pragma once
 
 #include <dcos/HeapAgent.hpp>
@@ -69,7 +68,7 @@ public:
     static bool overlapsArea(uintptr_t begin, uintptr_t end);
 
     /// Copies the state of the heap in slot @p slot; false when the slot is
-    /// free or inactive. O(free segments of that heap).
+    /// free or inactive. O(1).
     static bool snapshot(size_t slot, HeapInfo& info);
     /// Number of active heap slots.
     static size_t activeCount();

@@ -11,19 +11,29 @@
 // segment is allocated, and P, the segment before it is free. An allocated
 // segment's second word is the holder (a 16-bit tag the kernel derives from
 // the task id) and a check value bound to the heap's salt, the segment's
-// position, its first word and its holder. A free segment uses its second
-// word and its first data word for the links of a doubly linked free list,
-// and its last word for a boundary tag: its size scrambled with its end
-// position, so that a segment whose P flag is set finds where its free
-// predecessor starts in O(1) and can check the find.
+// position, its size and flags (P excepted: see seal()) and its holder. A
+// free segment uses its second word and its first data word for the links of
+// a doubly linked free list, and its last word for a boundary tag: its size
+// scrambled with its end position, so that a segment whose P flag is set
+// finds where its free predecessor starts in O(1) and can check the find.
 //
-// Allocation is first fit (seed 7.8): the free list is walked from its head,
-// in no particular order, and the first segment large enough is used. A
-// larger one is split and the allocation is cut from its end, so the free
-// remainder keeps its place in the list; a remainder under 16 bytes is not
-// split off but given with the allocation. Return merges the segment with a
-// free successor and a free predecessor, so no two free segments are ever
-// adjacent, and costs O(1).
+// Allocation is a two-level segregated fit (TLSF, Masmano et al. 2004), so
+// that Allocate and Return cost O(1) whatever the fragmentation, where the
+// seed's first fit walked the free list. Free segments are kept in one list
+// per size class: below 64 bytes one class per 8 bytes; above, each power of
+// two [2^k, 2^(k+1)) is cut into eight classes of equal width. Two bitmaps
+// (one bit per power of two, one bit per class within it) say which lists
+// are non-empty, so a bit scan (BSF/BSR on the i486) finds the smallest
+// non-empty class whose every segment fits the request: the request is
+// rounded up to the next class boundary first. When that finds nothing, the
+// first segment of the request's own class is tried, so a request fails only
+// when it is larger than that segment and than every segment of a higher
+// class: statistics() reports exactly that limit as the largest request that
+// can succeed. The allocation is cut from the start of the chosen segment and
+// the remainder, unless under 16 bytes (then given with the allocation),
+// goes to the list of its class. Return merges the segment with a free
+// successor and a free predecessor at once (boundary tags), so no two free
+// segments are ever adjacent.
 //
 // Every word is checked before any is written; a failed check (a double
 // return, a pointer that is not a segment's start, an overwritten header,
@@ -43,7 +53,7 @@
 
 namespace dcos::internal {
 
-/// A first-fit heap of variable-size segments in a caller-supplied contiguous area.
+/// A two-level segregated fit heap of variable-size segments in a caller-supplied contiguous area.
 class SegmentedHeap {
 public:
     /// The holder tag of segments that belong to the system: any holder may return them.
@@ -68,10 +78,10 @@ public:
     /// than kMaximumHeapBytes; the heap is then unused.
     Status initialise(void* area, size_t areaBytes, uint32_t salt);
 
-    /// Allocates a segment for at least @p bytes, first fit, for @p holder. O(free segments).
+    /// Allocates a segment for at least @p bytes for @p holder. O(1).
     ///
-    /// Fails with InvalidArgument for 0 bytes, NoMemory when no free
-    /// segment is large enough, and Corrupted.
+    /// Fails with InvalidArgument for 0 bytes, NoMemory when the request is
+    /// larger than statistics().largestFreeSegment, and Corrupted.
     Result<void*> allocate(size_t bytes, uint16_t holder);
 
     /// Returns @p segment on behalf of @p holder and merges it with its free neighbours. O(1).
@@ -92,14 +102,16 @@ public:
     /// When a check fails the heap is disabled and the walk stops.
     size_t reclaimHeldBy(uint16_t holder);
 
-    /// Usage counters plus the largest free segment, found by walking and
-    /// checking the free list. O(free segments). Fails with Corrupted.
+    /// Usage counters plus the largest request that can succeed now: the
+    /// first free segment of the highest non-empty class, less its header
+    /// (another segment of that class may be up to an eighth larger). O(1).
+    /// Checks that segment; fails with Corrupted.
     Result<HeapStatistics> statistics();
 
     /// Checks the whole heap: the segments tile the area, every header,
     /// tag and flag is right, no two free segments are adjacent, and the
-    /// free list holds exactly the free segments, each once, with
-    /// consistent back links. O(segments). Returns Ok or Corrupted (and
+    /// class lists hold exactly the free segments, each once, in its class,
+    /// with consistent back links and bitmaps. O(segments). Returns Ok or Corrupted (and
     /// disables the heap). For tests and diagnostics.
     Status audit();
 
@@ -123,6 +135,20 @@ private:
     static constexpr uint32_t kAllocatedFlag = 1;
     static constexpr uint32_t kPreviousFreeFlag = 2;
     static constexpr uint32_t kFlagMask = 7;
+    // Eight classes per power of two: a request rounded up to a class
+    // boundary is at most an eighth larger, and the heads of one heap take
+    // 832 bytes (sixteen classes would double that for every heap slot).
+    static constexpr uint32_t kClassBits = 3;
+    static constexpr uint32_t kClasses = 1u << kClassBits;
+    // Class 0 holds the linear classes below 64 bytes; class k >= 1 holds
+    // [2^(k+5), 2^(k+6)) bytes, up to the 1 GiB heap.
+    static constexpr uint32_t kLevels = 26;
+
+    // A size class: the power of two (level) and the class within it.
+    struct SizeClass {
+        uint32_t level;
+        uint32_t index;
+    };
 
     // What a checked allocated header says.
     struct Allocated {
@@ -131,19 +157,28 @@ private:
         bool previousFree;
     };
 
-    uint32_t word(uint32_t offset) const;
-    void setWord(uint32_t offset, uint32_t value);
-    uint16_t seal(uint32_t offset, uint32_t first, uint16_t holder) const;
-    uint32_t endTag(uint32_t size, uint32_t end) const;
-    bool isLink(uint32_t link) const;
-    bool checkFree(uint32_t offset, uint32_t& size) const;
-    bool checkAllocated(uint32_t offset, Allocated& header) const;
-    bool checkListNeighbours(uint32_t offset) const;
-    void writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder);
-    void writeFreeSize(uint32_t offset, uint32_t size);
-    void unlink(uint32_t offset);
+    [[gnu::always_inline]] static SizeClass classOf(uint32_t size);
+    [[gnu::always_inline]] uint32_t word(uint32_t offset) const;
+    [[gnu::always_inline]] void setWord(uint32_t offset, uint32_t value);
+    [[gnu::always_inline]] uint16_t seal(uint32_t offset, uint32_t first, uint16_t holder) const;
+    [[gnu::always_inline]] uint32_t endTag(uint32_t size, uint32_t end) const;
+    [[gnu::always_inline]] bool isLink(uint32_t link) const;
+    [[gnu::always_inline]] bool checkFree(uint32_t offset, uint32_t& size) const;
+    [[gnu::always_inline]] bool checkLinks(uint32_t offset) const;
+    [[gnu::always_inline]] bool checkAllocated(uint32_t offset, Allocated& header) const;
+    [[gnu::always_inline]] bool checkAllocatedFrame(uint32_t offset, uint32_t previousFreeFlag) const;
+    [[gnu::always_inline]] bool checkListNeighbours(uint32_t offset, SizeClass sizeClass) const;
+    [[gnu::always_inline]] void writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder);
+    [[gnu::always_inline]] void insert(uint32_t offset, uint32_t size);
+    [[gnu::always_inline]] void unlink(uint32_t offset, SizeClass sizeClass);
+    // Moves @p sizeClass to the smallest non-empty class at or above it; false when none.
+    [[gnu::always_inline]] bool findFrom(SizeClass& sizeClass) const;
+    // Takes the first segment off the list of @p sizeClass; @p next follows it.
+    [[gnu::always_inline]] void removeFirst(SizeClass sizeClass, uint32_t next);
+    // Clears the bits of the class whose list just became empty.
+    [[gnu::always_inline]] void emptied(SizeClass sizeClass);
     // Finds the offset of an allocated segment for release() and transfer().
-    Result<uint32_t> allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header);
+    [[gnu::always_inline]] Result<uint32_t> allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header);
     // Frees the checked allocated segment at @p offset and merges it; sets
     // @p freedEnd to the end of the resulting free segment.
     Status releaseAt(uint32_t offset, const Allocated& header, uint32_t& freedEnd);
@@ -153,7 +188,6 @@ private:
     uintptr_t areaBegin_ = 0;
     uintptr_t areaEnd_ = 0;
     uint32_t size_ = 0;
-    uint32_t head_ = kNone;
     uint32_t freeBytes_ = 0;
     uint32_t freeSegments_ = 0;
     uint32_t allocatedSegments_ = 0;
@@ -162,7 +196,17 @@ private:
     uint32_t failedAllocations_ = 0;
     uint32_t returns_ = 0;
     uint32_t salt_ = 0;
+    // Odd, derived from the salt by initialise(): the factor of the seals and
+    // tags. Zero until then, so that a table of unused heaps is all zero and
+    // lives in .bss, not in the image.
+    uint32_t multiplier_ = 0;
+    // Bit k: levelMaps_[k] is not zero.
+    uint32_t levelMap_ = 0;
+    // Bit i of levelMaps_[k]: the list heads_[k][i] is not empty. A head is
+    // valid only while its bit is set.
+    uint8_t levelMaps_[kLevels] = {};
     bool corrupted_ = false;
+    uint32_t heads_[kLevels][kClasses] = {};
 };
 
 } // namespace dcos::internal
