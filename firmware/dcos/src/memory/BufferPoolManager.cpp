@@ -52,7 +52,7 @@ void start()
 }
 
 // The id checks every primitive shares; call with interrupts disabled.
-Result<PoolObject*> lookup(ObjectId id)
+[[gnu::noinline]] Result<PoolObject*> resolveFully(ObjectId id)
 {
     // The table gives InvalidId, WrongType, Remote (another node's object,
     // served by the network manager once it exists) and StaleId.
@@ -62,6 +62,16 @@ Result<PoolObject*> lookup(ObjectId id)
         return entry.status();
     }
     return *entry.value();
+}
+
+// Every service's lookup: the table's inline one, and on a miss the full
+// resolve, which sets the tables up if need be and gives the reason.
+[[gnu::always_inline]] inline Result<PoolObject*> lookup(ObjectId id)
+{
+    if (PoolObject* const* found = poolTable.find(id)) [[likely]] {
+        return *found;
+    }
+    return resolveFully(id);
 }
 
 // Delete and XferOwnership of the pool need its owner or a super user.

@@ -50,7 +50,7 @@ void start()
 }
 
 // The id checks every primitive shares; call with interrupts disabled.
-Result<HeapObject*> lookup(ObjectId id)
+[[gnu::noinline]] Result<HeapObject*> resolveFully(ObjectId id)
 {
     // The table gives InvalidId, WrongType, Remote (another node's object,
     // served by the network manager once it exists) and StaleId.
@@ -60,6 +60,16 @@ Result<HeapObject*> lookup(ObjectId id)
         return entry.status();
     }
     return *entry.value();
+}
+
+// Every service's lookup: the table's inline one, and on a miss the full
+// resolve, which sets the tables up if need be and gives the reason.
+[[gnu::always_inline]] inline Result<HeapObject*> lookup(ObjectId id)
+{
+    if (HeapObject* const* found = heapTable.find(id)) [[likely]] {
+        return *found;
+    }
+    return resolveFully(id);
 }
 
 // Delete and XferOwnership of the heap need its owner or a super user.
