@@ -1,4 +1,5 @@
 #include <dcos/GregorianCalendar.hpp>
+#include <dcos/internal/CalendarCache.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
@@ -34,6 +35,9 @@ TimeWheel<TimeoutEntry, kTimeWheelSlots> wheel;
 volatile uint64_t tickCount = 0;
 volatile uint64_t incrementNs = 0; // Nanoseconds ticked since the tick started.
 uint64_t baseNs = 0;               // Time of day, in ns since 1970, when the tick started.
+uint64_t lastReportedUptimeNs = 0; // The latest precise uptime handed out (see preciseUptime).
+uint32_t clockGeneration = 0;      // Counts SetSystemClock calls, so a conversion knows its base is still in force.
+CalendarCache calendar;            // GetSystemClock's calendar of the current second.
 
 ObjectTable<TimerObject*, kTimerCapacity> timerTable(ObjectType::Timer, 0);
 TimerObject timers[kTimerCapacity];
@@ -101,6 +105,21 @@ void expire(TimeoutEntry& entry)
         break;
     }
     }
+}
+
+// Nanoseconds since the tick started, refined within the tick by the
+// board. Interrupts disabled. The tick timer's counter and its interrupt
+// request are read one after the other, and an emulated or real 8254 may
+// reload the counter a moment before the request shows: the sum could then
+// step back by up to a tick. Uptime must never run backwards (intervals are
+// computed by subtraction), so it holds at the last value instead.
+[[gnu::always_inline]] inline uint64_t preciseUptime()
+{
+    const uint64_t now = incrementNs + bsp::nanosecondsIntoTick();
+    if (now > lastReportedUptimeNs) {
+        lastReportedUptimeNs = now;
+    }
+    return lastReportedUptimeNs;
 }
 
 // The tick at which a time of day is reached with the clock as now set; a
@@ -190,18 +209,8 @@ uint64_t TimerManager::uptimeNs()
 
 uint64_t TimerManager::preciseUptimeNs()
 {
-    // The tick timer's counter and its interrupt request are read one after
-    // the other, and an emulated or real 8254 may reload the counter a
-    // moment before the request shows: the sum could then step back by up
-    // to a tick. Uptime must never run backwards (intervals are computed by
-    // subtraction), so it holds at the last value instead.
-    static uint64_t lastReported = 0;
     arch_x86::InterruptGuard guard;
-    const uint64_t now = incrementNs + bsp::nanosecondsIntoTick();
-    if (now > lastReported) {
-        lastReported = now;
-    }
-    return lastReported;
+    return preciseUptime();
 }
 
 uint64_t TimerManager::tickAfter(uint64_t ns)
@@ -245,10 +254,73 @@ void TimerManager::cancel(TimeoutEntry& entry)
 uint64_t TimerManager::timeOfDayNs()
 {
     arch_x86::InterruptGuard guard;
-    return baseNs + preciseUptimeNs();
+    return baseNs + preciseUptime();
 }
 
-Result<DateTime> TimerManager::getSystemClock() { return GregorianCalendar::fromNanoseconds(timeOfDayNs()); }
+namespace {
+
+// InterruptGuard as two calls, for GetSystemClock, whose fast path and slow
+// path leave the critical section at different points.
+[[gnu::always_inline]] inline uint32_t saveAndDisableInterrupts()
+{
+    const uint32_t flags = arch_x86::readEflags();
+    arch_x86::disableInterrupts();
+    return flags;
+}
+
+[[gnu::always_inline]] inline void restoreInterrupts(uint32_t savedFlags)
+{
+    if ((savedFlags & arch_x86::eflagsInterruptEnable) != 0) {
+        arch_x86::enableInterrupts();
+    }
+}
+
+// GetSystemClock's slow path: a read that is not within the second of the
+// cached calendar. Interrupts are disabled on entry and restored from
+// savedFlags on return. A read in the next second steps the cache; the full
+// conversion (about 800 instructions) runs with interrupts enabled and its
+// result is cached only if the clock was not set meanwhile, since the cache
+// holds uptimes and is right only for the base it was computed with.
+[[gnu::noinline]] Result<DateTime> convertSlowly(uint64_t uptime, uint32_t savedFlags)
+{
+    DateTime time;
+    if (calendar.advance(uptime) && calendar.read(uptime, time)) {
+        restoreInterrupts(savedFlags);
+        return time;
+    }
+    const uint64_t base = baseNs;
+    const uint32_t generation = clockGeneration;
+    restoreInterrupts(savedFlags);
+    time = GregorianCalendar::fromNanoseconds(base + uptime);
+    arch_x86::InterruptGuard guard;
+    if (generation == clockGeneration) {
+        calendar.refill(uptime, time);
+    }
+    return time;
+}
+
+// GetSystemClock, inlined into both of its entry points.
+[[gnu::always_inline]] inline Result<DateTime> readSystemClock()
+{
+    // The common case, a read within the second of the previous one, only
+    // subtracts and copies (CalendarCache), with interrupts held off for a
+    // few instructions.
+    const uint32_t savedFlags = saveAndDisableInterrupts();
+    const uint64_t uptime = preciseUptime();
+    Result<DateTime> result = calendar.answer();
+    uint32_t nanosecond;
+    if (calendar.contains(uptime, nanosecond)) {
+        CalendarCache::patchNanosecond(result, nanosecond);
+        restoreInterrupts(savedFlags);
+        return result;
+    }
+    result = convertSlowly(uptime, savedFlags);
+    return result;
+}
+
+} // namespace
+
+Result<DateTime> TimerManager::getSystemClock() { return readSystemClock(); }
 
 Status TimerManager::setSystemClock(const DateTime& time)
 {
@@ -260,11 +332,13 @@ Status TimerManager::setSystemClock(const DateTime& time)
         return target.status();
     }
     arch_x86::InterruptGuard guard;
-    const uint64_t elapsed = preciseUptimeNs();
+    const uint64_t elapsed = preciseUptime();
     if (target.value() < elapsed) {
         return Status::InvalidArgument; // Before the node was started.
     }
     baseNs = target.value() - elapsed;
+    ++clockGeneration;
+    calendar.invalidate(elapsed);
     // Day-clock alarms and SleepTill are times of day: move them with the
     // clock. This is a configuration service, so the O(N) walks are
     // acceptable.
@@ -426,3 +500,13 @@ size_t TimerManager::timerCount() { return timerTable.usedCount(); }
 DCOS_RESOURCE_RECOVERY(timerRecovery, "timer", recoverTimers);
 
 } // namespace dcos::internal
+
+namespace dcos {
+
+// Defined here rather than with the other interface functions in
+// TimerAgent.cpp so that the clock read is inlined into it: the call and
+// frame of a forwarding function would take a fifth of the primitive's
+// instruction budget.
+Result<DateTime> TimerAgent::GetSystemClock() const { return internal::readSystemClock(); }
+
+} // namespace dcos
