@@ -1,5 +1,6 @@
 #include <dcos/GregorianCalendar.hpp>
 #include <dcos/internal/CalendarCache.hpp>
+#include <dcos/internal/DayClockWheel.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
@@ -26,12 +27,16 @@ struct TimerObject {
     AlarmKind kind = AlarmKind::None;
     AlarmNotification notification;
     uint64_t periodNs = 0;
-    uint64_t nextDueNs = 0;  ///< Uptime of a periodic alarm's next expiry.
-    uint64_t dayClockNs = 0; ///< Time of day of a day-clock alarm, re-armed when the clock is set.
-    TimeoutEntry entry;
+    uint64_t nextDueNs = 0; ///< Uptime of a periodic alarm's next expiry.
+    TimeoutEntry entry;     ///< A day-clock alarm's time of day is entry.timeOfDayNs.
 };
 
+// Time-outs keyed by uptime tick: watch-dog and periodic alarms, waits,
+// deadlines, and day-clock entries due at this tick or the next.
 TimeWheel<TimeoutEntry, kTimeWheelSlots> wheel;
+// Day-clock alarms and SleepTill, keyed by time of day, so that setting the
+// clock touches none of them (DayClockWheel.hpp).
+DayClockWheel<TimeoutEntry, kTimeWheelSlots> dayClock;
 volatile uint64_t tickCount = 0;
 volatile uint64_t incrementNs = 0; // Nanoseconds ticked since the tick started.
 uint64_t baseNs = 0;               // Time of day, in ns since 1970, when the tick started.
@@ -75,6 +80,9 @@ void notifyOwner(TimerObject& timer)
         TaskManager::sendSignal(*task.value(), timer.notification.value);
     }
 }
+
+// Takes an entry off whichever wheel holds it; nothing if it is not armed.
+[[gnu::always_inline]] inline void disarm(TimeoutEntry& entry) { dayClock.disarm(entry, wheel); }
 
 void expire(TimeoutEntry& entry)
 {
@@ -122,14 +130,6 @@ void expire(TimeoutEntry& entry)
     return lastReportedUptimeNs;
 }
 
-// The tick at which a time of day is reached with the clock as now set; a
-// time already past is due at once (the current tick, which the wheel fires
-// at the next). Interrupts disabled.
-uint64_t dayClockTick(uint64_t timeOfDayNs)
-{
-    return timeOfDayNs > baseNs ? firstTickAtOrAfter(timeOfDayNs - baseNs) : tickCount;
-}
-
 Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
 {
     const Result<TimerObject**> entry = timerTable.resolve(id);
@@ -149,8 +149,7 @@ Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
 // primitive one to four instructions (make bench).
 [[gnu::always_inline]] inline void replaceAlarm(TimerObject& timer, AlarmKind kind, const AlarmNotification& n)
 {
-    // NotFound only says no alarm was armed, which is what this makes sure of.
-    (void)wheel.cancel(timer.entry);
+    disarm(timer.entry);
     timer.kind = kind;
     timer.notification = n;
 }
@@ -167,7 +166,7 @@ unsigned recoverTimers(ObjectId deadTask)
 {
     arch_x86::InterruptGuard guard;
     return static_cast<unsigned>(timerTable.forEachOwnedBy(deadTask, [](ObjectId id, TimerObject*& timer) {
-        (void)wheel.cancel(timer->entry); // NotFound: no alarm was armed.
+        disarm(timer->entry);
         timer->kind = AlarmKind::None;
         // Cannot fail: the walk hands out only live ids of this table.
         (void)timerTable.Delete(id);
@@ -181,6 +180,7 @@ uint64_t TimerManager::tickPeriodNs_ = 1000000;
 void TimerManager::initialise(uint64_t tickPeriodNs)
 {
     tickPeriodNs_ = tickPeriodNs;
+    dayClock.setPeriod(tickPeriodNs);
     if (timerTable.setNode(bsp::nodeId()) != Status::Ok || timerTable.AddObjects(kTimersActiveAtBoot) != Status::Ok) {
         dcosPanic("cannot set up the timer table (node %u, %lu timers)", static_cast<unsigned>(bsp::nodeId()),
                   static_cast<unsigned long>(kTimersActiveAtBoot));
@@ -191,6 +191,8 @@ void TimerManager::onTick()
 {
     tickCount = tickCount + 1;
     incrementNs = incrementNs + tickPeriodNs_;
+    // Day-clock time-outs first (DayClockWheel.hpp says why).
+    dayClock.advance(tickCount, incrementNs, expire);
     wheel.advance(tickCount, expire);
     Scheduler::onTick();
 }
@@ -227,7 +229,7 @@ uint64_t TimerManager::tickAtUptime(uint64_t uptimeNs) { return firstTickAtOrAft
 uint64_t TimerManager::tickAtTimeOfDay(uint64_t timeOfDayNs)
 {
     arch_x86::InterruptGuard guard;
-    return dayClockTick(timeOfDayNs);
+    return timeOfDayNs > baseNs ? firstTickAtOrAfter(timeOfDayNs - baseNs) : tickCount;
 }
 
 Result<uint64_t> TimerManager::uptimeAtTimeOfDay(uint64_t timeOfDayNs)
@@ -239,16 +241,22 @@ Result<uint64_t> TimerManager::uptimeAtTimeOfDay(uint64_t timeOfDayNs)
 void TimerManager::arm(TimeoutEntry& entry, uint64_t dueTick)
 {
     arch_x86::InterruptGuard guard;
-    // Re-arms: cancel's NotFound only says it was not armed, and the insert
-    // after it cannot find the entry armed.
-    (void)wheel.cancel(entry);
+    // Re-arms: the insert after disarm cannot find the entry armed.
+    disarm(entry);
     (void)wheel.insert(entry, dueTick);
+}
+
+void TimerManager::armAtTimeOfDay(TimeoutEntry& entry, uint64_t timeOfDayNs)
+{
+    arch_x86::InterruptGuard guard;
+    disarm(entry);
+    dayClock.arm(entry, timeOfDayNs, tickCount);
 }
 
 void TimerManager::cancel(TimeoutEntry& entry)
 {
     arch_x86::InterruptGuard guard;
-    (void)wheel.cancel(entry); // NotFound: it has expired already, which is as good.
+    disarm(entry); // Not armed: it has expired already, which is as good.
 }
 
 uint64_t TimerManager::timeOfDayNs()
@@ -336,27 +344,14 @@ Status TimerManager::setSystemClock(const DateTime& time)
     if (target.value() < elapsed) {
         return Status::InvalidArgument; // Before the node was started.
     }
+    // Only the base changes (seed 7.5). Day-clock alarms and SleepTill are
+    // keyed by time of day (DayClockWheel), so none of them is touched: the
+    // time with interrupts held off is the same for any number of timers
+    // and tasks.
     baseNs = target.value() - elapsed;
+    dayClock.setBase(baseNs, tickCount);
     ++clockGeneration;
     calendar.invalidate(elapsed);
-    // Day-clock alarms and SleepTill are times of day: move them with the
-    // clock. This is a configuration service, so the O(N) walks are
-    // acceptable.
-    for (TimerObject& timer : timers) {
-        if (timer.kind == AlarmKind::DayClock) {
-            // An alarm that went off already stays off; one still armed moves.
-            if (wheel.cancel(timer.entry) == Status::Ok) {
-                (void)wheel.insert(timer.entry, dayClockTick(timer.dayClockNs)); // Cannot fail: just cancelled.
-            }
-        }
-    }
-    TaskManager::forEachTask([](Task& task) {
-        if (task.sleepsTillTimeOfDay && static_cast<TimeWheelNode<>&>(task.wakeTimeout).isLinked()) {
-            // Armed, as the condition checked, so both succeed.
-            (void)wheel.cancel(task.wakeTimeout);
-            (void)wheel.insert(task.wakeTimeout, dayClockTick(task.wakeTimeOfDayNs));
-        }
-    });
     return Status::Ok;
 }
 
@@ -391,7 +386,7 @@ Status TimerManager::deleteTimer(ObjectId id, ObjectId caller)
     if (!timer.ok()) {
         return timer.status();
     }
-    (void)wheel.cancel(timer.value()->entry); // NotFound: no alarm was armed.
+    disarm(timer.value()->entry);
     timer.value()->kind = AlarmKind::None;
     return timerTable.Delete(id);
 }
@@ -428,8 +423,7 @@ Status TimerManager::setDayClockAlarm(ObjectId id, ObjectId caller, const DateTi
     }
     TimerObject& t = *timer.value();
     replaceAlarm(t, AlarmKind::DayClock, n);
-    t.dayClockNs = target.value();
-    (void)wheel.insert(t.entry, dayClockTick(t.dayClockNs)); // Cannot fail: replaceAlarm disarmed it.
+    dayClock.arm(t.entry, target.value(), tickCount); // replaceAlarm disarmed it.
     return Status::Ok;
 }
 
@@ -463,7 +457,7 @@ Status TimerManager::cancelAlarm(ObjectId id, ObjectId caller)
     if (timer.value()->kind == AlarmKind::None) {
         return Status::InvalidArgument; // No alarm is set.
     }
-    (void)wheel.cancel(timer.value()->entry); // Cannot fail: an alarm still set is armed.
+    disarm(timer.value()->entry); // An alarm still set is armed.
     timer.value()->kind = AlarmKind::None;
     return Status::Ok;
 }

@@ -97,6 +97,20 @@ public:
         return Status::Ok;
     }
 
+    /// Moves the wheel's clock back to @p tick, for a wheel keyed by a clock
+    /// that was set back. Every armed entry is due after the current tick
+    /// (advance leaves none that is due), so all of them are still due after
+    /// @p tick and in the slot of their due tick, where the wheel, turning on
+    /// from @p tick, finds them. A @p tick not before the current one changes
+    /// nothing: popExpired catches up by itself. Cost O(1).
+    void rewind(uint64_t tick)
+    {
+        if (tick < cursor_) {
+            cursor_ = tick;
+            cursorSlot_ = slotOf(tick);
+        }
+    }
+
     /// Returns one entry due at or before @p nowTick and disarms it, or null when none is left.
     ///
     /// The caller loops until null after each clock tick. Entries come out in

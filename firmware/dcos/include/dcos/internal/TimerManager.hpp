@@ -51,6 +51,9 @@ public:
     static Result<uint64_t> uptimeAtTimeOfDay(uint64_t timeOfDayNs);
     /// Arms entry for the absolute tick dueTick.
     static void arm(TimeoutEntry& entry, uint64_t dueTick);
+    /// Arms entry for a time of day: it goes off at the first tick at or
+    /// after that time, and moves with the clock when SetSystemClock sets it.
+    static void armAtTimeOfDay(TimeoutEntry& entry, uint64_t timeOfDayNs);
     static void cancel(TimeoutEntry& entry);
 
     /// Nanoseconds since 1970-01-01 now (base + increment).
