@@ -22,7 +22,6 @@ constexpr size_t kSlots = 13;
 
 struct Entry : TimeWheelNode<> {
     uint64_t timeOfDayNs = 0;
-    uint8_t dayClockList = 0;
     size_t index = 0;
     bool armed = false;
     uint64_t firedAt = 0;
@@ -53,7 +52,7 @@ public:
     void armAt(size_t i, uint64_t timeOfDay)
     {
         Entry& e = entries_[i];
-        dayClock_.disarm(e, ticks_);
+        (void)ticks_.cancel(e); // Unlinks it from either wheel.
         dayClock_.arm(e, timeOfDay, tick_);
         e.armed = true;
         e.firedAt = 0;
@@ -61,7 +60,7 @@ public:
 
     void cancel(size_t i)
     {
-        dayClock_.disarm(entries_[i], ticks_);
+        (void)ticks_.cancel(entries_[i]);
         entries_[i].armed = false;
     }
 

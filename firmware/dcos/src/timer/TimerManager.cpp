@@ -81,8 +81,10 @@ void notifyOwner(TimerObject& timer)
     }
 }
 
-// Takes an entry off whichever wheel holds it; nothing if it is not armed.
-[[gnu::always_inline]] inline void disarm(TimeoutEntry& entry) { dayClock.disarm(entry, wheel); }
+// Takes an entry off whichever list holds it, the tick wheel's or the
+// day-clock wheel's (TimeWheel::cancel only unlinks); nothing if it is not
+// armed.
+[[gnu::always_inline]] inline void disarm(TimeoutEntry& entry) { (void)wheel.cancel(entry); }
 
 void expire(TimeoutEntry& entry)
 {

@@ -28,8 +28,9 @@
 // before, a day-clock alarm set before the wait for it fired first at a
 // shared tick, and the wait's time-out is commonly due at that very tick.
 //
-// T derives from TimeWheelNode<> and has the fields timeOfDayNs (uint64_t)
-// and dayClockList (uint8_t), as TimeoutEntry does. No
+// T derives from TimeWheelNode<> and has the field timeOfDayNs (uint64_t),
+// as TimeoutEntry does. An entry armed here is disarmed by the tick wheel's
+// cancel (TimeWheel::cancel), which only unlinks it, wherever it is. No
 // locking: the timer agent calls everything with interrupts disabled.
 #pragma once
 
@@ -45,11 +46,6 @@ template <typename T, size_t Slots>
 class DayClockWheel {
 public:
     using TickWheel = TimeWheel<T, Slots>;
-
-    /// Where an entry is, in its dayClockList field.
-    static constexpr uint8_t kNotHere = 0;   ///< Not armed, or on the tick wheel.
-    static constexpr uint8_t kOnWheel = 1;   ///< On the day-clock wheel.
-    static constexpr uint8_t kNextTick = 2;  ///< On the list for the next tick.
 
     explicit DayClockWheel(uint64_t periodNs = 1000000) : periodNs_(periodNs) {}
     DayClockWheel(const DayClockWheel&) = delete;
@@ -75,17 +71,6 @@ public:
         place(entry, tickCount);
     }
 
-    /// Takes @p entry off whichever list holds it, this wheel's or @p ticks;
-    /// nothing if it is not armed. Cost O(1).
-    [[gnu::always_inline]] void disarm(T& entry, TickWheel& ticks)
-    {
-        if (entry.dayClockList == kNotHere) [[likely]] {
-            (void)ticks.cancel(entry); // NotFound: it was not armed, which is as good.
-        } else {
-            disarmHere(entry);
-        }
-    }
-
     /// At tick @p tickCount, @p incrementNs after the base, before the tick
     /// wheel: hands every time-out the time of day has reached to
     /// @p fire(T&), those held for this tick first, and holds those due at
@@ -96,8 +81,6 @@ public:
         const uint64_t now = baseNs_ + incrementNs;
         SortedList<T, uint64_t>& held = nextTick_[tickCount & 1];
         while (T* entry = held.popFront()) {
-            --heldCount_;
-            entry->dayClockList = kNotHere;
             if (entry->timeOfDayNs <= now) {
                 fire(*entry);
             } else {
@@ -105,7 +88,6 @@ public:
             }
         }
         while (T* entry = wall_.popExpired(baseTicks_ + tickCount)) {
-            entry->dayClockList = kNotHere;
             if (entry->timeOfDayNs <= now) {
                 fire(*entry);
             } else {
@@ -114,8 +96,8 @@ public:
         }
     }
 
-    /// Time-outs armed here. Cost O(1).
-    size_t size() const { return wall_.size() + heldCount_; }
+    /// Time-outs armed here, for tests and diagnostics. Cost O(Slots + N).
+    size_t size() const { return wall_.size() + nextTick_[0].size() + nextTick_[1].size(); }
 
 private:
     // Puts an entry, not armed, where its time needs it at tick tickCount:
@@ -125,7 +107,6 @@ private:
     {
         const uint64_t wallTick = entry.timeOfDayNs / periodNs_;
         if (wallTick > baseTicks_ + tickCount) {
-            entry.dayClockList = kOnWheel;
             (void)wall_.insert(entry, wallTick); // Cannot fail: not armed.
         } else {
             holdForNextTick(entry, tickCount);
@@ -134,28 +115,14 @@ private:
 
     void holdForNextTick(T& entry, uint64_t tickCount)
     {
-        entry.dayClockList = kNextTick;
         // One key for all: first held, first fired.
         nextTick_[(tickCount + 1) & 1].insert(entry, 0);
-        ++heldCount_;
-    }
-
-    void disarmHere(T& entry)
-    {
-        if (entry.dayClockList == kOnWheel) {
-            (void)wall_.cancel(entry); // Cannot fail: the field says it is armed there.
-        } else {
-            static_cast<TimeWheelNode<>&>(entry).unlink();
-            --heldCount_;
-        }
-        entry.dayClockList = kNotHere;
     }
 
     TimeWheel<T, Slots> wall_;
     // The time-outs due at the next tick, by the parity of that tick: those
     // of tick t are taken at tick t, while any held again then go to t + 1.
     SortedList<T, uint64_t> nextTick_[2];
-    size_t heldCount_ = 0;
     uint64_t periodNs_;
     uint64_t baseNs_ = 0;
     uint64_t baseTicks_ = 0;

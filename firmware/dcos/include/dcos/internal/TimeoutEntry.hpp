@@ -22,9 +22,6 @@ struct TimeoutEntry : TimeWheelNode<> {
     constexpr TimeoutEntry(Kind entryKind, void* entryOwner) : kind(entryKind), owner(entryOwner) {}
 
     Kind kind;
-    /// Where on the timer agent's DayClockWheel it is armed, if there and not
-    /// on the wheel of ticks, so that a cancel unlinks it from there.
-    uint8_t dayClockList = 0;
     void* owner;
     /// The time of day a day-clock time-out (day-clock alarm, SleepTill) is due at.
     uint64_t timeOfDayNs = 0;
