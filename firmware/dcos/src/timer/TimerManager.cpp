@@ -126,10 +126,12 @@ void expire(TimeoutEntry& entry)
 [[gnu::always_inline]] inline uint64_t preciseUptime()
 {
     const uint64_t now = incrementNs + bsp::nanosecondsIntoTick();
-    if (now > lastReportedUptimeNs) {
-        lastReportedUptimeNs = now;
+    const uint64_t last = lastReportedUptimeNs;
+    if (now < last) [[unlikely]] {
+        return last;
     }
-    return lastReportedUptimeNs;
+    lastReportedUptimeNs = now;
+    return now;
 }
 
 Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
