@@ -230,18 +230,6 @@ uint64_t TimerManager::tickAfter(uint64_t ns)
 
 uint64_t TimerManager::tickAtUptime(uint64_t uptimeNs) { return firstTickAtOrAfter(uptimeNs); }
 
-uint64_t TimerManager::tickAtTimeOfDay(uint64_t timeOfDayNs)
-{
-    arch_x86::InterruptGuard guard;
-    return timeOfDayNs > baseNs ? firstTickAtOrAfter(timeOfDayNs - baseNs) : tickCount;
-}
-
-Result<uint64_t> TimerManager::uptimeAtTimeOfDay(uint64_t timeOfDayNs)
-{
-    arch_x86::InterruptGuard guard;
-    return timeOfDayNs > baseNs ? Result<uint64_t>(timeOfDayNs - baseNs) : Result<uint64_t>(uint64_t{0});
-}
-
 void TimerManager::arm(TimeoutEntry& entry, uint64_t dueTick)
 {
     arch_x86::InterruptGuard guard;
