@@ -9,6 +9,7 @@
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/Idt.hpp>
+#include <arch_x86/PortIo.hpp>
 #include <boot/Panic.hpp>
 
 namespace bsp {
@@ -47,9 +48,6 @@ uint16_t node = 1;
 // The cascade line 2 has no level of its own.
 constexpr uint8_t levelOfLine[interruptLineCount] = {0, 1, 0xFF, 10, 11, 12, 13, 14, 2, 3, 4, 5, 6, 7, 8, 9};
 
-// 1e9 / 1193182 Hz is 838.0958 ns per count; scaled by 64 it fits a 32-bit
-// product for any 16-bit count.
-constexpr uint32_t nanosecondsPerCountTimes64 = 53638;
 
 const BoardIdentity board{"isa486", "i486DX"};
 
@@ -94,6 +92,8 @@ arch_x86::InterruptFrame* dispatchInterrupt(arch_x86::InterruptFrame* frame)
 }
 
 } // namespace
+
+uint32_t tickTimerDivisor = 0;
 
 const BoardIdentity& identity() { return board; }
 
@@ -155,6 +155,7 @@ void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
     if (pit.start(rate) != dcos::Status::Ok) {
         dcosPanic("the 8254 refused a tick of %lu Hz", static_cast<unsigned long>(rate));
     }
+    tickTimerDivisor = pit.divisor();
 }
 
 dcos::Status attachInterrupt(unsigned line, InterruptHandler handler, void* context)
@@ -230,22 +231,6 @@ uint32_t spuriousInterruptCount() { return spurious; }
 uint32_t tickRateHz() { return pit.requestedRateHz(); }
 
 uint64_t tickPeriodNanoseconds() { return pit.tickPeriodNanoseconds(); }
-
-uint32_t nanosecondsIntoTick()
-{
-    const uint16_t divisor = pit.divisor();
-    if (divisor == 0) {
-        return 0;
-    }
-    const uint16_t count = pit.readCount();
-    uint32_t elapsed = count <= divisor ? static_cast<uint32_t>(divisor - count) : 0;
-    // A tick that has happened but is not serviced yet (interrupts are off)
-    // shows as a request: the count has already started the next period.
-    if ((pic.readRequestRegister() & (1u << systemTickLine)) != 0 && elapsed < divisor / 2u) {
-        elapsed += divisor;
-    }
-    return static_cast<uint32_t>((uint64_t{elapsed} * nanosecondsPerCountTimes64) >> 6);
-}
 
 uint8_t interruptLevelOf(unsigned line) { return line < interruptLineCount ? levelOfLine[line] : 0xFF; }
 

@@ -37,8 +37,9 @@ public:
 
     /// Sets the time of day (privileged). Only the clock's base changes, so
     /// intervals already running are not disturbed; day-clock alarms and
-    /// SleepTill move with the clock. InvalidArgument for a time before the
-    /// node started or after kLastClockYear.
+    /// SleepTill move with the clock, in time that does not depend on how
+    /// many there are. InvalidArgument for a time before the node started or
+    /// after kLastClockYear.
     Status SetSystemClock(const DateTime& time) const;
     /// Nanoseconds since the system tick started (monotonic).
     uint64_t Uptime() const;

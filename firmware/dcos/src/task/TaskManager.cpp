@@ -566,7 +566,7 @@ Status TaskManager::blockCurrentTillTimeOfDay(uint64_t timeOfDayNs)
     task.sleepsTillTimeOfDay = true;
     task.wakeTimeOfDayNs = timeOfDayNs;
     Scheduler::makeUnready(task);
-    TimerManager::arm(task.wakeTimeout, TimerManager::tickAtTimeOfDay(timeOfDayNs));
+    TimerManager::armAtTimeOfDay(task.wakeTimeout, timeOfDayNs);
     Scheduler::requestDispatch();
     task.sleepsTillTimeOfDay = false;
     return task.wakeStatus;

@@ -7,8 +7,6 @@ namespace dcos {
 
 using internal::TimerManager;
 
-Result<DateTime> TimerAgent::GetSystemClock() const { return TimerManager::getSystemClock(); }
-
 Status TimerAgent::SetSystemClock(const DateTime& time) const
 {
     if (!internal::currentTaskIsSuperUser()) {

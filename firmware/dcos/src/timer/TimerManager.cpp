@@ -1,4 +1,6 @@
 #include <dcos/GregorianCalendar.hpp>
+#include <dcos/internal/CalendarCache.hpp>
+#include <dcos/internal/DayClockWheel.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
@@ -25,15 +27,22 @@ struct TimerObject {
     AlarmKind kind = AlarmKind::None;
     AlarmNotification notification;
     uint64_t periodNs = 0;
-    uint64_t nextDueNs = 0;  ///< Uptime of a periodic alarm's next expiry.
-    uint64_t dayClockNs = 0; ///< Time of day of a day-clock alarm, re-armed when the clock is set.
-    TimeoutEntry entry;
+    uint64_t nextDueNs = 0; ///< Uptime of a periodic alarm's next expiry.
+    TimeoutEntry entry;     ///< A day-clock alarm's time of day is entry.timeOfDayNs.
 };
 
+// Time-outs keyed by uptime tick: watch-dog and periodic alarms, waits,
+// deadlines, and day-clock entries due at this tick or the next.
 TimeWheel<TimeoutEntry, kTimeWheelSlots> wheel;
+// Day-clock alarms and SleepTill, keyed by time of day, so that setting the
+// clock touches none of them (DayClockWheel.hpp).
+DayClockWheel<TimeoutEntry, kTimeWheelSlots> dayClock;
 volatile uint64_t tickCount = 0;
 volatile uint64_t incrementNs = 0; // Nanoseconds ticked since the tick started.
 uint64_t baseNs = 0;               // Time of day, in ns since 1970, when the tick started.
+uint64_t lastReportedUptimeNs = 0; // The latest precise uptime handed out (see preciseUptime).
+uint32_t clockGeneration = 0;      // Counts SetSystemClock calls, so a conversion knows its base is still in force.
+CalendarCache calendar;            // GetSystemClock's calendar of the current second.
 
 ObjectTable<TimerObject*, kTimerCapacity, TaskOwnerKeys> timerTable(ObjectType::Timer, 0);
 TimerObject timers[kTimerCapacity];
@@ -72,6 +81,11 @@ void notifyOwner(TimerObject& timer)
     }
 }
 
+// Takes an entry off whichever list holds it, the tick wheel's or the
+// day-clock wheel's (TimeWheel::cancel only unlinks); nothing if it is not
+// armed.
+[[gnu::always_inline]] inline void disarm(TimeoutEntry& entry) { (void)wheel.cancel(entry); }
+
 void expire(TimeoutEntry& entry)
 {
     switch (entry.kind) {
@@ -103,12 +117,21 @@ void expire(TimeoutEntry& entry)
     }
 }
 
-// The tick at which a time of day is reached with the clock as now set; a
-// time already past is due at once (the current tick, which the wheel fires
-// at the next). Interrupts disabled.
-uint64_t dayClockTick(uint64_t timeOfDayNs)
+// Nanoseconds since the tick started, refined within the tick by the
+// board. Interrupts disabled. The tick timer's counter and its interrupt
+// request are read one after the other, and an emulated or real 8254 may
+// reload the counter a moment before the request shows: the sum could then
+// step back by up to a tick. Uptime must never run backwards (intervals are
+// computed by subtraction), so it holds at the last value instead.
+[[gnu::always_inline]] inline uint64_t preciseUptime()
 {
-    return timeOfDayNs > baseNs ? firstTickAtOrAfter(timeOfDayNs - baseNs) : tickCount;
+    const uint64_t now = incrementNs + bsp::nanosecondsIntoTick();
+    const uint64_t last = lastReportedUptimeNs;
+    if (now < last) [[unlikely]] {
+        return last;
+    }
+    lastReportedUptimeNs = now;
+    return now;
 }
 
 Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
@@ -130,8 +153,7 @@ Result<TimerObject*> resolveOwnedTimer(ObjectId id, ObjectId caller)
 // primitive one to four instructions (make bench).
 [[gnu::always_inline]] inline void replaceAlarm(TimerObject& timer, AlarmKind kind, const AlarmNotification& n)
 {
-    // NotFound only says no alarm was armed, which is what this makes sure of.
-    (void)wheel.cancel(timer.entry);
+    disarm(timer.entry);
     timer.kind = kind;
     timer.notification = n;
 }
@@ -148,7 +170,7 @@ unsigned recoverTimers(ObjectId deadTask)
 {
     arch_x86::InterruptGuard guard;
     return static_cast<unsigned>(timerTable.forEachOwnedBy(deadTask, [](ObjectId id, TimerObject*& timer) {
-        (void)wheel.cancel(timer->entry); // NotFound: no alarm was armed.
+        disarm(timer->entry);
         timer->kind = AlarmKind::None;
         // Cannot fail: the walk hands out only live ids of this table.
         (void)timerTable.Delete(id);
@@ -162,6 +184,7 @@ uint64_t TimerManager::tickPeriodNs_ = 1000000;
 void TimerManager::initialise(uint64_t tickPeriodNs)
 {
     tickPeriodNs_ = tickPeriodNs;
+    dayClock.setPeriod(tickPeriodNs);
     if (timerTable.setNode(bsp::nodeId()) != Status::Ok || timerTable.AddObjects(kTimersActiveAtBoot) != Status::Ok) {
         dcosPanic("cannot set up the timer table (node %u, %lu timers)", static_cast<unsigned>(bsp::nodeId()),
                   static_cast<unsigned long>(kTimersActiveAtBoot));
@@ -172,6 +195,8 @@ void TimerManager::onTick()
 {
     tickCount = tickCount + 1;
     incrementNs = incrementNs + tickPeriodNs_;
+    // Day-clock time-outs first (DayClockWheel.hpp says why).
+    dayClock.advance(tickCount, incrementNs, expire);
     wheel.advance(tickCount, expire);
     Scheduler::onTick();
 }
@@ -190,18 +215,8 @@ uint64_t TimerManager::uptimeNs()
 
 uint64_t TimerManager::preciseUptimeNs()
 {
-    // The tick timer's counter and its interrupt request are read one after
-    // the other, and an emulated or real 8254 may reload the counter a
-    // moment before the request shows: the sum could then step back by up
-    // to a tick. Uptime must never run backwards (intervals are computed by
-    // subtraction), so it holds at the last value instead.
-    static uint64_t lastReported = 0;
     arch_x86::InterruptGuard guard;
-    const uint64_t now = incrementNs + bsp::nanosecondsIntoTick();
-    if (now > lastReported) {
-        lastReported = now;
-    }
-    return lastReported;
+    return preciseUptime();
 }
 
 uint64_t TimerManager::tickAfter(uint64_t ns)
@@ -215,40 +230,97 @@ uint64_t TimerManager::tickAfter(uint64_t ns)
 
 uint64_t TimerManager::tickAtUptime(uint64_t uptimeNs) { return firstTickAtOrAfter(uptimeNs); }
 
-uint64_t TimerManager::tickAtTimeOfDay(uint64_t timeOfDayNs)
-{
-    arch_x86::InterruptGuard guard;
-    return dayClockTick(timeOfDayNs);
-}
-
-Result<uint64_t> TimerManager::uptimeAtTimeOfDay(uint64_t timeOfDayNs)
-{
-    arch_x86::InterruptGuard guard;
-    return timeOfDayNs > baseNs ? Result<uint64_t>(timeOfDayNs - baseNs) : Result<uint64_t>(uint64_t{0});
-}
-
 void TimerManager::arm(TimeoutEntry& entry, uint64_t dueTick)
 {
     arch_x86::InterruptGuard guard;
-    // Re-arms: cancel's NotFound only says it was not armed, and the insert
-    // after it cannot find the entry armed.
-    (void)wheel.cancel(entry);
+    // Re-arms: the insert after disarm cannot find the entry armed.
+    disarm(entry);
     (void)wheel.insert(entry, dueTick);
+}
+
+void TimerManager::armAtTimeOfDay(TimeoutEntry& entry, uint64_t timeOfDayNs)
+{
+    arch_x86::InterruptGuard guard;
+    disarm(entry);
+    dayClock.arm(entry, timeOfDayNs, tickCount);
 }
 
 void TimerManager::cancel(TimeoutEntry& entry)
 {
     arch_x86::InterruptGuard guard;
-    (void)wheel.cancel(entry); // NotFound: it has expired already, which is as good.
+    disarm(entry); // Not armed: it has expired already, which is as good.
 }
 
 uint64_t TimerManager::timeOfDayNs()
 {
     arch_x86::InterruptGuard guard;
-    return baseNs + preciseUptimeNs();
+    return baseNs + preciseUptime();
 }
 
-Result<DateTime> TimerManager::getSystemClock() { return GregorianCalendar::fromNanoseconds(timeOfDayNs()); }
+namespace {
+
+// InterruptGuard as two calls, for GetSystemClock, whose fast path and slow
+// path leave the critical section at different points.
+[[gnu::always_inline]] inline uint32_t saveAndDisableInterrupts()
+{
+    const uint32_t flags = arch_x86::readEflags();
+    arch_x86::disableInterrupts();
+    return flags;
+}
+
+[[gnu::always_inline]] inline void restoreInterrupts(uint32_t savedFlags)
+{
+    if ((savedFlags & arch_x86::eflagsInterruptEnable) != 0) {
+        arch_x86::enableInterrupts();
+    }
+}
+
+// GetSystemClock's slow path: a read that is not within the second of the
+// cached calendar. Interrupts are disabled on entry and restored from
+// savedFlags on return. A read in the next second steps the cache; the full
+// conversion (about 800 instructions) runs with interrupts enabled and its
+// result is cached only if the clock was not set meanwhile, since the cache
+// holds uptimes and is right only for the base it was computed with.
+[[gnu::noinline]] Result<DateTime> convertSlowly(uint64_t uptime, uint32_t savedFlags)
+{
+    DateTime time;
+    if (calendar.advance(uptime) && calendar.read(uptime, time)) {
+        restoreInterrupts(savedFlags);
+        return time;
+    }
+    const uint64_t base = baseNs;
+    const uint32_t generation = clockGeneration;
+    restoreInterrupts(savedFlags);
+    time = GregorianCalendar::fromNanoseconds(base + uptime);
+    arch_x86::InterruptGuard guard;
+    if (generation == clockGeneration) {
+        calendar.refill(uptime, time);
+    }
+    return time;
+}
+
+// GetSystemClock, inlined into both of its entry points.
+[[gnu::always_inline]] inline Result<DateTime> readSystemClock()
+{
+    // The common case, a read within the second of the previous one, only
+    // subtracts and copies (CalendarCache), with interrupts held off for a
+    // few instructions.
+    const uint32_t savedFlags = saveAndDisableInterrupts();
+    const uint64_t uptime = preciseUptime();
+    Result<DateTime> result = calendar.answer();
+    uint32_t nanosecond;
+    if (calendar.contains(uptime, nanosecond)) {
+        CalendarCache::patchNanosecond(result, nanosecond);
+        restoreInterrupts(savedFlags);
+        return result;
+    }
+    result = convertSlowly(uptime, savedFlags);
+    return result;
+}
+
+} // namespace
+
+Result<DateTime> TimerManager::getSystemClock() { return readSystemClock(); }
 
 Status TimerManager::setSystemClock(const DateTime& time)
 {
@@ -260,29 +332,18 @@ Status TimerManager::setSystemClock(const DateTime& time)
         return target.status();
     }
     arch_x86::InterruptGuard guard;
-    const uint64_t elapsed = preciseUptimeNs();
+    const uint64_t elapsed = preciseUptime();
     if (target.value() < elapsed) {
         return Status::InvalidArgument; // Before the node was started.
     }
+    // Only the base changes (seed 7.5). Day-clock alarms and SleepTill are
+    // keyed by time of day (DayClockWheel), so none of them is touched: the
+    // time with interrupts held off is the same for any number of timers
+    // and tasks.
     baseNs = target.value() - elapsed;
-    // Day-clock alarms and SleepTill are times of day: move them with the
-    // clock. This is a configuration service, so the O(N) walks are
-    // acceptable.
-    for (TimerObject& timer : timers) {
-        if (timer.kind == AlarmKind::DayClock) {
-            // An alarm that went off already stays off; one still armed moves.
-            if (wheel.cancel(timer.entry) == Status::Ok) {
-                (void)wheel.insert(timer.entry, dayClockTick(timer.dayClockNs)); // Cannot fail: just cancelled.
-            }
-        }
-    }
-    TaskManager::forEachTask([](Task& task) {
-        if (task.sleepsTillTimeOfDay && static_cast<TimeWheelNode<>&>(task.wakeTimeout).isLinked()) {
-            // Armed, as the condition checked, so both succeed.
-            (void)wheel.cancel(task.wakeTimeout);
-            (void)wheel.insert(task.wakeTimeout, dayClockTick(task.wakeTimeOfDayNs));
-        }
-    });
+    dayClock.setBase(baseNs, tickCount);
+    ++clockGeneration;
+    calendar.invalidate(elapsed);
     return Status::Ok;
 }
 
@@ -317,7 +378,7 @@ Status TimerManager::deleteTimer(ObjectId id, ObjectId caller)
     if (!timer.ok()) {
         return timer.status();
     }
-    (void)wheel.cancel(timer.value()->entry); // NotFound: no alarm was armed.
+    disarm(timer.value()->entry);
     timer.value()->kind = AlarmKind::None;
     return timerTable.Delete(id);
 }
@@ -354,8 +415,7 @@ Status TimerManager::setDayClockAlarm(ObjectId id, ObjectId caller, const DateTi
     }
     TimerObject& t = *timer.value();
     replaceAlarm(t, AlarmKind::DayClock, n);
-    t.dayClockNs = target.value();
-    (void)wheel.insert(t.entry, dayClockTick(t.dayClockNs)); // Cannot fail: replaceAlarm disarmed it.
+    dayClock.arm(t.entry, target.value(), tickCount); // replaceAlarm disarmed it.
     return Status::Ok;
 }
 
@@ -389,7 +449,7 @@ Status TimerManager::cancelAlarm(ObjectId id, ObjectId caller)
     if (timer.value()->kind == AlarmKind::None) {
         return Status::InvalidArgument; // No alarm is set.
     }
-    (void)wheel.cancel(timer.value()->entry); // Cannot fail: an alarm still set is armed.
+    disarm(timer.value()->entry); // An alarm still set is armed.
     timer.value()->kind = AlarmKind::None;
     return Status::Ok;
 }
@@ -426,3 +486,13 @@ size_t TimerManager::timerCount() { return timerTable.usedCount(); }
 DCOS_RESOURCE_RECOVERY(timerRecovery, "timer", recoverTimers);
 
 } // namespace dcos::internal
+
+namespace dcos {
+
+// Defined here rather than with the other interface functions in
+// TimerAgent.cpp so that the clock read is inlined into it: the call and
+// frame of a forwarding function would take a fifth of the primitive's
+// instruction budget.
+Result<DateTime> TimerAgent::GetSystemClock() const { return internal::readSystemClock(); }
+
+} // namespace dcos

@@ -62,8 +62,17 @@ public:
 
     /// The tick whose slot the wheel is processing; all earlier ticks are done.
     constexpr uint64_t currentTick() const { return cursor_; }
-    /// Number of pending time-outs. Cost O(1).
-    constexpr size_t size() const { return count_; }
+    /// Number of pending time-outs, for tests and diagnostics. Cost
+    /// O(Slots + pending time-outs): the wheel keeps no count, so that
+    /// cancel is a bare unlink that needs no wheel (see cancel).
+    size_t size() const
+    {
+        size_t pending = 0;
+        for (const SortedList<T, uint64_t, Tag>& slot : slots_) {
+            pending += slot.size();
+        }
+        return pending;
+    }
 
     /// Arms @p item to expire at absolute tick @p dueTick.
     ///
@@ -78,14 +87,17 @@ public:
         }
         const size_t slot = dueTick <= cursor_ ? cursorSlot_ : slotOf(dueTick);
         slots_[slot].insert(item, dueTick);
-        ++count_;
         return Status::Ok;
     }
 
-    /// Disarms @p item, which must have been armed on this wheel.
+    /// Disarms @p item.
     ///
-    /// Fails with NotFound when @p item is not armed (it may just have
-    /// expired, a race the caller resolves). Cost O(1).
+    /// The wheel keeps no count and the lists are intrusive, so this only
+    /// unlinks @p item from whatever list holds it: any wheel of this type,
+    /// or the lists of a DayClockWheel. The timer agent relies on that to
+    /// cancel a time-out without knowing where it is armed. Fails with
+    /// NotFound when @p item is not armed (it may just have expired, a race
+    /// the caller resolves). Cost O(1).
     Status cancel(T& item)
     {
         Node& node = item;
@@ -93,8 +105,21 @@ public:
             return Status::NotFound;
         }
         node.unlink();
-        --count_;
         return Status::Ok;
+    }
+
+    /// Moves the wheel's clock back to @p tick, for a wheel keyed by a clock
+    /// that was set back. Every armed entry is due after the current tick
+    /// (advance leaves none that is due), so all of them are still due after
+    /// @p tick and in the slot of their due tick, where the wheel, turning on
+    /// from @p tick, finds them. A @p tick not before the current one changes
+    /// nothing: popExpired catches up by itself. Cost O(1).
+    void rewind(uint64_t tick)
+    {
+        if (tick < cursor_) {
+            cursor_ = tick;
+            cursorSlot_ = slotOf(tick);
+        }
     }
 
     /// Returns one entry due at or before @p nowTick and disarms it, or null when none is left.
@@ -115,7 +140,6 @@ public:
         for (;;) {
             SortedList<T, uint64_t, Tag>& slot = slots_[cursorSlot_];
             if (!slot.isEmpty() && SortedList<T, uint64_t, Tag>::keyOf(slot.front()) <= cursor_) {
-                --count_;
                 return slot.popFront();
             }
             if (cursor_ >= nowTick) {
@@ -149,7 +173,6 @@ private:
     SortedList<T, uint64_t, Tag> slots_[Slots];
     uint64_t cursor_;
     size_t cursorSlot_;
-    size_t count_ = 0;
 };
 
 } // namespace dcos::internal

@@ -23,6 +23,8 @@ struct TimeoutEntry : TimeWheelNode<> {
 
     Kind kind;
     void* owner;
+    /// The time of day a day-clock time-out (day-clock alarm, SleepTill) is due at.
+    uint64_t timeOfDayNs = 0;
 };
 
 } // namespace dcos::internal

@@ -4,7 +4,12 @@
 // The clock is two 64-bit nanosecond counts, as the seed's Fig. 7.8 shows:
 // the base (time of day at the moment the tick started) and the increment
 // (nanoseconds ticked since). SetSystemClock changes only the base, so every
-// interval and time-out in progress is undisturbed.
+// interval and time-out in progress is undisturbed. Time-outs due at a time
+// of day (day-clock alarms, SleepTill) are kept apart, keyed by time of day
+// (DayClockWheel.hpp), so that they follow the clock without being touched
+// when it is set: SetSystemClock costs the same for any number of them.
+// GetSystemClock converts through a cache of the current second's calendar
+// (CalendarCache.hpp) instead of dividing.
 #pragma once
 
 #include <dcos/DateTime.hpp>
@@ -44,13 +49,11 @@ public:
     static uint64_t tickAfter(uint64_t ns);
     /// The first tick at or after an uptime.
     static uint64_t tickAtUptime(uint64_t uptimeNs);
-    /// The tick at which a time of day is reached with the clock as set
-    /// now; a time already past is due at the next tick.
-    static uint64_t tickAtTimeOfDay(uint64_t timeOfDayNs);
-    /// The uptime at which a time of day is reached with the clock as set now (0 if past).
-    static Result<uint64_t> uptimeAtTimeOfDay(uint64_t timeOfDayNs);
     /// Arms entry for the absolute tick dueTick.
     static void arm(TimeoutEntry& entry, uint64_t dueTick);
+    /// Arms entry for a time of day: it goes off at the first tick at or
+    /// after that time, and moves with the clock when SetSystemClock sets it.
+    static void armAtTimeOfDay(TimeoutEntry& entry, uint64_t timeOfDayNs);
     static void cancel(TimeoutEntry& entry);
 
     /// Nanoseconds since 1970-01-01 now (base + increment).
