@@ -575,6 +575,21 @@ def test_the_hub_runs_standalone_for_host_tools(tmp_path):
 # routine starts, some hundred instructions (ns) after the interrupt.
 UPTIME_STEP_NS = 838
 ISR_ENTRY_BOUND_NS = 3000
+# Unless the 1 kHz tick's handler is running when the frame completes: the
+# CAN interrupt (IRQ 10) then waits for it to end. Which frames meet a tick
+# depends on when the host typed the send command, so the bound allows the
+# tick handler's length, but only where a tick fell just before the frame
+# completed (about one frame in 200; measured: 4,191 ns in all).
+TICK_HANDLER_BOUND_NS = 10_000
+TICK_UPTIME_NS = 999_847
+
+
+def latency_bound(completion_uptime):
+    """The latest uptime the interrupt for a frame completing at completion_uptime may start at."""
+    last_tick = completion_uptime // TICK_UPTIME_NS * TICK_UPTIME_NS
+    if completion_uptime - last_tick <= TICK_HANDLER_BOUND_NS:
+        return completion_uptime + TICK_HANDLER_BOUND_NS + ISR_ENTRY_BOUND_NS
+    return completion_uptime + ISR_ENTRY_BOUND_NS
 # The uptime counts each 1 kHz tick, 1193 periods of the 8254's 1,193,182 Hz
 # (999,847.47 ns), as a whole 999,847 ns (docs/api.md, timer agent): it runs
 # 0.47 ppm slow against the emulated clock, 0.6 us over a 1.3 s test.
@@ -619,8 +634,8 @@ def test_frame_latency_on_the_boards_matches_its_bit_length(canlab, bitrate):
         print(f"{bitrate} bit/s {frame}: TX request to RX interrupt {latency} ns, {completion_bits(frame)} bits "
               f"= {expected} ns")
         assert received.frame == frame
-        assert expected - UPTIME_STEP_NS <= latency <= expected + ISR_ENTRY_BOUND_NS
-        assert expected - UPTIME_STEP_NS <= sent.uptime - request <= expected + ISR_ENTRY_BOUND_NS
+        assert expected - UPTIME_STEP_NS <= latency <= latency_bound(request + expected) - request
+        assert expected - UPTIME_STEP_NS <= sent.uptime - request <= latency_bound(request + expected) - request
         assert sent.fields["sr"] & 0x0C == 0x0C  # TBS and TCS
         record = lab.hub.frames()[-1]
         assert (record.frame, record.outcome, record.rx, record.ack) == (frame, "ok", ("board2.0",), ("board2.0",))

@@ -145,8 +145,14 @@ inline uint32_t nanosecondsIntoTick()
     uint32_t elapsed = count <= divisor ? divisor - count : 0;
     // A tick that has happened but is not serviced yet (interrupts are off)
     // shows as a request: the count has already started the next period.
+    // The count reads the divisor itself only during the first count after
+    // the reload, too soon for the tick's handler to have run: that period
+    // is not counted yet either, request or not. QEMU's 8254 raises its
+    // output one count after the reload, so there a read in that window
+    // sees no request, and the uptime would be a whole tick short.
     arch_x86::portWrite8(masterPicCommandPort, ocw3ReadRequestRegister);
-    if ((arch_x86::portRead8(masterPicCommandPort) & 1u) != 0 && elapsed < divisor / 2u) {
+    const bool tickRequested = (arch_x86::portRead8(masterPicCommandPort) & 1u) != 0;
+    if ((tickRequested || (count == divisor && divisor != 0)) && elapsed < divisor / 2u) {
         elapsed += divisor;
     }
 #if defined(DCOS_HOST_BUILD)
