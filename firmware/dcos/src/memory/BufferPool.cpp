@@ -218,7 +218,8 @@ bool BufferPool::holderOf(size_t index, uint16_t& holder) const
 
 uint16_t BufferPool::seal(uint32_t kind, uint32_t index, uint32_t value) const
 {
-    return static_cast<uint16_t>(mixBits(salt_ ^ kind ^ (index * 0x9E3779B1u) ^ (value * 0x85EBCA77u)) >> 16);
+    return static_cast<uint16_t>(
+        mixBits(salt_ ^ kind ^ multiplyWord(index, 0x9E3779B1u) ^ multiplyWord(value, 0x85EBCA77u)) >> 16);
 }
 
 uint32_t BufferPool::freeWord(uint32_t index) const

@@ -146,13 +146,27 @@ private:
     bool corrupted_ = false;
 };
 
+/// value * factor, as one IMUL on the board. Tuned for the i486, GCC spells
+/// a multiplication by a constant as a chain of shifts, adds and LEAs: fewer
+/// cycles there, but up to thirty instructions, on every check value a pool
+/// or heap computes. Hiding the constant from the optimiser leaves the IMUL.
+constexpr uint32_t multiplyWord(uint32_t value, uint32_t factor)
+{
+#ifndef DCOS_HOST_BUILD
+    if (!__builtin_is_constant_evaluated()) {
+        asm("" : "+r"(factor));
+    }
+#endif
+    return value * factor;
+}
+
 /// Scrambles a 32-bit value (a finaliser with full avalanche); the check values of pools and heaps use it.
 constexpr uint32_t mixBits(uint32_t value)
 {
     value ^= value >> 16;
-    value *= 0x7FEB352Du;
+    value = multiplyWord(value, 0x7FEB352Du);
     value ^= value >> 15;
-    value *= 0x846CA68Bu;
+    value = multiplyWord(value, 0x846CA68Bu);
     value ^= value >> 16;
     return value;
 }
