@@ -8,6 +8,7 @@ same count on every call. No test here asserts a speed target.
 
 import os
 import re
+import subprocess
 import sys
 
 import pytest
@@ -206,3 +207,16 @@ def test_modbus_line_benchmarks_handle_real_characters_and_requests_with_exact_c
     assert write["line_limit_transactions_per_second"] == pytest.approx(1 / (37 * 11 / 115200 + 2 * 1.75e-3))
     assert read["share_of_emulated_cpu"] == pytest.approx(
         read["instructions_per_transaction"] * read["line_limit_transactions_per_second"] / 1e9)
+
+
+def test_the_instruction_trace_of_a_benchmark_accounts_for_its_figure_exactly():
+    """trace_primitive.py's trace of one call is the bench's figure plus the
+    empty function's ret that the bench subtracts, and names the functions."""
+    tool = os.path.join(os.path.dirname(os.path.abspath(__file__)), "bench", "trace_primitive.py")
+    result = subprocess.run([sys.executable, tool, "Semaphore.Acquire"], capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stdout + result.stderr
+    traced = re.search(r"^Semaphore.Acquire: (\d+) instructions from acquire\(\)", result.stdout, re.MULTILINE)
+    figure = re.search(r"^bench figure: (\d+)", result.stdout, re.MULTILINE)
+    assert traced and figure, result.stdout
+    assert int(traced.group(1)) == int(figure.group(1)) + 1, result.stdout
+    assert re.search(r"^\s+\d+\s+dcos::SemaphoreAgent::Acquire\(", result.stdout, re.MULTILINE), result.stdout

@@ -13,6 +13,9 @@ order they ran, and with --listing every instruction with its disassembly.
   tests_renode/bench/trace_primitive.py Semaphore.Acquire
   tests_renode/bench/trace_primitive.py Semaphore.Acquire --measure acquire --listing
 
+Under the per-function counts it prints the bench's own figure for the same
+call, which must be the trace's count less one (tests_renode/test_bench_framework.py).
+
 The measure function is found from the DCOS_BENCHMARK line that registers the
 benchmark in tests_renode/bench/*.cpp; --measure names it where that fails.
 Exit codes: 0 traced, 1 the benchmark or its call was not found, 2 usage.
@@ -187,8 +190,12 @@ def main():
     totals = collections.Counter()
     for name, count in runs:
         totals[name] += count
+    # The bench's figure for the same object count: the call less an empty
+    # call, whose function is a lone ret, so it is the trace less one.
+    figure = re.search(rf"^BENCH {re.escape(args.benchmark)} objects={args.objects} min=(\d+)", output, re.MULTILINE)
     print(f"{args.benchmark}: {len(path)} instructions from {measure}() to its return "
           f"({args.objects} objects; includes the call's own overhead)")
+    print(f"bench figure: {figure.group(1) if figure else '-'} (the trace less an empty function's ret)")
     for name, count in totals.most_common():
         print(f"  {count:6d}  {name}")
     return 0
