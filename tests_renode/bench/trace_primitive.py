@@ -82,10 +82,14 @@ def symbols(image):
     table = []
     for line in output.splitlines():
         parts = line.split(" ", 3)
-        if len(parts) == 4 and parts[2] in "tTwW":
+        if len(parts) == 4 and len(parts[2]) == 1 and parts[2] in "tTwW":
             table.append((int(parts[0], 16), int(parts[1], 16), parts[3]))
+        elif len(parts) >= 3 and len(parts[1]) == 1 and parts[1] in "tT":
+            # An assembly label has no size: it reaches to the next symbol.
+            table.append((int(parts[0], 16), 0, " ".join(parts[2:])))
     table.sort()
-    return table
+    return [(address, size or ((table[i + 1][0] - address) if i + 1 < len(table) else 1), name)
+            for i, (address, size, name) in enumerate(table)]
 
 
 def disassembly(image):
