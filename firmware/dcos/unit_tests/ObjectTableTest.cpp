@@ -491,7 +491,7 @@ private:
 
     // Owners include the system (null), two tasks that share an index on
     // different nodes, and a few more.
-    ObjectId randomOwner()
+    static const std::vector<ObjectId>& owners()
     {
         static const std::vector<ObjectId> owners = {
             ObjectId::null(),
@@ -501,8 +501,10 @@ private:
             ObjectId(kNode, ObjectType::Task, 4095),
             ObjectId(kNode + 1, ObjectType::Task, 1),
         };
-        return pickFrom(owners);
+        return owners;
     }
+
+    ObjectId randomOwner() { return pickFrom(owners()); }
 
     Visibility randomVisibility() { return static_cast<Visibility>(pick(3)); }
 
@@ -650,16 +652,10 @@ private:
                 }
             }
         }
-        static const std::vector<ObjectId> owners = {
-            ObjectId::null(),
-            ObjectId(kNode, ObjectType::Task, 1),
-            ObjectId(kNode, ObjectType::Task, 2),
-            ObjectId(kNode, ObjectType::Task, 3),
-            ObjectId(kNode, ObjectType::Task, 4095),
-            ObjectId(kNode + 1, ObjectType::Task, 1),
-            ObjectId(kNode, ObjectType::Task, 7),
-        };
-        for (const ObjectId owner : owners) {
+        // Every owner objects may have, and one that never owns any.
+        std::vector<ObjectId> walked = owners();
+        walked.push_back(ObjectId(kNode, ObjectType::Task, 7));
+        for (const ObjectId owner : walked) {
             std::set<uint32_t> expected;
             for (const auto& [raw, object] : objects_) {
                 if (object.owner == owner) {

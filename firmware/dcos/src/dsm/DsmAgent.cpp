@@ -108,6 +108,21 @@ Result<SubscriptionObject*> resolveSubscription(ObjectId id)
     return subscriptionTable.resolve(id);
 }
 
+// A subscription the calling task owns (Close and Read): only its owner
+// closes it or reads through it.
+Result<SubscriptionObject*> resolveOwnSubscription(ObjectId id)
+{
+    const Result<SubscriptionObject*> subscription = resolveSubscription(id);
+    if (!subscription.ok()) {
+        return subscription.status();
+    }
+    const Status owner = subscriptionTable.checkOwner(id, currentTaskId());
+    if (owner != Status::Ok) {
+        return owner;
+    }
+    return subscription.value();
+}
+
 // Invalidates every subscription, wakes the waiting readers with Deleted
 // and frees the slot. O(1) plus O(1) per waiting reader.
 //
@@ -280,14 +295,9 @@ Result<ObjectId> DsmAgent::Open(ObjectId publisherId) const
 Status DsmAgent::Close(ObjectId id) const
 {
     arch_x86::InterruptGuard guard;
-    start();
-    const Result<SubscriptionObject*> subscription = resolveSubscription(id);
+    const Result<SubscriptionObject*> subscription = internal::resolveOwnSubscription(id);
     if (!subscription.ok()) {
         return subscription.status();
-    }
-    const Status owner = subscriptionTable.checkOwner(id, internal::currentTaskId());
-    if (owner != Status::Ok) {
-        return owner;
     }
     return subscriptionTable.Delete(id);
 }
@@ -301,14 +311,9 @@ Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& p
     SubscriptionObject* subscription = subscriptionTable.find(id, owner);
     if (subscription == nullptr || !internal::Scheduler::started() || owner != internal::Scheduler::current().id)
         [[unlikely]] {
-        start();
-        const Result<SubscriptionObject*> resolved = resolveSubscription(id);
+        const Result<SubscriptionObject*> resolved = internal::resolveOwnSubscription(id);
         if (!resolved.ok()) {
             return resolved.status();
-        }
-        const Status ownerCheck = subscriptionTable.checkOwner(id, internal::currentTaskId());
-        if (ownerCheck != Status::Ok) {
-            return ownerCheck;
         }
         subscription = resolved.value();
     }

@@ -492,59 +492,56 @@ private:
     // folded in before the mask.
     static size_t bucketOf(uint32_t hash) { return (hash ^ (hash >> 16)) & (Capacity - 1); }
 
-    void linkName(uint16_t slot)
+    // Both lists a used slot is on (its name's bucket and its owner's list)
+    // are doubly linked through Chain: Next and Prev pick which.
+    template <Link Chain::*Next, Link Chain::*Prev>
+    void pushFront(uint16_t slot, Link& head)
     {
         Chain& chain = chains_[slot];
-        Link& head = buckets_[bucketOf(chain.nameHash)];
-        chain.namePrev = kNoLink;
-        chain.nameNext = head;
+        chain.*Prev = kNoLink;
+        chain.*Next = head;
         if (head != kNoLink) {
-            chains_[slotOfLink(head)].namePrev = linkOf(slot);
+            chains_[slotOfLink(head)].*Prev = linkOf(slot);
         }
         head = linkOf(slot);
+    }
+
+    template <Link Chain::*Next, Link Chain::*Prev>
+    void unlink(uint16_t slot, Link& head)
+    {
+        Chain& chain = chains_[slot];
+        if (chain.*Next != kNoLink) {
+            chains_[slotOfLink(chain.*Next)].*Prev = chain.*Prev;
+        }
+        if (chain.*Prev != kNoLink) {
+            chains_[slotOfLink(chain.*Prev)].*Next = chain.*Next;
+        } else {
+            head = chain.*Next;
+        }
+        chain.*Next = chain.*Prev = kNoLink;
+    }
+
+    void linkName(uint16_t slot)
+    {
+        pushFront<&Chain::nameNext, &Chain::namePrev>(slot, buckets_[bucketOf(chains_[slot].nameHash)]);
     }
 
     void unlinkName(uint16_t slot)
     {
-        Chain& chain = chains_[slot];
-        if (chain.nameNext != kNoLink) {
-            chains_[slotOfLink(chain.nameNext)].namePrev = chain.namePrev;
-        }
-        if (chain.namePrev != kNoLink) {
-            chains_[slotOfLink(chain.namePrev)].nameNext = chain.nameNext;
-        } else {
-            buckets_[bucketOf(chain.nameHash)] = chain.nameNext;
-        }
-        chain.nameNext = chain.namePrev = kNoLink;
+        unlink<&Chain::nameNext, &Chain::namePrev>(slot, buckets_[bucketOf(chains_[slot].nameHash)]);
     }
 
     void linkOwner(uint16_t slot, size_t key)
     {
-        Chain& chain = chains_[slot];
-        Link& head = ownerHeads_[key];
         entries_[slot].ownerKey = static_cast<uint16_t>(key);
-        chain.ownerPrev = kNoLink;
-        chain.ownerNext = head;
-        if (head != kNoLink) {
-            chains_[slotOfLink(head)].ownerPrev = linkOf(slot);
-        }
-        head = linkOf(slot);
+        pushFront<&Chain::ownerNext, &Chain::ownerPrev>(slot, ownerHeads_[key]);
     }
 
     // Uses the key stored at link time, not the owner's key now: the key of
     // a stale owner id may have changed since.
     void unlinkOwner(uint16_t slot)
     {
-        Chain& chain = chains_[slot];
-        if (chain.ownerNext != kNoLink) {
-            chains_[slotOfLink(chain.ownerNext)].ownerPrev = chain.ownerPrev;
-        }
-        if (chain.ownerPrev != kNoLink) {
-            chains_[slotOfLink(chain.ownerPrev)].ownerNext = chain.ownerNext;
-        } else {
-            ownerHeads_[entries_[slot].ownerKey] = chain.ownerNext;
-        }
-        chain.ownerNext = chain.ownerPrev = kNoLink;
+        unlink<&Chain::ownerNext, &Chain::ownerPrev>(slot, ownerHeads_[entries_[slot].ownerKey]);
     }
 
     // The index freed longest ago; indices never handed out count as freed
