@@ -173,6 +173,24 @@ def check_primitives(budgets, report, selection=""):
     return rows
 
 
+def _unmeasured(row, budget, offence):
+    """A row with no figure: "not measured yet" where the budget file says no
+    benchmark or image exists yet, otherwise a missing figure, an offence."""
+    row["verdict"] = NOT_MEASURED_YET if not budget["measured"] else MISSING
+    if budget["measured"]:
+        row["offences"].append(offence)
+
+
+def load_budgets_for_command(path):
+    """load_budgets for a `make bench` step: the budgets, or None after
+    saying on stderr why the file was refused (the step then exits 2)."""
+    try:
+        return load_budgets(path)
+    except BudgetFileError as error:
+        print(f"make bench: {error}", file=sys.stderr)
+        return None
+
+
 def check_thread_metric(budgets, results):
     """Rows for every budgeted Thread-Metric test; results is thread_metric.json's {test: {...}}."""
     rows = []
@@ -187,9 +205,7 @@ def check_thread_metric(budgets, results):
                "now": budget.get("now"), "note": budget["note"], "measured": budget["measured"],
                "instructions_per_iteration": figure, "offences": []}
         if figure is None:
-            row["verdict"] = NOT_MEASURED_YET if not budget["measured"] else MISSING
-            if budget["measured"]:
-                row["offences"].append(f"Thread-Metric {name}: no figure")
+            _unmeasured(row, budget, f"Thread-Metric {name}: no figure")
         else:
             row["verdict"] = OVER if figure > budget["budget"] else WITHIN
             if row["verdict"] == OVER:
@@ -210,9 +226,7 @@ def check_footprint(budgets, images):
                "image": budget.get("image"), "kernel": budget["kernel"], "note": budget["note"],
                "measured": budget["measured"], "kernel_text": text, "offences": []}
         if text is None:
-            row["verdict"] = NOT_MEASURED_YET if not budget["measured"] else MISSING
-            if budget["measured"]:
-                row["offences"].append(f"footprint {name}: no figure for {budget.get('image')}")
+            _unmeasured(row, budget, f"footprint {name}: no figure for {budget.get('image')}")
         else:
             row["verdict"] = OVER if text > budget["text_budget"] else WITHIN
             if row["verdict"] == OVER:

@@ -212,10 +212,8 @@ def main():
     parser.add_argument("--strict", action="store_true", help="exit 1 when a kernel is over its budget")
     arguments = parser.parse_args()
 
-    try:
-        budgets = budget_file.load_budgets(arguments.budgets)
-    except budget_file.BudgetFileError as error:
-        print(f"make bench: {error}", file=sys.stderr)
+    budgets = budget_file.load_budgets_for_command(arguments.budgets)
+    if budgets is None:
         return 2
     maps = {name: arguments.map for name, budget in budgets["footprint"].items()
             if budget["measured"] and budget.get("image") == "build/486/dcos486.elf"}

@@ -505,10 +505,8 @@ def main():
                         help="JSON report of the Modbus line's costs to write (when the Modbus benchmarks ran)")
     arguments = parser.parse_args()
 
-    try:
-        budgets = budget_file.load_budgets(arguments.budgets)
-    except budget_file.BudgetFileError as error:
-        print(f"make bench: {error}", file=sys.stderr)
+    budgets = budget_file.load_budgets_for_command(arguments.budgets)
+    if budgets is None:
         return 2
     board = load_board(arguments.board)
     if not board.benchmark_cpu:

@@ -69,10 +69,8 @@ def main():
     parser.add_argument("--budgets", default=budget_file.DEFAULT_BUDGETS, help="the budget file (budgets.toml)")
     parser.add_argument("--strict", action="store_true", help="exit 1 when a test is over its budget")
     arguments = parser.parse_args()
-    try:
-        budgets = budget_file.load_budgets(arguments.budgets)
-    except budget_file.BudgetFileError as error:
-        print(f"make bench: {error}", file=sys.stderr)
+    budgets = budget_file.load_budgets_for_command(arguments.budgets)
+    if budgets is None:
         return 2
     results = run(arguments.board)
     rows = budget_file.check_thread_metric(budgets, results)
