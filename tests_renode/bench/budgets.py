@@ -173,12 +173,19 @@ def check_primitives(budgets, report, selection=""):
     return rows
 
 
-def _unmeasured(row, budget, offence):
-    """A row with no figure: "not measured yet" where the budget file says no
-    benchmark or image exists yet, otherwise a missing figure, an offence."""
-    row["verdict"] = NOT_MEASURED_YET if not budget["measured"] else MISSING
-    if budget["measured"]:
-        row["offences"].append(offence)
+def _judge(row, budget, figure, limit, missing, over):
+    """The verdict on one figure against limit. With no figure: "not measured
+    yet" where the budget file says no benchmark or image exists yet,
+    otherwise a missing figure, offence `missing`; over the limit, the
+    offence over() says."""
+    if figure is None:
+        row["verdict"] = NOT_MEASURED_YET if not budget["measured"] else MISSING
+        if budget["measured"]:
+            row["offences"].append(missing)
+        return
+    row["verdict"] = OVER if figure > limit else WITHIN
+    if row["verdict"] == OVER:
+        row["offences"].append(over())
 
 
 def load_budgets_for_command(path):
@@ -204,14 +211,9 @@ def check_thread_metric(budgets, results):
         row = {"name": name, "budget": budget["budget"], "freertos": budget.get("freertos"),
                "now": budget.get("now"), "note": budget["note"], "measured": budget["measured"],
                "instructions_per_iteration": figure, "offences": []}
-        if figure is None:
-            _unmeasured(row, budget, f"Thread-Metric {name}: no figure")
-        else:
-            row["verdict"] = OVER if figure > budget["budget"] else WITHIN
-            if row["verdict"] == OVER:
-                row["offences"].append(f"Thread-Metric {name}: {figure:g} instructions per iteration, over its "
-                                       f"budget of {budget['budget']:g} (half of FreeRTOS's "
-                                       f"{budget.get('freertos', 2 * budget['budget']):g})")
+        _judge(row, budget, figure, budget["budget"], f"Thread-Metric {name}: no figure",
+               lambda: f"Thread-Metric {name}: {figure:g} instructions per iteration, over its budget of "
+                       f"{budget['budget']:g} (half of FreeRTOS's {budget.get('freertos', 2 * budget['budget']):g})")
         rows.append(row)
     return rows
 
@@ -225,13 +227,8 @@ def check_footprint(budgets, images):
         row = {"name": name, "text_budget": budget["text_budget"], "now": budget.get("now"),
                "image": budget.get("image"), "kernel": budget["kernel"], "note": budget["note"],
                "measured": budget["measured"], "kernel_text": text, "offences": []}
-        if text is None:
-            _unmeasured(row, budget, f"footprint {name}: no figure for {budget.get('image')}")
-        else:
-            row["verdict"] = OVER if text > budget["text_budget"] else WITHIN
-            if row["verdict"] == OVER:
-                row["offences"].append(f"footprint {name}: kernel code {text} bytes, over its budget of "
-                                       f"{budget['text_budget']} bytes")
+        _judge(row, budget, text, budget["text_budget"], f"footprint {name}: no figure for {budget.get('image')}",
+               lambda: f"footprint {name}: kernel code {text} bytes, over its budget of {budget['text_budget']} bytes")
         rows.append(row)
     return rows
 
