@@ -118,6 +118,26 @@ def test_an_isotp_message_passes_between_two_controllers(canlab):
     assert frames[0].data[:2] == bytes([0x10, 100]), lab.hub.log_text()
 
 
+def test_a_stale_flow_control_does_not_start_the_next_isotp_transfer(canlab):
+    # A flow control that came after an earlier transfer timed out (a slow
+    # peer) waits in the channel's queue. The next transfer must wait for the
+    # flow control its own first frame asks for, as a Linux can-isotp socket
+    # does, and not send consecutive frames to a peer that is not listening.
+    lab = canlab({"can0": 500_000}, TWO_BOARDS, pace=PACE, kind="production")
+    sender, other = lab.board("board1"), lab.board("board2")
+    for board in (sender, other):
+        up(board, 500_000)
+    lab.hub.inject("can0", "lab", Frame.data_frame(0x7E8, bytes([0x30, 0x00, 0x00])))
+    deadline = time.monotonic() + TIMEOUT
+    while not any(r.frame.id == 0x7E8 and r.outcome == "ok" for r in lab.hub.frames()):
+        assert time.monotonic() < deadline, lab.hub.log_text()
+        time.sleep(0.05)
+    output = sender.command(f"can isotp-send can0 7E0 7E8 {bytes(range(100)).hex()}")
+    assert "error: ISO-TP transfer failed: N_Bs time-out" in output, output
+    sent = [r.frame for r in lab.hub.frames() if r.sender == "board1.0"]
+    assert len(sent) == 1 and sent[0].id == 0x7E0 and sent[0].data[:2] == bytes([0x10, 100]), lab.hub.log_text()
+
+
 # -- faults on the driver: each reported to the owner and shown by `can state`/`can stats` --
 
 

@@ -378,6 +378,22 @@ bool nextFrame(unsigned channel, uint64_t deadlineNs, can::CanFrame& frame)
     }
 }
 
+// Empties the channel's receive queue. A transfer begins with it, as a Linux
+// can-isotp socket only sees frames that arrive after it was bound: a flow
+// control left over from an earlier, timed-out transfer must not let the
+// next one send its consecutive frames before the peer asked for them.
+void discardReceived(unsigned channel)
+{
+    can::CanFrame frame;
+    for (;;) {
+        const dcos::Result<size_t> read =
+            systemAgent.Read(consoleChannels[channel].id(), 0, &frame, sizeof(can::CanFrame));
+        if (!read.ok() || read.value() != sizeof(can::CanFrame)) {
+            return;
+        }
+    }
+}
+
 // Frames of other connections read while waiting are dropped: the console's
 // transfers own the channel while they run, as isotpsend owns its socket.
 CommandResult isoTpSend(shell::Shell& shell, int argc, char** argv)
@@ -408,6 +424,7 @@ CommandResult isoTpSend(shell::Shell& shell, int argc, char** argv)
         return CommandResult::Failed;
     }
     listenHere(channel);
+    discardReceived(channel);
     can::IsoTpSender sender = created.value();
     can::IsoTpStep step = sender.start(message, length, dcos::timerAgent.Uptime());
     while (!step.completed && step.aborted == can::LinkError::Ok &&
@@ -458,6 +475,7 @@ CommandResult isoTpReceive(shell::Shell& shell, int argc, char** argv)
         return CommandResult::Failed;
     }
     listenHere(channel);
+    discardReceived(channel);
     can::IsoTpReceiver receiver = created.value();
     const uint64_t giveUp = dcos::timerAgent.Uptime() + timeoutMs * kMillisecond;
     for (;;) {
