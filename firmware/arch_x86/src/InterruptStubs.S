@@ -49,6 +49,43 @@ interrupt_return:
     addl $8, %esp               /* Drop the vector number and error code. */
     iret
 
+/*
+ * void directSwitch(uint32_t** save, uint32_t* resumeStack, InterruptFrame* frame)
+ * with regparm(3): EAX = save, EDX = resumeStack, ECX = frame.
+ *
+ * The task-context switch (Scheduler::switchFromTask): a task that blocks,
+ * yields or readies a more urgent task leaves through here instead of the
+ * dispatch trap. It keeps only what the C++ ABI says a call preserves (EBX,
+ * ESI, EDI, EBP and the return address; the caller has interrupts disabled
+ * and restores its own flags once resumed) and stores its stack pointer at
+ * *save. The next task resumes the same way when it left through here
+ * (resumeStack not null), or from the interrupt frame it was preempted in.
+ */
+    .globl directSwitch
+directSwitch:
+    pushl %ebp
+    pushl %ebx
+    pushl %esi
+    pushl %edi
+    movl %esp, (%eax)
+    testl %edx, %edx
+    jz 1f
+    movl %edx, %esp
+/*
+ * A task saved by directSwitch resumes here: straight from the switch, or
+ * through iret from the frame Scheduler::frameForDirectResume() builds when
+ * an interrupt's exit is what picks it.
+ */
+    .globl directResume
+directResume:
+    popl %edi
+    popl %esi
+    popl %ebx
+    popl %ebp
+    ret
+1:  movl %ecx, %esp
+    jmp interrupt_return
+
     /* .altmacro makes %vector pass the counter's value, not its name. */
     .altmacro
 /*

@@ -2,9 +2,10 @@
 #include <dcos/internal/TaskManager.hpp>
 
 #include <arch_x86/Cpu.hpp>
+#include <arch_x86/Gdt.hpp>
 #include <arch_x86/Idt.hpp>
+#include <arch_x86/TaskSwitch.hpp>
 
-extern "C" [[noreturn]] void resumeInterruptFrame(arch_x86::InterruptFrame* frame);
 
 namespace dcos::internal {
 
@@ -99,8 +100,55 @@ void Scheduler::requestDispatch()
 {
     dispatchPending_ = true;
     if (current_ != nullptr && dispatchHolds_ == 0 && arch_x86::Idt::nestingDepth() == 0) {
-        asm volatile("int %0" : : "i"(kDispatchTrapVector) : "memory");
+        switchFromTask();
     }
+}
+
+
+void Scheduler::switchFromTask()
+{
+    const uint32_t flags = arch_x86::readEflags();
+    arch_x86::disableInterrupts();
+    Task* const previous = current_;
+    Task* const next = pickNext();
+    if (previous->state == TaskState::Terminating || hasDeliveryPending(*next)) {
+        // The full path: a dying task is reaped once its stack is left, and
+        // a delivery needs the interrupt frame prepareReturn works on.
+        asm volatile("int %0" : : "i"(kDispatchTrapVector) : "memory");
+    } else {
+        dispatchPending_ = false;
+        if (next != previous) {
+            current_ = next;
+            ++switchCount_;
+            if (previous->switchWork || next->switchWork) {
+                TaskManager::switchContext(*previous, *next);
+            }
+            uint32_t* const resumeStack = next->resumeStack;
+            next->resumeStack = nullptr;
+            directSwitch(&previous->resumeStack, resumeStack, next->savedFrame);
+        }
+    }
+    restoreInterrupts(flags);
+}
+
+arch_x86::InterruptFrame* Scheduler::frameForDirectResume(Task& task)
+{
+    // The frame ends where the CPU would have pushed a ring change's ESP, so
+    // after its IRET the stack pointer is resumeStack again. userEsp and
+    // userSs are not written: they overlay the saved registers.
+    auto* const top = reinterpret_cast<uint8_t*>(task.resumeStack);
+    task.resumeStack = nullptr;
+    auto* const frame = reinterpret_cast<arch_x86::InterruptFrame*>(top - offsetof(arch_x86::InterruptFrame, userEsp));
+    frame->gs = frame->fs = frame->es = frame->ds = arch_x86::Gdt::kernelData;
+    frame->edi = frame->esi = frame->ebp = frame->espAtPushal = frame->ebx = 0;
+    frame->edx = frame->ecx = frame->eax = 0;
+    frame->vector = kDispatchTrapVector;
+    frame->errorCode = 0;
+    frame->eip = static_cast<uint32_t>(reinterpret_cast<uintptr_t>(directResume));
+    frame->cs = arch_x86::Gdt::kernelCode;
+    // Interrupts stay disabled until the switch's caller restores its own flags.
+    frame->eflags = kEflagsReservedBit;
+    return frame;
 }
 
 void Scheduler::releaseDispatch()
@@ -168,8 +216,10 @@ arch_x86::InterruptFrame* Scheduler::onOutermostExit(arch_x86::InterruptFrame* f
             previous->savedFrame = frame;
             current_ = next;
             ++switchCount_;
-            TaskManager::switchContext(*previous, *next);
-            frame = next->savedFrame;
+            if (previous->switchWork || next->switchWork) {
+                TaskManager::switchContext(*previous, *next);
+            }
+            frame = next->resumeStack != nullptr ? frameForDirectResume(*next) : next->savedFrame;
         }
     }
     return TaskManager::prepareReturn(*current_, frame);

@@ -19,8 +19,7 @@ Status SchedulerAgent::Yield() const
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
     }
-    arch_x86::InterruptGuard guard;
-    Scheduler::rotateCurrent();
+    Scheduler::yieldCurrent();
     return Status::Ok;
 }
 
@@ -93,6 +92,7 @@ Status SchedulerAgent::StartProfiling(ObjectId id) const
     arch_x86::InterruptGuard guard;
     Task& t = *task.value();
     t.profiling = true;
+    t.refreshSwitchWork();
     t.profileAccumulatedNs = 0;
     t.runStartedNs = TimerManager::preciseUptimeNs();
     return Status::Ok;
@@ -114,6 +114,7 @@ Status SchedulerAgent::StopProfiling(ObjectId id) const
     }
     const uint64_t sample = t.profileAccumulatedNs;
     t.profiling = false;
+    t.refreshSwitchWork();
     if (t.profileSamples == 0 || sample < t.profileMinimumNs) {
         t.profileMinimumNs = sample;
     }

@@ -60,6 +60,7 @@ Result<uint8_t> InterruptManager::setInterruptLevel(uint8_t level)
     const uint8_t limit = legalLimits[task.priority];
     const uint8_t granted = level < limit ? limit : level;
     task.interruptLevel = granted;
+    task.refreshSwitchWork();
     applyTaskLevel(granted);
     return granted;
 }

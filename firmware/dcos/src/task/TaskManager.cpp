@@ -397,6 +397,7 @@ Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry
     task.entry = entry;
     task.argument = argument;
     task.sliceTicksLeft = Scheduler::quantumTicks();
+    task.refreshSwitchWork();
     if (task.floatingPoint) {
         initialiseFpuState(task.fpu);
     }

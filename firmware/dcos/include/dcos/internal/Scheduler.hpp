@@ -7,11 +7,15 @@
 // single bit scan. The running task stays at the head of its queue, so a
 // preempted task resumes before its equals.
 //
-// Task switches happen in exactly one place: at the exit of the outermost
-// interrupt (onOutermostExit). A task that blocks or yields enters that path
-// through the dispatch trap (int 0x30); an interrupt handler that readies a
-// task only marks a dispatch as pending, and the switch happens when the
-// last nested handler returns.
+// Task switches happen in two places. A task that blocks, yields or readies
+// a more urgent task switches at once, from task context, through
+// directSwitch (switchFromTask): it saves only its callee-saved registers.
+// An interrupt handler that readies a task only marks a dispatch as pending,
+// and the switch happens at the exit of the outermost interrupt
+// (onOutermostExit), from the interrupted frame. Either side resumes either
+// kind of saved context. A switch that must deliver a signal or an exception
+// on the way, or leave a dying task, takes the dispatch trap (int 0x30) to
+// the interrupt exit, where prepareReturn does that work.
 #pragma once
 
 #include <dcos/internal/DeadlineQueue.hpp>
@@ -20,7 +24,9 @@
 #include <dcos/internal/ReadyBitmap.hpp>
 #include <dcos/internal/Task.hpp>
 
+#include <arch_x86/Cpu.hpp>
 #include <arch_x86/InterruptFrame.hpp>
+#include <arch_x86/TaskSwitch.hpp>
 
 namespace dcos::internal {
 
@@ -74,6 +80,44 @@ public:
     /// Returns true when another task of the same priority was waiting.
     static bool rotateCurrent();
 
+    /// Yield from task context: rotateCurrent() and the switch to the next
+    /// equal in one pass, the common case without a call to the general
+    /// dispatcher. Interrupts may be enabled or not; their state is kept.
+    /// Inline, so that Yield's cost is this and the switch itself.
+    [[gnu::always_inline]] static void yieldCurrent()
+    {
+        const uint32_t flags = arch_x86::readEflags();
+        arch_x86::disableInterrupts();
+        Task* const task = current_;
+        auto& queue = readyQueues_[task->priority];
+        // The common case: a static-priority task at the head of its queue,
+        // equals behind it, no hold. With no hold, the running task is the
+        // most urgent one, so the next is the new head of its queue.
+        Task* next = nullptr;
+        if (!task->idle && !task->schedulesByDeadline() && dispatchHolds_ == 0 && &queue.front() == task) {
+            next = queue.rotate();
+            if (next == nullptr) {
+                restoreInterrupts(flags);
+                return; // Nobody of its priority waits.
+            }
+        }
+        if (next == nullptr || task->switchWork || next->switchWork || hasDeliveryPending(*next)) {
+            if (next == nullptr) {
+                (void)rotateCurrent(); // Not at the head, deadline-scheduled, or under a hold.
+            } else {
+                requestDispatch(); // Rotated; the general switch does the rest.
+            }
+            restoreInterrupts(flags);
+            return;
+        }
+        current_ = next;
+        ++switchCount_;
+        uint32_t* const resumeStack = next->resumeStack;
+        next->resumeStack = nullptr;
+        directSwitch(&task->resumeStack, resumeStack, next->savedFrame);
+        restoreInterrupts(flags);
+    }
+
     /// Counts a tick against the running task's time slice.
     static void onTick();
 
@@ -93,6 +137,34 @@ public:
 
 private:
     static Task* pickNext();
+
+    /// The switch from task context (requestDispatch with no interrupt
+    /// nesting and no hold): directly to the next task when nothing has to be
+    /// delivered on the way, else through the dispatch trap.
+    static void switchFromTask();
+    /// An interrupt frame on a directly switched task's stack that resumes it
+    /// where directSwitch left it, for a switch made at an interrupt's exit.
+    static arch_x86::InterruptFrame* frameForDirectResume(Task& task);
+
+    static void restoreInterrupts(uint32_t flags)
+    {
+        if ((flags & arch_x86::eflagsInterruptEnable) != 0) {
+            arch_x86::enableInterrupts();
+        }
+    }
+
+    /// Whether a task has something to be delivered before it runs on: an
+    /// exception or an unmasked signal (TaskManager::prepareReturn, which
+    /// works on an interrupt frame). A pending signal whose handler is busy
+    /// or absent also counts; the full path then finds nothing to do, which
+    /// costs time, never correctness.
+    static bool hasDeliveryPending(const Task& task)
+    {
+        return task.exceptionPending || (task.pendingSignals & ~task.signalMask) != 0;
+    }
+
+    /// EFLAGS bit 1, always set (Intel SDM Vol. 1, 3.4.3).
+    static constexpr uint32_t kEflagsReservedBit = 1u << 1;
 
     static Task* current_;
     static Task* idle_;

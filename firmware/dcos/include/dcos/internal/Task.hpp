@@ -68,8 +68,13 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     bool kernelTask = false;    ///< idle or the root (console): only a super user may kill or suspend it.
     ObjectId process;           ///< The process the task belongs to.
 
-    // Execution context.
+    // Execution context: where a task that is not running resumes. A task
+    // switched away at an interrupt's exit left a whole interrupt frame
+    // (savedFrame); one that left from task context through the direct
+    // switch left only its callee-saved registers, at resumeStack (not null
+    // exactly while it is parked that way).
     arch_x86::InterruptFrame* savedFrame = nullptr;
+    uint32_t* resumeStack = nullptr;
     uint8_t* stackBase = nullptr; ///< Lowest byte; the guard page lies below it.
     size_t stackSize = 0;         ///< Usable bytes: the size asked for, rounded to whole pages.
     TaskEntry entry = nullptr;
@@ -148,9 +153,17 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     uint64_t profileMaximumNs = 0;
     uint64_t profileTotalNs = 0;
 
+    /// Whether switching to or from this task has more to do than swap its
+    /// registers (TaskManager::switchContext): its FPU state, profiling, or
+    /// an interrupt level. refreshSwitchWork() keeps it wherever those change,
+    /// so that the common switch tests one byte per task.
+    bool switchWork = false;
+
     /// Whether the scheduler orders this task by a deadline: its own scope,
     /// or one a waiter lends it.
     bool schedulesByDeadline() const { return inDeadlineScope || inheritsDeadline; }
+
+    void refreshSwitchWork() { switchWork = floatingPoint || profiling || interruptLevel != 0xFF; }
 };
 
 } // namespace dcos::internal
