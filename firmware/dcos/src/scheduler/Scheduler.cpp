@@ -58,13 +58,27 @@ void Scheduler::makeReady(Task& task)
         return;
     }
     if (task.schedulesByDeadline()) {
-        // Cannot fail: the queue holds a slot for every task, and a ready
-        // task is not made ready twice.
-        (void)deadlineQueue_.insert(task, urgencyKey(task));
-    } else {
-        readyQueues_[task.priority].pushBack(task);
-        readyBitmap_.set(task.priority);
+        makeReadyByDeadline(task);
+        return;
     }
+    readyQueues_[task.priority].pushBack(task);
+    readyBitmap_.set(task.priority);
+    // A task ordered by priority alone displaces the runner when that is the
+    // idle task or of a lower priority; never one ordered by a deadline.
+    const Task* const running = current_;
+    if (running == nullptr || &task == running) {
+        return;
+    }
+    if (running->idle || (!running->schedulesByDeadline() && task.priority < running->priority)) {
+        requestDispatch();
+    }
+}
+
+void Scheduler::makeReadyByDeadline(Task& task)
+{
+    // Cannot fail: the queue holds a slot for every task, and a ready task
+    // is not made ready twice.
+    (void)deadlineQueue_.insert(task, urgencyKey(task));
     if (current_ != nullptr && &task != current_ && isMoreUrgent(task, *current_)) {
         requestDispatch();
     }

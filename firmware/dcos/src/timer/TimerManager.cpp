@@ -245,7 +245,7 @@ void TimerManager::armAtTimeOfDay(TimeoutEntry& entry, uint64_t timeOfDayNs)
     dayClock.arm(entry, timeOfDayNs, tickCount);
 }
 
-void TimerManager::cancel(TimeoutEntry& entry)
+void TimerManager::cancelArmed(TimeoutEntry& entry)
 {
     arch_x86::InterruptGuard guard;
     disarm(entry); // Not armed: it has expired already, which is as good.

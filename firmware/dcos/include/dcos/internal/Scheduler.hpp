@@ -137,6 +137,8 @@ public:
 
 private:
     static Task* pickNext();
+    /// makeReady for a task in a deadline scope, or lent a deadline.
+    static void makeReadyByDeadline(Task& task);
 
     /// The switch from task context (requestDispatch with no interrupt
     /// nesting and no hold): directly to the next task when nothing has to be

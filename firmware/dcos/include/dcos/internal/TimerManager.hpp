@@ -54,7 +54,15 @@ public:
     /// Arms entry for a time of day: it goes off at the first tick at or
     /// after that time, and moves with the clock when SetSystemClock sets it.
     static void armAtTimeOfDay(TimeoutEntry& entry, uint64_t timeOfDayNs);
-    static void cancel(TimeoutEntry& entry);
+    /// Disarms entry if it is armed. The test is inline: most waits are
+    /// woken before any time-out, or had none, and pay only for it.
+    static void cancel(TimeoutEntry& entry)
+    {
+        if (static_cast<TimeWheelNode<>&>(entry).isLinked()) {
+            cancelArmed(entry);
+        }
+    }
+    static void cancelArmed(TimeoutEntry& entry);
 
     /// Nanoseconds since 1970-01-01 now (base + increment).
     static uint64_t timeOfDayNs();
