@@ -781,7 +781,8 @@ def test_forced_bus_off_shows_in_the_status_register_and_interrupt(canlab):
     T = lab.bit_ns("can0")
     took = back.uptime - started
     print(f"recovery took {took} ns; 128 x 11 bits = {128 * 11 * T} ns")
-    assert 128 * 11 * T <= took <= 128 * 11 * T + lab.hub.quantum_ns + ISR_ENTRY_BOUND_NS
+    assert 128 * 11 * T <= took <= 128 * 11 * T + lab.hub.quantum_ns + ISR_ENTRY_BOUND_NS, \
+        f"bus log:\n{lab.hub.log_text()}\nboard1's console:\n{board.emulator.transcript[-3000:]}"
     assert back.fields["sr"] & 0xC0 == 0 and back.fields["tx"] == 0
     # Forcing error passive: EPI with TXERR 128.
     lab.hub.force_passive("board2.0")

@@ -80,7 +80,11 @@ extern "C" arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* fr
     Idt::depth_ = Idt::depth_ + 1;
     const uint32_t vector = frame->vector;
     InterruptFrame* resume;
-    if (vector < exceptionVectorCount) {
+    // Device requests first: they are the frequent ones and the ones whose
+    // latency counts.
+    if (vector - firstIrqVector < Idt::firstTrapVector - firstIrqVector) {
+        resume = interruptHandler(frame);
+    } else if (vector < exceptionVectorCount) {
         resume = exceptionHandler(frame);
     } else if (vector >= Idt::firstTrapVector && vector <= Idt::lastTrapVector) {
         resume = trapHandler(frame);

@@ -72,11 +72,8 @@ uint16_t Pic8259::readInServiceRegister() const
     return static_cast<uint16_t>(master_.read8(commandRegister) | (slave_.read8(commandRegister) << 8));
 }
 
-bool Pic8259::isGenuine(unsigned line) const
+bool Pic8259::isGenuineLowestLine(unsigned line) const
 {
-    if (line != 7 && line != 15) {
-        return true;
-    }
     return (readInServiceRegister() & (1u << line)) != 0;
 }
 

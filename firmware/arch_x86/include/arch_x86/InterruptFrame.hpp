@@ -30,6 +30,7 @@ struct InterruptFrame {
 
 static_assert(offsetof(InterruptFrame, vector) == 48, "InterruptStubs.S pushes 12 words first");
 static_assert(offsetof(InterruptFrame, eip) == 56, "the CPU frame follows vector and error code");
+static_assert(offsetof(InterruptFrame, cs) == 60, "InterruptStubs.S reads the interrupted CS at 60(%esp)");
 
 /// First vector used for hardware interrupt requests (the PIC is remapped
 /// here, above the 32 vectors Intel reserves for exceptions).

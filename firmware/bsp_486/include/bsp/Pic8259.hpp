@@ -62,11 +62,15 @@ public:
     /// The 16-bit in-service register: lines being serviced.
     uint16_t readInServiceRegister() const;
 
+    /// isGenuine() for line 7 or 15: whether its in-service bit is set.
+    bool isGenuineLowestLine(unsigned line) const;
+
     /// True when an interrupt on line was a real request. The 8259A
     /// reports IRQ 7 (or 15 on the slave) when a request goes away before
     /// the acknowledge cycle; such a spurious interrupt has no in-service
-    /// bit and must not get an EOI on its own chip.
-    bool isGenuine(unsigned line) const;
+    /// bit and must not get an EOI on its own chip. Only lines 7 and 15 can
+    /// be spurious, so only they cost a register read.
+    bool isGenuine(unsigned line) const { return (line & 7u) != 7u || isGenuineLowestLine(line); }
 
     /// Ends the interrupt on line with specific EOIs, slave first.
     void endOfInterrupt(unsigned line);

@@ -177,6 +177,7 @@ void reapEndedTasks()
         Task* task = reapList.popFront();
         releaseTask(*task);
     }
+    TaskManager::reapPending_ = !reapList.isEmpty();
 }
 
 // Takes a task out of every structure, recovers what it owns and marks it
@@ -245,6 +246,7 @@ void terminate(Task& task)
     if (&task == &Scheduler::current()) {
         // Queue it for reaping before any switch away can happen.
         reapList.pushBack(task);
+        TaskManager::reapPending_ = true;
     }
     Scheduler::releaseDispatch();
 }
@@ -342,7 +344,11 @@ void TaskManager::initialise(TaskEntry rootEntry)
 
 Result<Task*> TaskManager::resolve(ObjectId id)
 {
-    const Result<Task**> entry = table.resolve(id);
+    Task* const* found = table.find(id);
+    if (found != nullptr) [[likely]] {
+        return *found;
+    }
+    const Result<Task**> entry = table.resolve(id); // Says why not.
     if (!entry.ok()) {
         return entry.status();
     }
@@ -695,7 +701,9 @@ void TaskManager::switchContext(Task& from, Task& to)
     }
 }
 
-arch_x86::InterruptFrame* TaskManager::prepareReturn(Task& task, arch_x86::InterruptFrame* frame)
+bool TaskManager::reapPending_ = false;
+
+arch_x86::InterruptFrame* TaskManager::prepareReturnWithWork(Task& task, arch_x86::InterruptFrame* frame)
 {
     reapEndedTasks();
     if (task.idle || task.state == TaskState::Terminating) {

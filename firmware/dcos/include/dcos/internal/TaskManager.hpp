@@ -72,7 +72,14 @@ public:
     static void switchContext(Task& from, Task& to);
     /// Runs before returning to task: reaps ended tasks and arranges
     /// delivery of pending exceptions and signals. Returns the frame to resume.
-    static arch_x86::InterruptFrame* prepareReturn(Task& task, arch_x86::InterruptFrame* frame);
+    /// Inline for the common case of an interrupt's exit with nothing to do.
+    static arch_x86::InterruptFrame* prepareReturn(Task& task, arch_x86::InterruptFrame* frame)
+    {
+        if (!reapPending_ && !task.exceptionPending && (task.pendingSignals & ~task.signalMask) == 0) {
+            return frame;
+        }
+        return prepareReturnWithWork(task, frame);
+    }
 
     /// CPU exceptions (vectors 0-31).
     static arch_x86::InterruptFrame* onCpuException(arch_x86::InterruptFrame* frame);
@@ -100,6 +107,14 @@ public:
 private:
     // Posts with interrupts already off; both postEvent paths share it.
     static void postEventLocked(Task& task, uint32_t events);
+
+    /// prepareReturn() when a task may be reaped or something delivered.
+    static arch_x86::InterruptFrame* prepareReturnWithWork(Task& task, arch_x86::InterruptFrame* frame);
+
+public:
+    /// Whether an ended task waits to be reaped (its stack freed once left).
+    /// Kept by the task code beside its reap list, read by prepareReturn.
+    static bool reapPending_;
 };
 
 template <typename Visitor>
