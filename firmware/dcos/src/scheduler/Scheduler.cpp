@@ -79,7 +79,10 @@ void Scheduler::makeReadyByDeadline(Task& task)
     // Cannot fail: the queue holds a slot for every task, and a ready task
     // is not made ready twice.
     (void)deadlineQueue_.insert(task, urgencyKey(task));
-    if (current_ != nullptr && &task != current_ && isMoreUrgent(task, *current_)) {
+    // The runner is the heap's head when it is ordered by a deadline, and
+    // any deadline task runs before one that is not: the task displaces the
+    // runner exactly when it became the head, as pickNext() will find.
+    if (current_ != nullptr && &task != current_ && deadlineQueue_.peek() == &task) {
         requestDispatch();
     }
 }
