@@ -1,10 +1,12 @@
 #!/usr/bin/python3
-"""Reports the production kernel image's footprint by component: what `make bench` calls.
+"""Reports each kernel configuration's image footprint by component: what `make bench` calls.
 
-Reads the linker map of the production image (build/bench/dcos486.map,
-linked by mk/bench.mk from the same objects and linker script as
-build/486/dcos486.elf), adds up every input section by the source file its
-object came from, and prints code (.text), read-only data (.rodata, .multiboot),
+For every image a footprint budget names (tests_renode/bench/budgets.toml:
+the full production image build/486/dcos486.elf and the minimal one
+build/486/dcos486-minimal.elf), reads its linker map (build/bench/<image>.map,
+linked by mk/bench.mk from the same objects and linker script as the
+image), adds up every input section by the source file its object came
+from, and prints code (.text), read-only data (.rodata, .multiboot),
 data (.data, .init_array) and bss per component:
 
   dcos/<agent>     the kernel's agents, firmware/dcos/src/<agent>/
@@ -12,6 +14,7 @@ data (.data, .init_array) and bss per component:
   dcos/commands    the kernel's console commands (firmware/dcos/src/**/*Commands.cpp)
   boot, arch_x86, bsp_486, runtime (the freestanding libc-ish support), shell
   drivers/<name>, fieldbus/<name>
+  selfcheck        the minimal image's built-in self-check application
   build revision   the generated revision stamp
   alignment        the linker's padding between input sections
 
@@ -19,8 +22,10 @@ A map rather than the objects' own sizes: the map holds only what was
 linked, each inline function or template instance once. The "kernel" of a
 footprint budget is every object under the budget's `kernel` folders
 (tests_renode/bench/budgets.toml); its code is checked against
-`text_budget`. A budget whose image is not built is reported as not
-measured yet. Writes build/bench/footprint.json.
+`text_budget`. A budget marked `measured = false` is reported as not
+measured yet; a measured one whose image or map is missing is an error.
+Ends with one line per image comparing the kernels. Writes
+build/bench/footprint.json.
 
 The sums are checked against the image's own section sizes (`size -A`), so a
 stale or misread map is an error rather than a wrong report.
@@ -201,11 +206,29 @@ def print_footprint(name, image, report, budget):
           + (f"; the issue's figure: {budget['now'] / kib:g} KiB" if "now" in budget else ""))
 
 
+def map_of(image, maps):
+    """The linker map of an image: build/486/dcos486-minimal.elf -> <maps>/dcos486-minimal.map."""
+    return os.path.join(maps, os.path.splitext(os.path.basename(image))[0] + ".map")
+
+
+def print_comparison(images, budgets):
+    """One line per image: its kernel's sizes and its budget, side by side."""
+    print("Kernel footprint by configuration (bytes of the objects under each budget's kernel folders)")
+    rows = []
+    for name, image in images.items():
+        kernel, budget = image["kernel"], budgets["footprint"][name]["text_budget"]
+        rows.append((name, image["image"], *(str(kernel[kind]) for kind in KINDS), str(budget),
+                     "OVER" if kernel["text"] > budget else "within"))
+    for line in budget_file._table(("configuration", "image", "text", "rodata", "data", "bss", "text budget",
+                                    "verdict"), rows, ("<", "<", ">", ">", ">", ">", ">", "<")):
+        print(line)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--budgets", default=budget_file.DEFAULT_BUDGETS)
-    parser.add_argument("--map", default=os.path.join(REPOSITORY, "build", "bench", "dcos486.map"),
-                        help="linker map of the full production image")
+    parser.add_argument("--maps", default=os.path.join(REPOSITORY, "build", "bench"),
+                        help="the folder of the images' linker maps, <image name>.map")
     parser.add_argument("--build-directory", default="build/fw486",
                         help="where the image's objects were compiled, as the map names them")
     parser.add_argument("--output", default=os.path.join(REPOSITORY, "build", "bench", "footprint.json"))
@@ -215,8 +238,8 @@ def main():
     budgets = budget_file.load_budgets_for_command(arguments.budgets)
     if budgets is None:
         return 2
-    maps = {name: arguments.map for name, budget in budgets["footprint"].items()
-            if budget["measured"] and budget.get("image") == "build/486/dcos486.elf"}
+    maps = {name: map_of(budget["image"], arguments.maps) for name, budget in budgets["footprint"].items()
+            if budget["measured"]}
     images = {}
     for name, budget in budgets["footprint"].items():
         if name not in maps:
@@ -235,7 +258,10 @@ def main():
             return 1
         images[name] = dict(report, image=budget["image"], map=os.path.relpath(maps[name], REPOSITORY))
         print_footprint(name, budget["image"], report, budget)
+        print()
 
+    if images:
+        print_comparison(images, budgets)
     rows = budget_file.check_footprint(budgets, {name: image["kernel"]["text"] for name, image in images.items()})
     for row in rows:
         if row["verdict"] == budget_file.NOT_MEASURED_YET:
