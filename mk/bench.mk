@@ -60,6 +60,8 @@ fw_bench_objects = $(patsubst %,$(FW_BENCH_BUILD)/%.o,$(1))
 # The revision stamp does not depend on the configuration: the production object serves.
 FW_BENCH_KERNEL_OBJS := $(call fw_bench_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
 FW_BENCH_OBJS := $(call fw_bench_objects,$(FW_BENCH_SRCS))
+# Cold code is compiled for size here as in the production image (mk/firmware.mk).
+$(call fw_bench_objects,$(FW_COLD_SRCS)): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS)
 
 IMAGE_486_BENCH := $(BUILD)/486/dcos486-bench.elf
 BENCH_REPORT := $(BUILD)/bench/kernel.json
@@ -100,12 +102,12 @@ $(IMAGE_486_BENCH): $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS) firmware/boot/link.
 FW_BENCH_FLAGS_STAMP := $(FW_BENCH_BUILD)/flags.stamp
 $(FW_BENCH_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(FW_BENCH_CXXFLAGS) $(FW_BENCH_ASFLAGS)' | $(update_if_changed)
+	@echo '$(FW_BENCH_CXXFLAGS) $(FW_BENCH_ASFLAGS) $(FW_COLD_FLAGS) $(FW_COLD_SRCS)' | $(update_if_changed)
 
 $(FW_BENCH_BUILD)/%.cpp.o: %.cpp $(FW_BENCH_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
-	$(Q)g++ $(FW_BENCH_CXXFLAGS) -c $< -o $@
+	$(Q)g++ $(FW_BENCH_CXXFLAGS) $(FW_OBJECT_FLAGS) -c $< -o $@
 
 $(FW_BENCH_BUILD)/%.S.o: %.S $(FW_BENCH_FLAGS_STAMP)
 	@mkdir -p $(dir $@)

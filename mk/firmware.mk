@@ -26,13 +26,17 @@ FW_CODE_FLAGS := -std=c++20 $(FW_ARCH_FLAGS) -O2 -g \
 	-ffreestanding -fno-pic -fno-pie -fno-exceptions -fno-rtti -fno-threadsafe-statics \
 	-fno-stack-protector -fstack-clash-protection -fno-asynchronous-unwind-tables -fno-unwind-tables \
 	-fno-omit-frame-pointer -fno-tree-loop-distribute-patterns -mgeneral-regs-only \
-	-fno-isolate-erroneous-paths-dereference -fno-isolate-erroneous-paths-attribute
+	-fno-isolate-erroneous-paths-dereference -fno-isolate-erroneous-paths-attribute \
+	-ffunction-sections -fdata-sections
 # An ignored Status or Result is an error in applications too, whose build
 # does not otherwise stop at warnings (dcos/Status.hpp says why).
 FW_WARNING_FLAGS := -Wall -Wextra -Wno-missing-field-initializers -Werror=unused-result
 FW_CXXFLAGS := $(FW_CODE_FLAGS) $(FW_WARNING_FLAGS) -Werror -MMD -MP $(FW_INCLUDES)
 FW_ASFLAGS := $(FW_ARCH_FLAGS) -MMD -MP $(FW_INCLUDES)
-FW_LDFLAGS := -m elf_i386 -nostdlib -static -T firmware/boot/link.ld
+# --gc-sections drops what nothing reaches, each function and object on its
+# own (-ffunction-sections -fdata-sections); the linker script keeps the
+# kernel's application interface and the tables the linker gathers.
+FW_LDFLAGS := -m elf_i386 -nostdlib -static --gc-sections -T firmware/boot/link.ld
 
 include firmware/dcos/dcos.mk
 include drivers/iobus/iobus.mk
@@ -90,12 +94,32 @@ FW_MINIMAL_TARGET_TEST_SRCS := \
 	$(wildcard tests_renode/target/minimal/*.cpp) \
 	firmware/shell/src/Shell.cpp firmware/shell/src/LineEditor.cpp
 
+# Cold code, compiled for size (-Os) rather than speed: what runs at boot or
+# at an engineer's request, never on a path `make bench` measures. The
+# console shell and every console command, the application loader and its
+# configuration report, the root tasks, boot, the descriptor tables, and
+# the self-check. Everything else stays -O2: the agents' services, and
+# what they call, Kernel.cpp's tick handler and the page tables' guard
+# pages (task creation and deletion) among them.
+FW_COLD_SRCS := \
+	$(wildcard firmware/shell/src/*.cpp) \
+	$(filter %Commands.cpp,$(FW_SRCS)) \
+	$(wildcard firmware/dcos/src/application/*.cpp) \
+	firmware/dcos/src/kernel/ConsoleRoot.cpp firmware/dcos/src/kernel/MinimalRoot.cpp \
+	$(wildcard firmware/boot/src/*.cpp) \
+	firmware/arch_x86/src/Gdt.cpp \
+	$(FW_SELFCHECK_SRCS)
+FW_COLD_FLAGS := -Os
+
 fw_objects = $(patsubst %,$(FW_BUILD)/%.o,$(1))
 FW_OBJS := $(call fw_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
 FW_TARGET_TEST_OBJS := $(call fw_objects,$(FW_TARGET_TEST_SRCS))
 FW_MINIMAL_OBJS := $(call fw_objects,$(FW_MINIMAL_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
 FW_SELFCHECK_OBJS := $(call fw_objects,$(FW_SELFCHECK_SRCS))
 FW_MINIMAL_TARGET_TEST_OBJS := $(call fw_objects,$(FW_MINIMAL_TARGET_TEST_SRCS))
+
+# The cold objects' optimisation, after FW_CXXFLAGS' -O2 (the last -O counts).
+$(call fw_objects,$(FW_COLD_SRCS)): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS)
 
 IMAGE_486 := $(BUILD)/486/dcos486.elf
 IMAGE_486_TEST := $(BUILD)/486/dcos486-test.elf
@@ -143,12 +167,12 @@ $(FW_IMAGES_STAMP): FORCE
 FW_FLAGS_STAMP := $(FW_BUILD)/flags.stamp
 $(FW_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(FW_CXXFLAGS) $(FW_ASFLAGS)' | $(update_if_changed)
+	@echo '$(FW_CXXFLAGS) $(FW_ASFLAGS) $(FW_COLD_FLAGS) $(FW_COLD_SRCS)' | $(update_if_changed)
 
 $(FW_BUILD)/%.cpp.o: %.cpp $(FW_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
-	$(Q)g++ $(FW_CXXFLAGS) -c $< -o $@
+	$(Q)g++ $(FW_CXXFLAGS) $(FW_OBJECT_FLAGS) -c $< -o $@
 
 $(FW_BUILD)/%.S.o: %.S $(FW_FLAGS_STAMP)
 	@mkdir -p $(dir $@)

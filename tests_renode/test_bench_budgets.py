@@ -252,14 +252,15 @@ def test_the_footprint_report_sums_a_linker_map_by_component_and_counts_merged_s
     components = report["components"]
     assert components["runtime"]["text"] == 0x40
     assert components["dcos/task"]["text"] == 0x80
-    assert components["dcos/commands"]["text"] == 0x50
-    assert components["alignment"]["text"] == 0x10
+    # The fill before KernelCommands' section aligns it: it counts for that object.
+    assert components["dcos/commands"]["text"] == 0x10 + 0x50
+    assert "alignment" not in components
     assert components["dcos/timer"]["rodata"] == 0x20
     assert components["drivers/can"]["rodata"] == 0  # its strings merged into the timer's
     assert components["bsp_486"]["rodata"] == 0x10
     assert components["dcos/shared"]["bss"] == 0x100
-    assert report["kernel"] == {"text": 0x80 + 0x50, "rodata": 0x20, "data": 0, "bss": 0x100}
-    assert report["shell_and_commands"]["text"] == 0x50
+    assert report["kernel"] == {"text": 0x80 + 0x10 + 0x50, "rodata": 0x20, "data": 0, "bss": 0x100}
+    assert report["shell_and_commands"]["text"] == 0x10 + 0x50
 
 
 # The same slice for a minimal image: the kernel's core and the self-check, no shell.
@@ -299,11 +300,11 @@ def test_the_footprint_report_covers_every_configurations_image_and_compares_the
     assert "Footprint of build/486/small.elf (minimal)" in printed
     assert re.search(r"selfcheck\s+48\s+0\s+0\s+0", printed)
     assert re.search(r"^  minimal\s+build/486/small\.elf\s+64\s+0\s+0\s+16\s+48\s+OVER$", printed, re.MULTILINE)
-    assert re.search(r"^  full\s+build/486/full\.elf\s+208\s+32\s+0\s+256\s+1000\s+within$", printed, re.MULTILINE)
+    assert re.search(r"^  full\s+build/486/full\.elf\s+224\s+32\s+0\s+256\s+1000\s+within$", printed, re.MULTILINE)
     report = json.loads(output.read_text())
     assert report["images"]["minimal"]["kernel"] == {"text": 0x40, "rodata": 0, "data": 0, "bss": 0x10}
     assert report["images"]["minimal"]["components"]["selfcheck"]["text"] == 0x30
-    assert report["images"]["full"]["kernel"]["text"] == 0x80 + 0x50
+    assert report["images"]["full"]["kernel"]["text"] == 0x80 + 0x10 + 0x50
     assert [row["verdict"] for row in report["budgets"]] == [budgets.WITHIN, budgets.OVER]
 
 
@@ -314,6 +315,19 @@ def test_a_measured_configuration_whose_map_is_missing_is_an_error(tmp_path, mon
                                       "--output", str(tmp_path / "footprint.json")])
     assert footprint.main() == 1
     assert "small.map" in capsys.readouterr().err
+
+
+def test_padding_counts_for_the_section_it_aligns_and_only_trailing_padding_for_none():
+    text = ("Linker script and memory map\n\n.text           0x00100000       0x40\n"
+            " .text          0x00100000        0x8 build/fw486/firmware/boot/src/Panic.cpp.o\n"
+            " *fill*         0x00100008        0x8 \n"
+            " .text._ZN4dcos1fEv\n                0x00100010       0x20 build/fw486/firmware/dcos/src/task/TaskManager.cpp.o\n"
+            " *fill*         0x00100030       0x10 \n")
+    report = footprint.footprint(footprint.parse_map(text), "build/fw486", ["firmware/dcos/"])
+    assert report["components"]["boot"]["text"] == 0x8
+    assert report["components"]["dcos/task"]["text"] == 0x8 + 0x20
+    assert report["components"]["alignment"]["text"] == 0x10
+    assert report["total"]["text"] == 0x40
 
 
 def test_components_follow_the_source_tree():

@@ -16,7 +16,8 @@ data (.data, .init_array) and bss per component:
   drivers/<name>, fieldbus/<name>
   selfcheck        the minimal image's built-in self-check application
   build revision   the generated revision stamp
-  alignment        the linker's padding between input sections
+  alignment        padding that no input section follows (the padding before
+                   an input section counts for its object: see parse_map)
 
 A map rather than the objects' own sizes: the map holds only what was
 linked, each inline function or template instance once. The "kernel" of a
@@ -66,9 +67,13 @@ def parse_map(text):
 
     An input section's line names the section, its address, its size and
     the object; a long section name stands alone on its line and the rest
-    follows on the next. "*fill*" lines are padding (no object). Symbol
-    lines (address and name only) and the linker script's own lines are
-    skipped.
+    follows on the next. "*fill*" lines are padding: the linker puts it
+    before an input section to give that section the alignment its object
+    asks for (16-byte function starts at -O2, each function a section of
+    its own with -ffunction-sections), so the padding counts for the object
+    of the input section that follows it, and only padding that nothing
+    follows in its output section is left without an object. Symbol lines
+    (address and name only) and the linker script's own lines are skipped.
 
     Merged string sections (.rodata.str1.1 and the like) are listed once per
     object at overlapping addresses, each with the size it had before the
@@ -113,12 +118,21 @@ def parse_map(text):
     clipped = []
     for name in dict.fromkeys(entry[0] for entry in entries):
         covered = 0
+        in_section = []
         # sorted() is stable: at one address the map's order decides.
         for output, section, address, size, origin in sorted((entry for entry in entries if entry[0] == name),
                                                              key=lambda entry: entry[2]):
             start = max(address, covered)
             covered = max(covered, address + size)
-            clipped.append((output, section, max(0, address + size - start), origin))
+            in_section.append((output, section, max(0, address + size - start), origin))
+        following = None
+        for index in reversed(range(len(in_section))):
+            output, section, size, origin = in_section[index]
+            if section == "*fill*":
+                in_section[index] = (output, section, size, following)
+            else:
+                following = origin
+        clipped += in_section
     return clipped
 
 
