@@ -2,6 +2,8 @@
 #
 #   make          firmware images and host tools
 #   make run      boot the ISA 486 controller in the emulator, console on this terminal
+#                 (KERNEL_CONFIG=minimal: the minimal kernel's image, its self-check;
+#                 with APP=<dir>, the application built with that configuration)
 #                 (APP=<dir>: with the application in <dir>; ARGS="...": launcher options,
 #                 e.g. ARGS="--set isa-mfio.noise-lsb=0.5 --append node=3 --append tick_hz=100")
 #   make test     host unit tests, the emulator regression suite, then the examples
@@ -40,7 +42,7 @@ deps:
 run: deps
 ifeq ($(APP),)
 	@$(MAKE) --no-print-directory firmware
-	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(IMAGE_486) $(ARGS)
+	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(if $(filter minimal,$(KERNEL_CONFIG)),$(IMAGE_486_MINIMAL),$(IMAGE_486)) $(ARGS)
 else
 	@$(MAKE) --no-print-directory sdk
 	@$(call app_make,$(APP),run)

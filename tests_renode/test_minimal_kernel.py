@@ -25,6 +25,7 @@ import pytest
 import test_kernel_core as kernel_core
 import test_memory_protection as memory_protection
 from dcoslab.board import EXIT_PASS, REPOSITORY, load_board
+from dcoslab.emulator import EmulatorError
 from dcoslab.target import TARGET_TEST_TIMEOUT
 
 # The full test image's kernel-core tests that need an agent the minimal
@@ -113,3 +114,116 @@ def test_the_minimal_image_has_no_shell_and_no_console_command():
         if len(fields) == 3:
             addresses[fields[2]] = int(fields[0], 16)
     assert addresses["__start_dcos_shell_commands"] == addresses["__stop_dcos_shell_commands"]
+
+
+# --- Applications built against the minimal kernel (the staged installation) ---
+
+STAGED_SDK = os.path.join(REPOSITORY, "build", "sdk")
+APPLICATION_MAKEFILE = os.path.join(STAGED_SDK, "share", "dcos", "application.mk")
+BUILD_TIMEOUT = 600
+
+BLINK_SOURCE = """\
+#include <dcos/Application.hpp>
+#include <dcos/TimerAgent.hpp>
+#include <bsp/Board.hpp>
+#include <runtime/Format.hpp>
+
+namespace {
+void blinker(uintptr_t)
+{
+    for (unsigned blink = 1; blink <= 3; ++blink) {
+        if (dcos::taskAgent.SleepFor(2000000) == dcos::Status::Ok) {
+            runtime::format(bsp::console(), "blink %u\\r\\n", blink);
+        }
+    }
+}
+constexpr dcos::app::TaskDeclaration tasks[] = {{.name = "blinker", .entry = blinker, .priority = 8}};
+} // namespace
+
+DCOS_APPLICATION(blink, {.name = "blink", .tasks = tasks});
+"""
+
+BLINK_TEST = """\
+def test_it_blinks(application):
+    application.expect(r"blink 3")
+    assert "dcos> " not in application.transcript
+"""
+
+# An application that needs the semaphore agent: by its call, or by its declaration only.
+SEMAPHORE_CALL_SOURCE = """\
+#include <dcos/Application.hpp>
+
+namespace {
+void user(uintptr_t)
+{
+    dcos::SemaphoreAttributes attributes;
+    (void)dcos::semaphoreAgent.Create(attributes);
+}
+constexpr dcos::app::TaskDeclaration tasks[] = {{.name = "user", .entry = user}};
+} // namespace
+
+DCOS_APPLICATION(locking, {.name = "locking", .tasks = tasks});
+"""
+
+SEMAPHORE_DECLARATION_SOURCE = """\
+#include <dcos/Application.hpp>
+#include <bsp/Board.hpp>
+#include <runtime/Format.hpp>
+
+namespace {
+void user(uintptr_t) { runtime::format(bsp::console(), "user ran\\r\\n"); }
+constexpr dcos::app::TaskDeclaration tasks[] = {{.name = "user", .entry = user}};
+constexpr dcos::app::SemaphoreDeclaration semaphores[] = {{.name = "lock"}};
+} // namespace
+
+DCOS_APPLICATION(declaring, {.name = "declaring", .tasks = tasks, .semaphores = semaphores});
+"""
+
+
+def write_application(directory, source, test=None):
+    os.makedirs(directory, exist_ok=True)
+    with open(os.path.join(directory, "app.cpp"), "w", encoding="utf-8") as handle:
+        handle.write(source)
+    if test is not None:
+        os.makedirs(os.path.join(directory, "tests"), exist_ok=True)
+        with open(os.path.join(directory, "tests", "test_app.py"), "w", encoding="utf-8") as handle:
+            handle.write(test)
+    return directory
+
+
+def build_minimal(directory, target="app"):
+    return subprocess.run(["make", "--no-print-directory", "-f", APPLICATION_MAKEFILE, f"APP={directory}",
+                           "KERNEL_CONFIG=minimal", target], capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+
+
+def test_an_application_of_the_minimal_kernel_builds_runs_and_passes_its_own_tests(tmp_path):
+    blink = write_application(str(tmp_path / "blink"), BLINK_SOURCE, BLINK_TEST)
+    result = build_minimal(blink, "test")
+    output = result.stdout + result.stderr
+    assert result.returncode == 0, output
+    assert re.search(r"\b1 passed\b", output), output
+    image = os.path.join(blink, "build", "blink-486-minimal.elf")
+    symbols = defined_symbols(image)
+    assert not any(symbol.startswith(("shell::", "dcos::SemaphoreAgent::")) for symbol in symbols)
+
+
+def test_a_call_to_an_agent_the_minimal_kernel_leaves_out_does_not_link(tmp_path):
+    locking = write_application(str(tmp_path / "locking"), SEMAPHORE_CALL_SOURCE)
+    result = build_minimal(locking)
+    output = result.stdout + result.stderr
+    assert result.returncode != 0, output
+    assert "undefined reference to `dcos::SemaphoreAgent::Create(dcos::SemaphoreAttributes const&) const'" in output
+    assert not os.path.exists(os.path.join(locking, "build", "locking-486-minimal.elf"))
+
+
+def test_an_application_declaring_an_object_of_a_left_out_agent_is_refused_at_boot(tmp_path, boot, isa486):
+    declaring = write_application(str(tmp_path / "declaring"), SEMAPHORE_DECLARATION_SOURCE)
+    result = build_minimal(declaring)
+    assert result.returncode == 0, result.stdout + result.stderr
+    emulator = boot(isa486, os.path.join(declaring, "build", "declaring-486-minimal.elf"), icount=True)
+    emulator.expect(r"application 'declaring' not started: it declares semaphores, which the minimal kernel "
+                    r"configuration leaves out\r\n")
+    # Its task never runs: three seconds, a long time for the emulated board, show nothing more.
+    with pytest.raises(EmulatorError, match="timed out"):
+        emulator.expect(r"user ran", timeout=3)
+    assert "user ran" not in emulator.transcript
