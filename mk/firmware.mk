@@ -56,6 +56,9 @@ FW_BASE_SRCS := \
 # The full kernel configuration (docs/guide/kernel-configurations.md): every
 # agent, the application loader, the console shell and the drivers. The
 # production, test and bench images and the SDK's library are built from it.
+# In link order, which is the order of the tables the linker gathers (console
+# commands, recovery functions): hence the base sources spelt out around the
+# shell and the kernel rather than as FW_BASE_SRCS.
 FW_SRCS := \
 	$(wildcard firmware/runtime/src/*.cpp) \
 	$(wildcard firmware/arch_x86/src/*.cpp firmware/arch_x86/src/*.S) \
@@ -97,8 +100,7 @@ FW_MINIMAL_TARGET_TEST_SRCS := \
 # Cold code, compiled for size (-Os) rather than speed: what runs at boot or
 # at an engineer's request, never on a path `make bench` measures. The
 # console shell and every console command, the application loader and its
-# configuration report, the root tasks, boot, the descriptor tables, and
-# the self-check. Everything else stays -O2: the agents' services, and
+# configuration report, the root tasks, boot, the GDT, and the self-check. Everything else stays -O2: the agents' services, and
 # what they call, Kernel.cpp's tick handler and the page tables' guard
 # pages (task creation and deletion) among them.
 FW_COLD_SRCS := \
