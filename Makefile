@@ -2,6 +2,8 @@
 #
 #   make          firmware images and host tools
 #   make run      boot the ISA 486 controller in the emulator, console on this terminal
+#                 (KERNEL_CONFIG=minimal: the minimal kernel's image, its self-check;
+#                 with APP=<dir>, the application built with that configuration)
 #                 (APP=<dir>: with the application in <dir>; ARGS="...": launcher options,
 #                 e.g. ARGS="--set isa-mfio.noise-lsb=0.5 --append node=3 --append tick_hz=100")
 #   make test     host unit tests, the emulator regression suite, then the examples
@@ -40,7 +42,7 @@ deps:
 run: deps
 ifeq ($(APP),)
 	@$(MAKE) --no-print-directory firmware
-	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(IMAGE_486) $(ARGS)
+	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(if $(filter minimal,$(KERNEL_CONFIG)),$(IMAGE_486_MINIMAL),$(IMAGE_486)) $(ARGS)
 else
 	@$(MAKE) --no-print-directory sdk
 	@$(call app_make,$(APP),run)
@@ -72,17 +74,18 @@ test-emulator: firmware sdk
 # Builds the bench image and runs every benchmark on the board's benchmark CPU
 # with exact instruction counting, and under KVM where it works; prints the
 # seed's Tables 9.2-9.11 for DCOS and writes $(PRIMITIVES_REPORT) and $(BENCH_REPORT);
-# runs Thread-Metric; reports the production image's footprint by component;
+# runs Thread-Metric; reports the footprint of the full production image and
+# of the minimal one by component;
 # and prints every figure against its budget in $(BENCH_BUDGETS). STRICT=1
 # fails when any figure offends its budget (docs/performance.md, "Budgets").
 # The reports of the last run are removed first, so that the verdict never
 # reads a figure a failed step left behind.
 bench: deps
-	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH) $(IMAGE_486) $(FOOTPRINT_MAP)
+	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH) $(IMAGE_486) $(IMAGE_486_MINIMAL) $(FOOTPRINT_MAP) $(FOOTPRINT_MAP_MINIMAL)
 	@rm -f $(PRIMITIVES_REPORT) $(THREAD_METRIC_REPORT) $(FOOTPRINT_REPORT) $(BUDGET_REPORT)
 	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board isa486 --output $(BENCH_REPORT) --primitives $(PRIMITIVES_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/thread_metric/run_thread_metric.py --board isa486 --output $(THREAD_METRIC_REPORT) --budgets $(BENCH_BUDGETS)
-	@$(PYTHON) tests_renode/bench/footprint.py --map $(FOOTPRINT_MAP) --build-directory $(FW_BUILD) --output $(FOOTPRINT_REPORT) --budgets $(BENCH_BUDGETS)
+	@$(PYTHON) tests_renode/bench/footprint.py --maps $(FOOTPRINT_MAPS) --build-directory $(FW_BUILD) --output $(FOOTPRINT_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/bench/budgets.py --budgets $(BENCH_BUDGETS) --primitives $(PRIMITIVES_REPORT) --thread-metric $(THREAD_METRIC_REPORT) --footprint $(FOOTPRINT_REPORT) --output $(BUDGET_REPORT) $(BENCH_STRICT)
 
 clean:

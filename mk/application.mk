@@ -22,7 +22,10 @@
 #
 # Variables: APP (the application's directory, default: the current one),
 # BOARD (the board to build for, default 486; the installed ones are the
-# share/dcos/board-<board>.mk files),
+# share/dcos/board-<board>.mk files), KERNEL_CONFIG (the kernel configuration
+# to link with: full, the default, or minimal, the system, scheduler, task and
+# timer agents only, with no console shell; the image is then
+# build/<name>-<board>-minimal.elf; docs/guide/kernel-configurations.md),
 # APP_BUILD (where objects and the image go, default $(APP)/build),
 # APP_CXXFLAGS (extra compiler flags), APP_JUNIT (a JUnit XML report for
 # `test`), V=1 (show commands).
@@ -39,12 +42,18 @@ $(error BOARD=$(BOARD) is not a board this DCOS builds for; its boards are: $(DC
 endif
 include $(DCOS_SHARE)/board-$(BOARD).mk
 
+KERNEL_CONFIG ?= full
+ifeq ($(filter $(KERNEL_CONFIG),full minimal),)
+$(error KERNEL_CONFIG=$(KERNEL_CONFIG) is not a kernel configuration; they are: full minimal)
+endif
+APP_CONFIG_SUFFIX := $(if $(filter minimal,$(KERNEL_CONFIG)),-minimal)
+
 APP ?= $(CURDIR)
 APP_DIR := $(abspath $(APP))
 APP_NAME := $(notdir $(APP_DIR))
 APP_BUILD ?= $(APP_DIR)/build
 APP_BUILD_DIR := $(abspath $(APP_BUILD))
-APP_IMAGE := $(APP_BUILD_DIR)/$(APP_NAME)-$(BOARD).elf
+APP_IMAGE := $(APP_BUILD_DIR)/$(APP_NAME)-$(BOARD)$(APP_CONFIG_SUFFIX).elf
 APP_Q := $(if $(filter 1,$(V)),,@)
 APP_PYTHON := /usr/bin/python3
 
@@ -60,7 +69,9 @@ APP_SRCS := $(shell cd '$(APP_DIR)' && find . \( -path ./build -o -path ./tests 
 APP_OBJS := $(patsubst %,$(APP_BUILD_DIR)/obj/%.o,$(APP_SRCS))
 APP_TESTS := $(wildcard $(APP_DIR)/tests/test_*.py)
 
-DCOS_LIBRARY := $(DCOS_PREFIX)/lib/dcos/$(BOARD)/libdcos$(BOARD).a
+# The kernel configuration's library: an agent the minimal one leaves out is
+# not in it, so a call to one of its primitives is an undefined reference.
+DCOS_LIBRARY := $(DCOS_PREFIX)/lib/dcos/$(BOARD)/libdcos$(BOARD)$(APP_CONFIG_SUFFIX).a
 DCOS_LINK_SCRIPT := $(DCOS_PREFIX)/lib/dcos/$(BOARD)/link.ld
 APP_CPPFLAGS := -I$(DCOS_PREFIX)/include -I$(APP_DIR) -MMD -MP
 APP_ALL_CXXFLAGS := $(DCOS_BOARD_CXXFLAGS) $(APP_CPPFLAGS) $(APP_CXXFLAGS)
@@ -121,7 +132,8 @@ ifeq ($(APP_TESTS),)
 else
 	$(APP_Q)cd '$(APP_DIR)' && PYTHONPATH='$(DCOS_SHARE)/python' PYTHONDONTWRITEBYTECODE=1 \
 		$(APP_PYTHON) -m pytest -c '$(DCOS_SHARE)/pytest.ini' --rootdir '$(APP_DIR)' -p dcoslab.pytest_plugin \
-		--dcos-board $(DCOS_BOARD_EMULATED) --dcos-image '$(APP_IMAGE)' $(if $(APP_JUNIT),--junitxml='$(APP_JUNIT)') \
+		--dcos-board $(DCOS_BOARD_EMULATED) --dcos-image '$(APP_IMAGE)' --dcos-kernel-config $(KERNEL_CONFIG) \
+		$(if $(APP_JUNIT),--junitxml='$(APP_JUNIT)') \
 		$(APP_PYTEST_ARGS) tests
 endif
 

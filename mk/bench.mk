@@ -60,6 +60,8 @@ fw_bench_objects = $(patsubst %,$(FW_BENCH_BUILD)/%.o,$(1))
 # The revision stamp does not depend on the configuration: the production object serves.
 FW_BENCH_KERNEL_OBJS := $(call fw_bench_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
 FW_BENCH_OBJS := $(call fw_bench_objects,$(FW_BENCH_SRCS))
+# Cold code is compiled for size here as in the production image (mk/firmware.mk).
+$(call fw_bench_objects,$(FW_COLD_SRCS)): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS)
 
 IMAGE_486_BENCH := $(BUILD)/486/dcos486-bench.elf
 BENCH_REPORT := $(BUILD)/bench/kernel.json
@@ -72,17 +74,22 @@ BENCH_BUDGETS := tests_renode/bench/budgets.toml
 # (tests_renode/bench/budgets.py); without it the verdict is only printed.
 BENCH_STRICT := $(if $(filter 1,$(STRICT)),--strict)
 
-# The production image's linker map, for the footprint report
-# (tests_renode/bench/footprint.py). It is linked here, from the same objects
-# and linker script, rather than by the production image's own rule, so that
-# the image's build stays as it is; footprint.py checks that the map's
-# sections add up to the image's.
-FOOTPRINT_MAP := $(BUILD)/bench/dcos486.map
-$(FOOTPRINT_MAP): $(FW_OBJS) firmware/boot/link.ld
-	@mkdir -p $(dir $@)
-	@echo "  MAP     $@"
-	$(Q)ld $(FW_LDFLAGS) -Map=$@ -o $(@:.map=-map.elf) $(FW_OBJS)
-	$(Q)rm -f $(@:.map=-map.elf)
+# The linker maps of the full production image and of the minimal one, for
+# the footprint report (tests_renode/bench/footprint.py). They are linked
+# here, from the same objects, flags and linker script, rather than by the
+# images' own rules, so that the images' builds stay as they are;
+# footprint.py checks that a map's sections add up to its image's.
+FOOTPRINT_MAPS := $(BUILD)/bench
+FOOTPRINT_MAP := $(FOOTPRINT_MAPS)/dcos486.map
+FOOTPRINT_MAP_MINIMAL := $(FOOTPRINT_MAPS)/dcos486-minimal.map
+link_map = @mkdir -p $(dir $@) && echo "  MAP     $@" && \
+	ld $(FW_LDFLAGS) -Map=$@ -o $(@:.map=-map.elf) $(1) && rm -f $(@:.map=-map.elf)
+
+$(FOOTPRINT_MAP): $(FW_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
+	$(call link_map,$(FW_OBJS))
+
+$(FOOTPRINT_MAP_MINIMAL): $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
+	$(call link_map,$(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS))
 
 # Built with the other images, so the emulator suite can check the framework.
 firmware: $(IMAGE_486_BENCH)
@@ -95,12 +102,12 @@ $(IMAGE_486_BENCH): $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS) firmware/boot/link.
 FW_BENCH_FLAGS_STAMP := $(FW_BENCH_BUILD)/flags.stamp
 $(FW_BENCH_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(FW_BENCH_CXXFLAGS) $(FW_BENCH_ASFLAGS)' | $(update_if_changed)
+	@echo '$(FW_BENCH_CXXFLAGS) $(FW_BENCH_ASFLAGS) $(FW_COLD_FLAGS) $(FW_COLD_SRCS)' | $(update_if_changed)
 
 $(FW_BENCH_BUILD)/%.cpp.o: %.cpp $(FW_BENCH_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
-	$(Q)g++ $(FW_BENCH_CXXFLAGS) -c $< -o $@
+	$(Q)g++ $(FW_BENCH_CXXFLAGS) $(FW_OBJECT_FLAGS) -c $< -o $@
 
 $(FW_BENCH_BUILD)/%.S.o: %.S $(FW_BENCH_FLAGS_STAMP)
 	@mkdir -p $(dir $@)

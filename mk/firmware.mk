@@ -26,13 +26,17 @@ FW_CODE_FLAGS := -std=c++20 $(FW_ARCH_FLAGS) -O2 -g \
 	-ffreestanding -fno-pic -fno-pie -fno-exceptions -fno-rtti -fno-threadsafe-statics \
 	-fno-stack-protector -fstack-clash-protection -fno-asynchronous-unwind-tables -fno-unwind-tables \
 	-fno-omit-frame-pointer -fno-tree-loop-distribute-patterns -mgeneral-regs-only \
-	-fno-isolate-erroneous-paths-dereference -fno-isolate-erroneous-paths-attribute
+	-fno-isolate-erroneous-paths-dereference -fno-isolate-erroneous-paths-attribute \
+	-ffunction-sections -fdata-sections
 # An ignored Status or Result is an error in applications too, whose build
 # does not otherwise stop at warnings (dcos/Status.hpp says why).
 FW_WARNING_FLAGS := -Wall -Wextra -Wno-missing-field-initializers -Werror=unused-result
 FW_CXXFLAGS := $(FW_CODE_FLAGS) $(FW_WARNING_FLAGS) -Werror -MMD -MP $(FW_INCLUDES)
 FW_ASFLAGS := $(FW_ARCH_FLAGS) -MMD -MP $(FW_INCLUDES)
-FW_LDFLAGS := -m elf_i386 -nostdlib -static -T firmware/boot/link.ld
+# --gc-sections drops what nothing reaches, each function and object on its
+# own (-ffunction-sections -fdata-sections); the linker script keeps the
+# kernel's application interface and the tables the linker gathers.
+FW_LDFLAGS := -m elf_i386 -nostdlib -static --gc-sections -T firmware/boot/link.ld
 
 include firmware/dcos/dcos.mk
 include drivers/iobus/iobus.mk
@@ -41,14 +45,26 @@ include fieldbus/modbus/modbus.mk
 include drivers/can/can.mk
 include drivers/modbus/modbus.mk
 
-# Sources every image contains.
+# Sources every image contains, whatever its kernel configuration: the
+# runtime, the CPU, the loader's entry and the board.
+FW_BASE_SRCS := \
+	$(wildcard firmware/runtime/src/*.cpp) \
+	$(wildcard firmware/arch_x86/src/*.cpp firmware/arch_x86/src/*.S) \
+	$(wildcard firmware/boot/src/*.cpp firmware/boot/src/*.S) \
+	$(wildcard firmware/bsp_486/src/*.cpp)
+
+# The full kernel configuration (docs/guide/kernel-configurations.md): every
+# agent, the application loader, the console shell and the drivers. The
+# production, test and bench images and the SDK's library are built from it.
+# In link order, which is the order of the tables the linker gathers (console
+# commands, recovery functions): hence the base sources spelt out around the
+# shell and the kernel rather than as FW_BASE_SRCS.
 FW_SRCS := \
 	$(wildcard firmware/runtime/src/*.cpp) \
 	$(wildcard firmware/arch_x86/src/*.cpp firmware/arch_x86/src/*.S) \
 	$(wildcard firmware/boot/src/*.cpp firmware/boot/src/*.S) \
 	$(wildcard firmware/shell/src/*.cpp) \
-	$(DCOS_PORTABLE_SRCS) \
-	$(DCOS_TARGET_SRCS) \
+	$(DCOS_FULL_SRCS) \
 	$(wildcard firmware/bsp_486/src/*.cpp) \
 	$(IOBUS_PORTABLE_SRCS) \
 	$(IOBUS_TARGET_SRCS) \
@@ -59,27 +75,82 @@ FW_SRCS := \
 	$(MODBUS_DRIVER_PORTABLE_SRCS) \
 	$(MODBUS_DRIVER_TARGET_SRCS)
 
+# The minimal kernel configuration: the system, scheduler, task and timer
+# agents and what boot needs; no shell, no console commands, no other agent,
+# no application loader, no drivers. Its objects are the full
+# configuration's, compiled once, but for its own root task.
+FW_MINIMAL_SRCS := $(FW_BASE_SRCS) $(DCOS_MINIMAL_SRCS)
+# The minimal image's application: the built-in self-check, its proof of life.
+FW_SELFCHECK_SRCS := $(wildcard firmware/selfcheck/src/*.cpp)
+
 # The on-target test suite, linked only into the test image.
 FW_TARGET_TEST_SRCS := $(wildcard tests_renode/target/*.cpp)
+# The kernel-core on-target tests the minimal kernel runs (those that need
+# no agent, driver or shell command it leaves out; tests_renode/test_minimal_kernel.py),
+# with the runner that takes the test's name from the kernel command line.
+# The shell's sources are only the tests' output there (they print through
+# a shell object); no shell runs.
+FW_MINIMAL_TARGET_TEST_SRCS := \
+	$(addprefix tests_renode/target/, \
+		EmulatorExit.cpp KernelTestSupport.cpp SchedulingTest.cpp TaskServicesTest.cpp TimerAlarmTest.cpp \
+		ObjectLifecycleTest.cpp InterruptServiceTest.cpp ProfilingFpuTest.cpp MemoryProtectionTest.cpp) \
+	$(wildcard tests_renode/target/minimal/*.cpp) \
+	firmware/shell/src/Shell.cpp firmware/shell/src/LineEditor.cpp
+
+# Cold code, compiled for size (-Os) rather than speed: what runs at boot or
+# at an engineer's request, never on a path `make bench` measures. The
+# console shell and every console command, the application loader and its
+# configuration report, the root tasks, boot, the GDT, and the self-check. Everything else stays -O2: the agents' services, and
+# what they call, Kernel.cpp's tick handler and the page tables' guard
+# pages (task creation and deletion) among them.
+FW_COLD_SRCS := \
+	$(wildcard firmware/shell/src/*.cpp) \
+	$(filter %Commands.cpp,$(FW_SRCS)) \
+	$(wildcard firmware/dcos/src/application/*.cpp) \
+	firmware/dcos/src/kernel/ConsoleRoot.cpp firmware/dcos/src/kernel/MinimalRoot.cpp \
+	$(wildcard firmware/boot/src/*.cpp) \
+	firmware/arch_x86/src/Gdt.cpp \
+	$(FW_SELFCHECK_SRCS)
+FW_COLD_FLAGS := -Os
 
 fw_objects = $(patsubst %,$(FW_BUILD)/%.o,$(1))
 FW_OBJS := $(call fw_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
 FW_TARGET_TEST_OBJS := $(call fw_objects,$(FW_TARGET_TEST_SRCS))
+FW_MINIMAL_OBJS := $(call fw_objects,$(FW_MINIMAL_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
+FW_SELFCHECK_OBJS := $(call fw_objects,$(FW_SELFCHECK_SRCS))
+FW_MINIMAL_TARGET_TEST_OBJS := $(call fw_objects,$(FW_MINIMAL_TARGET_TEST_SRCS))
+
+# The cold objects' optimisation, after FW_CXXFLAGS' -O2 (the last -O counts).
+$(call fw_objects,$(FW_COLD_SRCS)): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS)
 
 IMAGE_486 := $(BUILD)/486/dcos486.elf
 IMAGE_486_TEST := $(BUILD)/486/dcos486-test.elf
+IMAGE_486_MINIMAL := $(BUILD)/486/dcos486-minimal.elf
+IMAGE_486_MINIMAL_TEST := $(BUILD)/486/dcos486-minimal-test.elf
 
-firmware: $(IMAGE_486) $(IMAGE_486_TEST)
+FW_IMAGES_STAMP := $(FW_BUILD)/images.stamp
 
-$(IMAGE_486): $(FW_OBJS) firmware/boot/link.ld
+firmware: $(IMAGE_486) $(IMAGE_486_TEST) $(IMAGE_486_MINIMAL) $(IMAGE_486_MINIMAL_TEST)
+
+$(IMAGE_486): $(FW_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS)
 
-$(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) firmware/boot/link.ld
+$(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS)
+
+$(IMAGE_486_MINIMAL): $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS)
+
+$(IMAGE_486_MINIMAL_TEST): $(FW_MINIMAL_OBJS) $(FW_MINIMAL_TARGET_TEST_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_MINIMAL_OBJS) $(FW_MINIMAL_TARGET_TEST_OBJS)
 
 # Replaces the target by the text piped into it, only when the text changed,
 # so that what depends on the target is rebuilt only then. The temporary file
@@ -87,17 +158,23 @@ $(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) firmware/boot/link.ld
 # own file, and a rename is atomic, so neither can find the other's file gone.
 update_if_changed = { new='$@.new.'$$$$; cat > "$$new" && { cmp -s "$$new" '$@' && rm -f "$$new" || mv -f "$$new" '$@'; }; }
 
+# Images depend on the lists of objects they link, as objects on their flags:
+# an object taken out of an image relinks it.
+$(FW_IMAGES_STAMP): FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(FW_LDFLAGS) $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) $(FW_MINIMAL_TARGET_TEST_OBJS)' | $(update_if_changed)
+
 # Objects depend on the flags they were compiled with: a change of flags
 # rebuilds everything instead of linking stale objects.
 FW_FLAGS_STAMP := $(FW_BUILD)/flags.stamp
 $(FW_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(FW_CXXFLAGS) $(FW_ASFLAGS)' | $(update_if_changed)
+	@echo '$(FW_CXXFLAGS) $(FW_ASFLAGS) $(FW_COLD_FLAGS) $(FW_COLD_SRCS)' | $(update_if_changed)
 
 $(FW_BUILD)/%.cpp.o: %.cpp $(FW_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
-	$(Q)g++ $(FW_CXXFLAGS) -c $< -o $@
+	$(Q)g++ $(FW_CXXFLAGS) $(FW_OBJECT_FLAGS) -c $< -o $@
 
 $(FW_BUILD)/%.S.o: %.S $(FW_FLAGS_STAMP)
 	@mkdir -p $(dir $@)

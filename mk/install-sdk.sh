@@ -1,13 +1,15 @@
 #!/bin/sh
 # Installs DCOS for building applications outside the source tree.
 #
-#   mk/install-sdk.sh <prefix> <library> <production image> <board flags file> <emulator>
+#   mk/install-sdk.sh <prefix> <library> <minimal library> <production image> <board flags file> <emulator> <host tools bin>
 #
 # Called by 'make install PREFIX=<prefix>' and, for the tree's own 'make app',
 # with the prefix build/sdk. Lays out:
 #
 #   include/                     the firmware's public and internal headers
 #   lib/dcos/486/libdcos486.a    the kernel, board support, shell and drivers
+#   lib/dcos/486/libdcos486-minimal.a  the minimal kernel configuration: the system,
+#                                scheduler, task and timer agents and board support
 #   lib/dcos/486/link.ld         the image's memory layout
 #   lib/dcos/486/dcos486.elf     the plain controller image (no application)
 #   share/dcos/application.mk    the application build (see its header)
@@ -30,13 +32,14 @@
 # when their content changes, so a repeated install is quick and keeps times.
 set -eu
 
-[ $# -eq 6 ] || { echo "usage: $0 <prefix> <library> <production image> <board flags file> <emulator> <host tools bin>" >&2; exit 2; }
+[ $# -eq 7 ] || { echo "usage: $0 <prefix> <library> <minimal library> <production image> <board flags file> <emulator> <host tools bin>" >&2; exit 2; }
 prefix=$1
 library=$2
-image=$3
-board_flags=$4
-emulator=$5
-host_tools_bin=$6
+minimal_library=$3
+image=$4
+board_flags=$5
+emulator=$6
+host_tools_bin=$7
 
 # Copies a file if it differs, creating directories on the way, with mode
 # $3 (default 644: readable by everyone, whatever the source's mode, e.g. a
@@ -70,6 +73,7 @@ for include_dir in firmware/*/include drivers/*/include fieldbus/*/include; do
 done
 
 put "$library" "$prefix/lib/dcos/486/libdcos486.a"
+put "$minimal_library" "$prefix/lib/dcos/486/libdcos486-minimal.a"
 put firmware/boot/link.ld "$prefix/lib/dcos/486/link.ld"
 put "$image" "$prefix/lib/dcos/486/dcos486.elf"
 

@@ -12,6 +12,9 @@
 SDK_STAGE := $(BUILD)/sdk
 SDK_STAMP := $(SDK_STAGE)/.installed
 LIBRARY_486 := $(BUILD)/486/libdcos486.a
+# The minimal kernel configuration's library (docs/guide/kernel-configurations.md):
+# an application built with KERNEL_CONFIG=minimal links this one instead.
+LIBRARY_486_MINIMAL := $(BUILD)/486/libdcos486-minimal.a
 BOARD_FLAGS_486 := $(BUILD)/486/board-486.mk
 APPLICATION_MAKEFILE := $(SDK_STAGE)/share/dcos/application.mk
 # The emulator's path changes with its sources (tests_renode/qemu/build_qemu.sh).
@@ -27,6 +30,11 @@ $(LIBRARY_486): $(FW_OBJS)
 	@echo "  AR      $@"
 	$(Q)rm -f $@ && ar rcs $@ $(FW_OBJS)
 
+$(LIBRARY_486_MINIMAL): $(FW_MINIMAL_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  AR      $@"
+	$(Q)rm -f $@ && ar rcs $@ $(FW_MINIMAL_OBJS)
+
 $(BOARD_FLAGS_486): $(FW_FLAGS_STAMP) mk/sdk.mk
 	@mkdir -p $(dir $@)
 	@printf '%s\n' '# How code for the ISA 486 board is compiled, linked, checked and emulated (written by make install).' \
@@ -39,7 +47,7 @@ $(BOARD_FLAGS_486): $(FW_FLAGS_STAMP) mk/sdk.mk
 $(QEMU_BINARY):
 	@$(QEMU_BUILD_SCRIPT)
 
-SDK_INPUTS := $(LIBRARY_486) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) mk/install-sdk.sh mk/application.mk \
+SDK_INPUTS := $(LIBRARY_486) $(LIBRARY_486_MINIMAL) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) mk/install-sdk.sh mk/application.mk \
 	firmware/boot/link.ld host_tools/isa_check/check_i486.py host_tools/app_build/explain_configuration_error.py tests_renode/launch.py tests_renode/pytest.ini \
 	$(wildcard tests_renode/dcoslab/*.py tests_renode/boards/*.json) \
 	host_tools/bringup/mfio_bringup.py host_tools/bringup/bringup_report.py host_tools/plant_simulator/plant_simulator.py \
@@ -47,7 +55,7 @@ SDK_INPUTS := $(LIBRARY_486) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) mk/i
 	$(HOST_TOOLS) \
 	$(shell find firmware/*/include drivers/*/include fieldbus/*/include -name '*.hpp')
 
-install_sdk = mk/install-sdk.sh '$(1)' $(LIBRARY_486) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) $(HOST_TOOLS_BIN)
+install_sdk = mk/install-sdk.sh '$(1)' $(LIBRARY_486) $(LIBRARY_486_MINIMAL) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) $(HOST_TOOLS_BIN)
 
 $(SDK_STAMP): $(SDK_INPUTS)
 	@echo "  STAGE   $(SDK_STAGE)"

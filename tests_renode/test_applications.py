@@ -377,7 +377,8 @@ def test_out_of_tree_application_against_the_tree_and_an_installed_dcos(tmp_path
 
     prefix = tmp_path / "opt" / "dcos"
     run_make(["install", f"PREFIX={prefix}"])
-    for installed in ["include/dcos/Application.hpp", "lib/dcos/486/libdcos486.a", "lib/dcos/486/link.ld",
+    for installed in ["include/dcos/Application.hpp", "lib/dcos/486/libdcos486.a", "lib/dcos/486/libdcos486-minimal.a",
+                      "lib/dcos/486/link.ld",
                       "share/dcos/application.mk", "share/dcos/boards/isa486.json",
                       "share/dcos/python/dcoslab/pytest_plugin.py", "libexec/dcos/qemu-system-i386",
                       "bin/mfio_bringup.py", "bin/plant_simulator.py", "share/dcos/tools/bringup/bringup_report.py",

@@ -252,14 +252,82 @@ def test_the_footprint_report_sums_a_linker_map_by_component_and_counts_merged_s
     components = report["components"]
     assert components["runtime"]["text"] == 0x40
     assert components["dcos/task"]["text"] == 0x80
-    assert components["dcos/commands"]["text"] == 0x50
-    assert components["alignment"]["text"] == 0x10
+    # The fill before KernelCommands' section aligns it: it counts for that object.
+    assert components["dcos/commands"]["text"] == 0x10 + 0x50
+    assert "alignment" not in components
     assert components["dcos/timer"]["rodata"] == 0x20
     assert components["drivers/can"]["rodata"] == 0  # its strings merged into the timer's
     assert components["bsp_486"]["rodata"] == 0x10
     assert components["dcos/shared"]["bss"] == 0x100
-    assert report["kernel"] == {"text": 0x80 + 0x50, "rodata": 0x20, "data": 0, "bss": 0x100}
-    assert report["shell_and_commands"]["text"] == 0x50
+    assert report["kernel"] == {"text": 0x80 + 0x10 + 0x50, "rodata": 0x20, "data": 0, "bss": 0x100}
+    assert report["shell_and_commands"]["text"] == 0x10 + 0x50
+
+
+# The same slice for a minimal image: the kernel's core and the self-check, no shell.
+MINIMAL_FIXTURE_MAP = """\
+Linker script and memory map
+
+.text           0x00100010       0x90
+ .text          0x00100010       0x40 build/fw486/firmware/dcos/src/timer/TimerManager.cpp.o
+ .text          0x00100050       0x30 build/fw486/firmware/selfcheck/src/SelfCheck.cpp.o
+ .text          0x00100080       0x20 build/fw486/firmware/bsp_486/src/Pit8254.cpp.o
+
+.bss            0x00102000       0x10
+ .bss           0x00102000       0x10 build/fw486/firmware/dcos/src/task/TaskManager.cpp.o
+"""
+
+
+def test_the_footprint_report_covers_every_configurations_image_and_compares_their_kernels(tmp_path, monkeypatch,
+                                                                                          capsys):
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    (maps / "full.map").write_text(FIXTURE_MAP)
+    (maps / "small.map").write_text(MINIMAL_FIXTURE_MAP)
+    budget_file = tmp_path / "budgets.toml"
+    budget_file.write_text('[footprint.full]\nimage = "build/486/full.elf"\nkernel = ["firmware/dcos/"]\n'
+                           "text_budget = 1000\n"
+                           '[footprint.minimal]\nimage = "build/486/small.elf"\nkernel = ["firmware/dcos/"]\n'
+                           "text_budget = 0x30\n")
+    sums = {"full.elf": {"text": 0x120, "rodata": 0x30, "data": 0, "bss": 0x100},
+            "small.elf": {"text": 0x90, "rodata": 0, "data": 0, "bss": 0x10}}
+    monkeypatch.setattr(footprint, "image_sections", lambda image: sums[os.path.basename(image)])
+    output = tmp_path / "footprint.json"
+    monkeypatch.setattr(sys, "argv", ["footprint.py", "--budgets", str(budget_file), "--maps", str(maps),
+                                      "--output", str(output), "--strict"])
+    assert footprint.main() == 1  # the minimal kernel's 0x40 bytes of code are over its 0x30
+    printed = capsys.readouterr().out
+    assert "Footprint of build/486/full.elf (full)" in printed
+    assert "Footprint of build/486/small.elf (minimal)" in printed
+    assert re.search(r"selfcheck\s+48\s+0\s+0\s+0", printed)
+    assert re.search(r"^  minimal\s+build/486/small\.elf\s+64\s+0\s+0\s+16\s+48\s+OVER$", printed, re.MULTILINE)
+    assert re.search(r"^  full\s+build/486/full\.elf\s+224\s+32\s+0\s+256\s+1000\s+within$", printed, re.MULTILINE)
+    report = json.loads(output.read_text())
+    assert report["images"]["minimal"]["kernel"] == {"text": 0x40, "rodata": 0, "data": 0, "bss": 0x10}
+    assert report["images"]["minimal"]["components"]["selfcheck"]["text"] == 0x30
+    assert report["images"]["full"]["kernel"]["text"] == 0x80 + 0x10 + 0x50
+    assert [row["verdict"] for row in report["budgets"]] == [budgets.WITHIN, budgets.OVER]
+
+
+def test_a_measured_configuration_whose_map_is_missing_is_an_error(tmp_path, monkeypatch, capsys):
+    budget_file = tmp_path / "budgets.toml"
+    budget_file.write_text('[footprint.minimal]\nimage = "build/486/small.elf"\ntext_budget = 100\n')
+    monkeypatch.setattr(sys, "argv", ["footprint.py", "--budgets", str(budget_file), "--maps", str(tmp_path),
+                                      "--output", str(tmp_path / "footprint.json")])
+    assert footprint.main() == 1
+    assert "small.map" in capsys.readouterr().err
+
+
+def test_padding_counts_for_the_section_it_aligns_and_only_trailing_padding_for_none():
+    text = ("Linker script and memory map\n\n.text           0x00100000       0x40\n"
+            " .text          0x00100000        0x8 build/fw486/firmware/boot/src/Panic.cpp.o\n"
+            " *fill*         0x00100008        0x8 \n"
+            " .text._ZN4dcos1fEv\n                0x00100010       0x20 build/fw486/firmware/dcos/src/task/TaskManager.cpp.o\n"
+            " *fill*         0x00100030       0x10 \n")
+    report = footprint.footprint(footprint.parse_map(text), "build/fw486", ["firmware/dcos/"])
+    assert report["components"]["boot"]["text"] == 0x8
+    assert report["components"]["dcos/task"]["text"] == 0x8 + 0x20
+    assert report["components"]["alignment"]["text"] == 0x10
+    assert report["total"]["text"] == 0x40
 
 
 def test_components_follow_the_source_tree():
@@ -271,6 +339,8 @@ def test_components_follow_the_source_tree():
     assert footprint.component_of("drivers/modbus/src/LineRunner.cpp") == "drivers/modbus"
     assert footprint.component_of("fieldbus/can/src/CanFrame.cpp") == "fieldbus/can"
     assert footprint.component_of("generated/BuildRevision.cpp") == "build revision"
+    assert footprint.component_of("firmware/selfcheck/src/SelfCheck.cpp") == "selfcheck"
+    assert footprint.component_of("firmware/dcos/src/kernel/MinimalRoot.cpp") == "dcos/kernel"
     assert footprint.component_of(None) == "alignment"
 
 
@@ -321,4 +391,7 @@ def test_every_thread_metric_budget_is_half_of_freertos_and_the_footprint_budget
         assert budget["budget"] == budget["freertos"] / 2, name
     assert real["footprint"]["full"]["text_budget"] == 87 * 1024 // 2
     assert real["footprint"]["minimal"]["text_budget"] == 8 * 1024
-    assert real["footprint"]["minimal"]["measured"] is False
+    assert real["footprint"]["full"]["image"] == "build/486/dcos486.elf"
+    assert real["footprint"]["minimal"]["image"] == "build/486/dcos486-minimal.elf"
+    # Both configurations are built and measured: neither budget waits for an image.
+    assert real["footprint"]["full"]["measured"] and real["footprint"]["minimal"]["measured"]

@@ -24,7 +24,7 @@ def assemble(tmp_path, name, source):
     return str(object_path)
 
 
-@pytest.mark.parametrize("kind", ["production", "test"])
+@pytest.mark.parametrize("kind", ["production", "test", "minimal", "minimal-test"])
 def test_486_images_hold_only_i486_instructions(kind):
     board = load_board("isa486")
     result = run_checker(board.image(kind))

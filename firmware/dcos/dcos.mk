@@ -1,3 +1,12 @@
+# The kernel's sources, by kernel configuration (docs/guide/kernel-configurations.md).
+#
+# The core is what every configuration links: the system, scheduler, task
+# and timer agents and what boot needs. The full configuration adds the
+# memory, port, DSM and semaphore agents, the application loader and the
+# console commands, with its root task (kernel/ConsoleRoot.cpp); the minimal
+# one adds only its own root task (kernel/MinimalRoot.cpp). Every source is
+# compiled once: an image's configuration is the set of objects it links.
+
 # Kernel sources with no hardware access: built for the host tests and the firmware.
 DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/GregorianCalendar.cpp \
@@ -8,12 +17,14 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/MessageBufferPool.cpp \
 	firmware/dcos/src/MessageQueue.cpp \
 	firmware/dcos/src/application/ConfigurationReport.cpp \
-	$(wildcard firmware/dcos/src/system/DeviceManager.cpp) \
-	$(wildcard firmware/dcos/src/system/DeviceCommands.cpp)
+	firmware/dcos/src/system/DeviceManager.cpp \
+	firmware/dcos/src/system/DeviceCommands.cpp
 
 # Kernel sources that run only on the target: task switching, the tick, traps.
 DCOS_TARGET_SRCS := \
-	$(wildcard firmware/dcos/src/kernel/*.cpp) \
+	firmware/dcos/src/kernel/Kernel.cpp \
+	firmware/dcos/src/kernel/ConsoleRoot.cpp \
+	firmware/dcos/src/kernel/KernelCommands.cpp \
 	$(wildcard firmware/dcos/src/task/*.cpp firmware/dcos/src/task/*.S) \
 	$(wildcard firmware/dcos/src/scheduler/*.cpp) \
 	$(wildcard firmware/dcos/src/timer/*.cpp) \
@@ -25,3 +36,23 @@ DCOS_TARGET_SRCS := \
 	$(wildcard firmware/dcos/src/semaphore/*.cpp) \
 	firmware/dcos/src/application/ApplicationLoader.cpp \
 	firmware/dcos/src/application/ApplicationCommands.cpp
+
+# The full configuration's kernel, in link order (which is the order of the
+# console commands' and the agents' recovery tables).
+DCOS_FULL_SRCS := $(DCOS_PORTABLE_SRCS) $(DCOS_TARGET_SRCS)
+
+# The core: the system agent (devices and interrupts), the scheduler, task
+# and timer agents, the kernel entry and what they share.
+DCOS_CORE_SRCS := \
+	firmware/dcos/src/kernel/Kernel.cpp \
+	firmware/dcos/src/GregorianCalendar.cpp \
+	firmware/dcos/src/ResourceRecovery.cpp \
+	firmware/dcos/src/StackArena.cpp \
+	firmware/dcos/src/system/DeviceManager.cpp \
+	firmware/dcos/src/system/InterruptManager.cpp \
+	$(wildcard firmware/dcos/src/task/*.cpp firmware/dcos/src/task/*.S) \
+	$(wildcard firmware/dcos/src/scheduler/*.cpp) \
+	$(wildcard firmware/dcos/src/timer/*.cpp)
+
+# The minimal configuration's kernel: the core, in the full one's order, and its root task.
+DCOS_MINIMAL_SRCS := $(filter $(DCOS_CORE_SRCS),$(DCOS_FULL_SRCS)) firmware/dcos/src/kernel/MinimalRoot.cpp

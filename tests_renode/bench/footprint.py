@@ -1,10 +1,12 @@
 #!/usr/bin/python3
-"""Reports the production kernel image's footprint by component: what `make bench` calls.
+"""Reports each kernel configuration's image footprint by component: what `make bench` calls.
 
-Reads the linker map of the production image (build/bench/dcos486.map,
-linked by mk/bench.mk from the same objects and linker script as
-build/486/dcos486.elf), adds up every input section by the source file its
-object came from, and prints code (.text), read-only data (.rodata, .multiboot),
+For every image a footprint budget names (tests_renode/bench/budgets.toml:
+the full production image build/486/dcos486.elf and the minimal one
+build/486/dcos486-minimal.elf), reads its linker map (build/bench/<image>.map,
+linked by mk/bench.mk from the same objects and linker script as the
+image), adds up every input section by the source file its object came
+from, and prints code (.text), read-only data (.rodata, .multiboot),
 data (.data, .init_array) and bss per component:
 
   dcos/<agent>     the kernel's agents, firmware/dcos/src/<agent>/
@@ -12,15 +14,19 @@ data (.data, .init_array) and bss per component:
   dcos/commands    the kernel's console commands (firmware/dcos/src/**/*Commands.cpp)
   boot, arch_x86, bsp_486, runtime (the freestanding libc-ish support), shell
   drivers/<name>, fieldbus/<name>
+  selfcheck        the minimal image's built-in self-check application
   build revision   the generated revision stamp
-  alignment        the linker's padding between input sections
+  alignment        padding that no input section follows (the padding before
+                   an input section counts for its object: see parse_map)
 
 A map rather than the objects' own sizes: the map holds only what was
 linked, each inline function or template instance once. The "kernel" of a
 footprint budget is every object under the budget's `kernel` folders
 (tests_renode/bench/budgets.toml); its code is checked against
-`text_budget`. A budget whose image is not built is reported as not
-measured yet. Writes build/bench/footprint.json.
+`text_budget`. A budget marked `measured = false` is reported as not
+measured yet; a measured one whose image or map is missing is an error.
+Ends with one line per image comparing the kernels. Writes
+build/bench/footprint.json.
 
 The sums are checked against the image's own section sizes (`size -A`), so a
 stale or misread map is an error rather than a wrong report.
@@ -61,9 +67,13 @@ def parse_map(text):
 
     An input section's line names the section, its address, its size and
     the object; a long section name stands alone on its line and the rest
-    follows on the next. "*fill*" lines are padding (no object). Symbol
-    lines (address and name only) and the linker script's own lines are
-    skipped.
+    follows on the next. "*fill*" lines are padding: the linker puts it
+    before an input section to give that section the alignment its object
+    asks for (16-byte function starts at -O2, each function a section of
+    its own with -ffunction-sections), so the padding counts for the object
+    of the input section that follows it, and only padding that nothing
+    follows in its output section is left without an object. Symbol lines
+    (address and name only) and the linker script's own lines are skipped.
 
     Merged string sections (.rodata.str1.1 and the like) are listed once per
     object at overlapping addresses, each with the size it had before the
@@ -108,12 +118,21 @@ def parse_map(text):
     clipped = []
     for name in dict.fromkeys(entry[0] for entry in entries):
         covered = 0
+        in_section = []
         # sorted() is stable: at one address the map's order decides.
         for output, section, address, size, origin in sorted((entry for entry in entries if entry[0] == name),
                                                              key=lambda entry: entry[2]):
             start = max(address, covered)
             covered = max(covered, address + size)
-            clipped.append((output, section, max(0, address + size - start), origin))
+            in_section.append((output, section, max(0, address + size - start), origin))
+        following = None
+        for index in reversed(range(len(in_section))):
+            output, section, size, origin = in_section[index]
+            if section == "*fill*":
+                in_section[index] = (output, section, size, following)
+            else:
+                following = origin
+        clipped += in_section
     return clipped
 
 
@@ -201,11 +220,29 @@ def print_footprint(name, image, report, budget):
           + (f"; the issue's figure: {budget['now'] / kib:g} KiB" if "now" in budget else ""))
 
 
+def map_of(image, maps):
+    """The linker map of an image: build/486/dcos486-minimal.elf -> <maps>/dcos486-minimal.map."""
+    return os.path.join(maps, os.path.splitext(os.path.basename(image))[0] + ".map")
+
+
+def print_comparison(images, budgets):
+    """One line per image: its kernel's sizes and its budget, side by side."""
+    print("Kernel footprint by configuration (bytes of the objects under each budget's kernel folders)")
+    rows = []
+    for name, image in images.items():
+        kernel, budget = image["kernel"], budgets["footprint"][name]["text_budget"]
+        rows.append((name, image["image"], *(str(kernel[kind]) for kind in KINDS), str(budget),
+                     "OVER" if kernel["text"] > budget else "within"))
+    for line in budget_file._table(("configuration", "image", "text", "rodata", "data", "bss", "text budget",
+                                    "verdict"), rows, ("<", "<", ">", ">", ">", ">", ">", "<")):
+        print(line)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--budgets", default=budget_file.DEFAULT_BUDGETS)
-    parser.add_argument("--map", default=os.path.join(REPOSITORY, "build", "bench", "dcos486.map"),
-                        help="linker map of the full production image")
+    parser.add_argument("--maps", default=os.path.join(REPOSITORY, "build", "bench"),
+                        help="the folder of the images' linker maps, <image name>.map")
     parser.add_argument("--build-directory", default="build/fw486",
                         help="where the image's objects were compiled, as the map names them")
     parser.add_argument("--output", default=os.path.join(REPOSITORY, "build", "bench", "footprint.json"))
@@ -215,8 +252,8 @@ def main():
     budgets = budget_file.load_budgets_for_command(arguments.budgets)
     if budgets is None:
         return 2
-    maps = {name: arguments.map for name, budget in budgets["footprint"].items()
-            if budget["measured"] and budget.get("image") == "build/486/dcos486.elf"}
+    maps = {name: map_of(budget["image"], arguments.maps) for name, budget in budgets["footprint"].items()
+            if budget["measured"]}
     images = {}
     for name, budget in budgets["footprint"].items():
         if name not in maps:
@@ -235,7 +272,10 @@ def main():
             return 1
         images[name] = dict(report, image=budget["image"], map=os.path.relpath(maps[name], REPOSITORY))
         print_footprint(name, budget["image"], report, budget)
+        print()
 
+    if images:
+        print_comparison(images, budgets)
     rows = budget_file.check_footprint(budgets, {name: image["kernel"]["text"] for name, image in images.items()})
     for row in rows:
         if row["verdict"] == budget_file.NOT_MEASURED_YET:

@@ -10,7 +10,8 @@ Fixtures:
 - `isa486`: the ISA 486 board definition;
 - `dcos_board`: the board named by --dcos-board (default isa486);
 - `dcos_image`: the image named by --dcos-image (an application's tests);
-- `application`: a booted emulator running --dcos-image on --dcos-board,
+- `application`: a booted emulator running --dcos-image on --dcos-board
+  (built with the kernel configuration --dcos-kernel-config, default full),
   with exact emulated time (-icount), at its first shell prompt;
 - `canlab(buses, wiring, pace=None, kind="test")`: the CAN bus hub with
   the named buses and bit rates, and the boards wired to them, booted in
@@ -35,6 +36,8 @@ def pytest_addoption(parser):
     group = parser.getgroup("dcos", "DCOS emulator lab")
     group.addoption("--dcos-image", default=None, help="firmware image the `application` fixture boots")
     group.addoption("--dcos-board", default="isa486", help="board the `application` fixture boots (default isa486)")
+    group.addoption("--dcos-kernel-config", default="full", choices=("full", "minimal"),
+                    help="the kernel configuration the image was built with (default full)")
 
 
 @pytest.fixture
@@ -107,10 +110,18 @@ def canlab(request, boot, isa486):
 
 
 @pytest.fixture
-def application(boot, dcos_board, dcos_image):
-    """The application image booted with exact emulated time, at its first prompt."""
+def application(request, boot, dcos_board, dcos_image):
+    """The application image booted with exact emulated time, at its first prompt.
+
+    An image of the minimal kernel configuration has no console shell and so
+    no prompt: it is returned once the kernel has started the application.
+    """
     emulator = boot(dcos_board, dcos_image, icount=True)
-    emulator.expect(r"dcos> ")
+    if request.config.getoption("--dcos-kernel-config") == "minimal":
+        emulator.expect(r"kernel configuration minimal\r\n")
+        emulator.expect(r"application '[^']*' (started|not started)[^\r]*\r\n")
+    else:
+        emulator.expect(r"dcos> ")
     return emulator
 
 

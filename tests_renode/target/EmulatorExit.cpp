@@ -1,4 +1,5 @@
 #include "EmulatorExit.hpp"
+#include "KernelTestSupport.hpp"
 #include "TargetTest.hpp"
 
 #include <arch_x86/Cpu.hpp>
@@ -21,10 +22,35 @@ namespace target_test {
     }
 }
 
-namespace {
-
 extern "C" const TargetTest __start_dcos_target_tests[];
 extern "C" const TargetTest __stop_dcos_target_tests[];
+
+void listTargetTests(shell::Shell& shell)
+{
+    for (const TargetTest* test = __start_dcos_target_tests; test != __stop_dcos_target_tests; ++test) {
+        shell.print("  %-10s %s\r\n", test->name, test->summary);
+    }
+}
+
+TestOutcome runTargetTest(shell::Shell& shell, const char* name, bool exit)
+{
+    for (const TargetTest* test = __start_dcos_target_tests; test != __stop_dcos_target_tests; ++test) {
+        if (runtime::textEquals(test->name, name)) {
+            // The tests' helpers wake the task that runs them (KernelTestSupport.hpp).
+            setTestTask(dcos::taskAgent.IdOfSelf());
+            shell.print("TEST %s: start\r\n", test->name);
+            const bool passed = test->run(shell);
+            shell.print("TEST %s: %s\r\n", test->name, passed ? "PASS" : "FAIL");
+            if (exit) {
+                exitEmulator(passed ? exitPass : exitFail);
+            }
+            return passed ? TestOutcome::Passed : TestOutcome::Failed;
+        }
+    }
+    return TestOutcome::Unknown;
+}
+
+namespace {
 
 shell::CommandResult runTest(shell::Shell& shell, int argc, char** argv)
 {
@@ -32,24 +58,14 @@ shell::CommandResult runTest(shell::Shell& shell, int argc, char** argv)
         return shell::CommandResult::UsageError;
     }
     if (runtime::textEquals(argv[1], "list")) {
-        for (const TargetTest* test = __start_dcos_target_tests; test != __stop_dcos_target_tests; ++test) {
-            shell.print("  %-10s %s\r\n", test->name, test->summary);
-        }
+        listTargetTests(shell);
         return shell::CommandResult::Ok;
     }
-    for (const TargetTest* test = __start_dcos_target_tests; test != __stop_dcos_target_tests; ++test) {
-        if (runtime::textEquals(test->name, argv[1])) {
-            shell.print("TEST %s: start\r\n", test->name);
-            const bool passed = test->run(shell);
-            shell.print("TEST %s: %s\r\n", test->name, passed ? "PASS" : "FAIL");
-            if (argc == 3) {
-                exitEmulator(passed ? exitPass : exitFail);
-            }
-            return passed ? shell::CommandResult::Ok : shell::CommandResult::Failed;
-        }
+    const TestOutcome outcome = runTargetTest(shell, argv[1], argc == 3);
+    if (outcome == TestOutcome::Unknown) {
+        shell.print("error: no target test '%s'; 'test list' shows them\r\n", argv[1]);
     }
-    shell.print("error: no target test '%s'; 'test list' shows them\r\n", argv[1]);
-    return shell::CommandResult::Failed;
+    return outcome == TestOutcome::Passed ? shell::CommandResult::Ok : shell::CommandResult::Failed;
 }
 
 } // namespace

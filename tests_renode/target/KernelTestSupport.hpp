@@ -43,8 +43,10 @@ dcos::ObjectId spawn(const char* name, uint8_t priority, dcos::TaskEntry entry, 
 /// The event test tasks post to the test task when they finish.
 constexpr uint32_t kDoneEvent = 1u << 30;
 
-/// The test task's id, for tasks that report back.
+/// The test task's id, for tasks that report back: the task that runs the
+/// tests, set by the runner (runTargetTest), by default the console's shell.
 dcos::ObjectId testTask();
+void setTestTask(dcos::ObjectId task);
 
 /// Called by a test task as it finishes: counts it and wakes the test task.
 void finished();

@@ -8,14 +8,11 @@
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/ConfigurationReport.hpp>
+#include <dcos/internal/KernelConfiguration.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/Scheduler.hpp>
 
 #include <bsp/Board.hpp>
-
-// Defined by DCOS_APPLICATION in the application's sources; weak, so an
-// image without an application links and its address is null.
-extern "C" [[gnu::weak]] const dcos::app::Application* const dcosApplication;
 
 namespace dcos::internal {
 
@@ -330,10 +327,7 @@ Result<ObjectId> ApplicationLoader::find(app::ObjectKind kind, const char* name)
     return Status::InvalidArgument;
 }
 
-const app::Application* ApplicationLoader::linked()
-{
-    return &dcosApplication != nullptr ? dcosApplication : nullptr;
-}
+const app::Application* ApplicationLoader::linked() { return linkedApplication(); }
 
 void ApplicationLoader::startLinked()
 {

@@ -1,14 +1,14 @@
-// The loader-independent kernel entry.
+// The loader-independent kernel entry, the same in every kernel configuration.
 //
 // kernelMain brings up the board, the timer agent and the task agent, then
 // starts scheduling. From then on the boot stack is abandoned: the root task
-// starts the application linked into the image, if any, then the console
-// shell, which it starts again if it ends; the idle task halts the CPU
-// whenever no other task is ready.
-#include <dcos/SemaphoreAgent.hpp>
+// of the configuration linked into the image (dcos/internal/KernelConfiguration.hpp)
+// starts the linked application; the idle task halts the CPU whenever no
+// other task is ready.
+#include <dcos/ConfigurationRules.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/Version.hpp>
-#include <dcos/internal/ApplicationLoader.hpp>
+#include <dcos/internal/KernelConfiguration.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/TimerManager.hpp>
@@ -20,7 +20,10 @@
 #include <boot/BootInfo.hpp>
 #include <boot/Panic.hpp>
 #include <bsp/Board.hpp>
-#include <shell/Shell.hpp>
+
+// Defined by DCOS_APPLICATION in the application's sources (dcos/Application.hpp);
+// weak, so an image without an application links and its address is null.
+extern "C" [[gnu::weak]] const dcos::app::Application* const dcosApplication;
 
 namespace dcos {
 
@@ -36,90 +39,7 @@ boot::BootInfo bootInfoCopy;
 // The first byte after the image and the page tables.
 uintptr_t firstFreeAddress = 0;
 
-// The shell task sleeps on this event until the console has input.
-constexpr uint32_t consoleInputEvent = 1u << 0;
-ObjectId shellTask;
-
-// Between two shells there is none to wake: the new one reads what came.
-void onConsoleInput(void*) { (void)taskAgent.PostEvent(shellTask, consoleInputEvent); }
-
 void onSystemTick(void*) { internal::TimerManager::onTick(); }
-
-// The console shell. It holds its life semaphore (the argument) for as long
-// as it runs, so that the root task learns of its end, whatever the cause.
-void shellTaskEntry(uintptr_t lifeSemaphore)
-{
-    shellTask = taskAgent.IdOfSelf();
-    // The root task released the semaphore before it started this shell, so
-    // the poll takes it; were it refused, the root task would only learn of
-    // this shell's end later, when it next polls.
-    if (semaphoreAgent.Acquire(ObjectId::fromRaw(static_cast<uint32_t>(lifeSemaphore)), kPoll) != Status::Ok) {
-        runtime::format(bsp::console(), "console: the shell could not take its life semaphore\r\n");
-    }
-    bsp::setConsoleInputNotifier(onConsoleInput, nullptr);
-    // A new shell, with an empty line, each time the task starts.
-    shell::Shell shell(bsp::console(), "dcos> ");
-    shell.start();
-    for (;;) {
-        char character;
-        while (bsp::consoleRead(character)) {
-            shell.feed(character);
-        }
-        // The only event is console input, read at the top of the loop
-        // whatever the wait answered.
-        (void)taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
-    }
-}
-
-Result<ObjectId> startShell(ObjectId lifeSemaphore)
-{
-    TaskAttributes attributes;
-    attributes.name = internal::kShellTaskName;
-    attributes.priority = internal::kShellTaskPriority;
-    attributes.stackSize = internal::kShellStackSize;
-    attributes.superUser = true;
-    return taskAgent.Create(attributes, shellTaskEntry, lifeSemaphore.raw());
-}
-
-// The root task. It starts the application linked into the image, then the
-// console shell, and starts the shell again when it ends (a fatal exception
-// in a command, or KillTask): the console is how an engineer reaches the
-// node, so it must outlive a fault in it. The shell holds a binary
-// semaphore while it lives; when it ends, resource recovery frees the
-// semaphore and wakes this task with Abandoned (seed 7.11).
-void rootTaskEntry(uintptr_t)
-{
-    internal::ApplicationLoader::startLinked();
-    SemaphoreAttributes life;
-    life.name = "shell-life";
-    const Result<ObjectId> lifeSemaphore = semaphoreAgent.Create(life);
-    if (!lifeSemaphore.ok()) {
-        dcosPanic("cannot create the shell's life semaphore: %s", statusName(lifeSemaphore.status()));
-    }
-    for (unsigned started = 0;; ++started) {
-        const Result<ObjectId> shell = startShell(lifeSemaphore.value());
-        if (!shell.ok()) {
-            runtime::format(bsp::console(), "console: cannot start the shell: %s\r\n", statusName(shell.status()));
-            break;
-        }
-        // The shell, more urgent, holds the semaphore by now; this waits for its end.
-        const Status ended = semaphoreAgent.Acquire(lifeSemaphore.value(), kWaitForever);
-        if (ended == Status::Ok) {
-            // Cannot fail: this task holds it, and the next shell takes it.
-            (void)semaphoreAgent.Release(lifeSemaphore.value());
-        }
-        if (started + 1 >= internal::kShellRestartLimit) {
-            runtime::format(bsp::console(), "console: the shell ended %u times; not starting it again\r\n",
-                            started + 1);
-            break;
-        }
-        runtime::format(bsp::console(), "console: the shell ended; starting it again\r\n");
-    }
-    // Nothing is left to do: wait for an event nobody posts to this task.
-    for (;;) {
-        (void)taskAgent.ReceiveEvent(consoleInputEvent, EventWait::Any, kWaitForever);
-    }
-}
 
 // Every tick rate an application may declare (ConfigurationRules.hpp) is one the board makes.
 static_assert(bsp::minimumTickRateHz <= app::kLowestTickRateHz && bsp::maximumTickRateHz >= app::kHighestTickRateHz);
@@ -176,6 +96,11 @@ void enableMemoryProtection(const boot::BootInfo& info)
 
 const boot::BootInfo& bootInfo() { return bootInfoCopy; }
 
+const app::Application* internal::linkedApplication()
+{
+    return &dcosApplication != nullptr ? dcosApplication : nullptr;
+}
+
 uintptr_t firstFreeMemory() { return firstFreeAddress; }
 
 } // namespace dcos
@@ -190,7 +115,7 @@ uintptr_t firstFreeMemory() { return firstFreeAddress; }
     arch_x86::Idt::setTrapHandler(internal::TaskManager::onTrap);
     arch_x86::Idt::setOutermostExitHook(internal::Scheduler::onOutermostExit);
     // The linked application may ask for a finer tick than the board's default.
-    const app::Application* application = internal::ApplicationLoader::linked();
+    const app::Application* application = internal::linkedApplication();
     const uint32_t tickRateHz = application != nullptr && application->tickRateHz != 0 ? application->tickRateHz
                                                                                        : bsp::defaultTickRateHz;
     bsp::initialise(bootInfo, tickRateHz);
@@ -206,11 +131,12 @@ uintptr_t firstFreeMemory() { return firstFreeAddress; }
                     static_cast<unsigned>(bsp::nodeId()),
                     static_cast<unsigned long>(bootInfo.lowerMemoryKib + bootInfo.upperMemoryKib),
                     static_cast<unsigned long>(bsp::tickRateHz()));
+    runtime::format(console, "kernel configuration %s\r\n", internal::kKernelConfiguration);
     if (bootInfo.commandLine[0] != '\0') {
         runtime::format(console, "command line: %s\r\n", bootInfo.commandLine);
     }
     setClockFromTheBoard(console);
 
-    internal::TaskManager::initialise(rootTaskEntry);
+    internal::TaskManager::initialise(internal::rootTaskEntry);
     internal::Scheduler::start();
 }
