@@ -49,7 +49,15 @@ interrupt_common:
     call interruptEntry
     movl %eax, %esp             /* Resume the frame the dispatcher chose. */
 interrupt_return:
-    popl %gs
+    /* The same rule on the way back: a return to ring 0 finds the kernel's
+       segments loaded and skips the four segment loads. */
+    testb $3, 60(%esp)
+    jnz 2f
+    addl $16, %esp
+    popal
+    addl $8, %esp               /* Drop the vector number and error code. */
+    iret
+2:  popl %gs
     popl %fs
     popl %es
     popl %ds
