@@ -11,6 +11,7 @@
 #include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/FastPath.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
@@ -147,18 +148,6 @@ size_t semaphoreCount()
     arch_x86::InterruptGuard guard;
     ensureTable();
     return table.usedCount();
-}
-
-// A fast path's hand-over to the complete service as an ordinary call, not a
-// jump: GCC prepares a tail call of a function with other arguments in the
-// prologue, which would put every argument through registers on the fast
-// path too.
-template <typename Service, typename... Arguments>
-[[gnu::always_inline]] inline Status callSlowPath(Service service, Arguments... arguments)
-{
-    Status status = service(arguments...);
-    asm("" : "+r"(status));
-    return status;
 }
 
 // The complete Acquire and Release: every case, from a resolved id.
