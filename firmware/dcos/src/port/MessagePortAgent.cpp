@@ -216,7 +216,7 @@ namespace {
     }
     PortObject& port = *resolved.value();
     if (MessageBuffer* buffer = port.queue.takeFirst()) {
-        internal::copyMessage(message, buffer->message);
+        internal::copySixteenBytes(message.bytes, buffer->message.bytes);
         bufferPool.give(*buffer);
         return Status::Ok;
     }
@@ -299,7 +299,7 @@ Status MessagePortAgent::Receive(ObjectId id, Message& message, uint64_t timeout
         if (found != nullptr && !(*found)->dying && internal::Scheduler::started()
             && owner == internal::Scheduler::current().id) [[likely]] {
             if (MessageBuffer* buffer = (*found)->queue.takeFirst()) {
-                internal::copyMessage(message, buffer->message);
+                internal::copySixteenBytes(message.bytes, buffer->message.bytes);
                 bufferPool.give(*buffer);
                 return Status::Ok;
             }

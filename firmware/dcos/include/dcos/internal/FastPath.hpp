@@ -3,6 +3,8 @@
 
 #include <dcos/Status.hpp>
 
+#include <stdint.h>
+
 namespace dcos::internal {
 
 /// A fast path's hand-over to the complete service, as an ordinary call
@@ -18,6 +20,26 @@ template <typename Service, typename... Arguments>
     Status status = service(arguments...);
     asm("" : "+r"(status));
     return status;
+}
+
+/// Copies 16 bytes (a port message, a DSM page) as four words. Those are
+/// arrays of bytes, so a plain assignment is a copy of unknown alignment,
+/// which GCC makes a REP MOVS with its set-up around it (tuned for the
+/// i486), twice as long as this; into an aligned destination it is a short
+/// REP MOVSL, as long as this.
+[[gnu::always_inline]] inline void copySixteenBytes(void* to, const void* from)
+{
+    uint32_t a, b, c, d;
+    const uint8_t* source = static_cast<const uint8_t*>(from);
+    uint8_t* destination = static_cast<uint8_t*>(to);
+    __builtin_memcpy(&a, source, 4);
+    __builtin_memcpy(&b, source + 4, 4);
+    __builtin_memcpy(&c, source + 8, 4);
+    __builtin_memcpy(&d, source + 12, 4);
+    __builtin_memcpy(destination, &a, 4);
+    __builtin_memcpy(destination + 4, &b, 4);
+    __builtin_memcpy(destination + 8, &c, 4);
+    __builtin_memcpy(destination + 12, &d, 4);
 }
 
 } // namespace dcos::internal

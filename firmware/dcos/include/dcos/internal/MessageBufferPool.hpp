@@ -18,24 +18,6 @@
 namespace dcos::internal {
 
 /// One buffer of the area: a message and the link that queues it.
-/// Copies a message as four words. A Message is bytes, so a plain
-/// assignment is a copy of unknown alignment, which GCC makes a REP MOVS
-/// with its set-up around it (tuned for the i486), twice as long as this
-/// into a caller's message; into a buffer, which is aligned, it is a short
-/// REP MOVSL.
-[[gnu::always_inline]] inline void copyMessage(Message& to, const Message& from)
-{
-    uint32_t a, b, c, d;
-    __builtin_memcpy(&a, from.bytes, 4);
-    __builtin_memcpy(&b, from.bytes + 4, 4);
-    __builtin_memcpy(&c, from.bytes + 8, 4);
-    __builtin_memcpy(&d, from.bytes + 12, 4);
-    __builtin_memcpy(to.bytes, &a, 4);
-    __builtin_memcpy(to.bytes + 4, &b, 4);
-    __builtin_memcpy(to.bytes + 8, &c, 4);
-    __builtin_memcpy(to.bytes + 12, &d, 4);
-}
-
 struct MessageBuffer {
     MessageBuffer* next = nullptr;
     Message message{};
