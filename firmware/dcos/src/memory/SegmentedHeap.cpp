@@ -83,12 +83,20 @@ Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
     const uint32_t current = heads_[found.level][found.index];
 
     // A listed segment is free, starts its list and fits; its successor in the list points back.
-    uint32_t currentSize;
-    if (!isLink(current) || !checkFree(current, currentSize) || word(current + 4) != kNone || currentSize < needed) {
+    // checkFree() and its links, each word read once: no previous segment
+    // (it starts its list), the next one a link leading back.
+    if (!isLink(current)) {
         return fail();
     }
+    const uint32_t currentFirst = word(current);
+    const uint32_t currentSize = currentFirst & ~kFlagMask;
+    if ((currentFirst & kFlagMask) != 0 || currentSize < needed || currentSize > size_ - current
+        || word(current + currentSize - 4) != endTag(currentSize, current + currentSize)
+        || word(current + 4) != kNone) {
+        return fail(); // needed >= kSmallestSegment, so the size is at least that too.
+    }
     const uint32_t next = word(current + 8);
-    if (next != kNone && word(next + 4) != current) {
+    if (next != kNone && (!isLink(next) || word(next + 4) != current)) {
         return fail();
     }
     uint32_t segmentSize = currentSize;
@@ -135,8 +143,7 @@ Status SegmentedHeap::release(void* segment, uint16_t holder)
     if (!offset.ok()) {
         return offset.status();
     }
-    uint32_t freedEnd;
-    return releaseAt(offset.value(), header, freedEnd);
+    return releaseAt(offset.value(), header.size, header.previousFree) != 0 ? Status::Ok : Status::Corrupted;
 }
 
 Status SegmentedHeap::transfer(void* segment, uint16_t from, uint16_t to)
@@ -178,8 +185,8 @@ size_t SegmentedHeap::reclaimHeldBy(uint16_t holder)
         }
         // The freed segment may merge with the free one before it; the walk
         // goes on after the merged segment, which ends on a segment boundary.
-        uint32_t freedEnd;
-        if (releaseAt(offset, header, freedEnd) != Status::Ok) {
+        const uint32_t freedEnd = releaseAt(offset, header.size, header.previousFree);
+        if (freedEnd == 0) {
             break;
         }
         ++reclaimed;
@@ -443,19 +450,22 @@ inline bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) co
            && header.size <= size_ - offset && (second >> 16) == seal(offset, first, header.holder);
 }
 
-inline bool SegmentedHeap::checkListNeighbours(uint32_t offset, SizeClass sizeClass) const
+inline bool SegmentedHeap::checkListed(uint32_t offset, SizeClass sizeClass) const
 {
-    // Called after checkLinks(), which checked that both links are offsets in the heap.
+    // checkLinks() and the list neighbours' links back, each word read
+    // once: the previous segment on the list (or, for the first, the head
+    // of the class's list) and the next one both lead back to this segment.
     const uint32_t previous = word(offset + 4);
     const uint32_t next = word(offset + 8);
-    bool previousOk;
     if (previous == kNone) {
-        previousOk = (levelMaps_[sizeClass.level] & (1u << sizeClass.index)) != 0
-                     && heads_[sizeClass.level][sizeClass.index] == offset;
-    } else {
-        previousOk = word(previous + 8) == offset;
+        if ((levelMaps_[sizeClass.level] & (1u << sizeClass.index)) == 0
+            || heads_[sizeClass.level][sizeClass.index] != offset) {
+            return false;
+        }
+    } else if (!isLink(previous) || word(previous + 8) != offset) {
+        return false;
     }
-    return previousOk && (next == kNone || word(next + 4) == offset);
+    return next == kNone || (isLink(next) && word(next + 4) == offset);
 }
 
 inline void SegmentedHeap::writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder)
@@ -486,21 +496,29 @@ inline Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t
     return static_cast<uint32_t>(offset);
 }
 
-Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32_t& freedEnd)
+uint32_t SegmentedHeap::releaseAt(uint32_t offset, uint32_t segmentSize, bool previousFree)
 {
+    const auto fail = [this] {
+        (void)this->fail();
+        return uint32_t{0};
+    };
     // Check both neighbours before anything is written.
-    const uint32_t nextOffset = offset + header.size;
+    const uint32_t nextOffset = offset + segmentSize;
     bool mergeNext = false;
     uint32_t nextSize = 0;
     SizeClass nextClass{};
     if (nextOffset < size_) {
         const uint32_t nextFirst = word(nextOffset);
         if ((nextFirst & kAllocatedFlag) == 0) {
-            if (!checkFree(nextOffset, nextSize)) {
+            // checkFree() with its links checked together with the list
+            // neighbours they lead to, each link read once.
+            nextSize = nextFirst & ~kFlagMask;
+            if ((nextFirst & kFlagMask) != 0 || nextSize < kSmallestSegment || nextSize > size_ - nextOffset
+                || word(nextOffset + nextSize - 4) != endTag(nextSize, nextOffset + nextSize)) {
                 return fail();
             }
             nextClass = classOf(nextSize);
-            if (!checkListNeighbours(nextOffset, nextClass)) {
+            if (!checkListed(nextOffset, nextClass)) {
                 return fail();
             }
             mergeNext = true;
@@ -511,7 +529,7 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
     uint32_t previousOffset = 0;
     uint32_t previousSize = 0;
     SizeClass previousClass{};
-    if (header.previousFree) {
+    if (previousFree) {
         if (offset < kSmallestSegment) {
             return fail();
         }
@@ -523,18 +541,18 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
             return fail();
         }
         previousOffset = offset - previousSize;
-        if (word(previousOffset) != previousSize || !checkLinks(previousOffset)) {
+        if (word(previousOffset) != previousSize) {
             return fail();
         }
         previousClass = classOf(previousSize);
-        if (!checkListNeighbours(previousOffset, previousClass)) {
+        if (!checkListed(previousOffset, previousClass)) {
             return fail();
         }
     }
 
     // Merge. An obsolete header is cleared so an old pointer to it reads as a double return.
     uint32_t start = offset;
-    uint32_t total = header.size;
+    uint32_t total = segmentSize;
     uint32_t tag;
     if (mergeNext) {
         unlink(nextOffset, nextClass);
@@ -550,7 +568,7 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
             setWord(nextOffset, word(nextOffset) | kPreviousFreeFlag); // The seal leaves P out.
         }
     }
-    if (header.previousFree) {
+    if (previousFree) {
         unlink(previousOffset, previousClass);
         setWord(offset, 0);
         setWord(offset + 4, 0);
@@ -562,11 +580,10 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
     setWord(start, total);
     setWord(start + total - 4, tag ^ total);
     insert(start, total);
-    freeBytes_ += header.size;
+    freeBytes_ += segmentSize;
     --allocatedSegments_;
     ++returns_;
-    freedEnd = start + total;
-    return Status::Ok;
+    return start + total;
 }
 
 Status SegmentedHeap::fail()

@@ -167,7 +167,8 @@ private:
     [[gnu::always_inline]] bool checkLinks(uint32_t offset) const;
     [[gnu::always_inline]] bool checkAllocated(uint32_t offset, Allocated& header) const;
     [[gnu::always_inline]] bool checkAllocatedFrame(uint32_t offset, uint32_t previousFreeFlag) const;
-    [[gnu::always_inline]] bool checkListNeighbours(uint32_t offset, SizeClass sizeClass) const;
+    // checkLinks() and the neighbours on the list of @p sizeClass linking back to @p offset.
+    [[gnu::always_inline]] bool checkListed(uint32_t offset, SizeClass sizeClass) const;
     [[gnu::always_inline]] void writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder);
     [[gnu::always_inline]] void insert(uint32_t offset, uint32_t size);
     [[gnu::always_inline]] void unlink(uint32_t offset, SizeClass sizeClass);
@@ -179,9 +180,11 @@ private:
     [[gnu::always_inline]] void emptied(SizeClass sizeClass);
     // Finds the offset of an allocated segment for release() and transfer().
     [[gnu::always_inline]] Result<uint32_t> allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header);
-    // Frees the checked allocated segment at @p offset and merges it; sets
-    // @p freedEnd to the end of the resulting free segment.
-    Status releaseAt(uint32_t offset, const Allocated& header, uint32_t& freedEnd);
+    // Frees the checked allocated segment of @p size bytes at @p offset and
+    // merges it; returns the end of the resulting free segment, or 0 when a
+    // check failed (the heap is then disabled). The header comes as values,
+    // not as an Allocated in memory, so that the caller need not store it.
+    uint32_t releaseAt(uint32_t offset, uint32_t size, bool previousFree);
     Status fail();
 
     uint8_t* base_ = nullptr;
