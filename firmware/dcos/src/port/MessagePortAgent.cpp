@@ -201,8 +201,9 @@ namespace {
     return Status::Ok;
 }
 
-[[gnu::noinline]] Status receiveFull(ObjectId id, Message* into, uint64_t timeoutNs)
+[[gnu::noinline]] Status receiveFull(ObjectId id, Message* into, const uint64_t* timeout)
 {
+    const uint64_t timeoutNs = *timeout;
     Message& message = *into;
     arch_x86::InterruptGuard guard;
     start();
@@ -305,7 +306,7 @@ Status MessagePortAgent::Receive(ObjectId id, Message& message, uint64_t timeout
             }
         }
     }
-    return internal::callSlowPath(receiveFull, id, &message, timeoutNs);
+    return internal::callSlowPath(receiveFull, id, &message, &timeoutNs);
 }
 
 Status MessagePortAgent::AddMsgBufs(size_t count) const

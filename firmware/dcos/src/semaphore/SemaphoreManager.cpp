@@ -152,8 +152,9 @@ size_t semaphoreCount()
 
 // The complete Acquire and Release: every case, from a resolved id.
 // The agent's fast paths (below) come here for all they do not handle.
-[[gnu::noinline]] Status acquireFull(ObjectId id, uint64_t timeout)
+[[gnu::noinline]] Status acquireFull(ObjectId id, const uint64_t* timeoutIn)
 {
+    const uint64_t timeout = *timeoutIn;
     arch_x86::InterruptGuard guard;
     const Result<Semaphore*> resolved = resolve(id);
     if (!resolved.ok()) {
@@ -330,7 +331,7 @@ Status SemaphoreAgent::Acquire(ObjectId id, uint64_t timeout) const
             }
         }
     }
-    return internal::callSlowPath(internal::acquireFull, id, timeout);
+    return internal::callSlowPath(internal::acquireFull, id, &timeout);
 }
 
 Status SemaphoreAgent::Release(ObjectId id) const

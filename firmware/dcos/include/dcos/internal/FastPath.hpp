@@ -13,7 +13,10 @@ namespace dcos::internal {
 /// prologue, so the fast path would pay for moving the slow path's
 /// arguments (a 64-bit time-out is two loads and two spills). The empty asm
 /// makes the call's result pass through a register the compiler cannot see
-/// through, which rules the tail call out.
+/// through, which rules the tail call out. A 64-bit time-out is best passed
+/// by address: by value, GCC loads both its words into registers on entry,
+/// which costs the fast path the registers it needs (Acquire, Receive and
+/// Read pass it so).
 template <typename Service, typename... Arguments>
 [[gnu::always_inline]] inline Status callSlowPath(Service service, Arguments... arguments)
 {

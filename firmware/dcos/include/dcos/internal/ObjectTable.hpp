@@ -168,7 +168,7 @@ public:
         Entry& entry = entries_[slot];
         const uint16_t index = takeIndex();
         indexSlot_[index] = static_cast<SlotNumber>(slot);
-        entry.key = ~ObjectId(node_, type_, index).raw();
+        entry.key = ObjectId(node_, type_, index).raw();
         entry.owner = owner;
         entry.visibility = visibility;
         copyName(entry.name, name);
@@ -227,12 +227,12 @@ public:
 
     /// The real-time services' lookup: the object @p id names, or null
     /// wherever resolve() fails (call resolve() then, for the reason). It is
-    /// inline and takes one compare: the slot the id's index last named
-    /// keeps the complement of its live object's whole id, so node, type,
-    /// index and use are checked at once (a free slot keeps 0, which no id
-    /// complements: type 15 is reserved), which also refuses an index never
-    /// handed out, since no slot holds one. Issue 14's remote ids will take
-    /// the null branch, so the local path stays this short. Cost O(1).
+    /// inline and takes two compares: the slot the id's index last named
+    /// keeps its live object's whole id, so node, type, index and use are
+    /// checked at once (a free slot keeps 0, the null id, which the other
+    /// compare refuses), which also refuses an index never handed out, since
+    /// no slot holds one. Issue 14's remote ids will take the null branch,
+    /// so the local path stays this short. Cost O(1).
     T* find(ObjectId id)
     {
         ObjectId unused; // Inline: the compiler drops the owner's load.
@@ -244,7 +244,7 @@ public:
     T* find(ObjectId id, ObjectId& owner)
     {
         Entry& entry = entries_[indexSlot_[id.index()]];
-        if (entry.key != ~id.raw()) {
+        if (entry.key != id.raw() || id.isNull()) {
             return nullptr;
         }
         owner = entry.owner;
@@ -435,14 +435,14 @@ private:
     struct Entry {
         T object{};
         ObjectId owner{};
-        /// The complement of the object's id while the slot is used, 0 while
-        /// it is free (no id's complement is 0: its type would be 15, reserved).
+        /// The object's whole id while the slot is used, 0 (the null id) while
+        /// it is free; find() refuses the null id, so no id finds a free slot.
         uint32_t key = 0;
         uint16_t ownerKey = 0; ///< The owner list the object is on.
         Visibility visibility = Visibility::Local;
         char name[kNameCapacity] = {};
 
-        uint16_t index() const { return static_cast<uint16_t>(~key & ObjectId::kMaxIndex); }
+        uint16_t index() const { return static_cast<uint16_t>(key & ObjectId::kMaxIndex); }
     };
 
     // The links of a used slot, kept apart from Entry for the reason above.
@@ -462,7 +462,7 @@ private:
     static Link linkOf(uint16_t slot) { return static_cast<Link>(slot + 1); }
     static uint16_t slotOfLink(Link link) { return static_cast<uint16_t>(link - 1); }
 
-    ObjectId idOf(uint16_t slot) const { return ObjectId::fromRaw(~entries_[slot].key); }
+    ObjectId idOf(uint16_t slot) const { return ObjectId::fromRaw(entries_[slot].key); }
 
     // The null owner has a list of its own, so that a walk for it finds the
     // system's objects as the slot-by-slot walk did.
@@ -583,7 +583,7 @@ private:
         }
         const uint16_t slot = indexSlot_[id.index()];
         const Entry& entry = entries_[slot];
-        if (entry.key != ~id.raw()) {
+        if (entry.key != id.raw()) {
             return Status::StaleId; // Handed out once; its object is gone.
         }
         return slot;
