@@ -11,9 +11,57 @@ constexpr uintptr_t roundUp8(uintptr_t value) { return (value + 7) & ~uintptr_t{
 
 // The index of the highest set bit of a non-zero value. Written with XOR,
 // not as 31 - clz, so that GCC emits a lone BSR.
-inline uint32_t highestBit(uint32_t value) { return static_cast<uint32_t>(__builtin_clz(value)) ^ 31; }
+constexpr uint32_t highestBit(uint32_t value) { return static_cast<uint32_t>(__builtin_clz(value)) ^ 31; }
 
 } // namespace
+
+constexpr SegmentedHeap::SizeClass SegmentedHeap::roundedClassOf(uint32_t needed)
+{
+    if (needed < kClasses * kAlignment) {
+        return {0, static_cast<uint32_t>(needed / kAlignment)}; // A multiple of 8 below 64 is a class boundary.
+    }
+    // The classes of [2^p, 2^(p+1)) are 2^(p-3) wide: needed takes steps of
+    // that width, 8 to 16 of them; 16 is the next level's first class.
+    const uint32_t power = highestBit(needed);
+    const uint32_t steps = ((needed - 1) >> (power - kClassBits)) + 1;
+    return {power - 5 + (steps >> (kClassBits + 1)), steps & (kClasses - 1)};
+}
+
+constexpr bool SegmentedHeap::roundedClassesAgree(uint32_t limit)
+{
+    for (uint32_t needed = kSmallestSegment; needed <= limit; needed += kAlignment) {
+        uint32_t rounded = needed; // The rounding as it was written before roundedClassOf().
+        if (needed >= 8 * kAlignment) {
+            rounded += (uint32_t{1} << (highestBit(needed) - kClassBits)) - 1;
+        }
+        const SizeClass expected = classOf(rounded);
+        const SizeClass actual = roundedClassOf(needed);
+        if (expected.level != actual.level || expected.index != actual.index) {
+            return false;
+        }
+    }
+    for (uint32_t power = 17; power <= 30; ++power) { // Around every larger power of two.
+        for (uint32_t needed = (1u << power) - 64; needed <= (1u << power) + 64; needed += kAlignment) {
+            const uint32_t rounded = needed + (uint32_t{1} << (highestBit(needed) - kClassBits)) - 1;
+            const SizeClass expected = classOf(rounded);
+            const SizeClass actual = roundedClassOf(needed);
+            if (expected.level != actual.level || expected.index != actual.index) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+constexpr SegmentedHeap::SizeClass SegmentedHeap::classOf(uint32_t size)
+{
+    const uint32_t units = static_cast<uint32_t>(size / kAlignment);
+    if (units < kClasses) {
+        return {0, units};
+    }
+    const uint32_t power = highestBit(units);
+    return {power - kClassBits + 1, (units >> (power - kClassBits)) & (kClasses - 1)};
+}
 
 Status SegmentedHeap::initialise(void* area, size_t areaBytes, uint32_t salt)
 {
@@ -62,11 +110,8 @@ Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
 
     // Round the request up to a class boundary: every segment of the class
     // found then fits, and the first one is taken without a search.
-    uint32_t rounded = needed;
-    if (needed >= 8 * kAlignment) {
-        rounded += (uint32_t{1} << (highestBit(needed) - kClassBits)) - 1;
-    }
-    SizeClass found = classOf(rounded);
+    static_assert(roundedClassesAgree(1u << 17));
+    SizeClass found = roundedClassOf(needed);
     if (!findFrom(found)) {
         // The request's own class may still hold a segment that fits: try its first.
         found = classOf(needed);
@@ -289,16 +334,6 @@ Status SegmentedHeap::audit()
         }
     }
     return steps == freeCount && (levelMap_ >> kLevels) == 0 ? Status::Ok : fail();
-}
-
-inline SegmentedHeap::SizeClass SegmentedHeap::classOf(uint32_t size)
-{
-    const uint32_t units = size / kAlignment;
-    if (units < kClasses) {
-        return {0, units};
-    }
-    const uint32_t power = highestBit(units);
-    return {power - kClassBits + 1, (units >> (power - kClassBits)) & (kClasses - 1)};
 }
 
 inline bool SegmentedHeap::findFrom(SizeClass& sizeClass) const

@@ -157,7 +157,13 @@ private:
         bool previousFree;
     };
 
-    [[gnu::always_inline]] static SizeClass classOf(uint32_t size);
+    [[gnu::always_inline]] static constexpr SizeClass classOf(uint32_t size);
+    // classOf() of @p needed rounded up to the next class boundary (the
+    // class whose every segment fits it), in one pass.
+    [[gnu::always_inline]] static constexpr SizeClass roundedClassOf(uint32_t needed);
+    // Whether roundedClassOf() agrees with classOf() of the rounded size
+    // for every segment size up to @p limit (a compile-time check).
+    static constexpr bool roundedClassesAgree(uint32_t limit);
     [[gnu::always_inline]] uint32_t word(uint32_t offset) const;
     [[gnu::always_inline]] void setWord(uint32_t offset, uint32_t value);
     [[gnu::always_inline]] uint16_t seal(uint32_t offset, uint32_t first, uint16_t holder) const;
