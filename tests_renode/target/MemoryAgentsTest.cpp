@@ -429,12 +429,19 @@ bool poolCorruption(shell::Shell& shell)
     runCommand(shell, "pools");
     ok = checkStatus(shell, bufferPoolAgent.Delete(pool), Status::Ok, "Delete, with a buffer still out") && ok;
 
-    // A task writes into a buffer after returning it: the free list is overwritten.
+    // A task writes into a buffer after returning it: the pool keeps nothing
+    // there, so only the task's own data suffers.
     const ObjectId second_pool =
         bufferPoolAgent.Create(otherPoolArea, sizeof otherPoolArea, 16, nullptr, Visibility::Local).value();
     void* buffer = bufferPoolAgent.Allocate(second_pool).value();
     ok = checkStatus(shell, bufferPoolAgent.Return(second_pool, buffer), Status::Ok, "Return") && ok;
     static_cast<volatile uint32_t*>(buffer)[0] = 0x12345678;
+    void* again = bufferPoolAgent.Allocate(second_pool).value();
+    ok = check(shell, again == buffer, "a write after Return leaves the free list intact") && ok;
+    ok = checkStatus(shell, bufferPoolAgent.Return(second_pool, again), Status::Ok, "Return it again") && ok;
+    // A stray write into the state table at the area's start (buffer 0's
+    // state word, the head of the free list) overwrites the free list.
+    reinterpret_cast<volatile uint32_t*>(otherPoolArea)[0] = 0x12345678;
     ok = checkStatus(shell, bufferPoolAgent.Allocate(second_pool).status(), Status::Corrupted,
                      "Allocate over an overwritten free list") && ok;
     ok = checkStatus(shell, bufferPoolAgent.Allocate(second_pool).status(), Status::Corrupted,

@@ -17,23 +17,7 @@ Status MessageBufferPool::AddMsgBufs(size_t count)
     return Status::Ok;
 }
 
-MessageBuffer* MessageBufferPool::take()
-{
-    MessageBuffer* buffer = freeHead_;
-    if (buffer != nullptr) {
-        freeHead_ = buffer->next;
-        buffer->next = nullptr;
-        --free_;
-    }
-    return buffer;
-}
-
-void MessageBufferPool::give(MessageBuffer& buffer)
-{
-    buffer.next = freeHead_;
-    freeHead_ = &buffer;
-    ++free_;
-}
+// take() and give() are inline in the header.
 
 void MessageBufferPool::giveChain(MessageBuffer& first, MessageBuffer& last, size_t count)
 {

@@ -290,20 +290,30 @@ TEST_F(BufferPoolCorruptionTest, ForeignPointerIsRefusedAndThePoolStaysInService
     EXPECT_EQ(pool.audit(), Status::Ok);
 }
 
-TEST_F(BufferPoolCorruptionTest, WriteAfterReturnIntoTheHeadIsCaughtByAllocate)
+TEST_F(BufferPoolCorruptionTest, WriteAfterReturnLeavesThePoolIntact)
 {
-    std::memset(buffers[3], 0, 4); // The task keeps writing into a buffer it returned.
+    // The pool keeps nothing inside its buffers: a task that keeps writing
+    // into a buffer it returned spoils only its own data.
+    std::memset(buffers[3], 0, 16);
+    std::memset(buffers[1], 0xFF, 16);
+    EXPECT_EQ(pool.audit(), Status::Ok);
+    EXPECT_EQ(pool.allocate(kTaskB).value(), buffers[3]);
+    EXPECT_EQ(pool.allocate(kTaskB).value(), buffers[1]);
+    EXPECT_FALSE(pool.isCorrupted());
+}
+
+TEST_F(BufferPoolCorruptionTest, OverwrittenStateWordOfTheHeadIsCaughtByAllocate)
+{
+    std::memset(area.data() + 3 * 4, 0, 4); // A stray write into the state table.
     EXPECT_EQ(pool.allocate(kTaskB).status(), Status::Corrupted);
     expectDisabled(pool, buffers[0]);
 }
 
-TEST_F(BufferPoolCorruptionTest, LinkWordCopiedFromAnotherBufferIsDetected)
+TEST_F(BufferPoolCorruptionTest, FreeStateWordCopiedFromAnotherBufferIsDetected)
 {
-    // Buffer 1's link word is well formed, but only for buffer 1: the check
-    // binds the buffer's index, so it cannot redirect the list from buffer 3.
-    uint32_t linkOf1;
-    std::memcpy(&linkOf1, buffers[1], 4);
-    std::memcpy(buffers[3], &linkOf1, 4);
+    // Buffer 1's free state word is well formed, but only for buffer 1: the
+    // check binds the buffer's index, so it cannot redirect the list from buffer 3.
+    std::memcpy(area.data() + 3 * 4, area.data() + 1 * 4, 4);
     EXPECT_EQ(pool.allocate(kTaskB).status(), Status::Corrupted);
     expectDisabled(pool, buffers[0]);
 }
@@ -342,13 +352,13 @@ TEST_F(BufferPoolCorruptionTest, RecoveryStopsAtAnOverwrittenStateWord)
 
 TEST_F(BufferPoolCorruptionTest, OverwrittenLinkDeeperInTheListIsFound)
 {
-    std::memset(buffers[1], 0xFF, 4); // Second on the list.
+    std::memset(area.data() + 1 * 4, 0xFF, 4); // Buffer 1's state word: second on the list.
     EXPECT_EQ(pool.audit(), Status::Corrupted);
 }
 
 TEST_F(BufferPoolCorruptionTest, OverwrittenLinkDeeperInTheListStopsAllocateWhenReached)
 {
-    std::memset(buffers[1], 0x00, 4);
+    std::memset(area.data() + 1 * 4, 0x00, 4);
     EXPECT_EQ(pool.allocate(kTaskB).value(), buffers[3]); // The head is intact.
     EXPECT_EQ(pool.allocate(kTaskB).status(), Status::Corrupted);
     expectDisabled(pool, buffers[0]);
@@ -365,6 +375,119 @@ TEST(BufferPoolSaltTest, PoolsWithDifferentSaltsRejectEachOthersWords)
     void* buffer = b.allocate(kTaskA).value();
     std::memcpy(second.data(), first.data(), 4 * 4); // b's state table replaced by a's.
     EXPECT_EQ(b.release(buffer, kTaskA), Status::Corrupted);
+}
+
+// The fast paths against the model: tryAllocate and tryRelease succeed
+// exactly where allocate and release would succeed without the slow path's
+// cases (an empty pool, a system buffer returned by a task), and change
+// nothing when they decline.
+TEST(BufferPoolFastPathTest, RandomizedFastPathsMatchTheModel)
+{
+    std::mt19937 random(20261130);
+    for (int round = 0; round < 40; ++round) {
+        const size_t size = 4 + random() % 200;
+        const size_t count = 1 + random() % 300;
+        Area area(BufferPoolAgent::AreaBytes(size, count) + random() % 8);
+        BufferPool pool;
+        ASSERT_EQ(pool.initialise(area.data(), area.size(), size, static_cast<uint32_t>(random())), Status::Ok);
+        ASSERT_EQ(pool.bufferCount(), count);
+        std::map<uint8_t*, uint16_t> allocated;
+        uint32_t allocations = 0;
+        uint32_t lowWater = static_cast<uint32_t>(count);
+        for (int step = 0; step < 4000; ++step) {
+            // Holders 0..2 are tasks, 3 stands for the system.
+            const unsigned pick = random() % 4;
+            const uint16_t holder = pick == 3 ? BufferPool::kSystemHolder : static_cast<uint16_t>(pick);
+            const unsigned action = random() % 8;
+            if (action < 4) {
+                void* buffer = pool.tryAllocate(holder);
+                if (allocated.size() == count) {
+                    ASSERT_EQ(buffer, nullptr);
+                    ASSERT_EQ(pool.allocate(holder).status(), Status::NoMemory);
+                    continue;
+                }
+                ASSERT_NE(buffer, nullptr);
+                uint8_t* bytes = static_cast<uint8_t*>(buffer);
+                ASSERT_EQ(allocated.count(bytes), 0u);
+                ASSERT_EQ((bytes - static_cast<uint8_t*>(pool.bufferAt(0))) % BufferPoolAgent::Stride(size), 0);
+                allocated[bytes] = holder;
+                std::memset(bytes, static_cast<int>(step), size);
+                ++allocations;
+                lowWater = std::min<uint32_t>(lowWater, static_cast<uint32_t>(count - allocated.size()));
+            } else if (!allocated.empty()) {
+                auto it = allocated.begin();
+                std::advance(it, static_cast<long>(random() % allocated.size()));
+                // A pointer just inside the buffer, another holder, then the holder itself.
+                ASSERT_FALSE(pool.tryRelease(it->first + 1 + random() % (size - 1), it->second));
+                const uint16_t other = static_cast<uint16_t>((it->second + 1) % 3);
+                ASSERT_FALSE(pool.tryRelease(it->first, other));
+                if (it->second == BufferPool::kSystemHolder) {
+                    ASSERT_EQ(pool.release(it->first, other), Status::Ok); // Anyone returns system buffers.
+                } else {
+                    ASSERT_TRUE(pool.tryRelease(it->first, it->second));
+                    ASSERT_FALSE(pool.tryRelease(it->first, it->second)); // Now free: declined.
+                }
+                allocated.erase(it);
+            }
+            ASSERT_EQ(pool.allocatedCount(), allocated.size());
+            if (step % 101 == 0) {
+                ASSERT_EQ(pool.audit(), Status::Ok);
+            }
+        }
+        ASSERT_EQ(pool.audit(), Status::Ok);
+        const dcos::BufferPoolStatistics statistics = pool.statistics();
+        EXPECT_EQ(statistics.allocations, allocations);
+        EXPECT_EQ(statistics.returns, allocations - allocated.size());
+        EXPECT_EQ(statistics.lowWaterMark, lowWater);
+        EXPECT_TRUE(area.guardsIntact());
+    }
+}
+
+// The range and alignment test of Return, a multiplication and a rotation
+// instead of a division: for every byte address in and around the pool,
+// only the start of a buffer is one; the state table, the padding, the
+// inside of every buffer and the bytes on either side of the area are not.
+TEST(BufferPoolFastPathTest, OnlyABuffersStartIsABuffer)
+{
+    for (size_t size = 4; size <= 100; ++size) {
+        const size_t count = 1 + size % 7;
+        Area area(BufferPoolAgent::AreaBytes(size, count));
+        BufferPool pool;
+        ASSERT_EQ(pool.initialise(area.data(), area.size(), size, 0x9E3779B9u * static_cast<uint32_t>(size)),
+                  Status::Ok);
+        std::set<uint8_t*> starts;
+        for (size_t i = 0; i < count; ++i) {
+            starts.insert(static_cast<uint8_t*>(pool.allocate(kTaskA).value()));
+        }
+        uint8_t* const begin = area.data();
+        for (uint8_t* p = begin - 64; p < begin + area.size() + 64; ++p) {
+            if (starts.count(p) == 0) {
+                ASSERT_FALSE(pool.tryRelease(p, kTaskA)) << "size " << size << " offset " << (p - begin);
+            }
+        }
+        uint8_t elsewhere[16];
+        EXPECT_EQ(pool.release(elsewhere, kTaskA), Status::InvalidArgument);
+        EXPECT_EQ(pool.release(begin + area.size(), kTaskA), Status::InvalidArgument);
+        for (uint8_t* start : starts) {
+            ASSERT_TRUE(pool.tryRelease(start, kTaskA));
+        }
+        EXPECT_EQ(pool.audit(), Status::Ok);
+        EXPECT_EQ(pool.allocatedCount(), 0u);
+    }
+}
+
+TEST(BufferPoolFastPathTest, ACorruptedPoolDeclinesEveryFastPath)
+{
+    Area area(BufferPoolAgent::AreaBytes(8, 4));
+    BufferPool pool;
+    ASSERT_EQ(pool.initialise(area.data(), area.size(), 8, 77), Status::Ok);
+    void* a = pool.allocate(kTaskA).value();
+    void* b = pool.allocate(kTaskA).value();
+    ASSERT_EQ(pool.release(b, kTaskA), Status::Ok);
+    ASSERT_EQ(pool.release(b, kTaskA), Status::Corrupted); // Double return.
+    EXPECT_EQ(pool.tryAllocate(kTaskA), nullptr);
+    EXPECT_FALSE(pool.tryRelease(a, kTaskA));
+    expectDisabled(pool, a);
 }
 
 } // namespace

@@ -6,6 +6,7 @@
 
 #include <deque>
 #include <random>
+#include <set>
 #include <vector>
 
 using dcos::kLifoMostUrgent;
@@ -191,5 +192,34 @@ TEST(MessageQueueTest, RandomSendsAndReceivesMatchAModel)
             ASSERT_EQ(queue.count(), queued);
             ASSERT_EQ(f.pool.freeCount(), 64 - queued);
         }
+    }
+}
+
+// Delete's clear() chains the non-empty levels into one list for the pool:
+// whatever levels hold messages, every buffer comes back exactly once.
+TEST(MessageQueueTest, ClearAfterRandomTrafficGivesEveryBufferBackOnce)
+{
+    std::mt19937 random(20261125);
+    for (int round = 0; round < 200; ++round) {
+        const PortOrder order = round % 4 == 0 ? PortOrder::Fifo : PortOrder::Priority;
+        Fixture f(48);
+        MessageQueue queue(order);
+        const int steps = static_cast<int>(random() % 120);
+        for (int step = 0; step < steps; ++step) {
+            if (f.pool.freeCount() != 0 && random() % 4 != 0) {
+                f.send(queue, static_cast<uint8_t>(step), static_cast<int>(random() % 64) - 32);
+            } else if (MessageBuffer* buffer = queue.takeFirst()) {
+                f.pool.give(*buffer);
+            }
+        }
+        queue.clear(f.pool);
+        ASSERT_TRUE(queue.isEmpty());
+        ASSERT_EQ(queue.count(), 0u);
+        ASSERT_EQ(f.pool.freeCount(), 48u);
+        std::set<MessageBuffer*> taken;
+        while (MessageBuffer* buffer = f.pool.take()) {
+            ASSERT_TRUE(taken.insert(buffer).second) << "a buffer came back twice";
+        }
+        ASSERT_EQ(taken.size(), 48u);
     }
 }

@@ -122,6 +122,38 @@ TEST(ObjectTableTest, ForgedIdsAreRejected)
     EXPECT_TRUE(table.resolve(good).ok());
 }
 
+// find() compares the whole id with the one kept in the slot its index
+// names, 0 (the null id) in a free slot, and refuses the null id: no id
+// passes for another, and no id finds a free slot, not the null id nor the
+// all-ones id (whose complement is the free slot's 0: an earlier form of the
+// key, the id's complement, let it through).
+TEST(ObjectTableTest, FindComparesTheWholeIdInOneWord)
+{
+    SmallTable table(ObjectType::Semaphore, kNode);
+    EXPECT_EQ(table.find(ObjectId::null()), nullptr); // Nothing active yet: every slot keeps 0.
+    EXPECT_EQ(table.find(ObjectId::fromRaw(0xFFFFFFFFu)), nullptr);
+    ASSERT_EQ(table.AddObjects(8), Status::Ok);
+    const ObjectId a = create(table);
+    const ObjectId b = create(table);
+    ObjectId owner;
+    ASSERT_NE(table.find(a, owner), nullptr);
+    EXPECT_EQ(owner, kTaskA);
+    EXPECT_NE(table.find(a), table.find(b));
+    EXPECT_EQ(table.find(ObjectId::null()), nullptr);
+    EXPECT_EQ(table.find(ObjectId::fromRaw(0xFFFFFFFFu)), nullptr);
+    for (uint32_t bit = 0; bit < 32; ++bit) {
+        // Any other node, type or index, one bit away: refused.
+        const ObjectId near = ObjectId::fromRaw(a.raw() ^ (1u << bit));
+        if (near != b) {
+            EXPECT_EQ(table.find(near), nullptr) << "bit " << bit;
+        }
+    }
+    ASSERT_EQ(table.Delete(a), Status::Ok);
+    EXPECT_EQ(table.find(a), nullptr);
+    EXPECT_NE(table.find(b), nullptr);
+    EXPECT_EQ(table.resolve(a).status(), Status::StaleId);
+}
+
 TEST(ObjectTableTest, DeletedIdIsStaleEvenAfterTheSlotIsReused)
 {
     ObjectTable<Semaphore, 8> table(ObjectType::Semaphore, kNode);

@@ -27,12 +27,14 @@
 // buffers from it (their Return then fails with StaleId; the area itself is
 // static application memory and stays valid).
 //
-// Corruption. The pool checks its own bookkeeping on every call: each
-// buffer's state word and each free buffer's link word carry a check value
-// bound to the pool and the buffer. A buffer returned twice, a pointer into
-// the pool that is not the start of a buffer, or a state or link word that an
-// application overwrote (for example by writing into a buffer after returning
-// it) makes the call fail with Corrupted and disables the pool: every later
+// Corruption. The pool keeps all its bookkeeping in the state words at the
+// start of the area, none inside the buffers (the free list is threaded
+// through the state words), so a task that writes into a buffer after
+// returning it spoils only its own data. Every state word carries a check
+// bound to the pool and the buffer, which the pool verifies before it acts
+// on the word. A buffer returned twice, a pointer into the pool that is not
+// the start of a buffer, or a state word that a stray write overwrote makes
+// the call fail with Corrupted and disables the pool: every later
 // call except Delete fails with Corrupted, as the seed prescribes, and no
 // buffer is ever handed out twice. A pointer outside the pool is refused with
 // InvalidArgument and leaves the pool in service, because it cannot have

@@ -30,6 +30,7 @@
 #include <dcos/DsmAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/DsmManager.hpp>
+#include <dcos/internal/FastPath.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
@@ -56,7 +57,9 @@ struct PublisherObject {
 };
 
 struct SubscriptionObject {
-    ObjectId publisher;
+    // The publisher's slot: the object array never moves, and the
+    // incarnation below tells whether the slot still holds that publisher.
+    PublisherObject* publisher = nullptr;
     uint32_t incarnation = 0; ///< The publisher slot's incarnation when it was opened.
 };
 
@@ -222,35 +225,30 @@ Status DsmAgent::Delete(ObjectId id) const
     return Status::Ok;
 }
 
-Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page) const
+namespace {
+
+// The next data identifier after @p dataId; kNoDsmData is skipped.
+uint32_t nextDataId(uint32_t dataId) { return dataId + 1 == kNoDsmData ? dataId + 2 : dataId + 1; }
+
+// The complete Write: every case, from the id. DsmAgent::Write's fast path
+// comes here for all it does not handle.
+[[gnu::noinline]] Result<uint32_t> writeFull(ObjectId id, const DsmPage* newPage)
 {
     arch_x86::InterruptGuard guard;
-    // The fast path: the table's inline lookup, with the owner, for a live
-    // publisher written by its owner (or by an interrupt handler).
-    ObjectId owner;
-    PublisherObject* const* found = publisherTable.find(id, owner);
-    PublisherObject* writable = nullptr;
-    if (found != nullptr && !(*found)->dying
-        && (internal::inInterruptContext()
-            || (internal::Scheduler::started() && owner == internal::Scheduler::current().id))) [[likely]] {
-        writable = *found;
-    } else {
-        start();
-        const Result<PublisherObject*> resolved = resolvePublisher(id);
-        if (!resolved.ok()) {
-            return resolved.status();
-        }
-        if (!internal::inInterruptContext()) {
-            const Status ownerCheck = publisherTable.checkOwner(id, internal::currentTaskId());
-            if (ownerCheck != Status::Ok) {
-                return ownerCheck; // Single writer: the owner, super user or not.
-            }
-        }
-        writable = resolved.value();
+    start();
+    const Result<PublisherObject*> resolved = resolvePublisher(id);
+    if (!resolved.ok()) {
+        return resolved.status();
     }
-    PublisherObject& publisher = *writable;
-    publisher.page = page;
-    publisher.dataId = publisher.dataId + 1 == kNoDsmData ? publisher.dataId + 2 : publisher.dataId + 1;
+    if (!internal::inInterruptContext()) {
+        const Status ownerCheck = publisherTable.checkOwner(id, internal::currentTaskId());
+        if (ownerCheck != Status::Ok) {
+            return ownerCheck; // Single writer: the owner, super user or not.
+        }
+    }
+    PublisherObject& publisher = *resolved.value();
+    internal::copySixteenBytes(publisher.page.bytes, newPage->bytes);
+    publisher.dataId = nextDataId(publisher.dataId);
     const uint32_t written = publisher.dataId;
     // Every reader that began to wait before this Write gets the page. A
     // woken reader more urgent than the writer runs at once, inside this
@@ -272,6 +270,33 @@ Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page) const
     return written;
 }
 
+} // namespace
+
+Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page) const
+{
+    // The fast path: the table's inline lookup, with the owner, for a live
+    // publisher written by its owner (or by an interrupt handler) with no
+    // reader waiting. A hand-over to waiting readers, an error or a wrong
+    // id goes the full way.
+    {
+        arch_x86::InterruptGuard guard;
+        ObjectId owner;
+        PublisherObject* const* found = publisherTable.find(id, owner);
+        if (found != nullptr) [[likely]] {
+            PublisherObject& publisher = **found;
+            if (!publisher.dying && publisher.readers.isEmpty()
+                && (internal::inInterruptContext()
+                    || (internal::Scheduler::started() && owner == internal::Scheduler::current().id))) [[likely]] {
+                internal::copySixteenBytes(publisher.page.bytes, page.bytes);
+                const uint32_t written = nextDataId(publisher.dataId);
+                publisher.dataId = written;
+                return written;
+            }
+        }
+    }
+    return writeFull(id, &page);
+}
+
 Result<ObjectId> DsmAgent::Open(ObjectId publisherId) const
 {
     if (internal::inInterruptContext()) {
@@ -288,7 +313,7 @@ Result<ObjectId> DsmAgent::Open(ObjectId publisherId) const
         return id.status();
     }
     *subscriptionTable.resolve(id.value()).value() =
-        SubscriptionObject{publisherId, publisher.value()->incarnation};
+        SubscriptionObject{publisher.value(), publisher.value()->incarnation};
     return id.value();
 }
 
@@ -302,27 +327,23 @@ Status DsmAgent::Close(ObjectId id) const
     return subscriptionTable.Delete(id);
 }
 
-Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& page, uint64_t timeoutNs) const
+namespace {
+
+// What Read does with a resolved subscription of the caller, under the
+// caller's interrupt guard: no newer data yet (the fast path's miss), a
+// deleted publisher, or a wait.
+//
+// The time-out comes by reference: passed by value, its two words are
+// loaded and spilled in the fast path's prologue, whether or not it calls.
+[[gnu::noinline]] Result<uint32_t> readResolved(const SubscriptionObject& subscription, uint32_t lastSeenDataId,
+                                                DsmPage& page, const uint64_t& timeoutNs)
 {
-    arch_x86::InterruptGuard guard;
-    // The fast path: the table's inline lookup, with the owner, for the
-    // subscription's owner; anything else is resolved and checked in full.
-    ObjectId owner;
-    SubscriptionObject* subscription = subscriptionTable.find(id, owner);
-    if (subscription == nullptr || !internal::Scheduler::started() || owner != internal::Scheduler::current().id)
-        [[unlikely]] {
-        const Result<SubscriptionObject*> resolved = internal::resolveOwnSubscription(id);
-        if (!resolved.ok()) {
-            return resolved.status();
-        }
-        subscription = resolved.value();
-    }
-    PublisherObject& publisher = internal::publishers[internal::publisherSlotOf(subscription->publisher)];
-    if (publisher.incarnation != subscription->incarnation) {
+    PublisherObject& publisher = *subscription.publisher;
+    if (publisher.incarnation != subscription.incarnation) {
         return Status::Deleted;
     }
     if (publisher.dataId != kNoDsmData && publisher.dataId != lastSeenDataId) {
-        page = publisher.page;
+        internal::copySixteenBytes(page.bytes, publisher.page.bytes);
         return publisher.dataId;
     }
     if (timeoutNs == kPoll) {
@@ -338,6 +359,44 @@ Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& p
         return woken;
     }
     return request.dataId;
+}
+
+// The complete Read from the id, for the ids the fast path's lookup refuses.
+[[gnu::noinline]] Result<uint32_t> readFull(ObjectId id, uint32_t lastSeenDataId, DsmPage* page,
+                                            const uint64_t& timeoutNs)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<SubscriptionObject*> resolved = internal::resolveOwnSubscription(id);
+    if (!resolved.ok()) {
+        return resolved.status();
+    }
+    return readResolved(*resolved.value(), lastSeenDataId, *page, timeoutNs);
+}
+
+} // namespace
+
+Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& page, uint64_t timeoutNs) const
+{
+    // The fast path: the table's inline lookup, with the owner, for the
+    // subscription's owner, when the publisher holds data newer than
+    // lastSeenDataId. A wait, an error or a wrong id goes the full way.
+    {
+        arch_x86::InterruptGuard guard;
+        ObjectId owner;
+        const SubscriptionObject* subscription = subscriptionTable.find(id, owner);
+        if (subscription != nullptr && internal::Scheduler::started() && owner == internal::Scheduler::current().id)
+            [[likely]] {
+            const PublisherObject& publisher = *subscription->publisher;
+            const uint32_t dataId = publisher.dataId;
+            if (publisher.incarnation == subscription->incarnation && dataId != kNoDsmData && dataId != lastSeenDataId)
+                [[likely]] {
+                internal::copySixteenBytes(page.bytes, publisher.page.bytes);
+                return dataId;
+            }
+            return readResolved(*subscription, lastSeenDataId, page, timeoutNs);
+        }
+    }
+    return readFull(id, lastSeenDataId, &page, timeoutNs);
 }
 
 Result<ObjectId> DsmAgent::NameToObject(const char* name) const

@@ -4,25 +4,27 @@ namespace dcos::internal {
 
 namespace {
 
-// Distinct constants for the three kinds of word, so that a state word can
-// never pass as a link word or the other way round.
-constexpr uint32_t kFreeKind = 0x46524545u;      // "FREE"
-constexpr uint32_t kAllocatedKind = 0x414C4F43u; // "ALOC"
-constexpr uint32_t kLinkKind = 0x4C494E4Bu;      // "LINK"
-
-// The area belongs to the application, which may declare it as bytes of any
-// type; words are therefore moved with memcpy, which the compiler turns into
-// a single load or store and which is valid whatever the declared type.
-uint32_t loadWord(const void* address)
-{
-    uint32_t word;
-    __builtin_memcpy(&word, address, sizeof word);
-    return word;
-}
-
-void storeWord(void* address, uint32_t word) { __builtin_memcpy(address, &word, sizeof word); }
+// The free key is the pool's salt; the allocated key differs from it in every
+// bit of the index half, so that a free word of one buffer is an allocated
+// word only of the buffer whose index is its complement (more than 32768
+// buffers), and in the holder half by a constant.
+constexpr uint32_t kAllocatedKeyDifference = 0x414CFFFFu; // "AL" and all ones
 
 constexpr uintptr_t roundUp8(uintptr_t value) { return (value + 7) & ~uintptr_t{7}; }
+
+// The inverse of an odd value modulo 2^N (N the bits of uintptr_t): Newton's
+// iteration doubles the correct low bits each step, from three (odd * odd
+// is 1 modulo 8).
+constexpr uintptr_t inverseOf(uintptr_t odd)
+{
+    uintptr_t inverse = odd;
+    for (int step = 0; step < 5; ++step) {
+        inverse *= 2 - odd * inverse;
+    }
+    return inverse;
+}
+
+static_assert(inverseOf(3) * 3 == 1 && inverseOf(0x12345) * 0x12345 == 1 && inverseOf(UINTPTR_MAX) * UINTPTR_MAX == 1);
 
 } // namespace
 
@@ -51,23 +53,26 @@ Status BufferPool::initialise(void* area, size_t areaBytes, size_t bufferSize, u
     }
 
     states_ = reinterpret_cast<uint8_t*>(aligned);
-    buffers_ = reinterpret_cast<uint8_t*>(aligned + roundUp8(count * 4));
+    base_ = aligned + roundUp8(count * 4);
     areaBegin_ = begin;
     areaEnd_ = begin + areaBytes;
     bufferSize_ = static_cast<uint32_t>(bufferSize);
     stride_ = static_cast<uint32_t>(stride);
+    shift_ = std::countr_zero(stride);
+    inverse_ = inverseOf(stride >> shift_);
     count_ = static_cast<uint32_t>(count);
-    salt_ = salt;
+    limit_ = count_;
+    freeKey_ = salt;
+    allocatedKey_ = salt ^ kAllocatedKeyDifference;
     // Pushed from the last buffer down, so buffers leave in address order.
     for (uint32_t index = count_; index-- > 0;) {
         pushFree(index);
     }
-    free_ = count_;
     lowWater_ = count_;
     return Status::Ok;
 }
 
-Result<void*> BufferPool::allocate(uint16_t holder)
+Result<void*> BufferPool::allocateSlowly(uint16_t holder)
 {
     if (corrupted_) {
         return Status::Corrupted;
@@ -77,36 +82,17 @@ Result<void*> BufferPool::allocate(uint16_t holder)
     }
     if (head_ == kEndOfList) {
         if (free_ != 0) {
-            return fail(); // Free buffers that no list reaches: the head was overwritten.
+            return fail(); // Free buffers that no list reaches: a state word was overwritten.
         }
         ++failedAllocations_;
         return Status::NoMemory;
     }
-    const uint32_t index = head_;
-    uint16_t ignored;
-    if (index >= count_ || free_ == 0 || stateOf(index, ignored) != State::Free) {
-        return fail();
-    }
-    void* buffer = bufferAt(index);
-    const uint32_t link = loadWord(buffer);
-    const uint16_t next = static_cast<uint16_t>(link);
-    if ((link >> 16) != seal(kLinkKind, index, next) || (next != kEndOfList && next >= count_)
-        || ((next == kEndOfList) != (free_ == 1))) {
-        return fail();
-    }
-    // Every word was checked before this point; now the buffer changes hands.
-    storeWord(buffer, 0); // An allocated buffer never holds a valid link.
-    storeWord(states_ + index * 4, allocatedWord(index, holder));
-    head_ = next;
-    --free_;
-    if (free_ < lowWater_) {
-        lowWater_ = free_;
-    }
-    ++allocations_;
-    return buffer;
+    // tryAllocate() refused a head that is not the end: it is out of range,
+    // or its state word does not say free.
+    return fail();
 }
 
-Status BufferPool::release(void* buffer, uint16_t holder)
+Status BufferPool::releaseSlowly(void* buffer, uint16_t holder)
 {
     if (corrupted_) {
         return Status::Corrupted;
@@ -115,9 +101,7 @@ Status BufferPool::release(void* buffer, uint16_t holder)
     if (!index.ok()) {
         return index.status();
     }
-    pushFree(index.value());
-    ++free_;
-    ++returns_;
+    pushFree(index.value()); // A system buffer, which tryRelease() leaves to this path.
     return Status::Ok;
 }
 
@@ -133,7 +117,7 @@ Status BufferPool::transfer(void* buffer, uint16_t from, uint16_t to)
     if (!index.ok()) {
         return index.status();
     }
-    storeWord(states_ + index.value() * 4, allocatedWord(index.value(), to));
+    storeState(index.value(), ((static_cast<uint32_t>(to) << 16) | index.value()) ^ allocatedKey_);
     return Status::Ok;
 }
 
@@ -142,13 +126,12 @@ size_t BufferPool::reclaimHeldBy(uint16_t holder)
     size_t reclaimed = 0;
     for (uint32_t index = 0; index < count_ && !corrupted_; ++index) {
         uint16_t current;
-        const State state = stateOf(index, current);
+        uint32_t next;
+        const State state = stateOf(index, current, next);
         if (state == State::Invalid) {
             (void)fail(); // Disables the pool, which ends the walk; recovery has no one to tell.
         } else if (state == State::Allocated && current == holder) {
             pushFree(index);
-            ++free_;
-            ++returns_;
             ++reclaimed;
         }
     }
@@ -163,7 +146,8 @@ Status BufferPool::audit()
     uint32_t freeStates = 0;
     for (uint32_t index = 0; index < count_; ++index) {
         uint16_t holder;
-        const State state = stateOf(index, holder);
+        uint32_t next;
+        const State state = stateOf(index, holder, next);
         if (state == State::Invalid) {
             return fail();
         }
@@ -177,12 +161,8 @@ Status BufferPool::audit()
     uint32_t steps = 0;
     for (uint32_t index = head_; index != kEndOfList;) {
         uint16_t holder;
-        if (index >= count_ || ++steps > free_ || stateOf(index, holder) != State::Free) {
-            return fail();
-        }
-        const uint32_t link = loadWord(bufferAt(index));
-        const uint16_t next = static_cast<uint16_t>(link);
-        if ((link >> 16) != seal(kLinkKind, index, next)) {
+        uint32_t next;
+        if (index >= count_ || ++steps > free_ || stateOf(index, holder, next) != State::Free) {
             return fail();
         }
         index = next;
@@ -199,7 +179,9 @@ BufferPoolStatistics BufferPool::statistics() const
     statistics.lowWaterMark = lowWater_;
     statistics.allocations = allocations_;
     statistics.failedAllocations = failedAllocations_;
-    statistics.returns = returns_;
+    // Every buffer allocated is either still out or was returned (by Return
+    // or by recovery), so the returns need no counter of their own.
+    statistics.returns = allocations_ - (count_ - free_);
     return statistics;
 }
 
@@ -208,7 +190,8 @@ bool BufferPool::holderOf(size_t index, uint16_t& holder) const
     if (index >= count_) {
         return false;
     }
-    switch (stateOf(static_cast<uint32_t>(index), holder)) {
+    uint32_t next;
+    switch (stateOf(static_cast<uint32_t>(index), holder, next)) {
     case State::Free: holder = kFreeMark; return true;
     case State::Allocated: return true;
     case State::Invalid: return false;
@@ -216,69 +199,47 @@ bool BufferPool::holderOf(size_t index, uint16_t& holder) const
     return false;
 }
 
-uint16_t BufferPool::seal(uint32_t kind, uint32_t index, uint32_t value) const
+BufferPool::State BufferPool::stateOf(uint32_t index, uint16_t& holder, uint32_t& next) const
 {
-    return static_cast<uint16_t>(
-        mixBits(salt_ ^ kind ^ multiplyWord(index, 0x9E3779B1u) ^ multiplyWord(value, 0x85EBCA77u)) >> 16);
-}
-
-uint32_t BufferPool::freeWord(uint32_t index) const
-{
-    return (static_cast<uint32_t>(seal(kFreeKind, index, kFreeMark)) << 16) | kFreeMark;
-}
-
-uint32_t BufferPool::allocatedWord(uint32_t index, uint16_t holder) const
-{
-    return (static_cast<uint32_t>(seal(kAllocatedKind, index, holder)) << 16) | holder;
-}
-
-uint32_t BufferPool::linkWord(uint32_t index, uint16_t next) const
-{
-    return (static_cast<uint32_t>(seal(kLinkKind, index, next)) << 16) | next;
-}
-
-BufferPool::State BufferPool::stateOf(uint32_t index, uint16_t& holder) const
-{
-    const uint32_t word = loadWord(states_ + index * 4);
-    holder = static_cast<uint16_t>(word);
-    if (holder == kFreeMark) {
-        return word == freeWord(index) ? State::Free : State::Invalid;
+    const uint32_t word = loadState(index);
+    if (static_cast<uint16_t>(word ^ freeKey_) == index) {
+        next = (word ^ freeKey_) >> 16;
+        // A free buffer's link is the end or another buffer.
+        return next == kEndOfList || next < count_ ? State::Free : State::Invalid;
     }
-    return word == allocatedWord(index, holder) ? State::Allocated : State::Invalid;
+    if (static_cast<uint16_t>(word ^ allocatedKey_) == index) {
+        holder = static_cast<uint16_t>((word ^ allocatedKey_) >> 16);
+        // kFreeMark is never stored as a holder (allocate and transfer refuse it).
+        return holder != kFreeMark ? State::Allocated : State::Invalid;
+    }
+    return State::Invalid;
 }
 
 Result<uint32_t> BufferPool::allocatedIndexOf(void* buffer, uint16_t holder)
 {
     const uintptr_t address = reinterpret_cast<uintptr_t>(buffer);
-    const uintptr_t base = reinterpret_cast<uintptr_t>(buffers_);
-    if (count_ == 0 || address < base || address - base >= size_t{count_} * stride_) {
+    if (count_ == 0 || address < base_ || address - base_ >= uintptr_t{count_} * stride_) {
         return Status::InvalidArgument; // Not this pool's memory: the pool is unharmed.
     }
-    const uintptr_t offset = address - base;
-    if (offset % stride_ != 0) {
+    const uintptr_t index = indexOf(buffer);
+    if (index >= count_) {
         return fail(); // A wild pointer into the pool.
     }
-    const uint32_t index = static_cast<uint32_t>(offset / stride_);
     uint16_t current;
-    if (stateOf(index, current) != State::Allocated) {
+    uint32_t next;
+    if (stateOf(static_cast<uint32_t>(index), current, next) != State::Allocated) {
         return fail(); // Returned twice, or its state word was overwritten.
     }
     if (current != holder && current != kSystemHolder) {
         return Status::NotOwner;
     }
-    return index;
-}
-
-void BufferPool::pushFree(uint32_t index)
-{
-    storeWord(bufferAt(index), linkWord(index, head_));
-    storeWord(states_ + index * 4, freeWord(index));
-    head_ = static_cast<uint16_t>(index);
+    return static_cast<uint32_t>(index);
 }
 
 Status BufferPool::fail()
 {
     corrupted_ = true;
+    limit_ = 0; // The fast paths' range test now fails for every index.
     return Status::Corrupted;
 }
 

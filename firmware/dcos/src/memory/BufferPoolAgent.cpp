@@ -15,9 +15,7 @@ Result<ObjectId> BufferPoolAgent::Create(void* area, size_t areaBytes, size_t bu
 
 Status BufferPoolAgent::Delete(ObjectId pool) const { return BufferPoolManager::Delete(pool); }
 
-Result<void*> BufferPoolAgent::Allocate(ObjectId pool) const { return BufferPoolManager::Allocate(pool); }
-
-Status BufferPoolAgent::Return(ObjectId pool, void* buffer) const { return BufferPoolManager::Return(pool, buffer); }
+// Allocate and Return, with their fast paths, are in BufferPoolManager.cpp.
 
 Result<BufferPoolStatistics> BufferPoolAgent::GetStatistics(ObjectId pool) const
 {

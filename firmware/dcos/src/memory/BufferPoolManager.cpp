@@ -291,3 +291,46 @@ size_t BufferPoolManager::capacity() { return kPoolCapacity; }
 DCOS_RESOURCE_RECOVERY(bufferPoolRecovery, "buffer pool", recoverPools);
 
 } // namespace dcos::internal
+
+namespace dcos {
+
+using internal::BufferPool;
+using internal::BufferPoolManager;
+
+// Allocate and Return are defined here rather than in BufferPoolAgent.cpp,
+// beside the pool table, so that the common case runs in the agent's own
+// call: under the interrupt guard, the table's inline lookup and the pool's
+// inline pop or push (BufferPool::tryAllocate, tryRelease). Every other
+// case, errors included, goes to the manager's complete service, which
+// resolves the id again under its own guard and gives the precise status.
+// callerHolder() never gives kFreeMark, as tryAllocate requires.
+
+Result<void*> BufferPoolAgent::Allocate(ObjectId id) const
+{
+    {
+        const internal::Lock lock;
+        if (internal::PoolObject* const* found = internal::poolTable.find(id)) [[likely]] {
+            if (void* buffer = (*found)->pool.tryAllocate(internal::memory_area::callerHolder(BufferPool::kSystemHolder)))
+                [[likely]] {
+                return buffer;
+            }
+        }
+    }
+    return BufferPoolManager::Allocate(id);
+}
+
+Status BufferPoolAgent::Return(ObjectId id, void* buffer) const
+{
+    {
+        const internal::Lock lock;
+        if (internal::PoolObject* const* found = internal::poolTable.find(id)) [[likely]] {
+            if ((*found)->pool.tryRelease(buffer, internal::memory_area::callerHolder(BufferPool::kSystemHolder)))
+                [[likely]] {
+                return Status::Ok;
+            }
+        }
+    }
+    return BufferPoolManager::Return(id, buffer);
+}
+
+} // namespace dcos

@@ -14,9 +14,7 @@ Result<ObjectId> HeapAgent::Create(void* area, size_t areaBytes, const char* nam
 
 Status HeapAgent::Delete(ObjectId heap) const { return HeapManager::Delete(heap); }
 
-Result<void*> HeapAgent::Allocate(ObjectId heap, size_t bytes) const { return HeapManager::Allocate(heap, bytes); }
-
-Status HeapAgent::Return(ObjectId heap, void* segment) const { return HeapManager::Return(heap, segment); }
+// Allocate and Return, with the table's inline lookup, are in HeapManager.cpp.
 
 Result<HeapStatistics> HeapAgent::GetStatistics(ObjectId heap) const { return HeapManager::GetStatistics(heap); }
 

@@ -273,3 +273,38 @@ size_t HeapManager::capacity() { return kHeapCapacity; }
 DCOS_RESOURCE_RECOVERY(heapRecovery, "heap", recoverHeaps);
 
 } // namespace dcos::internal
+
+namespace dcos {
+
+using internal::HeapManager;
+using internal::SegmentedHeap;
+
+// Allocate and Return are defined here rather than in HeapAgent.cpp,
+// beside the heap table, so that they run the allocator from the agent's
+// own call: under the interrupt guard, with the table's inline lookup. An id
+// that lookup refuses goes to the manager's complete service, which
+// resolves it again and gives the precise status.
+
+Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes) const
+{
+    {
+        const internal::Lock lock;
+        if (internal::HeapObject* const* found = internal::heapTable.find(id)) [[likely]] {
+            return (*found)->heap.allocate(bytes, internal::memory_area::callerHolder(SegmentedHeap::kSystemHolder));
+        }
+    }
+    return HeapManager::Allocate(id, bytes);
+}
+
+Status HeapAgent::Return(ObjectId id, void* segment) const
+{
+    {
+        const internal::Lock lock;
+        if (internal::HeapObject* const* found = internal::heapTable.find(id)) [[likely]] {
+            return (*found)->heap.release(segment, internal::memory_area::callerHolder(SegmentedHeap::kSystemHolder));
+        }
+    }
+    return HeapManager::Return(id, segment);
+}
+
+} // namespace dcos

@@ -11,9 +11,57 @@ constexpr uintptr_t roundUp8(uintptr_t value) { return (value + 7) & ~uintptr_t{
 
 // The index of the highest set bit of a non-zero value. Written with XOR,
 // not as 31 - clz, so that GCC emits a lone BSR.
-inline uint32_t highestBit(uint32_t value) { return static_cast<uint32_t>(__builtin_clz(value)) ^ 31; }
+constexpr uint32_t highestBit(uint32_t value) { return static_cast<uint32_t>(__builtin_clz(value)) ^ 31; }
 
 } // namespace
+
+constexpr SegmentedHeap::SizeClass SegmentedHeap::roundedClassOf(uint32_t needed)
+{
+    if (needed < kClasses * kAlignment) {
+        return {0, static_cast<uint32_t>(needed / kAlignment)}; // A multiple of 8 below 64 is a class boundary.
+    }
+    // The classes of [2^p, 2^(p+1)) are 2^(p-3) wide: needed takes steps of
+    // that width, 8 to 16 of them; 16 is the next level's first class.
+    const uint32_t power = highestBit(needed);
+    const uint32_t steps = ((needed - 1) >> (power - kClassBits)) + 1;
+    return {power - 5 + (steps >> (kClassBits + 1)), steps & (kClasses - 1)};
+}
+
+constexpr bool SegmentedHeap::roundedClassesAgree(uint32_t limit)
+{
+    for (uint32_t needed = kSmallestSegment; needed <= limit; needed += kAlignment) {
+        uint32_t rounded = needed; // The rounding as it was written before roundedClassOf().
+        if (needed >= 8 * kAlignment) {
+            rounded += (uint32_t{1} << (highestBit(needed) - kClassBits)) - 1;
+        }
+        const SizeClass expected = classOf(rounded);
+        const SizeClass actual = roundedClassOf(needed);
+        if (expected.level != actual.level || expected.index != actual.index) {
+            return false;
+        }
+    }
+    for (uint32_t power = 17; power <= 30; ++power) { // Around every larger power of two.
+        for (uint32_t needed = (1u << power) - 64; needed <= (1u << power) + 64; needed += kAlignment) {
+            const uint32_t rounded = needed + (uint32_t{1} << (highestBit(needed) - kClassBits)) - 1;
+            const SizeClass expected = classOf(rounded);
+            const SizeClass actual = roundedClassOf(needed);
+            if (expected.level != actual.level || expected.index != actual.index) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+constexpr SegmentedHeap::SizeClass SegmentedHeap::classOf(uint32_t size)
+{
+    const uint32_t units = static_cast<uint32_t>(size / kAlignment);
+    if (units < kClasses) {
+        return {0, units};
+    }
+    const uint32_t power = highestBit(units);
+    return {power - kClassBits + 1, (units >> (power - kClassBits)) & (kClasses - 1)};
+}
 
 Status SegmentedHeap::initialise(void* area, size_t areaBytes, uint32_t salt)
 {
@@ -62,11 +110,8 @@ Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
 
     // Round the request up to a class boundary: every segment of the class
     // found then fits, and the first one is taken without a search.
-    uint32_t rounded = needed;
-    if (needed >= 8 * kAlignment) {
-        rounded += (uint32_t{1} << (highestBit(needed) - kClassBits)) - 1;
-    }
-    SizeClass found = classOf(rounded);
+    static_assert(roundedClassesAgree(1u << 17));
+    SizeClass found = roundedClassOf(needed);
     if (!findFrom(found)) {
         // The request's own class may still hold a segment that fits: try its first.
         found = classOf(needed);
@@ -83,12 +128,20 @@ Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
     const uint32_t current = heads_[found.level][found.index];
 
     // A listed segment is free, starts its list and fits; its successor in the list points back.
-    uint32_t currentSize;
-    if (!isLink(current) || !checkFree(current, currentSize) || word(current + 4) != kNone || currentSize < needed) {
+    // checkFree() and its links, each word read once: no previous segment
+    // (it starts its list), the next one a link leading back.
+    if (!isLink(current)) {
         return fail();
     }
+    const uint32_t currentFirst = word(current);
+    const uint32_t currentSize = currentFirst & ~kFlagMask;
+    if ((currentFirst & kFlagMask) != 0 || currentSize < needed || currentSize > size_ - current
+        || word(current + currentSize - 4) != endTag(currentSize, current + currentSize)
+        || word(current + 4) != kNone) {
+        return fail(); // needed >= kSmallestSegment, so the size is at least that too.
+    }
     const uint32_t next = word(current + 8);
-    if (next != kNone && word(next + 4) != current) {
+    if (next != kNone && (!isLink(next) || word(next + 4) != current)) {
         return fail();
     }
     uint32_t segmentSize = currentSize;
@@ -135,8 +188,7 @@ Status SegmentedHeap::release(void* segment, uint16_t holder)
     if (!offset.ok()) {
         return offset.status();
     }
-    uint32_t freedEnd;
-    return releaseAt(offset.value(), header, freedEnd);
+    return releaseAt(offset.value(), header.size, header.previousFree) != 0 ? Status::Ok : Status::Corrupted;
 }
 
 Status SegmentedHeap::transfer(void* segment, uint16_t from, uint16_t to)
@@ -178,8 +230,8 @@ size_t SegmentedHeap::reclaimHeldBy(uint16_t holder)
         }
         // The freed segment may merge with the free one before it; the walk
         // goes on after the merged segment, which ends on a segment boundary.
-        uint32_t freedEnd;
-        if (releaseAt(offset, header, freedEnd) != Status::Ok) {
+        const uint32_t freedEnd = releaseAt(offset, header.size, header.previousFree);
+        if (freedEnd == 0) {
             break;
         }
         ++reclaimed;
@@ -282,16 +334,6 @@ Status SegmentedHeap::audit()
         }
     }
     return steps == freeCount && (levelMap_ >> kLevels) == 0 ? Status::Ok : fail();
-}
-
-inline SegmentedHeap::SizeClass SegmentedHeap::classOf(uint32_t size)
-{
-    const uint32_t units = size / kAlignment;
-    if (units < kClasses) {
-        return {0, units};
-    }
-    const uint32_t power = highestBit(units);
-    return {power - kClassBits + 1, (units >> (power - kClassBits)) & (kClasses - 1)};
 }
 
 inline bool SegmentedHeap::findFrom(SizeClass& sizeClass) const
@@ -443,19 +485,22 @@ inline bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) co
            && header.size <= size_ - offset && (second >> 16) == seal(offset, first, header.holder);
 }
 
-inline bool SegmentedHeap::checkListNeighbours(uint32_t offset, SizeClass sizeClass) const
+inline bool SegmentedHeap::checkListed(uint32_t offset, SizeClass sizeClass) const
 {
-    // Called after checkLinks(), which checked that both links are offsets in the heap.
+    // checkLinks() and the list neighbours' links back, each word read
+    // once: the previous segment on the list (or, for the first, the head
+    // of the class's list) and the next one both lead back to this segment.
     const uint32_t previous = word(offset + 4);
     const uint32_t next = word(offset + 8);
-    bool previousOk;
     if (previous == kNone) {
-        previousOk = (levelMaps_[sizeClass.level] & (1u << sizeClass.index)) != 0
-                     && heads_[sizeClass.level][sizeClass.index] == offset;
-    } else {
-        previousOk = word(previous + 8) == offset;
+        if ((levelMaps_[sizeClass.level] & (1u << sizeClass.index)) == 0
+            || heads_[sizeClass.level][sizeClass.index] != offset) {
+            return false;
+        }
+    } else if (!isLink(previous) || word(previous + 8) != offset) {
+        return false;
     }
-    return previousOk && (next == kNone || word(next + 4) == offset);
+    return next == kNone || (isLink(next) && word(next + 4) == offset);
 }
 
 inline void SegmentedHeap::writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder)
@@ -486,21 +531,29 @@ inline Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t
     return static_cast<uint32_t>(offset);
 }
 
-Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32_t& freedEnd)
+uint32_t SegmentedHeap::releaseAt(uint32_t offset, uint32_t segmentSize, bool previousFree)
 {
+    const auto fail = [this] {
+        (void)this->fail();
+        return uint32_t{0};
+    };
     // Check both neighbours before anything is written.
-    const uint32_t nextOffset = offset + header.size;
+    const uint32_t nextOffset = offset + segmentSize;
     bool mergeNext = false;
     uint32_t nextSize = 0;
     SizeClass nextClass{};
     if (nextOffset < size_) {
         const uint32_t nextFirst = word(nextOffset);
         if ((nextFirst & kAllocatedFlag) == 0) {
-            if (!checkFree(nextOffset, nextSize)) {
+            // checkFree() with its links checked together with the list
+            // neighbours they lead to, each link read once.
+            nextSize = nextFirst & ~kFlagMask;
+            if ((nextFirst & kFlagMask) != 0 || nextSize < kSmallestSegment || nextSize > size_ - nextOffset
+                || word(nextOffset + nextSize - 4) != endTag(nextSize, nextOffset + nextSize)) {
                 return fail();
             }
             nextClass = classOf(nextSize);
-            if (!checkListNeighbours(nextOffset, nextClass)) {
+            if (!checkListed(nextOffset, nextClass)) {
                 return fail();
             }
             mergeNext = true;
@@ -511,7 +564,7 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
     uint32_t previousOffset = 0;
     uint32_t previousSize = 0;
     SizeClass previousClass{};
-    if (header.previousFree) {
+    if (previousFree) {
         if (offset < kSmallestSegment) {
             return fail();
         }
@@ -523,18 +576,18 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
             return fail();
         }
         previousOffset = offset - previousSize;
-        if (word(previousOffset) != previousSize || !checkLinks(previousOffset)) {
+        if (word(previousOffset) != previousSize) {
             return fail();
         }
         previousClass = classOf(previousSize);
-        if (!checkListNeighbours(previousOffset, previousClass)) {
+        if (!checkListed(previousOffset, previousClass)) {
             return fail();
         }
     }
 
     // Merge. An obsolete header is cleared so an old pointer to it reads as a double return.
     uint32_t start = offset;
-    uint32_t total = header.size;
+    uint32_t total = segmentSize;
     uint32_t tag;
     if (mergeNext) {
         unlink(nextOffset, nextClass);
@@ -550,7 +603,7 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
             setWord(nextOffset, word(nextOffset) | kPreviousFreeFlag); // The seal leaves P out.
         }
     }
-    if (header.previousFree) {
+    if (previousFree) {
         unlink(previousOffset, previousClass);
         setWord(offset, 0);
         setWord(offset + 4, 0);
@@ -562,11 +615,10 @@ Status SegmentedHeap::releaseAt(uint32_t offset, const Allocated& header, uint32
     setWord(start, total);
     setWord(start + total - 4, tag ^ total);
     insert(start, total);
-    freeBytes_ += header.size;
+    freeBytes_ += segmentSize;
     --allocatedSegments_;
     ++returns_;
-    freedEnd = start + total;
-    return Status::Ok;
+    return start + total;
 }
 
 Status SegmentedHeap::fail()

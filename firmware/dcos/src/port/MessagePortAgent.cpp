@@ -18,6 +18,7 @@
 #include <dcos/MessagePortAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/FastPath.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/MessageBufferPool.hpp>
 #include <dcos/internal/MessageQueue.hpp>
@@ -195,13 +196,15 @@ namespace {
     if (buffer == nullptr) {
         return Status::NoMemory; // Refused, not dropped: the sender decides.
     }
-    buffer->message = message;
+    buffer->message = message; // A REP MOVSL: the destination is aligned.
     port.queue.post(*buffer, priority);
     return Status::Ok;
 }
 
-[[gnu::noinline]] Status receiveFull(ObjectId id, Message& message, uint64_t timeoutNs)
+[[gnu::noinline]] Status receiveFull(ObjectId id, Message* into, const uint64_t* timeout)
 {
+    const uint64_t timeoutNs = *timeout;
+    Message& message = *into;
     arch_x86::InterruptGuard guard;
     start();
     const Result<PortObject*> resolved = resolvePort(id);
@@ -214,7 +217,7 @@ namespace {
     }
     PortObject& port = *resolved.value();
     if (MessageBuffer* buffer = port.queue.takeFirst()) {
-        message = buffer->message;
+        internal::copySixteenBytes(message.bytes, buffer->message.bytes);
         bufferPool.give(*buffer);
         return Status::Ok;
     }
@@ -277,7 +280,7 @@ Status MessagePortAgent::Send(ObjectId id, const Message& message, int priority)
         PortObject* const* found = portTable.find(id);
         if (found != nullptr && !(*found)->dying && (*found)->receivers.isEmpty()) [[likely]] {
             if (MessageBuffer* buffer = bufferPool.take()) [[likely]] {
-                buffer->message = message;
+                buffer->message = message; // A REP MOVSL: the destination is aligned.
                 (*found)->queue.post(*buffer, priority);
                 return Status::Ok;
             }
@@ -297,13 +300,13 @@ Status MessagePortAgent::Receive(ObjectId id, Message& message, uint64_t timeout
         if (found != nullptr && !(*found)->dying && internal::Scheduler::started()
             && owner == internal::Scheduler::current().id) [[likely]] {
             if (MessageBuffer* buffer = (*found)->queue.takeFirst()) {
-                message = buffer->message;
+                internal::copySixteenBytes(message.bytes, buffer->message.bytes);
                 bufferPool.give(*buffer);
                 return Status::Ok;
             }
         }
     }
-    return receiveFull(id, message, timeoutNs);
+    return internal::callSlowPath(receiveFull, id, &message, &timeoutNs);
 }
 
 Status MessagePortAgent::AddMsgBufs(size_t count) const

@@ -11,6 +11,7 @@
 #include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/FastPath.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
@@ -38,6 +39,9 @@ struct Semaphore : InheritanceSource {
     uint32_t count = 0;
     uint32_t maximum = 1;
     bool inheritance = false;
+    // A binary semaphore without priority inheritance: the one kind whose
+    // Acquire and Release fast paths need no more than the holder list.
+    bool plainBinary = false;
     // InheritanceSource::holder is the holding task of a binary semaphore.
 };
 
@@ -148,8 +152,9 @@ size_t semaphoreCount()
 
 // The complete Acquire and Release: every case, from a resolved id.
 // The agent's fast paths (below) come here for all they do not handle.
-[[gnu::noinline]] Status acquireFull(ObjectId id, uint64_t timeout)
+[[gnu::noinline]] Status acquireFull(ObjectId id, const uint64_t* timeoutIn)
 {
+    const uint64_t timeout = *timeoutIn;
     arch_x86::InterruptGuard guard;
     const Result<Semaphore*> resolved = resolve(id);
     if (!resolved.ok()) {
@@ -271,6 +276,7 @@ Result<ObjectId> SemaphoreAgent::Create(const SemaphoreAttributes& attributes) c
     semaphore.count = attributes.initialCount;
     semaphore.maximum = binary ? 1 : attributes.maximumCount;
     semaphore.inheritance = attributes.priorityInheritance;
+    semaphore.plainBinary = binary && !attributes.priorityInheritance;
     semaphore.lendsPriority = attributes.priorityInheritance;
     semaphore.waiters.setOrder(attributes.order == WaitOrder::Fifo ? internal::WaitQueue::Order::Fifo
                                                                    : internal::WaitQueue::Order::Priority);
@@ -303,52 +309,59 @@ Status SemaphoreAgent::Delete(ObjectId id) const
 
 Status SemaphoreAgent::Acquire(ObjectId id, uint64_t timeout) const
 {
-    // The fast path takes a free semaphore (or a unit of a counting one)
-    // from a task; everything else, a wrong id included, goes the full way.
+    // The fast path takes a free binary semaphore without inheritance from
+    // a task, or a unit of a counting one; everything else, a wrong id and
+    // a semaphore with inheritance included, goes the full way.
     {
         arch_x86::InterruptGuard guard;
         Semaphore* const* found = internal::table.find(id);
         if (found != nullptr) [[likely]] {
             Semaphore& semaphore = **found;
-            if (semaphore.kind == SemaphoreKind::Binary) {
+            if (semaphore.plainBinary) {
                 if (semaphore.count == 1 && !internal::inInterruptContext()) {
+                    Task& self = Scheduler::current();
                     semaphore.count = 0;
-                    internal::takeHold(semaphore, Scheduler::current());
+                    semaphore.holder = &self;
+                    self.heldSources.pushBack(semaphore); // For recovery (see takeHold).
                     return Status::Ok;
                 }
-            } else if (semaphore.count > 0) {
+            } else if (semaphore.kind == SemaphoreKind::Counting && semaphore.count > 0) {
                 semaphore.count = semaphore.count - 1;
                 return Status::Ok;
             }
         }
     }
-    return internal::acquireFull(id, timeout);
+    return internal::callSlowPath(internal::acquireFull, id, &timeout);
 }
 
 Status SemaphoreAgent::Release(ObjectId id) const
 {
     // The fast path gives back what no task waits for; a hand-over to a
-    // waiter, an error or a wrong id goes the full way.
+    // waiter, a semaphore with inheritance, an error or a wrong id goes the
+    // full way.
     {
         arch_x86::InterruptGuard guard;
         Semaphore* const* found = internal::table.find(id);
         if (found != nullptr) [[likely]] {
             Semaphore& semaphore = **found;
             if (semaphore.waiters.isEmpty()) {
-                if (semaphore.kind == SemaphoreKind::Binary) {
+                if (semaphore.plainBinary) {
+                    // The holder is the caller, so it is not null and the
+                    // semaphore is on the caller's list (see dropHold).
                     if (semaphore.holder == &Scheduler::current() && !internal::inInterruptContext()) {
-                        internal::dropHold(semaphore);
+                        semaphore.holder = nullptr;
+                        Scheduler::current().heldSources.remove(semaphore);
                         semaphore.count = 1;
                         return Status::Ok;
                     }
-                } else if (semaphore.count != semaphore.maximum) {
+                } else if (semaphore.kind == SemaphoreKind::Counting && semaphore.count != semaphore.maximum) {
                     semaphore.count = semaphore.count + 1;
                     return Status::Ok;
                 }
             }
         }
     }
-    return internal::releaseFull(id);
+    return internal::callSlowPath(internal::releaseFull, id);
 }
 
 Result<uint32_t> SemaphoreAgent::GetCount(ObjectId id) const

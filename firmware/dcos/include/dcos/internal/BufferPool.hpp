@@ -4,25 +4,40 @@
 //
 //     | state[0] ... state[n-1] | pad to 8 | buffer 0 | buffer 1 | ... | buffer n-1 |
 //
-// Each buffer has a 32-bit state word in the table at the start of the area:
-// its low half is the holder (a 16-bit tag the kernel derives from the task
-// id, kSystemHolder for the system, kFreeMark for a free buffer) and its high
-// half a check value computed from the pool's salt, the buffer's index, the
-// state and the holder. Free buffers form a LIFO list threaded through their
-// first word: the next buffer's index in the low half and a check value in
-// the high half. Allocate pops the head and Return pushes onto it, so both
-// cost O(1), and both verify every word they read before they write any:
+// Each buffer has a 32-bit state word in the table at the start of the area.
+// Its low half is the buffer's own index and its high half the holder (a
+// 16-bit tag the kernel derives from the task id, kSystemHolder for the
+// system) of an allocated buffer, or the index of the next free buffer of a
+// free one, and the whole word is XORed with one of two per-pool keys, one
+// for each state. So the free buffers form a LIFO list threaded through the
+// state table, and the pool's bookkeeping lives in the state table only:
+// nothing of it is kept inside the buffers, so a task writing into a buffer
+// it has returned damages only its own data, never the pool.
 //
-// - a buffer is handed out only if its state word says free, and is marked
-//   allocated before it leaves, so a forged or looping free list can never
-//   hand out memory twice; it is detected as corruption instead;
-// - a buffer whose state word already says free is a double return;
-// - a link or state word that fails its check was overwritten by the
-//   application (typically a write into a buffer after returning it).
+// Allocate pops the head of the list and Return pushes onto it, so both cost
+// O(1), and both check every word they read before they write any:
+//
+// - a buffer is handed out only if its state word decodes as free under the
+//   free key with its own index, and is marked allocated before it leaves,
+//   so a forged or looping free list can never hand out memory twice; it is
+//   detected as corruption instead;
+// - a buffer whose state word decodes as free is a double return;
+// - a word that decodes as neither, or with another index, was overwritten
+//   (a stray write into the state table, or a state word copied from another
+//   buffer or pool).
 //
 // Once corruption is found the pool is disabled: every call fails with
-// Status::Corrupted until the owner deletes it. A check value has 16 bits,
-// so a random overwrite escapes detection with probability 2^-16 per word.
+// Status::Corrupted until the owner deletes it. The index half is the check:
+// a random overwrite passes for one particular buffer with probability 2^-16.
+//
+// The common cases have inline fast paths, tryAllocate() and tryRelease(),
+// which the kernel's services call directly: a pop (one state word read,
+// checked, rewritten) and a push after a range and alignment test that
+// takes one multiplication and one rotation (the stride's exact-division
+// inverse, so no division). They handle only the case that succeeds; every
+// other case, errors included, is left to allocate() and release(), which
+// give the precise status. The cost of a fast path is the same whatever the
+// pool holds.
 //
 // The class does no locking; its owner serialises calls.
 #pragma once
@@ -30,6 +45,7 @@
 #include <dcos/BufferPoolAgent.hpp>
 #include <dcos/Status.hpp>
 
+#include <bit>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -40,7 +56,7 @@ class BufferPool {
 public:
     /// The holder tag of buffers that belong to the system: any holder may return them.
     static constexpr uint16_t kSystemHolder = 0xFFFF;
-    /// Reserved: the holder field of a free buffer; never a valid holder.
+    /// Reserved: what holderOf() reports for a free buffer; never a valid holder.
     static constexpr uint16_t kFreeMark = 0xFFFE;
     /// Smallest buffer size, in bytes.
     static constexpr size_t kMinimumBufferSize = BufferPoolAgent::kMinimumBufferSize;
@@ -53,18 +69,66 @@ public:
     /// Lays out a pool of as many @p bufferSize byte buffers as fit in
     /// @p areaBytes bytes at @p area, all free. O(buffers).
     ///
-    /// @p salt makes the check values of this pool differ from those of
+    /// @p salt makes the state words of this pool differ from those of
     /// any other (the kernel passes a fresh value per pool). Fails with
     /// InvalidArgument for a null area, a buffer size below 4, no buffer
     /// fitting, or more than kMaximumBuffers fitting; the pool is then unused.
     Status initialise(void* area, size_t areaBytes, size_t bufferSize, uint32_t salt);
+
+    /// The fast path of allocate(): takes the head of the free list for
+    /// @p holder, or returns null when the list is empty, the pool is
+    /// corrupted or the head's state word fails its check (allocate() then
+    /// says which). @p holder must not be kFreeMark. O(1).
+    [[gnu::always_inline]] void* tryAllocate(uint16_t holder)
+    {
+        const uint32_t index = head_;
+        if (index >= limit_) {
+            return nullptr; // Empty (kEndOfList), corrupted (limit_ 0) or a bad head.
+        }
+        const uint32_t word = loadState(index) ^ freeKey_;
+        if (static_cast<uint16_t>(word) != index) {
+            return nullptr;
+        }
+        storeState(index, ((static_cast<uint32_t>(holder) << 16) | index) ^ allocatedKey_);
+        head_ = word >> 16; // Checked when it is the head: below limit_, or the end.
+        if (--free_ < lowWater_) {
+            lowWater_ = free_;
+        }
+        ++allocations_;
+        return reinterpret_cast<void*>(base_ + index * stride_);
+    }
+
+    /// The fast path of release(): gives back @p buffer if it is the start
+    /// of a buffer that @p holder itself holds; false in every other case
+    /// (release() then decides). O(1).
+    [[gnu::always_inline]] bool tryRelease(void* buffer, uint16_t holder)
+    {
+        const uintptr_t index = indexOf(buffer);
+        if (index >= limit_) {
+            return false; // Not a buffer's start, not this pool's, or corrupted.
+        }
+        if (loadState(static_cast<uint32_t>(index))
+            != (((static_cast<uint32_t>(holder) << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_)) {
+            return false; // Free already, another holder's, the system's, or overwritten.
+        }
+        pushFree(static_cast<uint32_t>(index));
+        return true;
+    }
 
     /// Takes the buffer at the head of the free list for @p holder. O(1).
     ///
     /// Fails with NoMemory when none is free, Corrupted when the pool is or
     /// turns out to be corrupted, and InvalidArgument for the reserved
     /// holder kFreeMark.
-    Result<void*> allocate(uint16_t holder);
+    Result<void*> allocate(uint16_t holder)
+    {
+        if (holder != kFreeMark) [[likely]] {
+            if (void* buffer = tryAllocate(holder)) [[likely]] {
+                return buffer;
+            }
+        }
+        return allocateSlowly(holder);
+    }
 
     /// Returns @p buffer on behalf of @p holder. O(1).
     ///
@@ -72,7 +136,13 @@ public:
     /// buffer is held by another holder than @p holder or the system;
     /// Corrupted (the pool is disabled) for a free buffer, a pointer that is
     /// not a buffer's start, or a state word that fails its check.
-    Status release(void* buffer, uint16_t holder);
+    Status release(void* buffer, uint16_t holder)
+    {
+        if (tryRelease(buffer, holder)) [[likely]] {
+            return Status::Ok;
+        }
+        return releaseSlowly(buffer, holder);
+    }
 
     /// Hands @p buffer, held by @p from or by the system, to the holder @p to. O(1).
     ///
@@ -111,38 +181,68 @@ public:
     /// Number of buffers.
     size_t bufferCount() const { return count_; }
     /// Address of the buffer with index @p index.
-    void* bufferAt(size_t index) const { return buffers_ + index * stride_; }
+    void* bufferAt(size_t index) const { return reinterpret_cast<void*>(base_ + index * stride_); }
 
 private:
-    static constexpr uint16_t kEndOfList = 0xFFFF;
+    static constexpr uint32_t kEndOfList = 0xFFFF;
 
     enum class State : uint8_t { Free, Allocated, Invalid };
 
-    uint16_t seal(uint32_t kind, uint32_t index, uint32_t value) const;
-    uint32_t freeWord(uint32_t index) const;
-    uint32_t allocatedWord(uint32_t index, uint16_t holder) const;
-    uint32_t linkWord(uint32_t index, uint16_t next) const;
-    State stateOf(uint32_t index, uint16_t& holder) const;
+    // The area belongs to the application, which may declare it as bytes of
+    // any type; words are therefore moved with memcpy, which the compiler
+    // turns into a single load or store and which is valid whatever the
+    // declared type.
+    uint32_t loadState(uint32_t index) const
+    {
+        uint32_t word;
+        __builtin_memcpy(&word, states_ + index * 4, sizeof word);
+        return word;
+    }
+    void storeState(uint32_t index, uint32_t word) { __builtin_memcpy(states_ + index * 4, &word, sizeof word); }
+
+    // The index of the buffer starting at @p buffer; count_ or more for any
+    // other address, inside the pool or not. offset / stride_ exactly, by
+    // the multiplicative inverse of the stride's odd part and a rotation by
+    // its power of two: the result is the quotient when the stride divides
+    // the offset, and above every buffer index when it does not (Granlund
+    // and Montgomery's divisibility test).
+    uintptr_t indexOf(const void* buffer) const
+    {
+        return std::rotr((reinterpret_cast<uintptr_t>(buffer) - base_) * inverse_, shift_);
+    }
+
+    void pushFree(uint32_t index)
+    {
+        storeState(index, ((head_ << 16) | index) ^ freeKey_);
+        head_ = index;
+        ++free_;
+    }
+
+    State stateOf(uint32_t index, uint16_t& holder, uint32_t& next) const;
+    Result<void*> allocateSlowly(uint16_t holder);
+    Status releaseSlowly(void* buffer, uint16_t holder);
     // Finds the index of an allocated buffer for release() and transfer();
     // fails (disabling the pool where the seed asks for it) otherwise.
     Result<uint32_t> allocatedIndexOf(void* buffer, uint16_t holder);
-    void pushFree(uint32_t index);
     Status fail();
 
     uint8_t* states_ = nullptr; // The state table: one 32-bit word per buffer.
-    uint8_t* buffers_ = nullptr;
-    uintptr_t areaBegin_ = 0;
-    uintptr_t areaEnd_ = 0;
-    uint32_t bufferSize_ = 0;
+    uintptr_t base_ = 0;        // The first buffer.
     uint32_t stride_ = 0;
-    uint32_t count_ = 0;
+    uintptr_t inverse_ = 0;     // Of the stride's odd part, modulo 2^32 (2^64 on a 64-bit host).
+    int shift_ = 0;             // The stride's trailing zero bits.
+    uint32_t limit_ = 0;        // count_ while in service, 0 once corrupted: the fast paths' one test.
+    uint32_t head_ = kEndOfList;
     uint32_t free_ = 0;
     uint32_t lowWater_ = 0;
     uint32_t allocations_ = 0;
+    uint32_t freeKey_ = 0;      // Every free buffer's state word is XORed with it,
+    uint32_t allocatedKey_ = 0; // every allocated buffer's with this one.
+    uint32_t count_ = 0;
     uint32_t failedAllocations_ = 0;
-    uint32_t returns_ = 0;
-    uint32_t salt_ = 0;
-    uint16_t head_ = kEndOfList;
+    uint32_t bufferSize_ = 0;
+    uintptr_t areaBegin_ = 0;
+    uintptr_t areaEnd_ = 0;
     bool corrupted_ = false;
 };
 

@@ -53,7 +53,7 @@ public:
     }
 
     /// Creates an empty queue of @p order.
-    explicit constexpr MessageQueue(PortOrder order = PortOrder::Priority) : order_(order) {}
+    explicit constexpr MessageQueue(PortOrder order = PortOrder::Priority) : order_(order), levelMask_(maskOf(order)) {}
 
     MessageQueue(const MessageQueue&) = delete;
     MessageQueue& operator=(const MessageQueue&) = delete;
@@ -62,13 +62,54 @@ public:
     PortOrder order() const { return order_; }
 
     /// Changes the order; only an empty queue may change it (a new port).
-    void reset(PortOrder order) { order_ = order; }
+    void reset(PortOrder order)
+    {
+        order_ = order;
+        levelMask_ = maskOf(order);
+    }
 
-    /// Queues @p buffer for a Send of @p priority, which must be valid. Cost O(1).
-    void post(MessageBuffer& buffer, int priority);
+    /// Queues @p buffer for a Send of @p priority, which must be valid. Cost
+    /// O(1). Inline, as takeFirst(), because Send and Receive are its fast paths.
+    void post(MessageBuffer& buffer, int priority)
+    {
+        // placementOf(order_, priority), with the order as a mask: the
+        // magnitude is at most 32, and its low five bits are the level.
+        const bool lifo = priority < 0;
+        const uint8_t levelNumber =
+            static_cast<uint8_t>((lifo ? static_cast<unsigned>(-priority) : static_cast<unsigned>(priority)) & levelMask_);
+        Level& level = level_[levelNumber];
+        if (level.head == nullptr) {
+            buffer.next = nullptr;
+            level.head = level.tail = &buffer;
+            levels_.set(levelNumber);
+        } else if (lifo) {
+            buffer.next = level.head;
+            level.head = &buffer;
+        } else {
+            buffer.next = nullptr;
+            level.tail->next = &buffer;
+            level.tail = &buffer;
+        }
+        ++count_;
+    }
 
     /// Takes the message Receive gets next, or null when empty. Cost O(1).
-    MessageBuffer* takeFirst();
+    MessageBuffer* takeFirst()
+    {
+        const uint8_t first = levels_.highest();
+        if (first == ReadyBitmap::kNone) {
+            return nullptr;
+        }
+        Level& level = level_[first];
+        MessageBuffer* buffer = level.head;
+        level.head = buffer->next;
+        if (level.head == nullptr) {
+            level.tail = nullptr;
+            levels_.clear(first);
+        }
+        --count_;
+        return buffer;
+    }
 
     /// Hands every queued buffer back to @p pool and leaves the queue
     /// empty. Cost O(levels): each level goes back as one chain.
@@ -85,13 +126,15 @@ private:
     struct Level {
         MessageBuffer* head = nullptr;
         MessageBuffer* tail = nullptr;
-        size_t count = 0;
     };
+
+    static constexpr uint8_t maskOf(PortOrder order) { return order == PortOrder::Fifo ? 0 : kLevels - 1; }
 
     Level level_[kLevels] = {};
     ReadyBitmap levels_;
     size_t count_ = 0;
     PortOrder order_;
+    uint8_t levelMask_; // kLevels - 1, or 0 for a FIFO port: every message on level 0.
 };
 
 } // namespace dcos::internal

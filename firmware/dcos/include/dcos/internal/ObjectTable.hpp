@@ -93,7 +93,7 @@ public:
     ///
     /// The constructor is constexpr so that a static table is constant
     /// initialised and needs no start-up code before the agents run.
-    constexpr ObjectTable(ObjectType type, uint16_t node) : type_(type), node_(node), prefix_(prefixOf(type, node)) {}
+    constexpr ObjectTable(ObjectType type, uint16_t node) : type_(type), node_(node) {}
 
     ObjectTable(const ObjectTable&) = delete;
     ObjectTable& operator=(const ObjectTable&) = delete;
@@ -121,7 +121,6 @@ public:
             return Status::Busy;
         }
         node_ = node;
-        prefix_ = prefixOf(type_, node);
         return Status::Ok;
     }
 
@@ -167,9 +166,9 @@ public:
         }
         const uint16_t slot = popFree();
         Entry& entry = entries_[slot];
-        entry.index = takeIndex();
-        indexSlot_[entry.index] = static_cast<SlotNumber>(slot);
-        entry.used = true;
+        const uint16_t index = takeIndex();
+        indexSlot_[index] = static_cast<SlotNumber>(slot);
+        entry.key = ObjectId(node_, type_, index).raw();
         entry.owner = owner;
         entry.visibility = visibility;
         copyName(entry.name, name);
@@ -201,10 +200,11 @@ public:
         }
         unlinkOwner(slot.value());
         entry.object = T{};
-        entry.used = false;
+        const uint16_t index = entry.index();
+        entry.key = 0;
         entry.owner = ObjectId::null();
         entry.name[0] = '\0';
-        giveBackIndex(entry.index);
+        giveBackIndex(index);
         pushFree(slot.value());
         --used_;
         return Status::Ok;
@@ -227,11 +227,12 @@ public:
 
     /// The real-time services' lookup: the object @p id names, or null
     /// wherever resolve() fails (call resolve() then, for the reason). It is
-    /// inline and takes three compares: node and type in one (the id's upper
-    /// 20 bits), then the slot's use and the index it holds, which also
-    /// refuses an index never handed out, since no slot holds one. Issue 14's
-    /// remote ids will take the null branch, so the local path stays this
-    /// short. Cost O(1).
+    /// inline and takes two compares: the slot the id's index last named
+    /// keeps its live object's whole id, so node, type, index and use are
+    /// checked at once (a free slot keeps 0, the null id, which the other
+    /// compare refuses), which also refuses an index never handed out, since
+    /// no slot holds one. Issue 14's remote ids will take the null branch,
+    /// so the local path stays this short. Cost O(1).
     T* find(ObjectId id)
     {
         ObjectId unused; // Inline: the compiler drops the owner's load.
@@ -242,11 +243,8 @@ public:
     /// ownership on the same lookup. @p owner is unchanged on a miss.
     T* find(ObjectId id, ObjectId& owner)
     {
-        if ((id.raw() >> ObjectId::kIndexBits) != prefix_) {
-            return nullptr;
-        }
         Entry& entry = entries_[indexSlot_[id.index()]];
-        if (!entry.used || entry.index != id.index()) {
+        if (entry.key != id.raw() || id.isNull()) {
             return nullptr;
         }
         owner = entry.owner;
@@ -430,18 +428,21 @@ private:
     // The key of the list of objects the system owns (the null owner).
     static constexpr size_t kSystemOwnerKey = OwnerKeys::kCount;
 
-    // resolve() reads only object, index and used. The entry keeps the
-    // layout it had before the chains came (the owner key sits where the
-    // free-list link was), so that its size, a power of two for a pointer
-    // T, still makes the fast paths' slot-to-entry arithmetic one shift.
+    // resolve() and find() read only object and key. The entry stays 32
+    // bytes for a pointer T (the key took the place of the index and the
+    // use flag), so that its size, a power of two, still makes the fast
+    // paths' slot-to-entry arithmetic one shift.
     struct Entry {
         T object{};
         ObjectId owner{};
-        uint16_t index = 0; ///< The id's index field while the slot is used.
+        /// The object's whole id while the slot is used, 0 (the null id) while
+        /// it is free; find() refuses the null id, so no id finds a free slot.
+        uint32_t key = 0;
         uint16_t ownerKey = 0; ///< The owner list the object is on.
-        bool used = false;
         Visibility visibility = Visibility::Local;
         char name[kNameCapacity] = {};
+
+        uint16_t index() const { return static_cast<uint16_t>(key & ObjectId::kMaxIndex); }
     };
 
     // The links of a used slot, kept apart from Entry for the reason above.
@@ -461,7 +462,7 @@ private:
     static Link linkOf(uint16_t slot) { return static_cast<Link>(slot + 1); }
     static uint16_t slotOfLink(Link link) { return static_cast<uint16_t>(link - 1); }
 
-    ObjectId idOf(uint16_t slot) const { return ObjectId(node_, type_, entries_[slot].index); }
+    ObjectId idOf(uint16_t slot) const { return ObjectId::fromRaw(entries_[slot].key); }
 
     // The null owner has a list of its own, so that a walk for it finds the
     // system's objects as the slot-by-slot walk did.
@@ -582,7 +583,7 @@ private:
         }
         const uint16_t slot = indexSlot_[id.index()];
         const Entry& entry = entries_[slot];
-        if (!entry.used || entry.index != id.index()) {
+        if (entry.key != id.raw()) {
             return Status::StaleId; // Handed out once; its object is gone.
         }
         return slot;
@@ -650,13 +651,6 @@ private:
     size_t issued_ = 0;
     ObjectType type_;
     uint16_t node_;
-    // The upper 20 bits (node and type) of every id this table issues.
-    uint32_t prefix_;
-
-    static constexpr uint32_t prefixOf(ObjectType type, uint16_t node)
-    {
-        return (static_cast<uint32_t>(node) << ObjectId::kTypeBits) | static_cast<uint32_t>(type);
-    }
     size_t active_ = 0;
     size_t used_ = 0;
 };

@@ -157,7 +157,13 @@ private:
         bool previousFree;
     };
 
-    [[gnu::always_inline]] static SizeClass classOf(uint32_t size);
+    [[gnu::always_inline]] static constexpr SizeClass classOf(uint32_t size);
+    // classOf() of @p needed rounded up to the next class boundary (the
+    // class whose every segment fits it), in one pass.
+    [[gnu::always_inline]] static constexpr SizeClass roundedClassOf(uint32_t needed);
+    // Whether roundedClassOf() agrees with classOf() of the rounded size
+    // for every segment size up to @p limit (a compile-time check).
+    static constexpr bool roundedClassesAgree(uint32_t limit);
     [[gnu::always_inline]] uint32_t word(uint32_t offset) const;
     [[gnu::always_inline]] void setWord(uint32_t offset, uint32_t value);
     [[gnu::always_inline]] uint16_t seal(uint32_t offset, uint32_t first, uint16_t holder) const;
@@ -167,7 +173,8 @@ private:
     [[gnu::always_inline]] bool checkLinks(uint32_t offset) const;
     [[gnu::always_inline]] bool checkAllocated(uint32_t offset, Allocated& header) const;
     [[gnu::always_inline]] bool checkAllocatedFrame(uint32_t offset, uint32_t previousFreeFlag) const;
-    [[gnu::always_inline]] bool checkListNeighbours(uint32_t offset, SizeClass sizeClass) const;
+    // checkLinks() and the neighbours on the list of @p sizeClass linking back to @p offset.
+    [[gnu::always_inline]] bool checkListed(uint32_t offset, SizeClass sizeClass) const;
     [[gnu::always_inline]] void writeAllocated(uint32_t offset, uint32_t size, bool previousFree, uint16_t holder);
     [[gnu::always_inline]] void insert(uint32_t offset, uint32_t size);
     [[gnu::always_inline]] void unlink(uint32_t offset, SizeClass sizeClass);
@@ -179,9 +186,11 @@ private:
     [[gnu::always_inline]] void emptied(SizeClass sizeClass);
     // Finds the offset of an allocated segment for release() and transfer().
     [[gnu::always_inline]] Result<uint32_t> allocatedOffsetOf(void* segment, uint16_t holder, Allocated& header);
-    // Frees the checked allocated segment at @p offset and merges it; sets
-    // @p freedEnd to the end of the resulting free segment.
-    Status releaseAt(uint32_t offset, const Allocated& header, uint32_t& freedEnd);
+    // Frees the checked allocated segment of @p size bytes at @p offset and
+    // merges it; returns the end of the resulting free segment, or 0 when a
+    // check failed (the heap is then disabled). The header comes as values,
+    // not as an Allocated in memory, so that the caller need not store it.
+    uint32_t releaseAt(uint32_t offset, uint32_t size, bool previousFree);
     Status fail();
 
     uint8_t* base_ = nullptr;
