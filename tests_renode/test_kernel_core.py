@@ -30,6 +30,7 @@ KERNEL_TARGET_TESTS = [
     "recovery",     # KillTask and Delete recover timers, devices, stack, slot
     "fulltable",    # TableFull, AddObjects, argument errors
     "forgedid",     # forged, foreign, mistyped, null and stale ids
+    "oddids",       # the null and all-ones ids on every agent's fast path
     "isrblock",     # blocking services refused in ISRs
     "intlevel",     # SetInterruptLevel and the legal limit
     "profiling",    # StartProfiling/StopProfiling/GetTimingInfo exclude preemption

@@ -32,6 +32,7 @@ from dcoslab.target import TARGET_TEST_TIMEOUT
 # configuration leaves out, and why.
 NEEDS_LEFT_OUT_AGENTS = {
     "recoverall": "a dying task's buffer, heap segment, semaphore and port: the memory, semaphore and port agents",
+    "oddids": "the fast paths of the semaphore, port, DSM, pool and heap agents",
 }
 
 # Every kernel-core on-target test of the full test image but those above,
