@@ -28,6 +28,21 @@ struct TaskDeclaration {
     bool superUser = false;        ///< May use privileged services (AddObjects, devices).
     Visibility visibility = Visibility::Local;
     ObjectId* id = nullptr;        ///< Optional: receives the task's id before any task runs.
+
+    /// The attributes TaskAgent::Create takes for this declaration; every
+    /// root task (the loader of either kernel configuration) creates from them.
+    TaskAttributes attributes() const
+    {
+        TaskAttributes made;
+        made.name = name;
+        made.priority = priority;
+        made.stackSize = stackSize;
+        made.timeSlicing = timeSlicing;
+        made.floatingPoint = floatingPoint;
+        made.superUser = superUser;
+        made.visibility = visibility;
+        return made;
+    }
 };
 
 /// A semaphore the loader creates (SemaphoreAgent::Create).

@@ -64,15 +64,7 @@ Result<ObjectId> createObject(const app::HeapDeclaration& declaration)
 
 Result<ObjectId> createObject(const app::TaskDeclaration& declaration)
 {
-    TaskAttributes attributes;
-    attributes.name = declaration.name;
-    attributes.priority = declaration.priority;
-    attributes.stackSize = declaration.stackSize;
-    attributes.timeSlicing = declaration.timeSlicing;
-    attributes.floatingPoint = declaration.floatingPoint;
-    attributes.superUser = declaration.superUser;
-    attributes.visibility = declaration.visibility;
-    return taskAgent.Create(attributes, declaration.entry, declaration.argument);
+    return taskAgent.Create(declaration.attributes(), declaration.entry, declaration.argument);
 }
 
 struct KindServices {

@@ -37,14 +37,7 @@ const char* leftOutDeclaration(const app::Application& application)
 
 Result<ObjectId> createTask(const app::TaskDeclaration& declaration)
 {
-    TaskAttributes attributes;
-    attributes.name = declaration.name;
-    attributes.priority = declaration.priority;
-    attributes.stackSize = declaration.stackSize;
-    attributes.timeSlicing = declaration.timeSlicing;
-    attributes.floatingPoint = declaration.floatingPoint;
-    attributes.superUser = declaration.superUser;
-    attributes.visibility = declaration.visibility;
+    const TaskAttributes attributes = declaration.attributes();
     Result<ObjectId> task = taskAgent.Create(attributes, declaration.entry, declaration.argument);
     // The compiler checked the total against the table's capacity; the
     // slots beyond those active at boot are activated as they are needed.
