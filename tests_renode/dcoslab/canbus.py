@@ -505,8 +505,17 @@ class Hub:
         except FileNotFoundError:
             pass
         self._listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-        self._listener.bind(self.socket_path)
+        # The path appears only once the socket listens: bound under another
+        # name and renamed, so a client that waits for the path (a host tool,
+        # a test) cannot connect between bind and listen and be refused.
+        binding_path = f"{self.socket_path}.{os.getpid()}.binding"
+        try:
+            os.unlink(binding_path)
+        except FileNotFoundError:
+            pass
+        self._listener.bind(binding_path)
         self._listener.listen(16)
+        os.rename(binding_path, self.socket_path)
         self._listener.setblocking(False)
         self._selector = selectors.DefaultSelector()
         self._selector.register(self._listener, selectors.EVENT_READ, "listen")
