@@ -6,7 +6,6 @@
 #include <arch_x86/Idt.hpp>
 #include <arch_x86/TaskSwitch.hpp>
 
-
 namespace dcos::internal {
 
 Task* Scheduler::current_ = nullptr;
@@ -121,28 +120,20 @@ void Scheduler::requestDispatch()
     }
 }
 
-
 void Scheduler::switchFromTask()
 {
     const uint32_t flags = arch_x86::readEflags();
     arch_x86::disableInterrupts();
     Task* const previous = current_;
     Task* const next = pickNext();
-    if (previous->state == TaskState::Terminating || hasDeliveryPending(*next)) {
+    if (previous->state == TaskState::Terminating || next->hasDeliveryPending()) {
         // The full path: a dying task is reaped once its stack is left, and
         // a delivery needs the interrupt frame prepareReturn works on.
         asm volatile("int %0" : : "i"(kDispatchTrapVector) : "memory");
     } else {
         dispatchPending_ = false;
         if (next != previous) {
-            current_ = next;
-            ++switchCount_;
-            if (previous->switchWork || next->switchWork) {
-                TaskManager::switchContext(*previous, *next);
-            }
-            uint32_t* const resumeStack = next->resumeStack;
-            next->resumeStack = nullptr;
-            directSwitch(&previous->resumeStack, resumeStack, next->savedFrame);
+            switchDirectly(*previous, *next);
         }
     }
     restoreInterrupts(flags);

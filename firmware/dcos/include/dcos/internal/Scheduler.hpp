@@ -23,6 +23,7 @@
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/ReadyBitmap.hpp>
 #include <dcos/internal/Task.hpp>
+#include <dcos/internal/TaskManager.hpp>
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/InterruptFrame.hpp>
@@ -91,30 +92,17 @@ public:
         Task* const task = current_;
         auto& queue = readyQueues_[task->priority];
         // The common case: a static-priority task at the head of its queue,
-        // equals behind it, no hold. With no hold, the running task is the
-        // most urgent one, so the next is the new head of its queue.
-        Task* next = nullptr;
-        if (!task->idle && !task->schedulesByDeadline() && dispatchHolds_ == 0 && &queue.front() == task) {
-            next = queue.rotate();
-            if (next == nullptr) {
-                restoreInterrupts(flags);
-                return; // Nobody of its priority waits.
-            }
+        // no hold. With no hold, the running task is the most urgent one, so
+        // the next is the new head of its queue.
+        if (task->idle || task->schedulesByDeadline() || dispatchHolds_ != 0 || &queue.front() != task) {
+            (void)rotateCurrent(); // The general rotation and dispatch.
+        } else if (Task* const next = queue.rotate(); next == nullptr) {
+            // Nobody of its priority waits: it runs on.
+        } else if (next->hasDeliveryPending()) {
+            requestDispatch(); // Rotated; the general switch delivers on the way.
+        } else {
+            switchDirectly(*task, *next);
         }
-        if (next == nullptr || task->switchWork || next->switchWork || hasDeliveryPending(*next)) {
-            if (next == nullptr) {
-                (void)rotateCurrent(); // Not at the head, deadline-scheduled, or under a hold.
-            } else {
-                requestDispatch(); // Rotated; the general switch does the rest.
-            }
-            restoreInterrupts(flags);
-            return;
-        }
-        current_ = next;
-        ++switchCount_;
-        uint32_t* const resumeStack = next->resumeStack;
-        next->resumeStack = nullptr;
-        directSwitch(&task->resumeStack, resumeStack, next->savedFrame);
         restoreInterrupts(flags);
     }
 
@@ -155,14 +143,20 @@ private:
         }
     }
 
-    /// Whether a task has something to be delivered before it runs on: an
-    /// exception or an unmasked signal (TaskManager::prepareReturn, which
-    /// works on an interrupt frame). A pending signal whose handler is busy
-    /// or absent also counts; the full path then finds nothing to do, which
-    /// costs time, never correctness.
-    static bool hasDeliveryPending(const Task& task)
+    /// The direct switch itself, for both callers (yieldCurrent and
+    /// switchFromTask): next becomes the runner, what the two tasks carry
+    /// beyond registers is saved and restored, and the stacks change.
+    /// Interrupts are disabled; returns when previous runs again.
+    [[gnu::always_inline]] static void switchDirectly(Task& previous, Task& next)
     {
-        return task.exceptionPending || (task.pendingSignals & ~task.signalMask) != 0;
+        current_ = &next;
+        ++switchCount_;
+        if (previous.switchWork || next.switchWork) {
+            TaskManager::switchContext(previous, next);
+        }
+        uint32_t* const resumeStack = next.resumeStack;
+        next.resumeStack = nullptr;
+        directSwitch(&previous.resumeStack, resumeStack, next.savedFrame);
     }
 
     /// EFLAGS bit 1, always set (Intel SDM Vol. 1, 3.4.3).

@@ -164,6 +164,13 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     bool schedulesByDeadline() const { return inDeadlineScope || inheritsDeadline; }
 
     void refreshSwitchWork() { switchWork = floatingPoint || profiling || interruptLevel != 0xFF; }
+
+    /// Whether something waits to be delivered before the task runs on: an
+    /// exception or an unmasked signal (TaskManager::prepareReturn, which
+    /// works on an interrupt frame). A pending signal whose handler is busy
+    /// or absent also counts; the full path then finds nothing to do, which
+    /// costs time, never correctness.
+    bool hasDeliveryPending() const { return exceptionPending || (pendingSignals & ~signalMask) != 0; }
 };
 
 } // namespace dcos::internal

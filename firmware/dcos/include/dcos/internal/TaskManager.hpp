@@ -75,7 +75,7 @@ public:
     /// Inline for the common case of an interrupt's exit with nothing to do.
     static arch_x86::InterruptFrame* prepareReturn(Task& task, arch_x86::InterruptFrame* frame)
     {
-        if (!reapPending_ && !task.exceptionPending && (task.pendingSignals & ~task.signalMask) == 0) {
+        if (!reapPending_ && !task.hasDeliveryPending()) {
             return frame;
         }
         return prepareReturnWithWork(task, frame);
