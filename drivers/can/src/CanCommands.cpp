@@ -361,13 +361,19 @@ bool sendConfirmed(unsigned channel, const can::CanFrame& frame, uint64_t timeou
     return taskAgent.ReceiveEvent(kSentEvent, dcos::EventWait::Any, timeoutNs).ok();
 }
 
+// Takes the next received frame off the channel's queue; false when it is empty.
+bool takeFrame(unsigned channel, can::CanFrame& frame)
+{
+    const dcos::Result<size_t> read =
+        systemAgent.Read(consoleChannels[channel].id(), 0, &frame, sizeof(can::CanFrame));
+    return read.ok() && read.value() == sizeof(can::CanFrame);
+}
+
 // Waits for the next received frame until @p deadlineNs (uptime); false when none came.
 bool nextFrame(unsigned channel, uint64_t deadlineNs, can::CanFrame& frame)
 {
     for (;;) {
-        const dcos::Result<size_t> read =
-            systemAgent.Read(consoleChannels[channel].id(), 0, &frame, sizeof(can::CanFrame));
-        if (read.ok() && read.value() == sizeof(can::CanFrame)) {
+        if (takeFrame(channel, frame)) {
             return true;
         }
         const uint64_t now = dcos::timerAgent.Uptime();
@@ -385,12 +391,7 @@ bool nextFrame(unsigned channel, uint64_t deadlineNs, can::CanFrame& frame)
 void discardReceived(unsigned channel)
 {
     can::CanFrame frame;
-    for (;;) {
-        const dcos::Result<size_t> read =
-            systemAgent.Read(consoleChannels[channel].id(), 0, &frame, sizeof(can::CanFrame));
-        if (!read.ok() || read.value() != sizeof(can::CanFrame)) {
-            return;
-        }
+    while (takeFrame(channel, frame)) {
     }
 }
 
