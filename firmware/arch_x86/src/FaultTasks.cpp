@@ -1,3 +1,4 @@
+#include <arch_x86/AssemblyLinkage.hpp>
 #include <arch_x86/CpuException.hpp>
 #include <arch_x86/FaultTasks.hpp>
 #include <arch_x86/Gdt.hpp>
@@ -118,7 +119,7 @@ using namespace arch_x86;
 
 // Runs in a fault task with interrupts off. The back link names the task
 // that faulted; for DCOS that is always the main TSS.
-extern "C" void faultTaskMain(uint32_t vector, uint32_t errorCode)
+DCOS_ASM_LINKAGE void faultTaskMain(uint32_t vector, uint32_t errorCode)
 {
     TaskStateSegment& self = vector == 8 ? doubleFaultTss : pageFaultTss;
     static InterruptFrame panicFrame;

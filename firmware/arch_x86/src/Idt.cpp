@@ -74,7 +74,7 @@ void Idt::setOutermostExitHook(Handler hook) { outermostExitHook = hook; }
 
 } // namespace arch_x86
 
-extern "C" arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame)
+DCOS_ASM_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame)
 {
     using namespace arch_x86;
     Idt::depth_ = Idt::depth_ + 1;

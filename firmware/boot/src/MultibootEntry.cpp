@@ -1,6 +1,7 @@
 // Turns the Multiboot v1 hand-over into a BootInfo and starts the kernel.
 #include <boot/BootInfo.hpp>
 
+#include <arch_x86/AssemblyLinkage.hpp>
 #include <arch_x86/Gdt.hpp>
 #include <arch_x86/Idt.hpp>
 
@@ -70,7 +71,7 @@ ImageLayout imageLayout()
 
 } // namespace boot
 
-extern "C" [[noreturn]] void bootFromMultiboot(uint32_t magic, const MultibootInfo* info)
+DCOS_ASM_LINKAGE [[noreturn]] void bootFromMultiboot(uint32_t magic, const MultibootInfo* info)
 {
     // Descriptor tables first: a fault from here on is reported, not a
     // triple fault and a silent reset.

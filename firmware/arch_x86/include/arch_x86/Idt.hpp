@@ -7,10 +7,11 @@
 // needs memory, and an unset vector is reported rather than ignored.
 #pragma once
 
+#include <arch_x86/AssemblyLinkage.hpp>
 #include <arch_x86/InterruptFrame.hpp>
 
 /// The single C++ entry for every vector, called from interrupt_common.
-extern "C" arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame);
+DCOS_ASM_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame);
 
 namespace arch_x86 {
 

@@ -2,12 +2,13 @@
 // to another's (InterruptStubs.S). The scheduler decides; these only switch.
 #pragma once
 
+#include <arch_x86/AssemblyLinkage.hpp>
 #include <arch_x86/InterruptFrame.hpp>
 
 #include <stdint.h>
 
 /// Starts the first task by "returning" into its initial frame; never returns.
-extern "C" [[noreturn]] void resumeInterruptFrame(arch_x86::InterruptFrame* frame);
+DCOS_ASM_LINKAGE [[noreturn]] void resumeInterruptFrame(arch_x86::InterruptFrame* frame);
 
 /// Saves the caller's callee-saved registers and return address on its
 /// stack, stores that stack pointer at *save, and resumes the next task: at
