@@ -1,8 +1,9 @@
 #include <dcos/internal/MessageBufferPool.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 namespace dcos::internal {
 
-Status MessageBufferPool::AddMsgBufs(size_t count)
+DCOS_CONFIGURATION_SERVICE Status MessageBufferPool::AddMsgBufs(size_t count)
 {
     if (count == 0) {
         return Status::InvalidArgument;

@@ -38,6 +38,7 @@
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/WaitQueue.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -189,7 +190,7 @@ using internal::SubscriptionObject;
 using internal::subscriptionTable;
 using internal::TaskManager;
 
-Result<ObjectId> DsmAgent::Create(const char* name, Visibility visibility) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Create(const char* name, Visibility visibility) const
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt; // The publisher would belong to whichever task was interrupted.
@@ -208,7 +209,7 @@ Result<ObjectId> DsmAgent::Create(const char* name, Visibility visibility) const
     return id.value();
 }
 
-Status DsmAgent::Delete(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::Delete(ObjectId id) const
 {
     arch_x86::InterruptGuard guard;
     start();
@@ -297,7 +298,7 @@ Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page) const
     return writeFull(id, &page);
 }
 
-Result<ObjectId> DsmAgent::Open(ObjectId publisherId) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Open(ObjectId publisherId) const
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -317,7 +318,7 @@ Result<ObjectId> DsmAgent::Open(ObjectId publisherId) const
     return id.value();
 }
 
-Status DsmAgent::Close(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::Close(ObjectId id) const
 {
     arch_x86::InterruptGuard guard;
     const Result<SubscriptionObject*> subscription = internal::resolveOwnSubscription(id);
@@ -399,14 +400,14 @@ Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& p
     return readFull(id, lastSeenDataId, &page, timeoutNs);
 }
 
-Result<ObjectId> DsmAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::NameToObject(const char* name) const
 {
     arch_x86::InterruptGuard guard;
     start();
     return publisherTable.NameToObject(name, Visibility::Local);
 }
 
-Status DsmAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddObjects(size_t count) const
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -416,7 +417,7 @@ Status DsmAgent::AddObjects(size_t count) const
     return publisherTable.AddObjects(count);
 }
 
-Status DsmAgent::AddSubscribers(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddSubscribers(size_t count) const
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -426,7 +427,7 @@ Status DsmAgent::AddSubscribers(size_t count) const
     return subscriptionTable.AddObjects(count);
 }
 
-Status DsmAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
 {
     const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
     if (newOwnerStatus != Status::Ok) {

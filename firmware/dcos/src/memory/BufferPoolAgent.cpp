@@ -2,18 +2,19 @@
 // forwards to the kernel side, internal::BufferPoolManager.
 #include <dcos/BufferPoolAgent.hpp>
 #include <dcos/internal/BufferPoolManager.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 namespace dcos {
 
 using internal::BufferPoolManager;
 
-Result<ObjectId> BufferPoolAgent::Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolAgent::Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
                                          Visibility visibility) const
 {
     return BufferPoolManager::Create(area, areaBytes, bufferSize, name, visibility);
 }
 
-Status BufferPoolAgent::Delete(ObjectId pool) const { return BufferPoolManager::Delete(pool); }
+DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::Delete(ObjectId pool) const { return BufferPoolManager::Delete(pool); }
 
 // Allocate and Return, with their fast paths, are in BufferPoolManager.cpp.
 
@@ -22,19 +23,19 @@ Result<BufferPoolStatistics> BufferPoolAgent::GetStatistics(ObjectId pool) const
     return BufferPoolManager::GetStatistics(pool);
 }
 
-Result<ObjectId> BufferPoolAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolAgent::NameToObject(const char* name) const
 {
     return BufferPoolManager::NameToObject(name, Visibility::Local);
 }
 
-Status BufferPoolAgent::AddObjects(size_t count) const { return BufferPoolManager::AddObjects(count); }
+DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::AddObjects(size_t count) const { return BufferPoolManager::AddObjects(count); }
 
-Status BufferPoolAgent::XferOwnership(ObjectId pool, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::XferOwnership(ObjectId pool, ObjectId newOwner) const
 {
     return BufferPoolManager::XferOwnership(pool, newOwner);
 }
 
-Status BufferPoolAgent::XferOwnership(ObjectId pool, void* buffer, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::XferOwnership(ObjectId pool, void* buffer, ObjectId newOwner) const
 {
     return BufferPoolManager::XferOwnership(pool, buffer, newOwner);
 }

@@ -8,6 +8,7 @@
 #include <dcos/internal/MemoryAreaServices.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -90,7 +91,7 @@ unsigned recoverPools(ObjectId deadTask) { return BufferPoolManager::recoverReso
 
 } // namespace
 
-Result<ObjectId> BufferPoolManager::Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolManager::Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
                                            Visibility visibility)
 {
     if (inInterruptContext()) {
@@ -145,7 +146,7 @@ Result<ObjectId> BufferPoolManager::Create(void* area, size_t areaBytes, size_t 
     return id;
 }
 
-Status BufferPoolManager::Delete(ObjectId id)
+DCOS_CONFIGURATION_SERVICE Status BufferPoolManager::Delete(ObjectId id)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -202,26 +203,26 @@ Result<BufferPoolStatistics> BufferPoolManager::GetStatistics(ObjectId id)
     return object.value()->pool.statistics();
 }
 
-Result<ObjectId> BufferPoolManager::NameToObject(const char* name, Visibility askingScope)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolManager::NameToObject(const char* name, Visibility askingScope)
 {
     return memory_area::nameToObject(poolTable, start, name, askingScope);
 }
 
-Status BufferPoolManager::AddObjects(size_t count) { return memory_area::addObjects(poolTable, start, count); }
+DCOS_CONFIGURATION_SERVICE Status BufferPoolManager::AddObjects(size_t count) { return memory_area::addObjects(poolTable, start, count); }
 
-Status BufferPoolManager::XferOwnership(ObjectId id, ObjectId newOwner)
+DCOS_CONFIGURATION_SERVICE Status BufferPoolManager::XferOwnership(ObjectId id, ObjectId newOwner)
 {
     return memory_area::transferObject(poolTable, lookup, id, newOwner, BufferPool::kSystemHolder);
 }
 
-Status BufferPoolManager::XferOwnership(ObjectId id, void* buffer, ObjectId newOwner)
+DCOS_CONFIGURATION_SERVICE Status BufferPoolManager::XferOwnership(ObjectId id, void* buffer, ObjectId newOwner)
 {
     return memory_area::transferMemory(
         lookup, [](PoolObject* object) -> BufferPool& { return object->pool; }, id, buffer, newOwner,
         BufferPool::kSystemHolder);
 }
 
-unsigned BufferPoolManager::recoverResourcesOf(ObjectId deadTask)
+DCOS_CONFIGURATION_SERVICE unsigned BufferPoolManager::recoverResourcesOf(ObjectId deadTask)
 {
     if (deadTask.isNull() || deadTask.type() != ObjectType::Task) {
         return 0;

@@ -10,6 +10,7 @@
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/SegmentedHeap.hpp>
 #include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -91,7 +92,7 @@ unsigned recoverHeaps(ObjectId deadTask) { return HeapManager::recoverResourcesO
 
 } // namespace
 
-Result<ObjectId> HeapManager::Create(void* area, size_t areaBytes, const char* name, Visibility visibility)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> HeapManager::Create(void* area, size_t areaBytes, const char* name, Visibility visibility)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -128,7 +129,7 @@ Result<ObjectId> HeapManager::Create(void* area, size_t areaBytes, const char* n
     return id;
 }
 
-Status HeapManager::Delete(ObjectId id)
+DCOS_CONFIGURATION_SERVICE Status HeapManager::Delete(ObjectId id)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -182,26 +183,26 @@ Result<HeapStatistics> HeapManager::GetStatistics(ObjectId id)
     return object.value()->heap.statistics();
 }
 
-Result<ObjectId> HeapManager::NameToObject(const char* name, Visibility askingScope)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> HeapManager::NameToObject(const char* name, Visibility askingScope)
 {
     return memory_area::nameToObject(heapTable, start, name, askingScope);
 }
 
-Status HeapManager::AddObjects(size_t count) { return memory_area::addObjects(heapTable, start, count); }
+DCOS_CONFIGURATION_SERVICE Status HeapManager::AddObjects(size_t count) { return memory_area::addObjects(heapTable, start, count); }
 
-Status HeapManager::XferOwnership(ObjectId id, ObjectId newOwner)
+DCOS_CONFIGURATION_SERVICE Status HeapManager::XferOwnership(ObjectId id, ObjectId newOwner)
 {
     return memory_area::transferObject(heapTable, lookup, id, newOwner, SegmentedHeap::kSystemHolder);
 }
 
-Status HeapManager::XferOwnership(ObjectId id, void* segment, ObjectId newOwner)
+DCOS_CONFIGURATION_SERVICE Status HeapManager::XferOwnership(ObjectId id, void* segment, ObjectId newOwner)
 {
     return memory_area::transferMemory(
         lookup, [](HeapObject* object) -> SegmentedHeap& { return object->heap; }, id, segment, newOwner,
         SegmentedHeap::kSystemHolder);
 }
 
-unsigned HeapManager::recoverResourcesOf(ObjectId deadTask)
+DCOS_CONFIGURATION_SERVICE unsigned HeapManager::recoverResourcesOf(ObjectId deadTask)
 {
     if (deadTask.isNull() || deadTask.type() != ObjectType::Task) {
         return 0;

@@ -28,6 +28,7 @@
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/WaitQueue.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -233,7 +234,7 @@ namespace {
 
 } // namespace
 
-Result<ObjectId> MessagePortAgent::Create(const char* name, Visibility visibility, PortOrder order) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> MessagePortAgent::Create(const char* name, Visibility visibility, PortOrder order) const
 {
     if (order != PortOrder::Priority && order != PortOrder::Fifo) {
         return Status::InvalidArgument;
@@ -254,7 +255,7 @@ Result<ObjectId> MessagePortAgent::Create(const char* name, Visibility visibilit
     return id.value();
 }
 
-Status MessagePortAgent::Delete(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::Delete(ObjectId id) const
 {
     arch_x86::InterruptGuard guard;
     start();
@@ -309,7 +310,7 @@ Status MessagePortAgent::Receive(ObjectId id, Message& message, uint64_t timeout
     return internal::callSlowPath(receiveFull, id, &message, &timeoutNs);
 }
 
-Status MessagePortAgent::AddMsgBufs(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddMsgBufs(size_t count) const
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -319,14 +320,14 @@ Status MessagePortAgent::AddMsgBufs(size_t count) const
     return bufferPool.AddMsgBufs(count);
 }
 
-Result<ObjectId> MessagePortAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> MessagePortAgent::NameToObject(const char* name) const
 {
     arch_x86::InterruptGuard guard;
     start();
     return portTable.NameToObject(name, Visibility::Local);
 }
 
-Status MessagePortAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddObjects(size_t count) const
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -336,7 +337,7 @@ Status MessagePortAgent::AddObjects(size_t count) const
     return portTable.AddObjects(count);
 }
 
-Status MessagePortAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
 {
     const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
     if (newOwnerStatus != Status::Ok) {

@@ -18,6 +18,7 @@
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/IdText.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 #include <boot/Panic.hpp>
@@ -248,7 +249,7 @@ using internal::Semaphore;
 using internal::Task;
 using internal::TaskManager;
 
-Result<ObjectId> SemaphoreAgent::Create(const SemaphoreAttributes& attributes) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::Create(const SemaphoreAttributes& attributes) const
 {
     const bool binary = attributes.kind == SemaphoreKind::Binary;
     if ((attributes.kind != SemaphoreKind::Binary && attributes.kind != SemaphoreKind::Counting) ||
@@ -288,7 +289,7 @@ Result<ObjectId> SemaphoreAgent::Create(const SemaphoreAttributes& attributes) c
     return semaphore.id;
 }
 
-Status SemaphoreAgent::Delete(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::Delete(ObjectId id) const
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -384,14 +385,14 @@ Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id) const
     return semaphore.value()->holder != nullptr ? semaphore.value()->holder->id : ObjectId::null();
 }
 
-Result<ObjectId> SemaphoreAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::NameToObject(const char* name) const
 {
     arch_x86::InterruptGuard guard;
     internal::ensureTable();
     return internal::table.NameToObject(name, Visibility::Local);
 }
 
-Status SemaphoreAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
 {
     arch_x86::InterruptGuard guard;
     const Result<Semaphore*> semaphore = internal::resolve(id);
@@ -410,7 +411,7 @@ Status SemaphoreAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
     return internal::table.XferOwnership(id, internal::table.ownerOf(id).value(), newOwner);
 }
 
-Status SemaphoreAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::AddObjects(size_t count) const
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;

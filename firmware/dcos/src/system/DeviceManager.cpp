@@ -6,6 +6,7 @@
 #include <dcos/SystemAgent.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -59,7 +60,7 @@ void DeviceManager::remove(ObjectId id, DeviceEntry& entry)
     (void)table_.Delete(id);
 }
 
-Result<ObjectId> DeviceManager::Create(Device& device, const char* name, Visibility visibility)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DeviceManager::Create(Device& device, const char* name, Visibility visibility)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -84,7 +85,7 @@ Result<ObjectId> DeviceManager::Create(Device& device, const char* name, Visibil
     return id;
 }
 
-Status DeviceManager::Delete(ObjectId id)
+DCOS_CONFIGURATION_SERVICE Status DeviceManager::Delete(ObjectId id)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -155,7 +156,7 @@ Status DeviceManager::Probe(ObjectId id)
     return status;
 }
 
-Status DeviceManager::Open(ObjectId id)
+DCOS_CONFIGURATION_SERVICE Status DeviceManager::Open(ObjectId id)
 {
     const Result<Device*> device = beginCall(id, Call::Open);
     if (!device.ok()) {
@@ -166,7 +167,7 @@ Status DeviceManager::Open(ObjectId id)
     return status;
 }
 
-Status DeviceManager::Close(ObjectId id)
+DCOS_CONFIGURATION_SERVICE Status DeviceManager::Close(ObjectId id)
 {
     const Result<Device*> device = beginCall(id, Call::Close);
     if (!device.ok()) {
@@ -226,7 +227,7 @@ Status DeviceManager::Control(ObjectId id, uint32_t command, void* argument, siz
     return status;
 }
 
-Result<ObjectId> DeviceManager::NameToObject(const char* name, Visibility askingScope)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DeviceManager::NameToObject(const char* name, Visibility askingScope)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -235,7 +236,7 @@ Result<ObjectId> DeviceManager::NameToObject(const char* name, Visibility asking
     return table_.NameToObject(name, askingScope);
 }
 
-Status DeviceManager::AddObjects(size_t count)
+DCOS_CONFIGURATION_SERVICE Status DeviceManager::AddObjects(size_t count)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -248,7 +249,7 @@ Status DeviceManager::AddObjects(size_t count)
     return table_.AddObjects(count);
 }
 
-Status DeviceManager::XferOwnership(ObjectId id, ObjectId newOwner)
+DCOS_CONFIGURATION_SERVICE Status DeviceManager::XferOwnership(ObjectId id, ObjectId newOwner)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -262,7 +263,7 @@ Status DeviceManager::XferOwnership(ObjectId id, ObjectId newOwner)
     return table_.XferOwnership(id, caller, newOwner);
 }
 
-unsigned DeviceManager::recoverDevicesOf(ObjectId deadTask)
+DCOS_CONFIGURATION_SERVICE unsigned DeviceManager::recoverDevicesOf(ObjectId deadTask)
 {
     if (deadTask.isNull()) {
         return 0;
@@ -332,12 +333,12 @@ namespace dcos {
 // ring 3 these become the trap stubs, and ids of other nodes will be routed
 // to the network manager here instead of being refused with Remote.
 
-Result<ObjectId> SystemAgent::Create(Device& device, const char* name, Visibility visibility) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> SystemAgent::Create(Device& device, const char* name, Visibility visibility) const
 {
     return internal::deviceManager().Create(device, name, visibility);
 }
 
-Status SystemAgent::Delete(ObjectId device) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::Delete(ObjectId device) const
 {
     return internal::deviceManager().Delete(device);
 }
@@ -347,12 +348,12 @@ Status SystemAgent::Probe(ObjectId device) const
     return internal::deviceManager().Probe(device);
 }
 
-Status SystemAgent::Open(ObjectId device) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::Open(ObjectId device) const
 {
     return internal::deviceManager().Open(device);
 }
 
-Status SystemAgent::Close(ObjectId device) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::Close(ObjectId device) const
 {
     return internal::deviceManager().Close(device);
 }
@@ -372,17 +373,17 @@ Status SystemAgent::Control(ObjectId device, uint32_t command, void* argument, s
     return internal::deviceManager().Control(device, command, argument, length);
 }
 
-Result<ObjectId> SystemAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> SystemAgent::NameToObject(const char* name) const
 {
     return internal::deviceManager().NameToObject(name, Visibility::Local);
 }
 
-Status SystemAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::AddObjects(size_t count) const
 {
     return internal::deviceManager().AddObjects(count);
 }
 
-Status SystemAgent::XferOwnership(ObjectId device, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::XferOwnership(ObjectId device, ObjectId newOwner) const
 {
     return internal::deviceManager().XferOwnership(device, newOwner);
 }

@@ -6,6 +6,7 @@
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/TimerManager.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -42,7 +43,7 @@ Status checkLifeControl(const Task& target)
 
 } // namespace
 
-Result<ObjectId> TaskAgent::Create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::Create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument) const
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -50,7 +51,7 @@ Result<ObjectId> TaskAgent::Create(const TaskAttributes& attributes, TaskEntry e
     return TaskManager::create(attributes, entry, argument);
 }
 
-Status TaskAgent::Delete() const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::Delete() const
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -58,7 +59,7 @@ Status TaskAgent::Delete() const
     TaskManager::exitCurrent();
 }
 
-Status TaskAgent::KillTask(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::KillTask(ObjectId id) const
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -175,7 +176,7 @@ Status TaskAgent::SendSignal(ObjectId id, unsigned signal) const
     return Status::Ok;
 }
 
-Status TaskAgent::SetSignalHandler(SignalHandler handler) const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::SetSignalHandler(SignalHandler handler) const
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -204,7 +205,7 @@ Result<uint32_t> TaskAgent::SetSignalMask(uint32_t mask) const
     return previous;
 }
 
-Status TaskAgent::SetExceptionHandler(ExceptionHandler handler) const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::SetExceptionHandler(ExceptionHandler handler) const
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -236,7 +237,7 @@ Status TaskAgent::ThrowException(ObjectId id, ExceptionClass exceptionClass, uin
 
 ObjectId TaskAgent::IdOfSelf() const { return internal::currentTaskId(); }
 
-Result<ObjectId> TaskAgent::NameToObject(const char* name) const { return TaskManager::nameToObject(name); }
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::NameToObject(const char* name) const { return TaskManager::nameToObject(name); }
 
 Result<TaskState> TaskAgent::GetState(ObjectId id) const
 {
@@ -261,7 +262,7 @@ Result<uint8_t> TaskAgent::GetPriority(ObjectId id) const
     return task.value()->basePriority;
 }
 
-Status TaskAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::AddObjects(size_t count) const
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;

@@ -7,6 +7,7 @@
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/TimerManager.hpp>
 #include <dcos/internal/InterruptManager.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/CpuException.hpp>
@@ -360,7 +361,7 @@ Status TaskManager::checkNewOwner(ObjectId newOwner)
     return newOwner.isNull() ? Status::Ok : resolve(newOwner).status();
 }
 
-Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument)
 {
     if (entry == nullptr || attributes.priority > kLowestPriority || attributes.stackSize < kMinimumStackSize ||
         attributes.stackSize > kStackArenaBytes) {
@@ -413,7 +414,7 @@ Result<ObjectId> TaskManager::create(const TaskAttributes& attributes, TaskEntry
     return task.id;
 }
 
-Status TaskManager::kill(Task& task)
+DCOS_CONFIGURATION_SERVICE Status TaskManager::kill(Task& task)
 {
     if (task.idle) {
         return Status::NotPermitted;
@@ -859,13 +860,13 @@ size_t TaskManager::stackHighWater(const Task& task)
 
 size_t TaskManager::taskCount() { return table.usedCount(); }
 
-Status TaskManager::addObjects(size_t count)
+DCOS_CONFIGURATION_SERVICE Status TaskManager::addObjects(size_t count)
 {
     arch_x86::InterruptGuard guard;
     return table.AddObjects(count);
 }
 
-Result<ObjectId> TaskManager::nameToObject(const char* name)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskManager::nameToObject(const char* name)
 {
     arch_x86::InterruptGuard guard;
     return table.NameToObject(name, Visibility::Local);

@@ -2,6 +2,7 @@
 #include <dcos/TimerAgent.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/TimerManager.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 namespace dcos {
 
@@ -17,12 +18,12 @@ Status TimerAgent::SetSystemClock(const DateTime& time) const
 
 uint64_t TimerAgent::Uptime() const { return TimerManager::preciseUptimeNs(); }
 
-Result<ObjectId> TimerAgent::Create(const char* name, Visibility visibility) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::Create(const char* name, Visibility visibility) const
 {
     return TimerManager::createTimer(internal::currentTaskId(), name, visibility);
 }
 
-Status TimerAgent::Delete(ObjectId timer) const { return TimerManager::deleteTimer(timer, internal::currentTaskId()); }
+DCOS_CONFIGURATION_SERVICE Status TimerAgent::Delete(ObjectId timer) const { return TimerManager::deleteTimer(timer, internal::currentTaskId()); }
 
 Status TimerAgent::SetWatchDogAlarm(ObjectId timer, uint64_t intervalNs, AlarmNotification notification) const
 {
@@ -41,14 +42,14 @@ Status TimerAgent::SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNoti
 
 Status TimerAgent::CancelAlarm(ObjectId timer) const { return TimerManager::cancelAlarm(timer, internal::currentTaskId()); }
 
-Result<ObjectId> TimerAgent::NameToObject(const char* name) const { return TimerManager::timerNameToObject(name); }
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::NameToObject(const char* name) const { return TimerManager::timerNameToObject(name); }
 
-Status TimerAgent::XferOwnership(ObjectId timer, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status TimerAgent::XferOwnership(ObjectId timer, ObjectId newOwner) const
 {
     return TimerManager::xferOwnership(timer, internal::currentTaskId(), newOwner);
 }
 
-Status TimerAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status TimerAgent::AddObjects(size_t count) const
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;

@@ -9,6 +9,7 @@
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/TimeWheel.hpp>
 #include <dcos/internal/TimerManager.hpp>
+#include <dcos/internal/ConfigurationService.hpp>
 
 #include <arch_x86/Cpu.hpp>
 #include <boot/Panic.hpp>
@@ -357,7 +358,7 @@ Result<uint64_t> TimerManager::nanosecondsUntil(const DateTime& time)
     return target.value() > now ? target.value() - now : 0;
 }
 
-Result<ObjectId> TimerManager::createTimer(ObjectId owner, const char* name, Visibility visibility)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerManager::createTimer(ObjectId owner, const char* name, Visibility visibility)
 {
     arch_x86::InterruptGuard guard;
     const Result<ObjectId> id = timerTable.Create(owner, name, visibility);
@@ -371,7 +372,7 @@ Result<ObjectId> TimerManager::createTimer(ObjectId owner, const char* name, Vis
     return id.value();
 }
 
-Status TimerManager::deleteTimer(ObjectId id, ObjectId caller)
+DCOS_CONFIGURATION_SERVICE Status TimerManager::deleteTimer(ObjectId id, ObjectId caller)
 {
     arch_x86::InterruptGuard guard;
     const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
@@ -460,7 +461,7 @@ Result<ObjectId> TimerManager::timerNameToObject(const char* name)
     return timerTable.NameToObject(name, Visibility::Local);
 }
 
-Status TimerManager::xferOwnership(ObjectId id, ObjectId caller, ObjectId newOwner)
+DCOS_CONFIGURATION_SERVICE Status TimerManager::xferOwnership(ObjectId id, ObjectId caller, ObjectId newOwner)
 {
     const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
     if (newOwnerStatus != Status::Ok) {
