@@ -17,16 +17,39 @@ using dcos::timerAgent;
 
 constexpr uint64_t kMillisecond = 1000000;
 
+// One alarm awaited: how it ended and when, measured before anything is
+// printed. A print can wait for the console, and under -icount the emulated
+// clock runs on while the CPU idles for it, so a print between two alarms
+// would move the second one's measurement.
+struct AlarmWait {
+    Status status = Status::Timeout;
+    uint64_t elapsedNs = 0;
+};
+
+AlarmWait awaitAlarm(uint32_t event, uint64_t start)
+{
+    const dcos::Result<uint32_t> got = taskAgent.ReceiveEvent(event, EventWait::Any, 1000 * kMillisecond);
+    return {got.status(), timerAgent.Uptime() - start};
+}
+
+// Reports one awaited alarm against the time it was due.
+bool reportAlarm(shell::Shell& shell, const AlarmWait& wait, uint64_t expectedNs, const char* what)
+{
+    shell.print("%s: %s after %llu ns (expected %llu)\r\n", what,
+                wait.status == Status::Ok ? "went off" : dcos::statusName(wait.status),
+                static_cast<unsigned long long>(wait.elapsedNs), static_cast<unsigned long long>(expectedNs));
+    // An alarm never goes off early, and at most one tick late (plus the
+    // tick the interval was rounded up into).
+    return check(shell,
+                 wait.status == Status::Ok && wait.elapsedNs >= expectedNs &&
+                     wait.elapsedNs <= expectedNs + 2 * kMillisecond,
+                 what);
+}
+
 // Waits for an alarm event and reports how long it took.
 bool expectAlarmAfter(shell::Shell& shell, uint32_t event, uint64_t start, uint64_t expectedNs, const char* what)
 {
-    const dcos::Result<uint32_t> got = taskAgent.ReceiveEvent(event, EventWait::Any, 1000 * kMillisecond);
-    const uint64_t elapsed = timerAgent.Uptime() - start;
-    shell.print("%s: %s after %llu ns (expected %llu)\r\n", what, got.ok() ? "went off" : dcos::statusName(got.status()),
-                static_cast<unsigned long long>(elapsed), static_cast<unsigned long long>(expectedNs));
-    // An alarm never goes off early, and at most one tick late (plus the
-    // tick the interval was rounded up into).
-    return check(shell, got.ok() && elapsed >= expectedNs && elapsed <= expectedNs + 2 * kMillisecond, what);
+    return reportAlarm(shell, awaitAlarm(event, start), expectedNs, what);
 }
 
 volatile unsigned alarmSignals = 0;
@@ -59,8 +82,13 @@ bool alarms(shell::Shell& shell)
     start = timerAgent.Uptime();
     ok = checkStatus(shell, timerAgent.SetPeriodicAlarm(timer, 10 * kMillisecond, AlarmNotification::event(1 << 5)),
                      Status::Ok, "SetPeriodicAlarm") && ok;
-    for (unsigned period = 1; period <= 5; ++period) {
-        ok = expectAlarmAfter(shell, 1 << 5, start, period * 10 * kMillisecond, "periodic alarm") && ok;
+    constexpr unsigned kPeriods = 5;
+    AlarmWait periods[kPeriods];
+    for (AlarmWait& wait : periods) {
+        wait = awaitAlarm(1 << 5, start);
+    }
+    for (unsigned period = 1; period <= kPeriods; ++period) {
+        ok = reportAlarm(shell, periods[period - 1], period * 10 * kMillisecond, "periodic alarm") && ok;
     }
     ok = checkStatus(shell, timerAgent.CancelAlarm(timer), Status::Ok, "CancelAlarm") && ok;
     ok = checkStatus(shell, taskAgent.ReceiveEvent(1 << 5, EventWait::Any, 30 * kMillisecond).status(), Status::Timeout,
