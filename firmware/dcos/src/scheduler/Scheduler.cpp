@@ -21,6 +21,7 @@ DeadlineQueue<Task, kTaskCapacity> Scheduler::deadlineQueue_;
 void Scheduler::setIdleTask(Task& idle)
 {
     idle.idle = true;
+    idle.refreshRotatesOnYield();
     idle_ = &idle;
 }
 

@@ -41,11 +41,11 @@ Status SchedulerAgent::SetDeadline(DeadlineStart start, uint64_t executionPeriod
     task.deadlinePeriodNs = deadlinePeriodNs;
     if (start == DeadlineStart::Now) {
         task.deadlineAtNextBlock = false;
-        task.inDeadlineScope = true;
+        task.setDeadlineScope(true);
         task.deadlineNs = TimerManager::uptimeNs() + deadlinePeriodNs;
         TimerManager::arm(task.deadlineTimeout, TimerManager::tickAfter(deadlinePeriodNs));
     } else {
-        task.inDeadlineScope = false;
+        task.setDeadlineScope(false);
         task.deadlineAtNextBlock = true;
     }
     Scheduler::requeue(task);
@@ -64,7 +64,7 @@ Status SchedulerAgent::ClearDeadline() const
     }
     Scheduler::makeUnready(task);
     TimerManager::cancel(task.deadlineTimeout);
-    task.inDeadlineScope = false;
+    task.setDeadlineScope(false);
     task.deadlineAtNextBlock = false;
     Scheduler::requeue(task);
     return Status::Ok;

@@ -198,7 +198,7 @@ Result<uint32_t> TaskAgent::SetSignalMask(uint32_t mask) const
     arch_x86::InterruptGuard guard;
     Task& task = Scheduler::current();
     const uint32_t previous = task.signalMask;
-    task.signalMask = mask;
+    task.setSignalMask(mask);
     if (task.signalHandler != nullptr && (task.pendingSignals & ~mask) != 0) {
         Scheduler::requestDispatch();
     }

@@ -215,7 +215,7 @@ void setRunningUrgency(Task& task, uint8_t priority, bool inheritsDeadline, cons
         Scheduler::makeUnready(task);
     }
     task.priority = priority;
-    task.inheritsDeadline = inheritsDeadline;
+    task.setInheritsDeadline(inheritsDeadline);
     task.inheritedDeadline = inheritsDeadline ? inheritedDeadline : DeadlineKey{};
     if (queued) {
         Scheduler::requeue(task);
@@ -240,8 +240,8 @@ void terminate(Task& task)
     Scheduler::makeUnready(task);
     TimerManager::cancel(task.wakeTimeout);
     TimerManager::cancel(task.deadlineTimeout);
-    task.inDeadlineScope = false;
-    task.inheritsDeadline = false;
+    task.setDeadlineScope(false);
+    task.setInheritsDeadline(false);
     task.deadlineAtNextBlock = false;
     recoverResourcesOf(task.id);
     if (&task == &Scheduler::current()) {
@@ -594,7 +594,7 @@ void TaskManager::wake(Task& task, Status result)
     if (task.deadlineAtNextBlock) {
         // "Set later": the real-time scope starts as the task is readied.
         task.deadlineAtNextBlock = false;
-        task.inDeadlineScope = true;
+        task.setDeadlineScope(true);
         task.deadlineNs = TimerManager::uptimeNs() + task.deadlinePeriodNs;
         TimerManager::arm(task.deadlineTimeout, TimerManager::tickAfter(task.deadlinePeriodNs));
     }
@@ -647,7 +647,7 @@ Status TaskManager::postEvent(ObjectId id, uint32_t events)
 void TaskManager::sendSignal(Task& task, unsigned signal)
 {
     arch_x86::InterruptGuard guard;
-    task.pendingSignals |= 1u << signal;
+    task.postSignal(signal);
     // A signal readies a suspended task (seed 7.6.1).
     if (task.suspended) {
         task.suspended = false;
@@ -672,7 +672,7 @@ void TaskManager::raiseException(Task& task, const ExceptionInfo& info)
         }
         return;
     }
-    task.exceptionPending = true;
+    task.setExceptionPending(true);
     task.pendingException = info;
     if (&task == &Scheduler::current()) {
         Scheduler::requestDispatch();
@@ -711,7 +711,7 @@ arch_x86::InterruptFrame* TaskManager::prepareReturnWithWork(Task& task, arch_x8
         return frame;
     }
     if (task.exceptionPending && !task.inExceptionHandler) {
-        task.exceptionPending = false;
+        task.setExceptionPending(false);
         if (task.exceptionHandler == nullptr) {
             if (task.pendingException.exceptionClass == ExceptionClass::Timing) {
                 return frame; // Ignored without a handler (seed 7.4.2).
@@ -738,7 +738,7 @@ arch_x86::InterruptFrame* TaskManager::prepareReturnWithWork(Task& task, arch_x8
         const unsigned signal = static_cast<unsigned>(__builtin_ctz(deliverable));
         if (enterHandler(task, frame, task.signalSavedFrame, task.signalFrameAddress, signalTrampoline, signal,
                          static_cast<uint32_t>(reinterpret_cast<uintptr_t>(task.signalHandler)))) {
-            task.pendingSignals &= ~(1u << signal);
+            task.clearSignal(signal);
             task.inSignalHandler = true;
             task.signalSavedWakeStatus = task.wakeStatus;
         }

@@ -94,7 +94,7 @@ public:
         // The common case: a static-priority task at the head of its queue,
         // no hold. With no hold, the running task is the most urgent one, so
         // the next is the new head of its queue.
-        if (task->idle || task->schedulesByDeadline() || dispatchHolds_ != 0 || &queue.front() != task) {
+        if (!task->rotatesOnYield || dispatchHolds_ != 0 || &queue.front() != task) {
             (void)rotateCurrent(); // The general rotation and dispatch.
         } else if (Task* const next = queue.rotate(); next == nullptr) {
             // Nobody of its priority waits: it runs on.

@@ -163,14 +163,60 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     /// or one a waiter lends it.
     bool schedulesByDeadline() const { return inDeadlineScope || inheritsDeadline; }
 
+    /// Whether Yield may simply rotate this task's ready queue: it is not
+    /// the idle task and no deadline orders it. One byte, so that Yield's
+    /// fast path tests one flag rather than three; setDeadlineScope,
+    /// setInheritsDeadline and the scheduler's setIdleTask keep it.
+    bool rotatesOnYield = true;
+
+    void setDeadlineScope(bool inScope)
+    {
+        inDeadlineScope = inScope;
+        refreshRotatesOnYield();
+    }
+    void setInheritsDeadline(bool inherits)
+    {
+        inheritsDeadline = inherits;
+        refreshRotatesOnYield();
+    }
+    void refreshRotatesOnYield() { rotatesOnYield = !idle && !schedulesByDeadline(); }
+
     void refreshSwitchWork() { switchWork = floatingPoint || profiling || interruptLevel != 0xFF; }
 
     /// Whether something waits to be delivered before the task runs on: an
     /// exception or an unmasked signal (TaskManager::prepareReturn, which
     /// works on an interrupt frame). A pending signal whose handler is busy
     /// or absent also counts; the full path then finds nothing to do, which
-    /// costs time, never correctness.
-    bool hasDeliveryPending() const { return exceptionPending || (pendingSignals & ~signalMask) != 0; }
+    /// costs time, never correctness. Kept in one byte by the setters below,
+    /// the only writers of the three fields it summarises, because every
+    /// switch and every interrupt's exit asks.
+    bool hasDeliveryPending() const { return deliveryPending; }
+
+    void postSignal(unsigned signal)
+    {
+        pendingSignals |= 1u << signal;
+        refreshDeliveryPending();
+    }
+    void clearSignal(unsigned signal)
+    {
+        pendingSignals &= ~(1u << signal);
+        refreshDeliveryPending();
+    }
+    void setSignalMask(uint32_t mask)
+    {
+        signalMask = mask;
+        refreshDeliveryPending();
+    }
+    void setExceptionPending(bool pending)
+    {
+        exceptionPending = pending;
+        refreshDeliveryPending();
+    }
+
+private:
+    bool deliveryPending = false;
+
+    void refreshDeliveryPending() { deliveryPending = exceptionPending || (pendingSignals & ~signalMask) != 0; }
 };
 
 } // namespace dcos::internal
