@@ -171,24 +171,24 @@ constexpr dcos::app::ModbusMapEntry map[] = {{
 }};
 }} // namespace
 
-DCOS_APPLICATION(mapped, {{.name = "mapped", .tasks = tasks, .publishers = publishers, .modbusMap = map}});
+DCOS_APPLICATION(mapped, {{.name = "mapped", .tasks = tasks, .publishers = publishers, .modbusMap = map{slave}}});
 """
 
 
 def write_map(directory, speed_table="HoldingRegisters", speed_address=4, speed_count=2, speed_object="setpoint",
-              speed_offset=8):
+              speed_offset=8, slave=""):
     os.makedirs(directory, exist_ok=True)
     with open(os.path.join(directory, "mapped.cpp"), "w", encoding="utf-8") as handle:
         handle.write(MAP_SOURCE.format(speed_table=speed_table, speed_address=speed_address,
                                        speed_count=speed_count, speed_object=speed_object,
-                                       speed_offset=speed_offset))
+                                       speed_offset=speed_offset, slave=slave))
     return directory
 
 
 def test_a_valid_modbus_map_compiles(tmp_path, boot, isa486):
     """The map the failures below break one rule of builds, so each failure is the rule's own.
 
-    It boots, and `app` lists the map with the notice that the line does not serve it yet.
+    It boots, and `app` lists the map with the notice that no slave serves it (none is declared).
     """
     application = write_map(str(tmp_path / "mapped"))
     result = build_with_staged_sdk(application)
@@ -197,7 +197,7 @@ def test_a_valid_modbus_map_compiles(tmp_path, boot, isa486):
     emulator.expect(r"dcos> ")
     output = emulator.command("app")
     assert "application 'mapped': running" in output, output
-    assert "modbus map, 2 entries, checked; not served yet" in output, output
+    assert "modbus map, 2 entries, checked; not served: no modbusSlave declared" in output, output
     assert re.search(r"setpoint +holding +0-3 +publisher setpoint byte 0", output), output
     assert re.search(r"speed +holding +4-5 +publisher setpoint byte \d+", output), output
 
@@ -219,6 +219,12 @@ def test_a_valid_modbus_map_compiles(tmp_path, boot, isa486):
     (dict(speed_object="measured"), ['ObjectName{"speed"}', "MapWritesReadOnly",
                                      "configuration error: Modbus map entry 'speed': a coil or holding register "
                                      "entry is bound to something read-only"]),
+    (dict(slave=", .modbusSlave = {.address = 248}"),
+     ['ObjectName{"mapped"}', "SlaveAddressOutOfRange, 248, 247",
+      "configuration error: Modbus slave 'mapped': the Modbus slave's address must be 1 to 247", "(value 248, limit 247)"]),
+    (dict(slave=", .modbusSlave = {.address = 17, .baud = 230400}"),
+     ['ObjectName{"mapped"}', "SlaveBaudOutOfRange, 230400, 115200",
+      "configuration error: Modbus slave 'mapped': the Modbus slave's baud rate must be 300 to 115200"]),
 ])
 def test_modbus_map_errors_name_the_entry_at_compile_time(tmp_path, change, phrases):
     application = write_map(str(tmp_path / "mapped"), **change)

@@ -10,12 +10,26 @@
 // the single-master rule of [SL] 2.1. The console changes the role and
 // submits a master's requests through a one-slot mailbox the task takes;
 // every wait of the console has a time-out.
+//
+// An application that declares a Modbus slave (modbusSlave) and its
+// register map (modbusMap) has the line start at boot, serving the map:
+// the application service below runs in the root task while the loader
+// holds dispatching, hands the publishers the master writes to the line's
+// task, installs the I/O board when the map names its points, and starts
+// the slave before any task runs. `modbus slave` by hand still serves the
+// console's data model instead.
 #include <mbline/LineInterrupt.hpp>
 #include <mbline/LineRunner.hpp>
+#include <mbline/NodeMapBackend.hpp>
 
 #include <bsp/Board.hpp>
+#include <dcos/DsmAgent.hpp>
+#include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
+#include <dcos/internal/ApplicationService.hpp>
+#include <iobus/MfioBoard.hpp>
+#include <runtime/Text.hpp>
 #include <modbus/InMemoryDataModel.hpp>
 #include <modbus/ModbusError.hpp>
 #include <modbus/Request.hpp>
@@ -55,6 +69,20 @@ const modbus::DeviceIdentification identification{
     .productName = "DCOS controller",
     .modelName = "isa486",
 };
+
+// The application's register map, served at boot when the application
+// declares its slave; the I/O board the map's points are read from.
+NodeMapBackend nodeBackend;
+ApplicationMapModel applicationModel({}, nodeBackend);
+iobus::MfioBoard mapBoard("modbus.io");
+// The application whose map the line serves, or null (the console's model
+// or no slave). Set by the application service before the line's task
+// runs; the task and the console only read it.
+const dcos::app::Application* servedApplication = nullptr;
+// Set when the service stops: the line's task closes the subscriptions it
+// opened for the map, which only their owner may.
+volatile bool backendStale = false;
+modbus::DeviceIdentification applicationIdentification = identification;
 
 // The task's events.
 constexpr uint32_t kLineEvent = 1u << 0;    // the UART's interrupt
@@ -142,6 +170,7 @@ void serveMailbox()
     switch (mailbox.kind) {
     case CommandKind::Stop:
         stopPort();
+        servedApplication = nullptr;
         break;
     case CommandKind::StartSlave:
     case CommandKind::StartMaster: {
@@ -161,6 +190,8 @@ void serveMailbox()
             stopPort();
             break;
         }
+        // By hand, the line serves the console's data model, whatever the application declared.
+        servedApplication = nullptr;
         mailbox.error = mailbox.kind == CommandKind::StartSlave
                             ? runner.startSlave(timing.value(), consoleModel, identification, mailbox.address, now)
                             : runner.startMaster(timing.value(), mailbox.masterConfig, now);
@@ -187,6 +218,10 @@ void serveMailbox()
 void lineTaskEntry(uintptr_t)
 {
     for (;;) {
+        if (backendStale) {
+            nodeBackend.closeSubscriptions();
+            backendStale = false;
+        }
         serveMailbox();
         const uint64_t now = timerAgent.Uptime();
         const uint64_t next = runner.service(now);
@@ -208,24 +243,34 @@ void lineTaskEntry(uintptr_t)
     }
 }
 
+// Creates the line's task the first time the line is needed.
+Status startLineTask()
+{
+    if (!lineTask.isNull()) {
+        return Status::Ok;
+    }
+    dcos::TaskAttributes attributes;
+    attributes.name = "modbus";
+    attributes.priority = kTaskPriority;
+    attributes.stackSize = 8192;
+    attributes.newProcess = true;
+    const dcos::Result<ObjectId> task = taskAgent.Create(attributes, lineTaskEntry, 0);
+    if (!task.ok()) {
+        return task.status();
+    }
+    lineTask = task.value();
+    return Status::Ok;
+}
+
 // Discards a stale answer event, so that the next wait sees only its own.
 void clearAnswerEvent() { (void)taskAgent.ReceiveEvent(kAnswerEvent, dcos::EventWait::Any, dcos::kPoll); }
 
 // Hands the mailbox to the task and waits for its answer.
 bool runCommand(shell::Shell& shell)
 {
-    if (lineTask.isNull()) {
-        dcos::TaskAttributes attributes;
-        attributes.name = "modbus";
-        attributes.priority = kTaskPriority;
-        attributes.stackSize = 8192;
-        attributes.newProcess = true;
-        const dcos::Result<ObjectId> task = taskAgent.Create(attributes, lineTaskEntry, 0);
-        if (!task.ok()) {
-            shell.print("error: cannot start the modbus task: %s\r\n", dcos::statusName(task.status()));
-            return false;
-        }
-        lineTask = task.value();
+    if (const Status started = startLineTask(); started != Status::Ok) {
+        shell.print("error: cannot start the modbus task: %s\r\n", dcos::statusName(started));
+        return false;
     }
     clearAnswerEvent();
     mailbox.requester = taskAgent.IdOfSelf();
@@ -266,35 +311,42 @@ bool parseNumber(shell::Shell& shell, const char* text, unsigned long limit, uns
     return true;
 }
 
+// The port's settings for a Modbus line: 8 data bits, a receive trigger of
+// one byte and the driver enable on RTS (docs/protocols/modbus.md, "The
+// port"). [SL] 2.5.1: no parity takes a second stop bit, so that a
+// character stays 11 bits.
+bsp::UartSettings lineSettings(uint32_t baud, dcos::app::ModbusParity parity)
+{
+    return bsp::UartSettings{.baud = baud,
+                             .dataBits = 8,
+                             .parity = parity == dcos::app::ModbusParity::None  ? bsp::UartParity::None
+                                       : parity == dcos::app::ModbusParity::Odd ? bsp::UartParity::Odd
+                                                                                : bsp::UartParity::Even,
+                             .stopBits = static_cast<uint8_t>(parity == dcos::app::ModbusParity::None ? 2 : 1),
+                             .receiveTrigger = 1,
+                             .driverEnable = bsp::DriverEnable::Rts};
+}
+
 // [baud] [parity n|e|o]: the line's settings, 19200 8E1 by default ([SL] 2.5.1).
 bool parseLine(shell::Shell& shell, int argc, char** argv, int first, bsp::UartSettings& settings)
 {
-    settings = bsp::UartSettings{.baud = 19200,
-                                 .dataBits = 8,
-                                 .parity = bsp::UartParity::Even,
-                                 .stopBits = 1,
-                                 .receiveTrigger = 1,
-                                 .driverEnable = bsp::DriverEnable::Rts};
-    unsigned long baud = 0;
-    if (argc > first) {
-        if (!parseNumber(shell, argv[first], 115200, baud, "baud rate")) {
-            return false;
-        }
-        settings.baud = static_cast<uint32_t>(baud);
+    unsigned long baud = 19200;
+    if (argc > first && !parseNumber(shell, argv[first], dcos::app::kHighestModbusBaud, baud, "baud rate")) {
+        return false;
     }
+    dcos::app::ModbusParity parity = dcos::app::ModbusParity::Even;
     if (argc > first + 1) {
-        const char* parity = argv[first + 1];
-        if (parity[0] == 'n' && parity[1] == '\0') {
-            // [SL] 2.5.1: no parity takes a second stop bit, so a character stays 11 bits.
-            settings.parity = bsp::UartParity::None;
-            settings.stopBits = 2;
-        } else if (parity[0] == 'o' && parity[1] == '\0') {
-            settings.parity = bsp::UartParity::Odd;
-        } else if (!(parity[0] == 'e' && parity[1] == '\0')) {
-            shell.print("error: parity '%s' is not n, e or o\r\n", parity);
+        const char* letter = argv[first + 1];
+        if (letter[0] == 'n' && letter[1] == '\0') {
+            parity = dcos::app::ModbusParity::None;
+        } else if (letter[0] == 'o' && letter[1] == '\0') {
+            parity = dcos::app::ModbusParity::Odd;
+        } else if (!(letter[0] == 'e' && letter[1] == '\0')) {
+            shell.print("error: parity '%s' is not n, e or o\r\n", letter);
             return false;
         }
     }
+    settings = lineSettings(static_cast<uint32_t>(baud), parity);
     return true;
 }
 
@@ -406,6 +458,17 @@ CommandResult state(shell::Shell& shell, int, char**)
                     static_cast<unsigned long>(runner.timing().t35Ns / 1000), uart.driverEnabled() ? "on" : "off");
     }
     shell.print("\r\n");
+    if (role == Role::Slave) {
+        if (servedApplication != nullptr) {
+            shell.print("serving: the register map of application '%s', %u entries, backend failures %lu "
+                        "(last: %s)\r\n",
+                        servedApplication->name, static_cast<unsigned>(servedApplication->modbusMap.count),
+                        static_cast<unsigned long>(nodeBackend.failures()),
+                        dcos::statusName(nodeBackend.lastFailure()));
+        } else {
+            shell.print("serving: the console's data model\r\n");
+        }
+    }
     const LineCounters& line = runner.counters();
     const bsp::Uart16550::Statistics& errors = uart.statistics();
     shell.print("line: characters %lu frames-sent %lu refused %lu temt-polls %lu queue-overflows %lu "
@@ -701,6 +764,142 @@ CommandResult modbusCommand(shell::Shell& shell, int argc, char** argv)
     }
     return shell::runSubcommand(shell, argc, argv, kSubcommands);
 }
+
+// --- The application's slave, started at boot -------------------------------
+
+using dcos::app::ConfigurationError;
+using dcos::app::ConfigurationRule;
+using dcos::app::ModbusMapEntry;
+using dcos::app::ObjectKind;
+
+// The service's refusal: the loader names the application's slave, the
+// rule and the status, and deletes the whole application.
+ConfigurationError refused(const dcos::app::Application& application, Status status)
+{
+    return dcos::app::rules::broken(ConfigurationRule::CreateFailed, ObjectKind::ModbusSlave, application.name,
+                                    static_cast<size_t>(status));
+}
+
+bool namesBoardPoints(const dcos::app::DeclarationList<ModbusMapEntry>& map)
+{
+    for (const ModbusMapEntry& entry : map) {
+        if (entry.source != dcos::app::ModbusSource::Publisher) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Hands each publisher the master writes (bound to coils or holding
+// registers; the rules allow only publishers without a writer task there)
+// to the line's task, its single writer from now on. A publisher named by
+// several entries is handed over once.
+Status handOverWrittenPublishers(const dcos::app::DeclarationList<ModbusMapEntry>& map)
+{
+    for (size_t i = 0; i < map.count; ++i) {
+        const ModbusMapEntry& entry = map[i];
+        if (entry.source != dcos::app::ModbusSource::Publisher || !dcos::app::rules::isWritable(entry.table)) {
+            continue;
+        }
+        bool handed = false;
+        for (size_t j = 0; j < i && !handed; ++j) {
+            handed = map[j].source == dcos::app::ModbusSource::Publisher && dcos::app::rules::isWritable(map[j].table)
+                     && runtime::textEquals(map[j].object, entry.object);
+        }
+        if (handed) {
+            continue;
+        }
+        const dcos::Result<ObjectId> publisher = dcos::dsmAgent.NameToObject(entry.object);
+        const Status transferred =
+            publisher.ok() ? dcos::dsmAgent.XferOwnership(publisher.value(), lineTask) : publisher.status();
+        if (transferred != Status::Ok) {
+            return transferred;
+        }
+    }
+    return Status::Ok;
+}
+
+// Installs and opens the line's own I/O board object (the board the
+// console's `iobus` commands also reach, as "mfio0", which then finds its
+// resources taken and says so).
+dcos::Result<ObjectId> openMapBoard()
+{
+    iobus::IsaConflict conflict{};
+    const dcos::Result<ObjectId> installed =
+        mapBoard.installed() ? dcos::Result<ObjectId>(mapBoard.id())
+                             : mapBoard.install("modbus.io", dcos::Visibility::Local, &conflict);
+    if (!installed.ok()) {
+        return installed.status();
+    }
+    const Status opened = dcos::systemAgent.Open(installed.value());
+    if (opened != Status::Ok) {
+        (void)mapBoard.uninstall();
+        return opened;
+    }
+    return installed.value();
+}
+
+ConfigurationError startApplicationSlave(const dcos::app::Application& application)
+{
+    const dcos::app::ModbusSlaveDeclaration& declared = application.modbusSlave;
+    if (declared.address == 0) {
+        return {};
+    }
+    if (const Status started = startLineTask(); started != Status::Ok) {
+        return refused(application, started);
+    }
+    if (const Status handed = handOverWrittenPublishers(application.modbusMap); handed != Status::Ok) {
+        return refused(application, handed);
+    }
+    ObjectId board{};
+    if (namesBoardPoints(application.modbusMap)) {
+        const dcos::Result<ObjectId> opened = openMapBoard();
+        if (!opened.ok()) {
+            return refused(application, opened.status());
+        }
+        board = opened.value();
+    }
+    const bsp::UartSettings settings = lineSettings(declared.baud, declared.parity);
+    const modbus::ModbusResult<modbus::RtuTiming> timing =
+        modbus::RtuTiming::make(settings.baud, static_cast<uint8_t>(settings.characterBits()));
+    // The rules keep the baud rate in RtuTiming's range; a refusal here is the port's.
+    Status status = timing.ok() ? startPort(settings) : Status::InvalidArgument;
+    if (status == Status::Ok) {
+        nodeBackend.useBoard(board);
+        applicationModel.serve(application.modbusMap);
+        applicationIdentification.userApplicationName = application.name;
+        const ModbusError error = runner.startSlave(timing.value(), applicationModel, applicationIdentification,
+                                                    static_cast<uint8_t>(declared.address), timerAgent.Uptime());
+        status = error == ModbusError::Ok ? Status::Ok : modbus::toStatus(error);
+    }
+    if (status != Status::Ok) {
+        stopPort();
+        if (!board.isNull()) {
+            (void)dcos::systemAgent.Close(board);
+            (void)mapBoard.uninstall();
+        }
+        return refused(application, status);
+    }
+    servedApplication = &application;
+    return {};
+}
+
+void stopApplicationSlave(const dcos::app::Application& application)
+{
+    if (servedApplication != &application) {
+        return;
+    }
+    stopPort();
+    servedApplication = nullptr;
+    backendStale = true;
+    if (mapBoard.installed()) {
+        (void)dcos::systemAgent.Close(mapBoard.id());
+        (void)mapBoard.uninstall();
+    }
+    (void)taskAgent.PostEvent(lineTask, kCommandEvent);
+}
+
+DCOS_APPLICATION_SERVICE(modbusApplicationService, "modbus", startApplicationSlave, stopApplicationSlave);
 
 } // namespace
 

@@ -78,6 +78,7 @@ struct Configuration {
     std::vector<BufferPoolDeclaration> pools;
     std::vector<HeapDeclaration> heaps;
     std::vector<ModbusMapEntry> map;
+    dcos::app::ModbusSlaveDeclaration slave{};
     const char* name = "demo";
     uint32_t tickRateHz = 0;
 
@@ -91,6 +92,7 @@ struct Configuration {
                                 .bufferPools = {pools.data(), pools.size()},
                                 .heaps = {heaps.data(), heaps.size()},
                                 .modbusMap = {map.data(), map.size()},
+                                .modbusSlave = slave,
                                 .tickRateHz = tickRateHz};
         return findConfigurationError(application);
     }
@@ -503,4 +505,34 @@ TEST(ConfigurationRulesTest, MapEntriesHaveUniqueNamesAndAreCounted)
     EXPECT_EQ(error.rule, ConfigurationRule::TooManyObjects);
     EXPECT_EQ(error.value, dcos::app::kMaximumModbusMapEntries + 1);
     EXPECT_EQ(error.limit, dcos::app::kMaximumModbusMapEntries);
+}
+
+TEST(ConfigurationRulesTest, TheSlaveHasAnAddressABaudRateAndAMapToServe)
+{
+    Configuration configuration = mappedConfiguration();
+    // Address 0 declares no slave, whatever the other settings say.
+    configuration.slave.baud = 7;
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.slave = {.address = 247, .baud = 300, .parity = dcos::app::ModbusParity::None};
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.slave.address = 248;
+    ConfigurationError error = configuration.check();
+    expectBroken(error, ConfigurationRule::SlaveAddressOutOfRange, ObjectKind::ModbusSlave, "demo");
+    EXPECT_EQ(error.value, 248u);
+    EXPECT_EQ(error.limit, 247u);
+    EXPECT_EQ(message("demo", error), "application 'demo' not started: Modbus slave 'demo' has an address out of "
+                                      "range (1 to 247) (248, limit 247)");
+    configuration.slave.address = 1;
+    configuration.slave.baud = 299;
+    error = configuration.check();
+    expectBroken(error, ConfigurationRule::SlaveBaudOutOfRange, ObjectKind::ModbusSlave, "demo");
+    EXPECT_EQ(error.value, 299u);
+    configuration.slave.baud = 115200;
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.slave.baud = 115201;
+    EXPECT_EQ(configuration.check().rule, ConfigurationRule::SlaveBaudOutOfRange);
+    // A slave with nothing to serve is refused rather than left answering 02 to everything.
+    configuration.slave.baud = 19200;
+    configuration.map.clear();
+    expectBroken(configuration.check(), ConfigurationRule::SlaveWithoutMap, ObjectKind::ModbusSlave, "demo");
 }

@@ -130,8 +130,8 @@ constexpr uint32_t kModbusDigitalOutputPoints = 16;
 
 /// One range of a Modbus slave's addresses bound to a DCOS object; the
 /// application's `modbusMap` lists them. The compiler and the loader check
-/// them; the controller's `modbus slave` line does not serve them yet (it
-/// serves the console's data model), which the `app` command says.
+/// them; the controller's RS-485 line serves them from boot on when the
+/// application also declares its `modbusSlave` (drivers/modbus).
 struct ModbusMapEntry {
     const char* name = nullptr;    ///< Required, 1 to 15 characters, unique in the map; errors name it.
     ModbusTable table = ModbusTable::HoldingRegisters;
@@ -140,6 +140,30 @@ struct ModbusMapEntry {
     ModbusSource source = ModbusSource::Publisher;
     const char* object = nullptr;  ///< Publisher: the declared publisher's name; unused for the I/O board.
     uint32_t offset = 0;           ///< Publisher: the first byte in its page; I/O board: the first channel.
+};
+
+/// The parity of a Modbus serial line ([SL] 2.5.1: even by default; no
+/// parity takes a second stop bit, so that a character stays 11 bits).
+enum class ModbusParity : uint8_t {
+    Even,
+    Odd,
+    None,
+};
+
+/// The lowest and highest baud rates of a declared Modbus line: what the
+/// 16550's divisor reaches from 1.8432 MHz with an error the line tolerates,
+/// the same range the `modbus` console command takes.
+constexpr uint32_t kLowestModbusBaud = 300;
+constexpr uint32_t kHighestModbusBaud = 115200;
+
+/// The controller's Modbus slave on its RS-485 port, which serves the
+/// application's `modbusMap` from boot on. An application that declares no
+/// address (0) has no slave at boot; the console's `modbus slave` still
+/// starts one by hand.
+struct ModbusSlaveDeclaration {
+    uint32_t address = 0;          ///< The slave's address, 1 to 247 ([SL] 2.2); 0: none.
+    uint32_t baud = 19200;         ///< kLowestModbusBaud to kHighestModbusBaud.
+    ModbusParity parity = ModbusParity::Even;
 };
 
 /// The declared task an object is handed to: its owner, a port's receiver,
@@ -179,9 +203,10 @@ struct Application {
     DeclarationList<PublisherDeclaration> publishers;
     DeclarationList<BufferPoolDeclaration> bufferPools;
     DeclarationList<HeapDeclaration> heaps;
-    /// The Modbus register map the controller's slave serves (empty: the
-    /// console's data model).
+    /// The Modbus register map the controller's slave serves.
     DeclarationList<ModbusMapEntry> modbusMap;
+    /// The slave that serves modbusMap from boot on (address 0: none).
+    ModbusSlaveDeclaration modbusSlave{};
     /// The system tick the application needs, in Hz (timer resolution is one
     /// tick); 0 keeps the board's default. A tick_hz= on the kernel command
     /// line still wins.

@@ -6,8 +6,8 @@
 // and the application loader, which runs it again at boot on the linked
 // configuration before it creates anything. Rules are checked in declaration
 // order: the application, then tasks, semaphores, ports, publishers, pools
-// and heaps, then the totals, then the Modbus register map; the first broken
-// rule is reported.
+// and heaps, then the totals, then the Modbus register map and slave; the
+// first broken rule is reported.
 #pragma once
 
 #include <dcos/ApplicationDeclarations.hpp>
@@ -33,6 +33,7 @@ enum class ObjectKind : uint8_t {
     BufferPool,
     Heap,
     ModbusMapEntry,
+    ModbusSlave,
 };
 
 /// The rule a configuration breaks.
@@ -62,6 +63,9 @@ enum class ConfigurationRule : uint8_t {
     MapTooLarge,          ///< value: page bytes or I/O points it needs (offset + size); limit: what there is.
     MapWritesReadOnly,    ///< A coil or holding register entry bound to something Modbus may not write.
     MapOverlap,           ///< value: the first address it shares with an earlier entry of its table; limit: the last.
+    SlaveAddressOutOfRange, ///< value: the Modbus slave's address; limit: 247.
+    SlaveBaudOutOfRange,  ///< value: the baud rate; limit: kHighestModbusBaud.
+    SlaveWithoutMap,      ///< A Modbus slave declared with an empty register map.
     // Rules only the running node can check (application loader).
     NameInUse,            ///< An object of the node already has the name.
     CreateFailed,         ///< The agent refused; the loader prints its status.
@@ -91,6 +95,8 @@ constexpr size_t kMaximumObjectName = 15;
 constexpr size_t kMaximumModbusMapEntries = 32;
 /// The last Modbus address of every table ([AP] 4.4: addresses 0 to 65535).
 constexpr uint32_t kLastModbusAddress = 0xFFFF;
+/// The highest address of a Modbus slave ([SL] 2.2: 248 to 255 are reserved).
+constexpr uint32_t kMaxModbusSlaveAddress = 247;
 
 /// Tasks the kernel itself runs on every node (idle, the root task and the console shell).
 constexpr const char* kKernelTaskNames[] = {internal::kIdleTaskName, internal::kRootTaskName,
@@ -116,6 +122,7 @@ constexpr const char* objectKindName(ObjectKind kind)
     case ObjectKind::BufferPool: return "buffer pool";
     case ObjectKind::Heap: return "heap";
     case ObjectKind::ModbusMapEntry: return "Modbus map entry";
+    case ObjectKind::ModbusSlave: return "Modbus slave";
     }
     return "object";
 }
@@ -151,6 +158,9 @@ constexpr const char* ruleText(ConfigurationRule rule)
     case ConfigurationRule::MapWritesReadOnly:
         return "is writable (coils, holding registers) but bound to something read-only";
     case ConfigurationRule::MapOverlap: return "overlaps an earlier entry of its table";
+    case ConfigurationRule::SlaveAddressOutOfRange: return "has an address out of range (1 to 247)";
+    case ConfigurationRule::SlaveBaudOutOfRange: return "has a baud rate out of range (300 to 115200)";
+    case ConfigurationRule::SlaveWithoutMap: return "is declared without a register map to serve";
     case ConfigurationRule::NameInUse: return "has a name another object of the node already uses";
     case ConfigurationRule::CreateFailed: return "was refused by its agent";
     }
@@ -470,6 +480,29 @@ constexpr ConfigurationError checkModbusMap(const Application& application)
     return {};
 }
 
+/// The declared slave's line settings. The error names the application,
+/// since an application declares at most one slave.
+constexpr ConfigurationError checkModbusSlave(const Application& application)
+{
+    const ModbusSlaveDeclaration& slave = application.modbusSlave;
+    constexpr ObjectKind kind = ObjectKind::ModbusSlave;
+    if (slave.address == 0) {
+        return {};
+    }
+    if (slave.address > kMaxModbusSlaveAddress) {
+        return broken(ConfigurationRule::SlaveAddressOutOfRange, kind, application.name, slave.address,
+                      kMaxModbusSlaveAddress);
+    }
+    if (slave.baud < kLowestModbusBaud || slave.baud > kHighestModbusBaud) {
+        return broken(ConfigurationRule::SlaveBaudOutOfRange, kind, application.name, slave.baud,
+                      kHighestModbusBaud);
+    }
+    if (application.modbusMap.count == 0) {
+        return broken(ConfigurationRule::SlaveWithoutMap, kind, application.name);
+    }
+    return {};
+}
+
 } // namespace rules
 
 /// The first rule @p application breaks, or an error with rule None.
@@ -495,6 +528,7 @@ constexpr ConfigurationError findConfigurationError(const Application& applicati
     if (error.ok()) error = rules::checkMemoryAreas(application);
     if (error.ok()) error = rules::checkTotals(application);
     if (error.ok()) error = rules::checkModbusMap(application);
+    if (error.ok()) error = rules::checkModbusSlave(application);
     return error;
 }
 

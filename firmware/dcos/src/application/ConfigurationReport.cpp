@@ -23,6 +23,8 @@ bool showsValueAndLimit(ConfigurationRule rule)
     case ConfigurationRule::MapAddressPastEnd:
     case ConfigurationRule::MapTooLarge:
     case ConfigurationRule::MapOverlap:
+    case ConfigurationRule::SlaveAddressOutOfRange:
+    case ConfigurationRule::SlaveBaudOutOfRange:
         return true;
     default:
         return false;

@@ -73,6 +73,11 @@ struct ConfigurationRejected {
     static_assert(rule != Rule::MapOverlap,
                   "the Modbus map entry overlaps an earlier entry of its table (value: the first shared address, "
                   "limit: the last)");
+    static_assert(rule != Rule::SlaveAddressOutOfRange,
+                  "the Modbus slave's address must be 1 to 247, or 0 for no slave (value: the address, limit: 247)");
+    static_assert(rule != Rule::SlaveBaudOutOfRange,
+                  "the Modbus slave's baud rate must be 300 to 115200 (value: the rate, limit: the highest)");
+    static_assert(rule != Rule::SlaveWithoutMap, "a Modbus slave is declared but the register map is empty");
     // NameInUse and CreateFailed come from the running node only.
     static constexpr bool passed = rule == Rule::None;
 };
