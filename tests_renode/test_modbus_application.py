@@ -200,3 +200,15 @@ def test_libmodbus_master_reads_and_writes_the_map(bridged_mapped):
     # An unmapped address: libmodbus names the controller's exception 02.
     status, answer, errors = dcos_modbus(emulator, line, "read-holding-registers", "4", "1")
     assert status == 1 and "02" in str(answer), (answer, errors)
+
+
+def test_a_map_naming_board_points_is_refused_at_boot_without_the_board(boot, isa486, mapped_image):
+    # Only the node knows whether the I/O board is there: the loader refuses
+    # the whole application, names the slave and the board's status, and
+    # the console comes up with the line off.
+    emulator = boot(isa486, mapped_image, icount=True, without_devices=["isa-mfio"])
+    match = emulator.expect(r"application 'mbmap' not started: Modbus slave 'mbmap' was refused by its agent "
+                            r"\(([a-z -]+)\)")
+    emulator.expect("dcos> ")
+    assert "control" not in emulator.command("tasks")
+    assert "modbus: off" in emulator.command("modbus state"), match.group(0)
