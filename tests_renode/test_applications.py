@@ -221,10 +221,10 @@ def test_a_valid_modbus_map_compiles(tmp_path, boot, isa486):
                                      "entry is bound to something read-only"]),
     (dict(slave=", .modbusSlave = {.address = 248}"),
      ['ObjectName{"mapped"}', "SlaveAddressOutOfRange, 248, 247",
-      "configuration error: Modbus slave 'mapped': the Modbus slave's address must be 1 to 247", "(value 248, limit 247)"]),
+      "configuration error: Modbus slave 'mapped': a Modbus slave address must be 1 to 247", "(value 248, limit 247)"]),
     (dict(slave=", .modbusSlave = {.address = 17, .baud = 230400}"),
-     ['ObjectName{"mapped"}', "SlaveBaudOutOfRange, 230400, 115200",
-      "configuration error: Modbus slave 'mapped': the Modbus slave's baud rate must be 300 to 115200"]),
+     ['ObjectName{"mapped"}', "BaudOutOfRange, 230400, 115200",
+      "configuration error: Modbus slave 'mapped': the Modbus line's baud rate must be 300 to 115200"]),
 ])
 def test_modbus_map_errors_name_the_entry_at_compile_time(tmp_path, change, phrases):
     application = write_map(str(tmp_path / "mapped"), **change)

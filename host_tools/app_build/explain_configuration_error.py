@@ -45,12 +45,14 @@ KIND_NAMES = {
     "Heap": "heap",
     "ModbusMapEntry": "Modbus map entry",
     "ModbusSlave": "Modbus slave",
+    "ModbusPollEntry": "Modbus poll entry",
+    "ModbusMaster": "Modbus master",
 }
 # Rules whose value and limit mean something (ConfigurationReport.cpp shows the same ones).
 RULES_WITH_VALUES = {"NameTooLong", "PriorityOutOfRange", "StackTooSmall", "StacksExceedArena", "TooManyObjects",
                      "InitialCountTooLarge", "TickRateOutOfRange", "AreaTooSmall", "BufferTooSmall",
                      "MapAddressPastEnd", "MapTooLarge", "MapOverlap", "SlaveAddressOutOfRange",
-                     "SlaveBaudOutOfRange"}
+                     "BaudOutOfRange", "PollPeriodOutOfRange", "TimeoutOutOfRange", "RetriesOutOfRange"}
 # The summary is one line: a name or rule text longer than this is cut.
 MAX_PART = 200
 

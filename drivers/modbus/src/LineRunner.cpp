@@ -57,7 +57,7 @@ ModbusError LineRunner::startPolling(const modbus::RtuTiming& timing, const modb
 {
     const ModbusError error = startMaster(timing, config, nowNs);
     if (error == ModbusError::Ok) {
-        schedule_ = Schedule(master_);
+        schedule_.clear();
         polling_ = true;
     }
     return error;

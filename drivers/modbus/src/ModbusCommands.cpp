@@ -18,9 +18,11 @@
 // task, installs the I/O board when the map names its points, and starts
 // the slave before any task runs. `modbus slave` by hand still serves the
 // console's data model instead.
-#include <mbline/LineInterrupt.hpp>
+#include <mbline/BoardLine.hpp>
 #include <mbline/LineRunner.hpp>
+#include <mbline/LineService.hpp>
 #include <mbline/NodeMapBackend.hpp>
+#include <mbline/PollLine.hpp>
 
 #include <bsp/Board.hpp>
 #include <dcos/DsmAgent.hpp>
@@ -47,15 +49,9 @@ using dcos::timerAgent;
 using modbus::ModbusError;
 using shell::CommandResult;
 
-// The RS-485 port as the runner sees it: the board's COM2 16550.
-class Rs485Port final : public LinePort {
-public:
-    Status transmit(const uint8_t* bytes, size_t length) override { return bsp::rs485Uart().transmit(bytes, length); }
-    bool finishTransmission() override { return bsp::rs485Uart().finishTransmission(); }
-};
-
-Rs485Port rs485Port;
-LineRunner runner(rs485Port);
+// The RS-485 port the console and the application's slave use: the board's COM2 16550.
+BoardLine com2(bsp::rs485Uart(), bsp::rs485Line, bsp::rs485PortAddress, "COM2");
+LineRunner& runner = com2.runner();
 
 // The data the console's slave serves when no application map is linked:
 // 256 of each table. Discrete inputs and input registers hold a pattern a
@@ -85,8 +81,7 @@ volatile bool backendStale = false;
 modbus::DeviceIdentification applicationIdentification = identification;
 
 // The task's events.
-constexpr uint32_t kLineEvent = 1u << 0;    // the UART's interrupt
-constexpr uint32_t kCommandEvent = 1u << 1; // the console's mailbox
+constexpr uint32_t kCommandEvent = 1u << 1; // the console's mailbox (BoardLine::kLineEvent is the UART's)
 // The console task's event for a mailbox answer; bit 0 is its input, the
 // can command uses bits 20 to 22.
 constexpr uint32_t kAnswerEvent = 1u << 23;
@@ -130,34 +125,10 @@ void fillPattern()
     }
 }
 
-void onFifoEmptied(void*) { runner.fifoEmptied(timerAgent.Uptime()); }
-
-void lineInterrupt(void*)
-{
-    bsp::rs485Uart().handleInterrupt();
-    (void)taskAgent.PostEvent(lineTask, kLineEvent);
-}
-
-void stopPort()
-{
-    (void)bsp::detachInterrupt(bsp::rs485Line);
-    bsp::rs485Uart().shutdown();
-    runner.stop();
-}
+void stopPort() { com2.stop(); }
 
 // Brings the port up with the mailbox's settings; the runner is started by the caller.
-Status startPort(const bsp::UartSettings& settings)
-{
-    stopPort();
-    bsp::Uart16550& uart = bsp::rs485Uart();
-    const Status status = uart.initialise(settings);
-    if (status != Status::Ok) {
-        return status;
-    }
-    uart.setReceiveSink(stampReceivedByte, &runner);
-    uart.setTransmitNotifier(onFifoEmptied, nullptr);
-    return bsp::attachInterrupt(bsp::rs485Line, lineInterrupt, nullptr);
-}
+Status startPort(const bsp::UartSettings& settings) { return com2.start(settings); }
 
 void serveMailbox()
 {
@@ -223,23 +194,14 @@ void lineTaskEntry(uintptr_t)
             backendStale = false;
         }
         serveMailbox();
-        const uint64_t now = timerAgent.Uptime();
-        const uint64_t next = runner.service(now);
+        const uint64_t timeout = com2.service(timerAgent.Uptime());
         Completion completion;
         if (runner.takeCompletion(completion)) {
             lastCompletion = completion;
             completionReady = true;
             (void)taskAgent.PostEvent(completionWaiter, kAnswerEvent);
         }
-        uint64_t timeout = dcos::kWaitForever;
-        if (next != ~0ull) {
-            const uint64_t later = timerAgent.Uptime();
-            // A deadline already passed is served by the next round at once.
-            timeout = next > later ? next - later : dcos::kPoll;
-        }
-        if (timeout != dcos::kPoll) {
-            (void)taskAgent.ReceiveEvent(kLineEvent | kCommandEvent, dcos::EventWait::Any, timeout);
-        }
+        (void)com2.wait(timeout, kCommandEvent);
     }
 }
 
@@ -259,6 +221,7 @@ Status startLineTask()
         return task.status();
     }
     lineTask = task.value();
+    com2.setTask(lineTask);
     return Status::Ok;
 }
 
@@ -309,22 +272,6 @@ bool parseNumber(shell::Shell& shell, const char* text, unsigned long limit, uns
         return false;
     }
     return true;
-}
-
-// The port's settings for a Modbus line: 8 data bits, a receive trigger of
-// one byte and the driver enable on RTS (docs/protocols/modbus.md, "The
-// port"). [SL] 2.5.1: no parity takes a second stop bit, so that a
-// character stays 11 bits.
-bsp::UartSettings lineSettings(uint32_t baud, dcos::app::ModbusParity parity)
-{
-    return bsp::UartSettings{.baud = baud,
-                             .dataBits = 8,
-                             .parity = parity == dcos::app::ModbusParity::None  ? bsp::UartParity::None
-                                       : parity == dcos::app::ModbusParity::Odd ? bsp::UartParity::Odd
-                                                                                : bsp::UartParity::Even,
-                             .stopBits = static_cast<uint8_t>(parity == dcos::app::ModbusParity::None ? 2 : 1),
-                             .receiveTrigger = 1,
-                             .driverEnable = bsp::DriverEnable::Rts};
 }
 
 // [baud] [parity n|e|o]: the line's settings, 19200 8E1 by default ([SL] 2.5.1).
@@ -752,9 +699,20 @@ CommandResult result(shell::Shell& shell, int, char**)
     return awaitCompletion(shell);
 }
 
+// poll: the application's polling schedule on the second RS-485 port.
+CommandResult poll(shell::Shell& shell, int argc, char**)
+{
+    if (argc != 2) {
+        return CommandResult::UsageError;
+    }
+    printPollStatus(shell);
+    return CommandResult::Ok;
+}
+
 constexpr shell::Subcommand kSubcommands[] = {
     {"state", state}, {"slave", slave}, {"master", master}, {"off", off},
     {"read", read},   {"write", write}, {"data", data}, {"submit", submit}, {"result", result},
+    {"poll", poll},
 };
 
 CommandResult modbusCommand(shell::Shell& shell, int argc, char** argv)
@@ -772,14 +730,6 @@ using dcos::app::ConfigurationRule;
 using dcos::app::ModbusMapEntry;
 using dcos::app::ObjectKind;
 
-// The service's refusal: the loader names the application's slave, the
-// rule and the status, and deletes the whole application.
-ConfigurationError refused(const dcos::app::Application& application, Status status)
-{
-    return dcos::app::rules::broken(ConfigurationRule::CreateFailed, ObjectKind::ModbusSlave, application.name,
-                                    static_cast<size_t>(status));
-}
-
 bool namesBoardPoints(const dcos::app::DeclarationList<ModbusMapEntry>& map)
 {
     for (const ModbusMapEntry& entry : map) {
@@ -790,33 +740,11 @@ bool namesBoardPoints(const dcos::app::DeclarationList<ModbusMapEntry>& map)
     return false;
 }
 
-// Hands each publisher the master writes (bound to coils or holding
-// registers; the rules allow only publishers without a writer task there)
-// to the line's task, its single writer from now on. A publisher named by
-// several entries is handed over once.
-Status handOverWrittenPublishers(const dcos::app::DeclarationList<ModbusMapEntry>& map)
+// The publishers the master writes through the map: those bound to coils or
+// holding registers (the rules allow only publishers without a writer task there).
+bool mapWritesPublisher(const ModbusMapEntry& entry)
 {
-    for (size_t i = 0; i < map.count; ++i) {
-        const ModbusMapEntry& entry = map[i];
-        if (entry.source != dcos::app::ModbusSource::Publisher || !dcos::app::rules::isWritable(entry.table)) {
-            continue;
-        }
-        bool handed = false;
-        for (size_t j = 0; j < i && !handed; ++j) {
-            handed = map[j].source == dcos::app::ModbusSource::Publisher && dcos::app::rules::isWritable(map[j].table)
-                     && runtime::textEquals(map[j].object, entry.object);
-        }
-        if (handed) {
-            continue;
-        }
-        const dcos::Result<ObjectId> publisher = dcos::dsmAgent.NameToObject(entry.object);
-        const Status transferred =
-            publisher.ok() ? dcos::dsmAgent.XferOwnership(publisher.value(), lineTask) : publisher.status();
-        if (transferred != Status::Ok) {
-            return transferred;
-        }
-    }
-    return Status::Ok;
+    return entry.source == dcos::app::ModbusSource::Publisher && dcos::app::rules::isWritable(entry.table);
 }
 
 // Installs and opens the line's own I/O board object (the board the
@@ -846,16 +774,17 @@ ConfigurationError startApplicationSlave(const dcos::app::Application& applicati
         return {};
     }
     if (const Status started = startLineTask(); started != Status::Ok) {
-        return refused(application, started);
+        return refusedBy(application, ObjectKind::ModbusSlave, started);
     }
-    if (const Status handed = handOverWrittenPublishers(application.modbusMap); handed != Status::Ok) {
-        return refused(application, handed);
+    if (const Status handed = handOverPublishers(application.modbusMap, mapWritesPublisher, lineTask);
+        handed != Status::Ok) {
+        return refusedBy(application, ObjectKind::ModbusSlave, handed);
     }
     ObjectId board{};
     if (namesBoardPoints(application.modbusMap)) {
         const dcos::Result<ObjectId> opened = openMapBoard();
         if (!opened.ok()) {
-            return refused(application, opened.status());
+            return refusedBy(application, ObjectKind::ModbusSlave, opened.status());
         }
         board = opened.value();
     }
@@ -878,7 +807,7 @@ ConfigurationError startApplicationSlave(const dcos::app::Application& applicati
             (void)dcos::systemAgent.Close(board);
             (void)mapBoard.uninstall();
         }
-        return refused(application, status);
+        return refusedBy(application, ObjectKind::ModbusSlave, status);
     }
     servedApplication = &application;
     return {};
@@ -903,12 +832,6 @@ DCOS_APPLICATION_SERVICE(modbusApplicationService, "modbus", startApplicationSla
 
 } // namespace
 
-void stampReceivedByte(void* runner, uint8_t byte)
-{
-    // A full queue counts the byte as lost (TimedByteQueue::push); the
-    // frame it belonged to then fails its CRC and is discarded.
-    (void)static_cast<LineRunner*>(runner)->queue().push(byte, timerAgent.Uptime());
-}
 
 } // namespace mbline
 
@@ -916,10 +839,11 @@ DCOS_SHELL_COMMAND_DETAILED(modbusShellCommand, "modbus", "run the Modbus RTU li
                             "modbus [state] | slave <address> [baud] [n|e|o] | master [baud] [n|e|o] [time-out ms] "
                             "[retries] | off | read <unit> <table> <address> <count> | "
                             "write <unit> <coils|holding> <address> <value>... | submit read|write ... | result | "
-                            "data <table> <address> <count>",
+                            "data <table> <address> <count> | poll",
                             "  tables: coils, inputs, holding, input-registers; the line is 19200 baud 8E1 unless\r\n"
                             "  told; state shows the line's, the receiver's, the slave's and the master's counters;\r\n"
                             "  data shows what the console slave serves (input register n is 0x1000 + n,\r\n"
                             "  discrete input n is on for multiples of 3); submit starts a read or write without\r\n"
-                            "  waiting for it, result waits for its end",
+                            "  waiting for it, result waits for its end; poll shows the application's polling schedule\r\n"
+                            "  on the second RS-485 port (COM3), one line per entry",
                             mbline::modbusCommand);

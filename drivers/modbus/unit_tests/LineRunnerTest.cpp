@@ -506,4 +506,27 @@ TEST_F(LineRunnerTest, ASchedulePollsItsEntriesAndSaysWhichEnded)
     EXPECT_EQ(port_.startedNs[3], 510 * kMillisecond + timing_.characterNs);
     runner_.stop();
     EXPECT_FALSE(runner_.polling());
+    // Polling again starts from an empty schedule.
+    ASSERT_EQ(runner_.startPolling(timing_, config, now_), ModbusError::Ok);
+    EXPECT_EQ(runner_.schedule().size(), 0u);
+    EXPECT_EQ(runner_.schedule().statistics(0).transactions, 0u);
+}
+
+TEST_F(LineRunnerTest, AReplacedRequestGoesOutFromItsEntrysNextSubmission)
+{
+    modbus::MasterConfig config;
+    config.responseTimeoutNs = 50 * kMillisecond;
+    config.retries = 0;
+    ASSERT_EQ(runner_.startPolling(timing_, config, now_), ModbusError::Ok);
+    ASSERT_TRUE(runner_.schedule().add(Request::writeSingleRegister(kUnit, 4, 1).value(), 100 * kMillisecond).ok());
+    runUntil(60 * kMillisecond);
+    ASSERT_EQ(port_.frames.size(), 1u);
+    EXPECT_EQ(port_.frames[0], withCrc({kUnit, 0x06, 0x00, 0x04, 0x00, 0x01}));
+    ASSERT_EQ(runner_.schedule().replace(0, Request::writeSingleRegister(kUnit, 4, 2).value()), ModbusError::Ok);
+    runUntil(160 * kMillisecond);
+    ASSERT_EQ(port_.frames.size(), 2u);
+    EXPECT_EQ(port_.frames[1], withCrc({kUnit, 0x06, 0x00, 0x04, 0x00, 0x02}));
+    EXPECT_EQ(runner_.schedule().statistics(0).transactions, 2u);
+    EXPECT_EQ(runner_.schedule().replace(1, Request::writeSingleRegister(kUnit, 4, 2).value()),
+              ModbusError::InvalidArgument);
 }

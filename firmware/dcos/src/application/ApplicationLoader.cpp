@@ -349,7 +349,9 @@ Result<ObjectId> ApplicationLoader::find(app::ObjectKind kind, const char* name)
     case ObjectKind::Heap: return kindServices<app::HeapDeclaration>.nameToObject(name);
     case ObjectKind::Application:
     case ObjectKind::ModbusMapEntry:
-    case ObjectKind::ModbusSlave: break; // None is an object of the node.
+    case ObjectKind::ModbusSlave:
+    case ObjectKind::ModbusPollEntry:
+    case ObjectKind::ModbusMaster: break; // None is an object of the node.
     }
     return Status::InvalidArgument;
 }

@@ -24,7 +24,10 @@ bool showsValueAndLimit(ConfigurationRule rule)
     case ConfigurationRule::MapTooLarge:
     case ConfigurationRule::MapOverlap:
     case ConfigurationRule::SlaveAddressOutOfRange:
-    case ConfigurationRule::SlaveBaudOutOfRange:
+    case ConfigurationRule::BaudOutOfRange:
+    case ConfigurationRule::PollPeriodOutOfRange:
+    case ConfigurationRule::TimeoutOutOfRange:
+    case ConfigurationRule::RetriesOutOfRange:
         return true;
     default:
         return false;
