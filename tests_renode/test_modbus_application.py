@@ -43,21 +43,25 @@ from dcoslab.board import REPOSITORY  # noqa: E402
 from dcoslab.serial_line import SerialLine  # noqa: E402
 from test_modbus_rs485 import BAUD, UNIT, WAIT, exception_of, exchange, state, wait_for, dcos_modbus  # noqa: E402
 
-SOURCES = os.path.join(REPOSITORY, "tests_renode", "modbus", "mapped_app")
 APPLICATION_MAKEFILE = os.path.join(REPOSITORY, "build", "sdk", "share", "dcos", "application.mk")
 MBMAP = re.compile(r"mbmap: command (?P<command0>\d+) (?P<command1>\d+) enable 0x(?P<enable>[0-9a-f]{2}) "
                    r"updates (?P<updates>\d+) cycles (?P<cycles>\d+) errors (?P<errors>\d+)")
 
 
-@pytest.fixture(scope="session")
-def mapped_image(tmp_path_factory):
-    """The mapped application built against the staged SDK (`make sdk`)."""
-    directory = tmp_path_factory.mktemp("apps") / "mbmap"
-    shutil.copytree(SOURCES, directory)
+def build_application(tmp_path_factory, name):
+    """tests_renode/modbus/<name> built against the staged SDK (`make sdk`); returns its image."""
+    directory = tmp_path_factory.mktemp("apps") / name
+    shutil.copytree(os.path.join(REPOSITORY, "tests_renode", "modbus", name), directory)
     result = subprocess.run(["make", "--no-print-directory", "-f", APPLICATION_MAKEFILE, f"APP={directory}", "app"],
                             capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stdout + result.stderr
-    return str(directory / "build" / "mbmap-486.elf")
+    return str(directory / "build" / f"{name}-486.elf")
+
+
+@pytest.fixture(scope="session")
+def mapped_image(tmp_path_factory):
+    """The mapped application (tests_renode/modbus/mapped_app)."""
+    return build_application(tmp_path_factory, "mapped_app")
 
 
 def boot_mapped(boot, isa486, image, bridge):
