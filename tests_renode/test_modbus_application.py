@@ -25,7 +25,6 @@ import os
 import re
 import shutil
 import subprocess
-import time
 
 import pytest
 
@@ -41,7 +40,8 @@ from pymodbus.register_write_message import WriteMultipleRegistersRequest, Write
 
 from dcoslab.board import REPOSITORY  # noqa: E402
 from dcoslab.serial_line import SerialLine  # noqa: E402
-from test_modbus_rs485 import BAUD, UNIT, WAIT, exception_of, exchange, state, wait_for, dcos_modbus  # noqa: E402
+from dcoslab.waiting import wait_until  # noqa: E402
+from test_modbus_rs485 import BAUD, UNIT, dcos_modbus, exception_of, exchange, state  # noqa: E402
 
 APPLICATION_MAKEFILE = os.path.join(REPOSITORY, "build", "sdk", "share", "dcos", "application.mk")
 MBMAP = re.compile(r"mbmap: command (?P<command0>\d+) (?P<command1>\d+) enable 0x(?P<enable>[0-9a-f]{2}) "
@@ -64,17 +64,13 @@ def mapped_image(tmp_path_factory):
     return build_application(tmp_path_factory, "mapped_app")
 
 
-def boot_mapped(boot, isa486, image, bridge):
-    emulator = boot(isa486, image, icount=True, serial_sockets=["rs485"])
+@pytest.fixture(params=[False], ids=["socket"])
+def mapped_line(request, boot, isa486, mapped_image):
+    """The mapped application booted, COM2's bytes in the test's hands (param True: bridged to a pty)."""
+    emulator = boot(isa486, mapped_image, icount=True, serial_sockets=["rs485"])
     emulator.expect(r"application 'mbmap' started: 1 task, 2 publishers")
     emulator.expect("dcos> ")
-    line = SerialLine(emulator.serial_socket_path("rs485"), bridge=bridge)
-    return emulator, line
-
-
-@pytest.fixture
-def mapped_line(boot, isa486, mapped_image):
-    emulator, line = boot_mapped(boot, isa486, mapped_image, bridge=False)
+    line = SerialLine(emulator.serial_socket_path("rs485"), bridge=request.param)
     yield emulator, line
     line.close()
 
@@ -89,13 +85,7 @@ def seen(emulator):
 
 def wait_seen(emulator, predicate, what):
     """Runs `mbmap` until predicate holds: the application has read the master's write."""
-    deadline = time.monotonic() + WAIT
-    while True:
-        values = seen(emulator)
-        if predicate(values):
-            return values
-        if time.monotonic() > deadline:
-            raise AssertionError(f"the application never saw {what}; it read {values}\n{emulator.transcript}")
+    return wait_until(lambda: seen(emulator), predicate, what, emulator)
 
 
 def test_the_line_serves_the_map_from_boot(mapped_line):
@@ -180,15 +170,9 @@ def test_unmapped_addresses_and_read_only_bindings_are_refused(mapped_line):
     assert counters["slave.exceptions"] == 6, counters
 
 
-@pytest.fixture
-def bridged_mapped(boot, isa486, mapped_image):
-    emulator, line = boot_mapped(boot, isa486, mapped_image, bridge=True)
-    yield emulator, line
-    line.close()
-
-
-def test_libmodbus_master_reads_and_writes_the_map(bridged_mapped):
-    emulator, line = bridged_mapped
+@pytest.mark.parametrize("mapped_line", [True], ids=["pty"], indirect=True)
+def test_libmodbus_master_reads_and_writes_the_map(mapped_line):
+    emulator, line = mapped_line
     status, answer, errors = dcos_modbus(emulator, line, "write-registers", "0=300,400")
     assert status == 0, (answer, errors, emulator.transcript)
     wait_seen(emulator, lambda s: (s["command0"], s["command1"]) == (300, 400), "registers 300 400")

@@ -29,6 +29,7 @@ from pymodbus.factory import ServerDecoder  # noqa: E402
 from pymodbus.framer.rtu_framer import ModbusRtuFramer  # noqa: E402
 
 from dcoslab.serial_line import SerialLine  # noqa: E402
+from dcoslab.waiting import wait_until  # noqa: E402
 from modbus.pymodbus_slave import COILS, DISCRETE_INPUTS, HOLDING_REGISTERS, INPUT_REGISTERS  # noqa: E402
 from test_modbus_application import build_application  # noqa: E402
 
@@ -109,14 +110,8 @@ def poll_table(emulator):
 
 
 def wait_polled(emulator, predicate, what):
-    deadline = time.monotonic() + WAIT
-    while True:
-        entries, line, output = poll_table(emulator)
-        if predicate(entries):
-            return entries, line, output
-        if time.monotonic() > deadline:
-            raise AssertionError(f"never reached: {what}\n{output}\n{emulator.transcript}")
-        time.sleep(0.05)
+    """Runs `modbus poll` until predicate(entries) holds; returns the entries, the line's counters and the output."""
+    return wait_until(lambda: poll_table(emulator), lambda seen: predicate(seen[0]), what, emulator, timeout=WAIT)
 
 
 def pages(emulator):
@@ -170,8 +165,7 @@ def test_a_slave_that_does_not_answer_times_out_after_its_retries_and_the_applic
     # The page the absent slave would fill stays as it was, and the application runs on.
     read, cycles, failures = pages(emulator)
     assert read["ghost"][0:2] == b"\0\0" and failures == 0
-    time.sleep(0.5)
-    assert pages(emulator)[1] > cycles
+    wait_until(lambda: pages(emulator)[1], lambda now: now > cycles + 5, "more cycles of the application", emulator)
 
 
 def test_an_exception_answer_is_counted_and_named(polled):

@@ -41,6 +41,27 @@ bsp::UartSettings lineSettings(uint32_t baud, dcos::app::ModbusParity parity)
                              .driverEnable = bsp::DriverEnable::Rts};
 }
 
+Status BoardLine::startTask(const char* name, void (*entry)(uintptr_t))
+{
+    if (!task_.isNull()) {
+        return Status::Ok;
+    }
+    // Above the application's tasks by default (16) and below the console,
+    // so that a line keeps its character timing while the application works.
+    constexpr uint8_t kLineTaskPriority = 6;
+    dcos::TaskAttributes attributes;
+    attributes.name = name;
+    attributes.priority = kLineTaskPriority;
+    attributes.stackSize = 8192;
+    attributes.newProcess = true;
+    const dcos::Result<dcos::ObjectId> task = taskAgent.Create(attributes, entry, 0);
+    if (!task.ok()) {
+        return task.status();
+    }
+    task_ = task.value();
+    return Status::Ok;
+}
+
 void BoardLine::stop()
 {
     (void)bsp::detachInterrupt(interruptLine_);

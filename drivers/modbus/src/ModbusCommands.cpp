@@ -75,9 +75,6 @@ iobus::MfioBoard mapBoard("modbus.io");
 // or no slave). Set by the application service before the line's task
 // runs; the task and the console only read it.
 const dcos::app::Application* servedApplication = nullptr;
-// Set when the service stops: the line's task closes the subscriptions it
-// opened for the map, which only their owner may.
-volatile bool backendStale = false;
 modbus::DeviceIdentification applicationIdentification = identification;
 
 // The task's events.
@@ -86,7 +83,6 @@ constexpr uint32_t kCommandEvent = 1u << 1; // the console's mailbox (BoardLine:
 // can command uses bits 20 to 22.
 constexpr uint32_t kAnswerEvent = 1u << 23;
 
-constexpr uint8_t kTaskPriority = 6;
 constexpr uint64_t kMillisecond = 1'000'000;
 constexpr uint64_t kCommandTimeoutNs = 2000 * kMillisecond;
 
@@ -189,10 +185,7 @@ void serveMailbox()
 void lineTaskEntry(uintptr_t)
 {
     for (;;) {
-        if (backendStale) {
-            nodeBackend.closeSubscriptions();
-            backendStale = false;
-        }
+        nodeBackend.closeIfRequested();
         serveMailbox();
         const uint64_t timeout = com2.service(timerAgent.Uptime());
         Completion completion;
@@ -208,21 +201,9 @@ void lineTaskEntry(uintptr_t)
 // Creates the line's task the first time the line is needed.
 Status startLineTask()
 {
-    if (!lineTask.isNull()) {
-        return Status::Ok;
-    }
-    dcos::TaskAttributes attributes;
-    attributes.name = "modbus";
-    attributes.priority = kTaskPriority;
-    attributes.stackSize = 8192;
-    attributes.newProcess = true;
-    const dcos::Result<ObjectId> task = taskAgent.Create(attributes, lineTaskEntry, 0);
-    if (!task.ok()) {
-        return task.status();
-    }
-    lineTask = task.value();
-    com2.setTask(lineTask);
-    return Status::Ok;
+    const Status started = com2.startTask("modbus", lineTaskEntry);
+    lineTask = com2.task();
+    return started;
 }
 
 // Discards a stale answer event, so that the next wait sees only its own.
@@ -322,11 +303,6 @@ const char* masterStateName(modbus::Master::State state)
     case modbus::Master::State::Turnaround: return "turnaround";
     }
     return "?";
-}
-
-char parityLetter(bsp::UartParity parity)
-{
-    return parity == bsp::UartParity::None ? 'N' : parity == bsp::UartParity::Odd ? 'O' : 'E';
 }
 
 CommandResult slave(shell::Shell& shell, int argc, char** argv)
@@ -820,7 +796,7 @@ void stopApplicationSlave(const dcos::app::Application& application)
     }
     stopPort();
     servedApplication = nullptr;
-    backendStale = true;
+    nodeBackend.requestClose();
     if (mapBoard.installed()) {
         (void)dcos::systemAgent.Close(mapBoard.id());
         (void)mapBoard.uninstall();

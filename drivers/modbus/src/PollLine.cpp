@@ -45,7 +45,6 @@ using dcos::app::ModbusTable;
 using dcos::app::ObjectKind;
 using modbus::ModbusError;
 
-constexpr uint8_t kTaskPriority = 6;
 constexpr uint64_t kMillisecond = 1'000'000;
 // Posted by the service's stop, so that the task closes its subscriptions.
 constexpr uint32_t kStopEvent = 1u << 1;
@@ -57,7 +56,6 @@ ObjectId pollTask;
 // The application whose schedule runs, or null; set by the service before
 // the task first runs, read by the task and the console.
 const dcos::app::Application* polled = nullptr;
-volatile bool stopRequested = false;
 
 static_assert(dcos::app::kMaximumModbusPollEntries <= LineRunner::kPollCapacity,
               "the line's schedule holds every entry an application may declare");
@@ -139,10 +137,7 @@ void publishResults(const dcos::app::Application& application, uint32_t ended)
 void pollTaskEntry(uintptr_t)
 {
     for (;;) {
-        if (stopRequested) {
-            pages.closeSubscriptions();
-            stopRequested = false;
-        }
+        pages.closeIfRequested();
         const dcos::app::Application* application = polled;
         if (application != nullptr) {
             refreshWrites(*application);
@@ -158,21 +153,9 @@ void pollTaskEntry(uintptr_t)
 
 Status startPollTask()
 {
-    if (!pollTask.isNull()) {
-        return Status::Ok;
-    }
-    dcos::TaskAttributes attributes;
-    attributes.name = "modbus-poll";
-    attributes.priority = kTaskPriority;
-    attributes.stackSize = 8192;
-    attributes.newProcess = true;
-    const dcos::Result<ObjectId> task = taskAgent.Create(attributes, pollTaskEntry, 0);
-    if (!task.ok()) {
-        return task.status();
-    }
-    pollTask = task.value();
-    com3.setTask(pollTask);
-    return Status::Ok;
+    const Status started = com3.startTask("modbus-poll", pollTaskEntry);
+    pollTask = com3.task();
+    return started;
 }
 
 bool pollPublishes(const ModbusPollEntry& entry) { return !entry.write; }
@@ -242,13 +225,8 @@ void stopPolling(const dcos::app::Application& application)
     }
     com3.stop();
     polled = nullptr;
-    stopRequested = true;
+    pages.requestClose();
     (void)taskAgent.PostEvent(pollTask, kStopEvent);
-}
-
-char parityLetter(bsp::UartParity parity)
-{
-    return parity == bsp::UartParity::None ? 'N' : parity == bsp::UartParity::Odd ? 'O' : 'E';
 }
 
 const char* tableLetters(const ModbusPollEntry& entry)

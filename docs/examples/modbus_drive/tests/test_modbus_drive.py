@@ -19,11 +19,11 @@ import json
 import pathlib
 import re
 import subprocess
-import time
 
 import dcoslab
 import pytest
 from dcoslab.serial_line import SerialLine
+from dcoslab.waiting import wait_until
 
 SHARE = pathlib.Path(dcoslab.__file__).resolve().parents[2]
 BIN = SHARE.parents[1] / "bin"
@@ -50,14 +50,8 @@ def drive_state(emulator):
 
 
 def wait_drive(emulator, predicate, what):
-    deadline = time.monotonic() + WAIT
-    while True:
-        state = drive_state(emulator)
-        if predicate(state):
-            return state
-        if time.monotonic() > deadline:
-            raise AssertionError(f"never reached: {what}; last {state}\n{emulator.transcript}")
-        time.sleep(0.05)
+    """Runs `drive` until predicate holds: an event in the controller's time."""
+    return wait_until(lambda: drive_state(emulator), predicate, what, emulator, timeout=WAIT)
 
 
 def poll_lines(emulator):
@@ -106,9 +100,8 @@ def plant(boot, dcos_board, dcos_image):
 
 def plant_master(emulator, line, *arguments):
     """One dcos-modbus (libmodbus) transaction with the controller's slave 1."""
-    deadline = time.monotonic() + WAIT
-    while "receiver idle" not in emulator.command("modbus state"):
-        assert time.monotonic() < deadline, emulator.transcript
+    wait_until(lambda: emulator.command("modbus state"), lambda state: "receiver idle" in state,
+               "COM2's receiver idle", emulator, timeout=WAIT, pause=0)
     result = subprocess.run([str(BIN / "dcos-modbus"), "-d", line.pty_path, "-b", "19200", "-a", "1", "-r", "0",
                              "--json", *arguments], capture_output=True, text=True, timeout=WAIT)
     assert result.returncode == 0, (arguments, result.stdout, result.stderr, emulator.transcript)
@@ -148,10 +141,8 @@ def test_a_drive_that_stops_answering_is_noticed_and_the_controller_goes_on(plan
     assert state["losses"] == 1, state
     # Each entry now takes two transmissions of a 1 s time-out, so the
     # schedule comes round to the drive's values only seconds later.
-    deadline = time.monotonic() + WAIT
-    while (entries := poll_lines(emulator))["drive-values"]["timeouts"] == 0:
-        assert time.monotonic() < deadline, f"no time-out counted: {entries}\n{emulator.transcript}"
-        time.sleep(0.1)
+    entries = wait_until(lambda: poll_lines(emulator), lambda e: e["drive-values"]["timeouts"] > 0,
+                         "a time-out of the drive's values", emulator, timeout=WAIT)
     assert entries["drive-values"]["last"] == "error: response time-out", entries
     # The controller goes on: its control task runs, and the plant master
     # reads the drive's loss in the status it serves.

@@ -37,8 +37,10 @@ public:
     dcos::Status transmit(const uint8_t* bytes, size_t length) override { return uart_.transmit(bytes, length); }
     bool finishTransmission() override { return uart_.finishTransmission(); }
 
-    /// The task the interrupt wakes; set before start().
-    void setTask(dcos::ObjectId task) { task_ = task; }
+    /// Creates the line's task, @p name running @p entry, the first time
+    /// it is asked for (a line lives as long as the node); the interrupt
+    /// wakes it. Fails with TaskAgent::Create's status.
+    dcos::Status startTask(const char* name, void (*entry)(uintptr_t));
     dcos::ObjectId task() const { return task_; }
 
     /// Brings the port up with @p settings (stopping it first); the runner

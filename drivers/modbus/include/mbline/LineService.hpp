@@ -26,6 +26,12 @@ namespace mbline {
 /// character stays 11 bits.
 bsp::UartSettings lineSettings(uint32_t baud, dcos::app::ModbusParity parity);
 
+/// The letter of @p parity in a line's settings, as in 8E1.
+constexpr char parityLetter(bsp::UartParity parity)
+{
+    return parity == bsp::UartParity::None ? 'N' : parity == bsp::UartParity::Odd ? 'O' : 'E';
+}
+
 /// A service's refusal: the loader names the application's @p kind (its
 /// slave or master), the rule and the status, and deletes the application.
 inline dcos::app::ConfigurationError refusedBy(const dcos::app::Application& application, dcos::app::ObjectKind kind,

@@ -59,6 +59,16 @@ public:
 
     /// Closes the subscriptions the line's task opened (call it in that task).
     void closeSubscriptions();
+    /// Asks the line's task to close them (from another task: only a
+    /// subscription's owner may close it), and, in that task, does so when asked.
+    void requestClose() { closeRequested_ = true; }
+    void closeIfRequested()
+    {
+        if (closeRequested_) {
+            closeRequested_ = false;
+            closeSubscriptions();
+        }
+    }
 
     /// Accesses refused by the kernel or the board, and the last refusal's status.
     uint32_t failures() const { return failures_; }
@@ -75,6 +85,7 @@ private:
     dcos::ObjectId board_{};
     uint32_t failures_ = 0;
     dcos::Status lastFailure_ = dcos::Status::Ok;
+    volatile bool closeRequested_ = false;
 };
 
 } // namespace mbline
