@@ -246,7 +246,7 @@ void printPollStatus(shell::Shell& shell)
 {
     const dcos::app::Application* application = polled;
     if (application == nullptr) {
-        shell.print("poll: no schedule runs (the application declares no modbusPolls)\r\n");
+        shell.print("poll: no schedule runs (no application with modbusPolls was started; see 'app')\r\n");
         return;
     }
     const bsp::UartSettings& settings = com3.uart().settings();

@@ -128,5 +128,5 @@ DCOS_APPLICATION(polling, {.name = "polling",
                            .tasks = tasks,
                            .publishers = publishers,
                            .modbusPolls = polls,
-                           .modbusMaster = {.baud = 19200, .timeoutMs = 300, .retries = 2},
+                           .modbusMaster = {.baud = 19200, .timeoutMs = 1000, .retries = 2},
                            .tickRateHz = 10000});
