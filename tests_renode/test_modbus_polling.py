@@ -55,6 +55,9 @@ class PymodbusSlave(threading.Thread):
         self.framer = ModbusRtuFramer(ServerDecoder())
         self.requests = []
         self.unanswered = 0
+        # Function codes answered with a bad CRC, and with another request's data.
+        self.corrupt = set()
+        self.wrong = set()
         self.stopping = threading.Event()
 
     def run(self):
@@ -69,11 +72,18 @@ class PymodbusSlave(threading.Thread):
             self.unanswered += 1
             return
         time.sleep(TURNAROUND_S)
+        function = request.function_code
+        if function in self.wrong:
+            # The answer to another request: one register more than asked for.
+            request.count += 1
         response = request.execute(self.store)
         response.unit_id = request.unit_id
         response.transaction_id = request.transaction_id
-        self.requests.append(request.function_code)
-        self.line.write(self.framer.buildPacket(response))
+        self.requests.append(function)
+        frame = self.framer.buildPacket(response)
+        if function in self.corrupt:
+            frame = frame[:-1] + bytes([frame[-1] ^ 0xFF])
+        self.line.write(frame)
 
     def stop(self):
         self.stopping.set()
@@ -193,3 +203,28 @@ def test_the_application_is_refused_at_boot_without_the_second_port(boot, isa486
     emulator.expect("dcos> ")
     assert "app" not in emulator.command("tasks").split()
     assert "no schedule runs" in emulator.command("modbus poll")
+
+
+def test_answers_with_a_bad_crc_or_another_requests_data_are_retried_then_counted(polled):
+    emulator, slave = polled
+    before, line_before, _ = wait_polled(emulator, lambda e: e["holding"]["ok"] >= 1 and e["input-regs"]["ok"] >= 1,
+                                         "good answers first")
+    slave.corrupt.add(0x04)
+    slave.wrong.add(0x03)
+    entries, line, output = wait_polled(
+        emulator, lambda e: e["input-regs"]["timeouts"] >= 1 and e["holding"]["errors"] >= 1,
+        "a time-out of the corrupted answers and an error of the wrong ones")
+    # A frame with a bad CRC is dropped by the receiver, so the request is
+    # sent again and, never answered well, ends in a time-out.
+    assert entries["input-regs"]["last"] == "error: response time-out", output
+    assert line["crc-errors"] - line_before["crc-errors"] >= 3, output
+    # An answer that does not match the request (three registers for two) is
+    # malformed: retried, then the transaction ends with the error, named.
+    assert entries["holding"]["last"] == "error: invalid response", output
+    # The other entries and the application go on.
+    assert entries["coils"]["ok"] > before["coils"]["ok"], output
+    read, _, failures = pages(emulator)
+    assert failures == 0
+    # The pages keep the last good values.
+    assert read["read"][4:8] == b"".join(value.to_bytes(2, "big") for value in HOLDING_REGISTERS[10:12]), read
+    assert read["read"][8:12] == b"".join(value.to_bytes(2, "big") for value in INPUT_REGISTERS[3:5]), read
