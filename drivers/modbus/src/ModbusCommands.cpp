@@ -75,6 +75,10 @@ iobus::MfioBoard mapBoard("modbus.io");
 // or no slave). Set by the application service before the line's task
 // runs; the task and the console only read it.
 const dcos::app::Application* servedApplication = nullptr;
+// The application the service started the slave for, which keeps the line's
+// task, subscriptions and board until the service stops, even after the
+// console took the line over by hand.
+const dcos::app::Application* startedFor = nullptr;
 modbus::DeviceIdentification applicationIdentification = identification;
 
 // The task's events.
@@ -786,16 +790,20 @@ ConfigurationError startApplicationSlave(const dcos::app::Application& applicati
         return refusedBy(application, ObjectKind::ModbusSlave, status);
     }
     servedApplication = &application;
+    startedFor = &application;
     return {};
 }
 
 void stopApplicationSlave(const dcos::app::Application& application)
 {
-    if (servedApplication != &application) {
+    if (startedFor != &application) {
         return;
     }
-    stopPort();
-    servedApplication = nullptr;
+    if (servedApplication == &application) {
+        stopPort(); // A line the console took over by hand stays as it is.
+        servedApplication = nullptr;
+    }
+    startedFor = nullptr;
     nodeBackend.requestClose();
     if (mapBoard.installed()) {
         (void)dcos::systemAgent.Close(mapBoard.id());

@@ -37,7 +37,6 @@ namespace {
 
 using dcos::ObjectId;
 using dcos::Status;
-using dcos::taskAgent;
 using dcos::timerAgent;
 using dcos::app::ConfigurationError;
 using dcos::app::ModbusPollEntry;
@@ -226,7 +225,7 @@ void stopPolling(const dcos::app::Application& application)
     com3.stop();
     polled = nullptr;
     pages.requestClose();
-    (void)taskAgent.PostEvent(pollTask, kStopEvent);
+    (void)dcos::taskAgent.PostEvent(pollTask, kStopEvent);
 }
 
 const char* tableLetters(const ModbusPollEntry& entry)
