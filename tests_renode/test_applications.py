@@ -171,24 +171,24 @@ constexpr dcos::app::ModbusMapEntry map[] = {{
 }};
 }} // namespace
 
-DCOS_APPLICATION(mapped, {{.name = "mapped", .tasks = tasks, .publishers = publishers, .modbusMap = map}});
+DCOS_APPLICATION(mapped, {{.name = "mapped", .tasks = tasks, .publishers = publishers, .modbusMap = map{slave}}});
 """
 
 
 def write_map(directory, speed_table="HoldingRegisters", speed_address=4, speed_count=2, speed_object="setpoint",
-              speed_offset=8):
+              speed_offset=8, slave=""):
     os.makedirs(directory, exist_ok=True)
     with open(os.path.join(directory, "mapped.cpp"), "w", encoding="utf-8") as handle:
         handle.write(MAP_SOURCE.format(speed_table=speed_table, speed_address=speed_address,
                                        speed_count=speed_count, speed_object=speed_object,
-                                       speed_offset=speed_offset))
+                                       speed_offset=speed_offset, slave=slave))
     return directory
 
 
 def test_a_valid_modbus_map_compiles(tmp_path, boot, isa486):
     """The map the failures below break one rule of builds, so each failure is the rule's own.
 
-    It boots, and `app` lists the map with the notice that the line does not serve it yet.
+    It boots, and `app` lists the map with the notice that no slave serves it (none is declared).
     """
     application = write_map(str(tmp_path / "mapped"))
     result = build_with_staged_sdk(application)
@@ -197,7 +197,7 @@ def test_a_valid_modbus_map_compiles(tmp_path, boot, isa486):
     emulator.expect(r"dcos> ")
     output = emulator.command("app")
     assert "application 'mapped': running" in output, output
-    assert "modbus map, 2 entries, checked; not served yet" in output, output
+    assert "modbus map, 2 entries, checked; not served: no modbusSlave declared" in output, output
     assert re.search(r"setpoint +holding +0-3 +publisher setpoint byte 0", output), output
     assert re.search(r"speed +holding +4-5 +publisher setpoint byte \d+", output), output
 
@@ -219,12 +219,76 @@ def test_a_valid_modbus_map_compiles(tmp_path, boot, isa486):
     (dict(speed_object="measured"), ['ObjectName{"speed"}', "MapWritesReadOnly",
                                      "configuration error: Modbus map entry 'speed': a coil or holding register "
                                      "entry is bound to something read-only"]),
+    (dict(slave=", .modbusSlave = {.address = 248}"),
+     ['ObjectName{"mapped"}', "SlaveAddressOutOfRange, 248, 247",
+      "configuration error: Modbus slave 'mapped': a Modbus slave address must be 1 to 247", "(value 248, limit 247)"]),
+    (dict(slave=", .modbusSlave = {.address = 17, .baud = 230400}"),
+     ['ObjectName{"mapped"}', "BaudOutOfRange, 230400, 115200",
+      "configuration error: Modbus slave 'mapped': the Modbus line's baud rate must be 300 to 115200"]),
 ])
 def test_modbus_map_errors_name_the_entry_at_compile_time(tmp_path, change, phrases):
     application = write_map(str(tmp_path / "mapped"), **change)
     output = expect_build_failure(application, *phrases)
     assert "DCOS_APPLICATION: the configuration breaks the rule named above" in output
     assert not os.path.exists(os.path.join(application, "build", "mapped-486.elf"))
+
+
+POLL_SOURCE = """\
+#include <dcos/Application.hpp>
+
+namespace {{
+void control(uintptr_t) {{}}
+
+constexpr dcos::app::TaskDeclaration tasks[] = {{{{.name = "control", .entry = control}}}};
+constexpr dcos::app::PublisherDeclaration publishers[] = {{
+    {{.name = "drive"}},
+    {{.name = "command", .writer = "control"}},
+}};
+using dcos::app::ModbusTable;
+constexpr dcos::app::ModbusPollEntry polls[] = {{
+    {{.name = "speed", .unit = {unit}, .table = ModbusTable::InputRegisters, .address = 0, .count = {count},
+     .periodMs = {period}, .object = "{speed_object}"}},
+    {{.name = "setpoint", .unit = 17, .table = ModbusTable::{setpoint_table}, .write = true, .address = 0,
+     .object = "command"}},
+}};
+}} // namespace
+
+DCOS_APPLICATION(polling, {{.name = "polling", .tasks = tasks, .publishers = publishers, .modbusPolls = polls,
+                           .modbusMaster = {{.baud = 19200, .timeoutMs = {timeout}}}}});
+"""
+
+
+@pytest.mark.parametrize("change, phrases", [
+    (dict(), []),
+    (dict(unit=0), ['ObjectName{"speed"}', "SlaveAddressOutOfRange, 0, 247",
+                    "configuration error: Modbus poll entry 'speed': a Modbus slave address must be 1 to 247"]),
+    (dict(period=0), ['ObjectName{"speed"}', "PollPeriodOutOfRange, 0, 3600000",
+                      "configuration error: Modbus poll entry 'speed': a Modbus poll entry's period must be 1 to "
+                      "3600000 ms", "(value 0, limit 3600000)"]),
+    (dict(count=9), ['ObjectName{"speed"}', "MapTooLarge, 18, 16"]),
+    (dict(speed_object="command"), ['ObjectName{"speed"}', "PollPublisherHasWriter",
+                                    "configuration error: Modbus poll entry 'speed': a Modbus poll read publishes on "
+                                    "a publisher with no writer task"]),
+    (dict(setpoint_table="InputRegisters"), ['ObjectName{"setpoint"}', "PollWritesReadOnlyTable",
+                                             "configuration error: Modbus poll entry 'setpoint': a Modbus poll entry "
+                                             "writes only coils or holding registers"]),
+    (dict(timeout=60001), ['ObjectName{"polling"}', "TimeoutOutOfRange, 60001, 60000",
+                           "configuration error: Modbus master 'polling': the Modbus master's time-out must be 1 to "
+                           "60000 ms", "(value 60001, limit 60000)"]),
+])
+def test_poll_schedule_errors_name_the_entry_at_compile_time(tmp_path, change, phrases):
+    """The schedule with no change builds; each change breaks one rule, named in the build's last line."""
+    directory = tmp_path / "polling"
+    directory.mkdir()
+    values = dict(unit=17, count=2, period=100, speed_object="drive", setpoint_table="HoldingRegisters", timeout=1000)
+    values.update(change)
+    (directory / "polling.cpp").write_text(POLL_SOURCE.format(**values))
+    if not phrases:
+        result = build_with_staged_sdk(str(directory))
+        assert result.returncode == 0, result.stdout + result.stderr
+        return
+    output = expect_build_failure(str(directory), *phrases)
+    assert "DCOS_APPLICATION: the configuration breaks the rule named above" in output
 
 
 def test_an_unchecked_status_does_not_compile(tmp_path):

@@ -484,3 +484,22 @@ def test_simulator_arguments_and_ports(tmp_path):
         result = subprocess.run([DCOS_MODBUS_SIM, *arguments], capture_output=True, text=True, timeout=TIMEOUT)
         assert result.returncode == status, (arguments, result.stderr)
         assert message in result.stderr, result.stderr
+
+
+def test_simulator_answers_after_its_turnaround(link):
+    # A slave that takes 300 ms: a master waiting 1 s gets its answer no
+    # sooner than that, and one waiting 100 ms times out, as against a late
+    # device.
+    simulator = Simulator(os.path.join(EXAMPLES, "drive.toml"), link.paths[1], "--turnaround", "300")
+    try:
+        port = link.paths[0]
+        started = time.monotonic()
+        assert values(tool(port, "read-holding-registers", "1", parity="E", timeout_ms=1000)) == {1: 500}
+        assert time.monotonic() - started >= 0.3
+        late = tool(port, "read-holding-registers", "1", parity="E", timeout_ms=100)
+        assert late.returncode != 0 and "no answer" in late.stderr, late.stderr
+    finally:
+        stop(simulator.process)
+    bad = subprocess.run([DCOS_MODBUS_SIM, "--turnaround", "-1", "--check", os.path.join(EXAMPLES, "drive.toml")],
+                         capture_output=True, text=True, timeout=TIMEOUT)
+    assert bad.returncode == 2 and "turnaround" in bad.stderr, bad.stderr

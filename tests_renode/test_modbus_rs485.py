@@ -65,6 +65,7 @@ from pymodbus.utilities import computeCRC  # noqa: E402
 
 from dcoslab.board import REPOSITORY  # noqa: E402
 from dcoslab.serial_line import SerialLine  # noqa: E402
+from dcoslab.waiting import wait_until  # noqa: E402
 
 UNIT = 17
 # 19200 baud 8E1, the default line of [SL] 2.5.1.
@@ -138,13 +139,7 @@ def state(emulator):
 
 def wait_for(emulator, predicate, what):
     """Runs `modbus state` until predicate(state) holds: a wait in the controller's time."""
-    deadline = time.monotonic() + WAIT
-    while True:
-        seen = state(emulator)
-        if predicate(seen):
-            return seen
-        if time.monotonic() > deadline:
-            raise AssertionError(f"the controller never reached: {what}; last state {seen}\n{emulator.transcript}")
+    return wait_until(lambda: state(emulator), predicate, what, emulator, timeout=WAIT, pause=0)
 
 
 def wait_line_idle(emulator):

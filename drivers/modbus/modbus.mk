@@ -8,4 +8,7 @@ MODBUS_DRIVER_PORTABLE_SRCS := \
 
 # Sources that run only on the target: the line's task and the console command.
 MODBUS_DRIVER_TARGET_SRCS := \
-	drivers/modbus/src/ModbusCommands.cpp
+	drivers/modbus/src/BoardLine.cpp \
+	drivers/modbus/src/ModbusCommands.cpp \
+	drivers/modbus/src/NodeMapBackend.cpp \
+	drivers/modbus/src/PollLine.cpp

@@ -44,11 +44,15 @@ KIND_NAMES = {
     "BufferPool": "buffer pool",
     "Heap": "heap",
     "ModbusMapEntry": "Modbus map entry",
+    "ModbusSlave": "Modbus slave",
+    "ModbusPollEntry": "Modbus poll entry",
+    "ModbusMaster": "Modbus master",
 }
 # Rules whose value and limit mean something (ConfigurationReport.cpp shows the same ones).
 RULES_WITH_VALUES = {"NameTooLong", "PriorityOutOfRange", "StackTooSmall", "StacksExceedArena", "TooManyObjects",
                      "InitialCountTooLarge", "TickRateOutOfRange", "AreaTooSmall", "BufferTooSmall",
-                     "MapAddressPastEnd", "MapTooLarge", "MapOverlap"}
+                     "MapAddressPastEnd", "MapTooLarge", "MapOverlap", "SlaveAddressOutOfRange",
+                     "BaudOutOfRange", "PollPeriodOutOfRange", "TimeoutOutOfRange", "RetriesOutOfRange"}
 # The summary is one line: a name or rule text longer than this is cut.
 MAX_PART = 200
 

@@ -66,7 +66,9 @@ class Board:
         name is "null": the UART is on the board, its line goes nowhere (the
         isa486's RS-485 port, COM2, unless a test joins it to a host
         program). The order of serial_ports is the order of the -serial
-        arguments: COM1, COM2, ... on a PC. cpu replaces the
+        arguments: COM1, COM2, ... on a PC; a port a device entry names as
+        its "serial_port" (a UART at an address and line of the board
+        file's choosing) is that device's chardev instead. cpu replaces the
         board's CPU model (the bench image runs on benchmark_cpu), memory_mib
         the board's memory (the bench image runs with benchmark_memory()).
         accel names a QEMU accelerator, e.g. "kvm" (default: QEMU's, TCG);
@@ -108,11 +110,27 @@ class Board:
                 continue
             merged = dict(device.get("properties", {}))
             merged.update((device_properties or {}).get(device["driver"], {}))
+            port = device.get("serial_port")
+            if port:
+                # A UART the board file places itself (its own address and
+                # line, where -serial would take the PC's defaults) joins its
+                # serial port through a chardev of the port's name.
+                backend = serial_backends.get(port, "null")
+                if backend.startswith("chardev:"):
+                    merged["chardev"] = backend[len("chardev:"):]
+                elif backend in ("null", "pty"):
+                    command += ["-chardev", f"{backend},id={port}"]
+                    merged["chardev"] = port
+                else:
+                    raise ValueError(f"serial port '{port}' of board {self.name} is a device's: "
+                                     f"it takes null, pty or chardev:ID, not {backend!r}")
             properties = "".join(f",{key}={value}" for key, value in merged.items())
             command += ["-device", device["driver"] + properties]
         command += list(extra_args)
+        device_ports = {device.get("serial_port") for device in self.devices}
         for port in self.serial_ports:
-            command += ["-serial", serial_backends.get(port, "null")]
+            if port not in device_ports:
+                command += ["-serial", serial_backends.get(port, "null")]
         return command
 
 

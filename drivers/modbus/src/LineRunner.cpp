@@ -52,9 +52,22 @@ ModbusError LineRunner::startMaster(const modbus::RtuTiming& timing, const modbu
     return ModbusError::Ok;
 }
 
+ModbusError LineRunner::startPolling(const modbus::RtuTiming& timing, const modbus::MasterConfig& config,
+                                     uint64_t nowNs)
+{
+    const ModbusError error = startMaster(timing, config, nowNs);
+    if (error == ModbusError::Ok) {
+        schedule_.clear();
+        polling_ = true;
+    }
+    return error;
+}
+
 void LineRunner::stop()
 {
     role_ = Role::Off;
+    polling_ = false;
+    polled_ = 0;
     transmitting_ = false;
     fifoEmptied_ = false;
     completed_ = false;
@@ -65,6 +78,9 @@ ModbusError LineRunner::submit(const modbus::Request& request, uint64_t nowNs)
 {
     if (role_ != Role::Master) {
         return ModbusError::NotExpected;
+    }
+    if (polling_) {
+        return ModbusError::Busy; // The schedule has the master.
     }
     completed_ = false;
     const modbus::StationStep step = master_.submit(request, nowNs);
@@ -99,7 +115,7 @@ void LineRunner::apply(const modbus::StationStep& step, uint64_t nowNs)
             if (role_ == Role::Slave) {
                 (void)slave_.onTransmitDone(nowNs);
             } else if (role_ == Role::Master) {
-                apply(master_.onTransmitDone(nowNs), nowNs);
+                masterTransmitDone(nowNs);
             }
         }
     }
@@ -115,6 +131,23 @@ void LineRunner::apply(const modbus::StationStep& step, uint64_t nowNs)
             completion_.pdu[i] = response.pdu()[i];
         }
         completed_ = true;
+    }
+}
+
+void LineRunner::applyPoll(const modbus::PollStep& step, uint64_t nowNs)
+{
+    apply(step, nowNs);
+    if (step.completed) {
+        polled_ |= 1u << step.entry;
+    }
+}
+
+void LineRunner::masterTransmitDone(uint64_t nowNs)
+{
+    if (polling_) {
+        applyPoll(schedule_.onTransmitDone(nowNs), nowNs);
+    } else {
+        apply(master_.onTransmitDone(nowNs), nowNs);
     }
 }
 
@@ -137,7 +170,7 @@ void LineRunner::finishIfSent(uint64_t nowNs)
     if (role_ == Role::Slave) {
         (void)slave_.onTransmitDone(doneNs);
     } else if (role_ == Role::Master) {
-        apply(master_.onTransmitDone(doneNs), nowNs);
+        masterTransmitDone(doneNs);
     }
 }
 
@@ -151,6 +184,8 @@ void LineRunner::feedReceived()
         ++counters_.charactersReceived;
         if (role_ == Role::Slave) {
             apply(slave_.onBytes(&received.byte, 1, received.timeNs), received.timeNs);
+        } else if (polling_) {
+            applyPoll(schedule_.onBytes(&received.byte, 1, received.timeNs), received.timeNs);
         } else if (role_ == Role::Master) {
             apply(master_.onBytes(&received.byte, 1, received.timeNs), received.timeNs);
         }
@@ -174,12 +209,16 @@ uint64_t LineRunner::service(uint64_t nowNs)
     const uint64_t silentUntilNs = nowNs > timing_.characterNs ? nowNs - timing_.characterNs : 0;
     if (role_ == Role::Slave) {
         apply(slave_.poll(silentUntilNs), nowNs);
+    } else if (polling_) {
+        applyPoll(schedule_.poll(silentUntilNs), nowNs);
     } else {
         apply(master_.poll(silentUntilNs), nowNs);
     }
     // A transmit interrupt that comes after the check above posts the
     // task's event, so the shift register is looked at again on that wake.
-    uint64_t next = role_ == Role::Slave ? slave_.nextDeadlineNs() : master_.nextDeadlineNs();
+    uint64_t next = role_ == Role::Slave ? slave_.nextDeadlineNs()
+                    : polling_          ? schedule_.nextDeadlineNs()
+                                        : master_.nextDeadlineNs();
     if (next != ~0ull) {
         // The station's deadline is in line time; it is reached when the
         // line is known silent up to it, one character time later.

@@ -10,12 +10,28 @@
 // the single-master rule of [SL] 2.1. The console changes the role and
 // submits a master's requests through a one-slot mailbox the task takes;
 // every wait of the console has a time-out.
-#include <mbline/LineInterrupt.hpp>
+//
+// An application that declares a Modbus slave (modbusSlave) and its
+// register map (modbusMap) has the line start at boot, serving the map:
+// the application service below runs in the root task while the loader
+// holds dispatching, hands the publishers the master writes to the line's
+// task, installs the I/O board when the map names its points, and starts
+// the slave before any task runs. `modbus slave` by hand still serves the
+// console's data model instead.
+#include <mbline/BoardLine.hpp>
 #include <mbline/LineRunner.hpp>
+#include <mbline/LineService.hpp>
+#include <mbline/NodeMapBackend.hpp>
+#include <mbline/PollLine.hpp>
 
 #include <bsp/Board.hpp>
+#include <dcos/DsmAgent.hpp>
+#include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
+#include <dcos/internal/ApplicationService.hpp>
+#include <iobus/MfioBoard.hpp>
+#include <runtime/Text.hpp>
 #include <modbus/InMemoryDataModel.hpp>
 #include <modbus/ModbusError.hpp>
 #include <modbus/Request.hpp>
@@ -33,15 +49,9 @@ using dcos::timerAgent;
 using modbus::ModbusError;
 using shell::CommandResult;
 
-// The RS-485 port as the runner sees it: the board's COM2 16550.
-class Rs485Port final : public LinePort {
-public:
-    Status transmit(const uint8_t* bytes, size_t length) override { return bsp::rs485Uart().transmit(bytes, length); }
-    bool finishTransmission() override { return bsp::rs485Uart().finishTransmission(); }
-};
-
-Rs485Port rs485Port;
-LineRunner runner(rs485Port);
+// The RS-485 port the console and the application's slave use: the board's COM2 16550.
+BoardLine com2(bsp::rs485Uart(), bsp::rs485Line, bsp::rs485PortAddress, "COM2");
+LineRunner& runner = com2.runner();
 
 // The data the console's slave serves when no application map is linked:
 // 256 of each table. Discrete inputs and input registers hold a pattern a
@@ -56,14 +66,27 @@ const modbus::DeviceIdentification identification{
     .modelName = "isa486",
 };
 
+// The application's register map, served at boot when the application
+// declares its slave; the I/O board the map's points are read from.
+NodeMapBackend nodeBackend;
+ApplicationMapModel applicationModel({}, nodeBackend);
+iobus::MfioBoard mapBoard("modbus.io");
+// The application whose map the line serves, or null (the console's model
+// or no slave). Set by the application service before the line's task
+// runs; the task and the console only read it.
+const dcos::app::Application* servedApplication = nullptr;
+// The application the service started the slave for, which keeps the line's
+// task, subscriptions and board until the service stops, even after the
+// console took the line over by hand.
+const dcos::app::Application* startedFor = nullptr;
+modbus::DeviceIdentification applicationIdentification = identification;
+
 // The task's events.
-constexpr uint32_t kLineEvent = 1u << 0;    // the UART's interrupt
-constexpr uint32_t kCommandEvent = 1u << 1; // the console's mailbox
+constexpr uint32_t kCommandEvent = 1u << 1; // the console's mailbox (BoardLine::kLineEvent is the UART's)
 // The console task's event for a mailbox answer; bit 0 is its input, the
 // can command uses bits 20 to 22.
 constexpr uint32_t kAnswerEvent = 1u << 23;
 
-constexpr uint8_t kTaskPriority = 6;
 constexpr uint64_t kMillisecond = 1'000'000;
 constexpr uint64_t kCommandTimeoutNs = 2000 * kMillisecond;
 
@@ -102,34 +125,10 @@ void fillPattern()
     }
 }
 
-void onFifoEmptied(void*) { runner.fifoEmptied(timerAgent.Uptime()); }
-
-void lineInterrupt(void*)
-{
-    bsp::rs485Uart().handleInterrupt();
-    (void)taskAgent.PostEvent(lineTask, kLineEvent);
-}
-
-void stopPort()
-{
-    (void)bsp::detachInterrupt(bsp::rs485Line);
-    bsp::rs485Uart().shutdown();
-    runner.stop();
-}
+void stopPort() { com2.stop(); }
 
 // Brings the port up with the mailbox's settings; the runner is started by the caller.
-Status startPort(const bsp::UartSettings& settings)
-{
-    stopPort();
-    bsp::Uart16550& uart = bsp::rs485Uart();
-    const Status status = uart.initialise(settings);
-    if (status != Status::Ok) {
-        return status;
-    }
-    uart.setReceiveSink(stampReceivedByte, &runner);
-    uart.setTransmitNotifier(onFifoEmptied, nullptr);
-    return bsp::attachInterrupt(bsp::rs485Line, lineInterrupt, nullptr);
-}
+Status startPort(const bsp::UartSettings& settings) { return com2.start(settings); }
 
 void serveMailbox()
 {
@@ -142,6 +141,7 @@ void serveMailbox()
     switch (mailbox.kind) {
     case CommandKind::Stop:
         stopPort();
+        servedApplication = nullptr;
         break;
     case CommandKind::StartSlave:
     case CommandKind::StartMaster: {
@@ -161,6 +161,8 @@ void serveMailbox()
             stopPort();
             break;
         }
+        // By hand, the line serves the console's data model, whatever the application declared.
+        servedApplication = nullptr;
         mailbox.error = mailbox.kind == CommandKind::StartSlave
                             ? runner.startSlave(timing.value(), consoleModel, identification, mailbox.address, now)
                             : runner.startMaster(timing.value(), mailbox.masterConfig, now);
@@ -187,25 +189,25 @@ void serveMailbox()
 void lineTaskEntry(uintptr_t)
 {
     for (;;) {
+        nodeBackend.closeIfRequested();
         serveMailbox();
-        const uint64_t now = timerAgent.Uptime();
-        const uint64_t next = runner.service(now);
+        const uint64_t timeout = com2.service(timerAgent.Uptime());
         Completion completion;
         if (runner.takeCompletion(completion)) {
             lastCompletion = completion;
             completionReady = true;
             (void)taskAgent.PostEvent(completionWaiter, kAnswerEvent);
         }
-        uint64_t timeout = dcos::kWaitForever;
-        if (next != ~0ull) {
-            const uint64_t later = timerAgent.Uptime();
-            // A deadline already passed is served by the next round at once.
-            timeout = next > later ? next - later : dcos::kPoll;
-        }
-        if (timeout != dcos::kPoll) {
-            (void)taskAgent.ReceiveEvent(kLineEvent | kCommandEvent, dcos::EventWait::Any, timeout);
-        }
+        (void)com2.wait(timeout, kCommandEvent);
     }
+}
+
+// Creates the line's task the first time the line is needed.
+Status startLineTask()
+{
+    const Status started = com2.startTask("modbus", lineTaskEntry);
+    lineTask = com2.task();
+    return started;
 }
 
 // Discards a stale answer event, so that the next wait sees only its own.
@@ -214,18 +216,9 @@ void clearAnswerEvent() { (void)taskAgent.ReceiveEvent(kAnswerEvent, dcos::Event
 // Hands the mailbox to the task and waits for its answer.
 bool runCommand(shell::Shell& shell)
 {
-    if (lineTask.isNull()) {
-        dcos::TaskAttributes attributes;
-        attributes.name = "modbus";
-        attributes.priority = kTaskPriority;
-        attributes.stackSize = 8192;
-        attributes.newProcess = true;
-        const dcos::Result<ObjectId> task = taskAgent.Create(attributes, lineTaskEntry, 0);
-        if (!task.ok()) {
-            shell.print("error: cannot start the modbus task: %s\r\n", dcos::statusName(task.status()));
-            return false;
-        }
-        lineTask = task.value();
+    if (const Status started = startLineTask(); started != Status::Ok) {
+        shell.print("error: cannot start the modbus task: %s\r\n", dcos::statusName(started));
+        return false;
     }
     clearAnswerEvent();
     mailbox.requester = taskAgent.IdOfSelf();
@@ -269,32 +262,23 @@ bool parseNumber(shell::Shell& shell, const char* text, unsigned long limit, uns
 // [baud] [parity n|e|o]: the line's settings, 19200 8E1 by default ([SL] 2.5.1).
 bool parseLine(shell::Shell& shell, int argc, char** argv, int first, bsp::UartSettings& settings)
 {
-    settings = bsp::UartSettings{.baud = 19200,
-                                 .dataBits = 8,
-                                 .parity = bsp::UartParity::Even,
-                                 .stopBits = 1,
-                                 .receiveTrigger = 1,
-                                 .driverEnable = bsp::DriverEnable::Rts};
-    unsigned long baud = 0;
-    if (argc > first) {
-        if (!parseNumber(shell, argv[first], 115200, baud, "baud rate")) {
-            return false;
-        }
-        settings.baud = static_cast<uint32_t>(baud);
+    unsigned long baud = 19200;
+    if (argc > first && !parseNumber(shell, argv[first], dcos::app::kHighestModbusBaud, baud, "baud rate")) {
+        return false;
     }
+    dcos::app::ModbusParity parity = dcos::app::ModbusParity::Even;
     if (argc > first + 1) {
-        const char* parity = argv[first + 1];
-        if (parity[0] == 'n' && parity[1] == '\0') {
-            // [SL] 2.5.1: no parity takes a second stop bit, so a character stays 11 bits.
-            settings.parity = bsp::UartParity::None;
-            settings.stopBits = 2;
-        } else if (parity[0] == 'o' && parity[1] == '\0') {
-            settings.parity = bsp::UartParity::Odd;
-        } else if (!(parity[0] == 'e' && parity[1] == '\0')) {
-            shell.print("error: parity '%s' is not n, e or o\r\n", parity);
+        const char* letter = argv[first + 1];
+        if (letter[0] == 'n' && letter[1] == '\0') {
+            parity = dcos::app::ModbusParity::None;
+        } else if (letter[0] == 'o' && letter[1] == '\0') {
+            parity = dcos::app::ModbusParity::Odd;
+        } else if (!(letter[0] == 'e' && letter[1] == '\0')) {
+            shell.print("error: parity '%s' is not n, e or o\r\n", letter);
             return false;
         }
     }
+    settings = lineSettings(static_cast<uint32_t>(baud), parity);
     return true;
 }
 
@@ -323,11 +307,6 @@ const char* masterStateName(modbus::Master::State state)
     case modbus::Master::State::Turnaround: return "turnaround";
     }
     return "?";
-}
-
-char parityLetter(bsp::UartParity parity)
-{
-    return parity == bsp::UartParity::None ? 'N' : parity == bsp::UartParity::Odd ? 'O' : 'E';
 }
 
 CommandResult slave(shell::Shell& shell, int argc, char** argv)
@@ -406,6 +385,17 @@ CommandResult state(shell::Shell& shell, int, char**)
                     static_cast<unsigned long>(runner.timing().t35Ns / 1000), uart.driverEnabled() ? "on" : "off");
     }
     shell.print("\r\n");
+    if (role == Role::Slave) {
+        if (servedApplication != nullptr) {
+            shell.print("serving: the register map of application '%s', %u entries, backend failures %lu "
+                        "(last: %s)\r\n",
+                        servedApplication->name, static_cast<unsigned>(servedApplication->modbusMap.count),
+                        static_cast<unsigned long>(nodeBackend.failures()),
+                        dcos::statusName(nodeBackend.lastFailure()));
+        } else {
+            shell.print("serving: the console's data model\r\n");
+        }
+    }
     const LineCounters& line = runner.counters();
     const bsp::Uart16550::Statistics& errors = uart.statistics();
     shell.print("line: characters %lu frames-sent %lu refused %lu temt-polls %lu queue-overflows %lu "
@@ -689,9 +679,20 @@ CommandResult result(shell::Shell& shell, int, char**)
     return awaitCompletion(shell);
 }
 
+// poll: the application's polling schedule on the second RS-485 port.
+CommandResult poll(shell::Shell& shell, int argc, char**)
+{
+    if (argc != 2) {
+        return CommandResult::UsageError;
+    }
+    printPollStatus(shell);
+    return CommandResult::Ok;
+}
+
 constexpr shell::Subcommand kSubcommands[] = {
     {"state", state}, {"slave", slave}, {"master", master}, {"off", off},
     {"read", read},   {"write", write}, {"data", data}, {"submit", submit}, {"result", result},
+    {"poll", poll},
 };
 
 CommandResult modbusCommand(shell::Shell& shell, int argc, char** argv)
@@ -702,14 +703,119 @@ CommandResult modbusCommand(shell::Shell& shell, int argc, char** argv)
     return shell::runSubcommand(shell, argc, argv, kSubcommands);
 }
 
+// --- The application's slave, started at boot -------------------------------
+
+using dcos::app::ConfigurationError;
+using dcos::app::ConfigurationRule;
+using dcos::app::ModbusMapEntry;
+using dcos::app::ObjectKind;
+
+bool namesBoardPoints(const dcos::app::DeclarationList<ModbusMapEntry>& map)
+{
+    for (const ModbusMapEntry& entry : map) {
+        if (entry.source != dcos::app::ModbusSource::Publisher) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// The publishers the master writes through the map: those bound to coils or
+// holding registers (the rules allow only publishers without a writer task there).
+bool mapWritesPublisher(const ModbusMapEntry& entry)
+{
+    return entry.source == dcos::app::ModbusSource::Publisher && dcos::app::rules::isWritable(entry.table);
+}
+
+// Installs and opens the line's own I/O board object (the board the
+// console's `iobus` commands also reach, as "mfio0", which then finds its
+// resources taken and says so).
+dcos::Result<ObjectId> openMapBoard()
+{
+    iobus::IsaConflict conflict{};
+    const dcos::Result<ObjectId> installed =
+        mapBoard.installed() ? dcos::Result<ObjectId>(mapBoard.id())
+                             : mapBoard.install("modbus.io", dcos::Visibility::Local, &conflict);
+    if (!installed.ok()) {
+        return installed.status();
+    }
+    const Status opened = dcos::systemAgent.Open(installed.value());
+    if (opened != Status::Ok) {
+        (void)mapBoard.uninstall();
+        return opened;
+    }
+    return installed.value();
+}
+
+ConfigurationError startApplicationSlave(const dcos::app::Application& application)
+{
+    const dcos::app::ModbusSlaveDeclaration& declared = application.modbusSlave;
+    if (declared.address == 0) {
+        return {};
+    }
+    if (const Status started = startLineTask(); started != Status::Ok) {
+        return refusedBy(application, ObjectKind::ModbusSlave, started);
+    }
+    if (const Status handed = handOverPublishers(application.modbusMap, mapWritesPublisher, lineTask);
+        handed != Status::Ok) {
+        return refusedBy(application, ObjectKind::ModbusSlave, handed);
+    }
+    ObjectId board{};
+    if (namesBoardPoints(application.modbusMap)) {
+        const dcos::Result<ObjectId> opened = openMapBoard();
+        if (!opened.ok()) {
+            return refusedBy(application, ObjectKind::ModbusSlave, opened.status());
+        }
+        board = opened.value();
+    }
+    const bsp::UartSettings settings = lineSettings(declared.baud, declared.parity);
+    const modbus::ModbusResult<modbus::RtuTiming> timing =
+        modbus::RtuTiming::make(settings.baud, static_cast<uint8_t>(settings.characterBits()));
+    // The rules keep the baud rate in RtuTiming's range; a refusal here is the port's.
+    Status status = timing.ok() ? startPort(settings) : Status::InvalidArgument;
+    if (status == Status::Ok) {
+        nodeBackend.useBoard(board);
+        applicationModel.serve(application.modbusMap);
+        applicationIdentification.userApplicationName = application.name;
+        const ModbusError error = runner.startSlave(timing.value(), applicationModel, applicationIdentification,
+                                                    static_cast<uint8_t>(declared.address), timerAgent.Uptime());
+        status = error == ModbusError::Ok ? Status::Ok : modbus::toStatus(error);
+    }
+    if (status != Status::Ok) {
+        stopPort();
+        if (!board.isNull()) {
+            (void)dcos::systemAgent.Close(board);
+            (void)mapBoard.uninstall();
+        }
+        return refusedBy(application, ObjectKind::ModbusSlave, status);
+    }
+    servedApplication = &application;
+    startedFor = &application;
+    return {};
+}
+
+void stopApplicationSlave(const dcos::app::Application& application)
+{
+    if (startedFor != &application) {
+        return;
+    }
+    if (servedApplication == &application) {
+        stopPort(); // A line the console took over by hand stays as it is.
+        servedApplication = nullptr;
+    }
+    startedFor = nullptr;
+    nodeBackend.requestClose();
+    if (mapBoard.installed()) {
+        (void)dcos::systemAgent.Close(mapBoard.id());
+        (void)mapBoard.uninstall();
+    }
+    (void)taskAgent.PostEvent(lineTask, kCommandEvent);
+}
+
+DCOS_APPLICATION_SERVICE(modbusApplicationService, "modbus", startApplicationSlave, stopApplicationSlave);
+
 } // namespace
 
-void stampReceivedByte(void* runner, uint8_t byte)
-{
-    // A full queue counts the byte as lost (TimedByteQueue::push); the
-    // frame it belonged to then fails its CRC and is discarded.
-    (void)static_cast<LineRunner*>(runner)->queue().push(byte, timerAgent.Uptime());
-}
 
 } // namespace mbline
 
@@ -717,10 +823,11 @@ DCOS_SHELL_COMMAND_DETAILED(modbusShellCommand, "modbus", "run the Modbus RTU li
                             "modbus [state] | slave <address> [baud] [n|e|o] | master [baud] [n|e|o] [time-out ms] "
                             "[retries] | off | read <unit> <table> <address> <count> | "
                             "write <unit> <coils|holding> <address> <value>... | submit read|write ... | result | "
-                            "data <table> <address> <count>",
+                            "data <table> <address> <count> | poll",
                             "  tables: coils, inputs, holding, input-registers; the line is 19200 baud 8E1 unless\r\n"
                             "  told; state shows the line's, the receiver's, the slave's and the master's counters;\r\n"
                             "  data shows what the console slave serves (input register n is 0x1000 + n,\r\n"
                             "  discrete input n is on for multiples of 3); submit starts a read or write without\r\n"
-                            "  waiting for it, result waits for its end",
+                            "  waiting for it, result waits for its end; poll shows the application's polling schedule\r\n"
+                            "  on the second RS-485 port (COM3), one line per entry",
                             mbline::modbusCommand);

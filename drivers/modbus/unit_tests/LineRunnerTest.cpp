@@ -464,3 +464,69 @@ TEST_F(LineRunnerTest, MasterBroadcastCompletesAfterTheTurnaroundDelay)
 }
 
 } // namespace
+
+// -- a polling schedule on the line ------------------------------------------
+
+TEST_F(LineRunnerTest, ASchedulePollsItsEntriesAndSaysWhichEnded)
+{
+    modbus::MasterConfig config;
+    config.responseTimeoutNs = 100 * kMillisecond;
+    config.retries = 1;
+    ASSERT_EQ(runner_.startPolling(timing_, config, now_), ModbusError::Ok);
+    EXPECT_TRUE(runner_.polling());
+    ASSERT_TRUE(runner_.schedule().add(Request::readHoldingRegisters(kUnit, 0, 2).value(), 500 * kMillisecond,
+                                       10 * kMillisecond).ok());
+    ASSERT_TRUE(runner_.schedule().add(Request::readHoldingRegisters(kUnit + 1, 0, 2).value(), 500 * kMillisecond,
+                                       10 * kMillisecond).ok());
+    // The console's submit is refused while the schedule has the master.
+    EXPECT_EQ(runner_.submit(Request::readHoldingRegisters(kUnit, 0, 2).value(), now_), ModbusError::Busy);
+    runUntil(10 * kMillisecond + timing_.characterNs);
+    ASSERT_EQ(port_.frames.size(), 1u);
+    EXPECT_EQ(port_.frames[0], kReadTwoHolding);
+    // Entry 0 is answered; nothing ended before its answer.
+    runUntil(port_.startedNs[0] + kSlaveDelayNs);
+    EXPECT_EQ(runner_.takePolled(), 0u);
+    const uint64_t last = receive(kTwoHoldingAnswer, now_);
+    runUntil(frameEndNs(last) + timing_.characterNs);
+    EXPECT_EQ(runner_.takePolled(), 1u << 0);
+    EXPECT_EQ(runner_.schedule().statistics(0).successes, 1u);
+    EXPECT_EQ(runner_.schedule().response(0).registerValue(1), 0xABCD);
+    // Entry 1's slave never answers: two transmissions, then its time-out ends it.
+    runUntil(now_ + 400 * kMillisecond);
+    ASSERT_EQ(port_.frames.size(), 3u);
+    EXPECT_EQ(runner_.takePolled(), 1u << 1);
+    EXPECT_EQ(runner_.schedule().statistics(1).timeouts, 1u);
+    EXPECT_EQ(runner_.schedule().statistics(1).lastError, ModbusError::Timeout);
+    // The next cycle polls entry 0 again, 500 ms after its first due time
+    // (seen, like every deadline, once the line is known silent up to it:
+    // one character later).
+    runUntil(510 * kMillisecond + timing_.characterNs);
+    ASSERT_EQ(port_.frames.size(), 4u);
+    EXPECT_EQ(port_.startedNs[0], 10 * kMillisecond + timing_.characterNs);
+    EXPECT_EQ(port_.startedNs[3], 510 * kMillisecond + timing_.characterNs);
+    runner_.stop();
+    EXPECT_FALSE(runner_.polling());
+    // Polling again starts from an empty schedule.
+    ASSERT_EQ(runner_.startPolling(timing_, config, now_), ModbusError::Ok);
+    EXPECT_EQ(runner_.schedule().size(), 0u);
+    EXPECT_EQ(runner_.schedule().statistics(0).transactions, 0u);
+}
+
+TEST_F(LineRunnerTest, AReplacedRequestGoesOutFromItsEntrysNextSubmission)
+{
+    modbus::MasterConfig config;
+    config.responseTimeoutNs = 50 * kMillisecond;
+    config.retries = 0;
+    ASSERT_EQ(runner_.startPolling(timing_, config, now_), ModbusError::Ok);
+    ASSERT_TRUE(runner_.schedule().add(Request::writeSingleRegister(kUnit, 4, 1).value(), 100 * kMillisecond).ok());
+    runUntil(60 * kMillisecond);
+    ASSERT_EQ(port_.frames.size(), 1u);
+    EXPECT_EQ(port_.frames[0], withCrc({kUnit, 0x06, 0x00, 0x04, 0x00, 0x01}));
+    ASSERT_EQ(runner_.schedule().replace(0, Request::writeSingleRegister(kUnit, 4, 2).value()), ModbusError::Ok);
+    runUntil(160 * kMillisecond);
+    ASSERT_EQ(port_.frames.size(), 2u);
+    EXPECT_EQ(port_.frames[1], withCrc({kUnit, 0x06, 0x00, 0x04, 0x00, 0x02}));
+    EXPECT_EQ(runner_.schedule().statistics(0).transactions, 2u);
+    EXPECT_EQ(runner_.schedule().replace(1, Request::writeSingleRegister(kUnit, 4, 2).value()),
+              ModbusError::InvalidArgument);
+}

@@ -24,6 +24,8 @@ constexpr uint16_t com1Port = 0x3F8;
 // COM2: the same chip core as the console, with the RS-485 port's settings
 // given by its user when the line comes up (bsp::rs485Uart()).
 static_assert(rs485PortAddress == 0x2F8 && rs485Line == 3, "COM2 is at 0x2F8, IRQ 3 on a PC/AT");
+// COM3: the same again, on its own line (see secondRs485Line).
+static_assert(secondRs485PortAddress == 0x3E8, "COM3 is at 0x3E8 on a PC/AT");
 
 Pic8259 pic(arch_x86::IoWindow::ports(masterPicPort, 2), arch_x86::IoWindow::ports(slavePicPort, 2));
 // The PC/AT's CMOS real-time clock: index port 0x70, data port 0x71.
@@ -32,6 +34,7 @@ const Rtc146818 rtc(arch_x86::IoWindow::ports(rtcPort, 2));
 Pit8254 pit(arch_x86::IoWindow::ports(pitPort, 4));
 Uart16550 uart(arch_x86::IoWindow::ports(com1Port, 8));
 Uart16550 rs485(arch_x86::IoWindow::ports(rs485PortAddress, 8));
+Uart16550 secondRs485(arch_x86::IoWindow::ports(secondRs485PortAddress, 8));
 
 struct Attachment {
     InterruptHandler handler;
@@ -257,6 +260,8 @@ bool consoleHasInput() { return uart.hasInput(); }
 void consoleFlush() { uart.flush(); }
 
 Uart16550& rs485Uart() { return rs485; }
+
+Uart16550& secondRs485Uart() { return secondRs485; }
 
 void setConsoleInputNotifier(InterruptHandler notifier, void* context) { uart.setReceiveNotifier(notifier, context); }
 

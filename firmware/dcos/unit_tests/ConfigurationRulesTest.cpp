@@ -78,6 +78,9 @@ struct Configuration {
     std::vector<BufferPoolDeclaration> pools;
     std::vector<HeapDeclaration> heaps;
     std::vector<ModbusMapEntry> map;
+    dcos::app::ModbusSlaveDeclaration slave{};
+    std::vector<dcos::app::ModbusPollEntry> polls;
+    dcos::app::ModbusMasterDeclaration master{};
     const char* name = "demo";
     uint32_t tickRateHz = 0;
 
@@ -91,6 +94,9 @@ struct Configuration {
                                 .bufferPools = {pools.data(), pools.size()},
                                 .heaps = {heaps.data(), heaps.size()},
                                 .modbusMap = {map.data(), map.size()},
+                                .modbusSlave = slave,
+                                .modbusPolls = {polls.data(), polls.size()},
+                                .modbusMaster = master,
                                 .tickRateHz = tickRateHz};
         return findConfigurationError(application);
     }
@@ -503,4 +509,154 @@ TEST(ConfigurationRulesTest, MapEntriesHaveUniqueNamesAndAreCounted)
     EXPECT_EQ(error.rule, ConfigurationRule::TooManyObjects);
     EXPECT_EQ(error.value, dcos::app::kMaximumModbusMapEntries + 1);
     EXPECT_EQ(error.limit, dcos::app::kMaximumModbusMapEntries);
+}
+
+TEST(ConfigurationRulesTest, TheSlaveHasAnAddressABaudRateAndAMapToServe)
+{
+    Configuration configuration = mappedConfiguration();
+    // Address 0 declares no slave, whatever the other settings say.
+    configuration.slave.baud = 7;
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.slave = {.address = 247, .baud = 300, .parity = dcos::app::ModbusParity::None};
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.slave.address = 248;
+    ConfigurationError error = configuration.check();
+    expectBroken(error, ConfigurationRule::SlaveAddressOutOfRange, ObjectKind::ModbusSlave, "demo");
+    EXPECT_EQ(error.value, 248u);
+    EXPECT_EQ(error.limit, 247u);
+    EXPECT_EQ(message("demo", error), "application 'demo' not started: Modbus slave 'demo' has a slave address "
+                                      "out of range (1 to 247) (248, limit 247)");
+    configuration.slave.address = 1;
+    configuration.slave.baud = 299;
+    error = configuration.check();
+    expectBroken(error, ConfigurationRule::BaudOutOfRange, ObjectKind::ModbusSlave, "demo");
+    EXPECT_EQ(error.value, 299u);
+    configuration.slave.baud = 115200;
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.slave.baud = 115201;
+    EXPECT_EQ(configuration.check().rule, ConfigurationRule::BaudOutOfRange);
+    // A slave with nothing to serve is refused rather than left answering 02 to everything.
+    configuration.slave.baud = 19200;
+    configuration.map.clear();
+    expectBroken(configuration.check(), ConfigurationRule::SlaveWithoutMap, ObjectKind::ModbusSlave, "demo");
+}
+
+namespace {
+
+// The valid map with a polling schedule: a drive's speed read into a
+// publisher of its own ("drive", no writer), its setpoint written from the
+// application's "measured".
+Configuration pollingConfiguration()
+{
+    Configuration configuration = mappedConfiguration();
+    configuration.publishers.push_back({.name = "drive"});
+    configuration.polls.push_back({.name = "speed", .unit = 1, .table = ModbusTable::InputRegisters, .address = 0,
+                                   .count = 8, .periodMs = 100, .object = "drive"});
+    configuration.polls.push_back({.name = "setpoint", .unit = 1, .table = ModbusTable::HoldingRegisters,
+                                   .write = true, .address = 10, .count = 1, .periodMs = 100, .object = "measured",
+                                   .offset = 14});
+    return configuration;
+}
+
+} // namespace
+
+TEST(ConfigurationRulesTest, AValidPollingSchedulePasses)
+{
+    EXPECT_TRUE(pollingConfiguration().check().ok());
+}
+
+TEST(ConfigurationRulesTest, APollEntryNamesASlaveAPeriodAndARangeThatFitsItsPage)
+{
+    Configuration configuration = pollingConfiguration();
+    configuration.polls[0].unit = 0;
+    ConfigurationError error = configuration.check();
+    expectBroken(error, ConfigurationRule::SlaveAddressOutOfRange, ObjectKind::ModbusPollEntry, "speed");
+    configuration.polls[0].unit = 248;
+    EXPECT_EQ(configuration.check().value, 248u);
+    configuration.polls[0].unit = 247;
+    EXPECT_TRUE(configuration.check().ok());
+    configuration.polls[0].periodMs = 0;
+    expectBroken(configuration.check(), ConfigurationRule::PollPeriodOutOfRange, ObjectKind::ModbusPollEntry, "speed");
+    configuration.polls[0].periodMs = 3600001;
+    EXPECT_EQ(configuration.check().rule, ConfigurationRule::PollPeriodOutOfRange);
+    configuration.polls[0].periodMs = 3600000;
+    EXPECT_TRUE(configuration.check().ok());
+    // Eight registers fill the page; nine do not.
+    configuration.polls[0].count = 9;
+    error = configuration.check();
+    expectBroken(error, ConfigurationRule::MapTooLarge, ObjectKind::ModbusPollEntry, "speed");
+    EXPECT_EQ(error.value, 18u);
+    EXPECT_EQ(error.limit, 16u);
+    configuration.polls[0].count = 0;
+    EXPECT_EQ(configuration.check().rule, ConfigurationRule::MapRangeEmpty);
+    configuration.polls[0].count = 2;
+    configuration.polls[0].address = 65535;
+    EXPECT_EQ(configuration.check().rule, ConfigurationRule::MapAddressPastEnd);
+    configuration.polls[0].address = 0;
+    configuration.polls[0].object = "pressure";
+    expectBroken(configuration.check(), ConfigurationRule::MapObjectNotDeclared, ObjectKind::ModbusPollEntry, "speed");
+}
+
+TEST(ConfigurationRulesTest, APollReadIsItsPublishersOnlyWriter)
+{
+    // The application's own publication cannot take a slave's answers.
+    Configuration owned = pollingConfiguration();
+    owned.polls[0].object = "measured";
+    expectBroken(owned.check(), ConfigurationRule::PollPublisherHasWriter, ObjectKind::ModbusPollEntry, "speed");
+    // Nor can a publisher the slave's map writes (holding registers 0-7 are "setpoint").
+    Configuration shared = pollingConfiguration();
+    shared.polls[0].object = "setpoint";
+    expectBroken(shared.check(), ConfigurationRule::PollPublisherHasWriter, ObjectKind::ModbusPollEntry, "speed");
+    // A write reads any publisher; it only writes the slave's coils or holding registers.
+    Configuration writes = pollingConfiguration();
+    writes.polls[1].object = "setpoint";
+    writes.polls[1].offset = 0;
+    EXPECT_TRUE(writes.check().ok());
+    writes.polls[1].table = ModbusTable::InputRegisters;
+    expectBroken(writes.check(), ConfigurationRule::PollWritesReadOnlyTable, ObjectKind::ModbusPollEntry,
+                 "setpoint");
+}
+
+TEST(ConfigurationRulesTest, TheMastersLineHasABaudRateATimeOutAndRetries)
+{
+    Configuration configuration = pollingConfiguration();
+    configuration.master.baud = 115201;
+    ConfigurationError error = configuration.check();
+    expectBroken(error, ConfigurationRule::BaudOutOfRange, ObjectKind::ModbusMaster, "demo");
+    configuration.master.baud = 300;
+    configuration.master.timeoutMs = 0;
+    expectBroken(configuration.check(), ConfigurationRule::TimeoutOutOfRange, ObjectKind::ModbusMaster, "demo");
+    configuration.master.timeoutMs = 60001;
+    EXPECT_EQ(configuration.check().value, 60001u);
+    configuration.master.timeoutMs = 60000;
+    configuration.master.retries = 16;
+    error = configuration.check();
+    expectBroken(error, ConfigurationRule::RetriesOutOfRange, ObjectKind::ModbusMaster, "demo");
+    EXPECT_EQ(message("demo", error), "application 'demo' not started: Modbus master 'demo' has too many retries "
+                                      "(at most 15) (16, limit 15)");
+    configuration.master.retries = 15;
+    EXPECT_TRUE(configuration.check().ok());
+    // Without a schedule the master's settings are not looked at.
+    configuration.polls.clear();
+    configuration.master.baud = 7;
+    EXPECT_TRUE(configuration.check().ok());
+}
+
+TEST(ConfigurationRulesTest, AScheduleHasAtMostSixteenUniquelyNamedEntries)
+{
+    Configuration twice = pollingConfiguration();
+    twice.polls.push_back(twice.polls[0]);
+    expectBroken(twice.check(), ConfigurationRule::DuplicateName, ObjectKind::ModbusPollEntry, "speed");
+    Configuration crowd = pollingConfiguration();
+    std::vector<std::string> names;
+    for (size_t i = crowd.polls.size(); i <= dcos::app::kMaximumModbusPollEntries; ++i) {
+        names.push_back("poll" + std::to_string(i));
+    }
+    for (const std::string& name : names) {
+        crowd.polls.push_back(crowd.polls[0]);
+        crowd.polls.back().name = name.c_str();
+    }
+    const ConfigurationError error = crowd.check();
+    EXPECT_EQ(error.rule, ConfigurationRule::TooManyObjects);
+    EXPECT_EQ(error.value, dcos::app::kMaximumModbusPollEntries + 1);
 }

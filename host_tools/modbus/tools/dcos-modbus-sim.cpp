@@ -38,6 +38,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <thread>
 
 namespace {
 
@@ -173,6 +174,7 @@ int main(int argc, char** argv)
     std::string slaveText;
     double seconds = 0;
     uint32_t seed = 1;
+    double turnaroundMs = 0;
     bool json = false;
     bool verbose = false;
     bool checkOnly = false;
@@ -187,6 +189,11 @@ int main(int argc, char** argv)
     app.add_option("--seed", seed, "the noise generator's seed, for repeatable runs")->capture_default_str();
     app.add_flag("--json", json, "status as JSON lines: ready, each request, stopped with the values");
     app.add_flag("-v,--verbose", verbose, "a line for each request answered");
+    app.add_option("--turnaround", turnaroundMs,
+                   "milliseconds between a request's end and the answer, as a slow device takes; also how a test "
+                   "makes a slave answer after the master's time-out")
+        ->check(CLI::Range(0.0, 60000.0))
+        ->capture_default_str();
     app.add_flag("--check", checkOnly, "check the file and exit");
 
     try {
@@ -351,6 +358,9 @@ int main(int argc, char** argv)
             simulator.advance(std::chrono::duration<double>(arrived - last).count());
             last = arrived;
             ++counts.requests;
+            if (turnaroundMs > 0) {
+                std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(turnaroundMs));
+            }
             const int exception = answer(context.get(), simulator, frame.data(), static_cast<int>(frame.size()), counts);
             counts.exceptions += exception != 0 ? 1 : 0;
             logRequest(frame, exception, json, verbose);

@@ -56,6 +56,9 @@ public:
     {
     }
 
+    /// Serves @p map from now on (the same conditions as the constructor's).
+    void serve(const dcos::app::DeclarationList<dcos::app::ModbusMapEntry>& map) { map_ = map; }
+
     modbus::ExceptionCode readCoils(uint16_t address, uint16_t quantity, uint8_t* bits) override;
     modbus::ExceptionCode readDiscreteInputs(uint16_t address, uint16_t quantity, uint8_t* bits) override;
     modbus::ExceptionCode readHoldingRegisters(uint16_t address, uint16_t quantity, uint16_t* values) override;

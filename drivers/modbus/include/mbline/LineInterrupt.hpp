@@ -1,7 +1,7 @@
 // The RS-485 line's work in the UART's receive interrupt, declared here so
 // that the bench image (tests_renode/bench/ModbusBench.cpp) measures the
 // very function the line's task gives its port rather than a copy of it.
-// Defined with the line's task in ModbusCommands.cpp (target only: it reads
+// Defined with the board's lines in BoardLine.cpp (target only: it reads
 // the timer agent's clock).
 #pragma once
 

@@ -27,6 +27,7 @@
 #include <dcos/Status.hpp>
 #include <modbus/DataModel.hpp>
 #include <modbus/Master.hpp>
+#include <modbus/PollSchedule.hpp>
 #include <modbus/RtuTransport.hpp>
 #include <modbus/Server.hpp>
 #include <modbus/Slave.hpp>
@@ -86,6 +87,27 @@ public:
     /// Becomes a master on a line with @p timing.
     modbus::ModbusError startMaster(const modbus::RtuTiming& timing, const modbus::MasterConfig& config,
                                     uint64_t nowNs);
+
+    /// Most entries of a polling schedule (an application declares at most as many).
+    static constexpr size_t kPollCapacity = 16;
+    using Schedule = modbus::PollSchedule<kPollCapacity>;
+
+    /// Becomes a master that runs a polling schedule: the schedule, empty
+    /// now, is filled by the caller (schedule().add()) before the next
+    /// service(); from then on the schedule submits its entries itself,
+    /// and submit() is refused (Busy) while it runs them.
+    modbus::ModbusError startPolling(const modbus::RtuTiming& timing, const modbus::MasterConfig& config,
+                                     uint64_t nowNs);
+    Schedule& schedule() { return schedule_; }
+    const Schedule& schedule() const { return schedule_; }
+    bool polling() const { return polling_; }
+    /// The entries whose transaction ended since the last call, bit n entry n.
+    uint32_t takePolled()
+    {
+        const uint32_t polled = polled_;
+        polled_ = 0;
+        return polled;
+    }
     /// Leaves the line (Off). The caller has stopped the port's interrupt.
     void stop();
 
@@ -118,6 +140,10 @@ private:
     void feedReceived();
     void apply(const modbus::StationStep& step, uint64_t nowNs);
     void finishIfSent(uint64_t nowNs);
+    /// A master's frame has left the line (or was refused): told to the schedule when polling.
+    void masterTransmitDone(uint64_t nowNs);
+    /// A schedule's step: the master's step, and the entry it ended.
+    void applyPoll(const modbus::PollStep& step, uint64_t nowNs);
 
     LinePort& port_;
     Role role_ = Role::Off;
@@ -126,6 +152,9 @@ private:
     modbus::Server server_{};
     modbus::Slave slave_{};
     modbus::Master master_{};
+    Schedule schedule_{master_};
+    bool polling_ = false;
+    uint32_t polled_ = 0;
     TimedByteQueue<kQueueCapacity> queue_;
     LineCounters counters_{};
     bool transmitting_ = false;

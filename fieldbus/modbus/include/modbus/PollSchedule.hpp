@@ -65,6 +65,31 @@ public:
         return count_++;
     }
 
+    /// Empties the table, so that add() fills it again; the master stays. In
+    /// place: a schedule is too large to be built anew on a task's stack.
+    void clear()
+    {
+        for (size_t i = 0; i < count_; ++i) {
+            entries_[i] = Entry{};
+        }
+        count_ = 0;
+        current_ = 0;
+    }
+
+    /// Replaces the request of @p entry, keeping its period, due time and
+    /// statistics: an entry that writes values the application changes
+    /// sends them from its next submission on (a transaction under way
+    /// keeps its ADU, retries included). InvalidArgument for an empty
+    /// request or an entry that does not exist.
+    ModbusError replace(size_t entry, const Request& request)
+    {
+        if (entry >= count_ || request.length == 0) {
+            return ModbusError::InvalidArgument;
+        }
+        entries_[entry].request = request;
+        return ModbusError::Ok;
+    }
+
     /// Bytes received from the line at @p nowNs.
     PollStep onBytes(const uint8_t* bytes, size_t count, uint64_t nowNs)
     {

@@ -37,6 +37,14 @@ constexpr unsigned rs485Line = 3;
 /// The RS-485 port's UART: its I/O address, for messages.
 constexpr uint16_t rs485PortAddress = 0x2F8;
 
+/// The line of the second RS-485 port's UART (COM3). A PC/AT puts COM3 on
+/// IRQ 4 with COM1, but the console owns IRQ 4 alone here, and IRQ 7 is
+/// the parallel port's: the board routes COM3 to IRQ 9, free on the slave
+/// controller (the I/O board has 5, the CAN card 10 and 11).
+constexpr unsigned secondRs485Line = 9;
+/// The second RS-485 port's UART: its I/O address.
+constexpr uint16_t secondRs485PortAddress = 0x3E8;
+
 /// The default system tick rate; "tick_hz=N" on the command line changes it.
 constexpr uint32_t defaultTickRateHz = 1000;
 /// The tick rates the board's timer makes, in Hz (the 8254's limits).
@@ -200,6 +208,12 @@ void consoleFlush();
 /// drivers/modbus) initialises it with DriverEnable::Rts settings and
 /// attaches rs485Line when it brings the line up.
 Uart16550& rs485Uart();
+
+/// The board's second RS-485 port: COM3, the same chip core and wiring as
+/// COM2 (driver enable on RTS), left to its user the same way; the Modbus
+/// line that polls the application's slaves (drivers/modbus) brings it up
+/// and attaches secondRs485Line.
+Uart16550& secondRs485Uart();
 
 /// Called from the console interrupt after bytes arrive, so a task can
 /// sleep until there is input instead of polling.

@@ -130,8 +130,8 @@ constexpr uint32_t kModbusDigitalOutputPoints = 16;
 
 /// One range of a Modbus slave's addresses bound to a DCOS object; the
 /// application's `modbusMap` lists them. The compiler and the loader check
-/// them; the controller's `modbus slave` line does not serve them yet (it
-/// serves the console's data model), which the `app` command says.
+/// them; the controller's RS-485 line serves them from boot on when the
+/// application also declares its `modbusSlave` (drivers/modbus).
 struct ModbusMapEntry {
     const char* name = nullptr;    ///< Required, 1 to 15 characters, unique in the map; errors name it.
     ModbusTable table = ModbusTable::HoldingRegisters;
@@ -140,6 +140,63 @@ struct ModbusMapEntry {
     ModbusSource source = ModbusSource::Publisher;
     const char* object = nullptr;  ///< Publisher: the declared publisher's name; unused for the I/O board.
     uint32_t offset = 0;           ///< Publisher: the first byte in its page; I/O board: the first channel.
+};
+
+/// The parity of a Modbus serial line ([SL] 2.5.1: even by default; no
+/// parity takes a second stop bit, so that a character stays 11 bits).
+enum class ModbusParity : uint8_t {
+    Even,
+    Odd,
+    None,
+};
+
+/// The lowest and highest baud rates of a declared Modbus line: what the
+/// 16550's divisor reaches from 1.8432 MHz with an error the line tolerates,
+/// the same range the `modbus` console command takes.
+constexpr uint32_t kLowestModbusBaud = 300;
+constexpr uint32_t kHighestModbusBaud = 115200;
+
+/// The controller's Modbus slave on its RS-485 port, which serves the
+/// application's `modbusMap` from boot on. An application that declares no
+/// address (0) has no slave at boot; the console's `modbus slave` still
+/// starts one by hand.
+struct ModbusSlaveDeclaration {
+    uint32_t address = 0;          ///< The slave's address, 1 to 247 ([SL] 2.2); 0: none.
+    uint32_t baud = 19200;         ///< kLowestModbusBaud to kHighestModbusBaud.
+    ModbusParity parity = ModbusParity::Even;
+};
+
+/// One request the controller's Modbus master sends a slave periodically,
+/// on the board's second RS-485 port; the application's `modbusPolls`
+/// lists them (run by fieldbus/modbus's PollSchedule, drivers/modbus).
+///
+/// A read (function 01, 02, 03 or 04 by `table`) publishes what the slave
+/// answered on the publisher `object`, from byte `offset` on, laid out as a
+/// map entry's bytes (registers two bytes each, high byte first; bits
+/// packed from bit 0); the publisher has no writer task, the master's line
+/// is its writer, and the application subscribes to it. A write (0F for
+/// coils, 10 for holding registers) sends the slave those bytes of the
+/// publisher `object`, as they are when the request is due; any declared
+/// publisher will do (the application's, typically).
+struct ModbusPollEntry {
+    const char* name = nullptr;    ///< Required, 1 to 15 characters, unique in the schedule; errors name it.
+    uint32_t unit = 1;             ///< The slave's address, 1 to 247.
+    ModbusTable table = ModbusTable::HoldingRegisters;
+    bool write = false;            ///< Write the slave's coils or holding registers rather than read.
+    uint32_t address = 0;          ///< The slave's first address, 0 to 65535.
+    uint32_t count = 1;            ///< Registers or bits; they fit in the page from `offset`.
+    uint32_t periodMs = 100;       ///< How often, 1 ms to one hour; due times do not drift.
+    const char* object = nullptr;  ///< A declared publisher's name.
+    uint32_t offset = 0;           ///< The first byte in its page.
+};
+
+/// The controller's Modbus master on its second RS-485 port, which runs the
+/// application's `modbusPolls` from boot on.
+struct ModbusMasterDeclaration {
+    uint32_t baud = 19200;         ///< kLowestModbusBaud to kHighestModbusBaud.
+    ModbusParity parity = ModbusParity::Even;
+    uint32_t timeoutMs = 1000;     ///< A response's time-out, 1 to 60000 ms.
+    uint32_t retries = 2;          ///< Transmissions after the first, 0 to 15.
 };
 
 /// The declared task an object is handed to: its owner, a port's receiver,
@@ -179,9 +236,14 @@ struct Application {
     DeclarationList<PublisherDeclaration> publishers;
     DeclarationList<BufferPoolDeclaration> bufferPools;
     DeclarationList<HeapDeclaration> heaps;
-    /// The Modbus register map the controller's slave serves (empty: the
-    /// console's data model).
+    /// The Modbus register map the controller's slave serves.
     DeclarationList<ModbusMapEntry> modbusMap;
+    /// The slave that serves modbusMap from boot on (address 0: none).
+    ModbusSlaveDeclaration modbusSlave{};
+    /// The requests the controller's master polls its slaves with (empty: no master).
+    DeclarationList<ModbusPollEntry> modbusPolls;
+    /// The master's line, when modbusPolls is not empty.
+    ModbusMasterDeclaration modbusMaster{};
     /// The system tick the application needs, in Hz (timer resolution is one
     /// tick); 0 keeps the board's default. A tick_hz= on the kernel command
     /// line still wins.

@@ -6,8 +6,8 @@
 // and the application loader, which runs it again at boot on the linked
 // configuration before it creates anything. Rules are checked in declaration
 // order: the application, then tasks, semaphores, ports, publishers, pools
-// and heaps, then the totals, then the Modbus register map; the first broken
-// rule is reported.
+// and heaps, then the totals, then the Modbus register map and slave; the
+// first broken rule is reported.
 #pragma once
 
 #include <dcos/ApplicationDeclarations.hpp>
@@ -33,6 +33,9 @@ enum class ObjectKind : uint8_t {
     BufferPool,
     Heap,
     ModbusMapEntry,
+    ModbusSlave,
+    ModbusPollEntry,
+    ModbusMaster,
 };
 
 /// The rule a configuration breaks.
@@ -62,6 +65,14 @@ enum class ConfigurationRule : uint8_t {
     MapTooLarge,          ///< value: page bytes or I/O points it needs (offset + size); limit: what there is.
     MapWritesReadOnly,    ///< A coil or holding register entry bound to something Modbus may not write.
     MapOverlap,           ///< value: the first address it shares with an earlier entry of its table; limit: the last.
+    SlaveAddressOutOfRange, ///< value: the Modbus slave's address (or a poll entry's unit); limit: 247.
+    BaudOutOfRange,       ///< value: a Modbus line's baud rate; limit: kHighestModbusBaud.
+    SlaveWithoutMap,      ///< A Modbus slave declared with an empty register map.
+    PollPeriodOutOfRange, ///< value: the period in ms; limit: kLongestModbusPollMs.
+    PollWritesReadOnlyTable, ///< A poll entry writing discrete inputs or input registers.
+    PollPublisherHasWriter, ///< A read's publisher has a writer task, or the slave's map writes it too.
+    TimeoutOutOfRange,    ///< value: the master's time-out in ms; limit: kLongestModbusTimeoutMs.
+    RetriesOutOfRange,    ///< value: the master's retries; limit: 15.
     // Rules only the running node can check (application loader).
     NameInUse,            ///< An object of the node already has the name.
     CreateFailed,         ///< The agent refused; the loader prints its status.
@@ -91,6 +102,15 @@ constexpr size_t kMaximumObjectName = 15;
 constexpr size_t kMaximumModbusMapEntries = 32;
 /// The last Modbus address of every table ([AP] 4.4: addresses 0 to 65535).
 constexpr uint32_t kLastModbusAddress = 0xFFFF;
+/// The highest address of a Modbus slave ([SL] 2.2: 248 to 255 are reserved).
+constexpr uint32_t kMaxModbusSlaveAddress = 247;
+/// Most entries in an application's Modbus polling schedule.
+constexpr size_t kMaximumModbusPollEntries = 16;
+/// The longest poll period and master time-out, in milliseconds.
+constexpr uint32_t kLongestModbusPollMs = 3600000;
+constexpr uint32_t kLongestModbusTimeoutMs = 60000;
+/// Most retries of the master ([SL] leaves it to the implementation; modbus::MasterConfig's limit).
+constexpr uint32_t kMostModbusRetries = 15;
 
 /// Tasks the kernel itself runs on every node (idle, the root task and the console shell).
 constexpr const char* kKernelTaskNames[] = {internal::kIdleTaskName, internal::kRootTaskName,
@@ -116,6 +136,9 @@ constexpr const char* objectKindName(ObjectKind kind)
     case ObjectKind::BufferPool: return "buffer pool";
     case ObjectKind::Heap: return "heap";
     case ObjectKind::ModbusMapEntry: return "Modbus map entry";
+    case ObjectKind::ModbusSlave: return "Modbus slave";
+    case ObjectKind::ModbusPollEntry: return "Modbus poll entry";
+    case ObjectKind::ModbusMaster: return "Modbus master";
     }
     return "object";
 }
@@ -151,6 +174,16 @@ constexpr const char* ruleText(ConfigurationRule rule)
     case ConfigurationRule::MapWritesReadOnly:
         return "is writable (coils, holding registers) but bound to something read-only";
     case ConfigurationRule::MapOverlap: return "overlaps an earlier entry of its table";
+    case ConfigurationRule::SlaveAddressOutOfRange: return "has a slave address out of range (1 to 247)";
+    case ConfigurationRule::BaudOutOfRange: return "has a baud rate out of range (300 to 115200)";
+    case ConfigurationRule::SlaveWithoutMap: return "is declared without a register map to serve";
+    case ConfigurationRule::PollPeriodOutOfRange: return "has a period out of range (1 ms to one hour)";
+    case ConfigurationRule::PollWritesReadOnlyTable:
+        return "writes a read-only table (only coils and holding registers are written)";
+    case ConfigurationRule::PollPublisherHasWriter:
+        return "publishes on a publisher another writer has (a writer task, or the slave's map)";
+    case ConfigurationRule::TimeoutOutOfRange: return "has a response time-out out of range (1 to 60000 ms)";
+    case ConfigurationRule::RetriesOutOfRange: return "has too many retries (at most 15)";
     case ConfigurationRule::NameInUse: return "has a name another object of the node already uses";
     case ConfigurationRule::CreateFailed: return "was refused by its agent";
     }
@@ -379,17 +412,20 @@ constexpr const PublisherDeclaration* findPublisher(const Application& applicati
     return nullptr;
 }
 
-/// Page bytes a publisher entry takes: two per register, eight bits a byte.
-constexpr uint64_t pageBytesOf(const ModbusMapEntry& entry)
+/// Page bytes @p count items of @p table take: two per register, eight bits a byte.
+constexpr uint64_t pageBytesOf(ModbusTable table, uint32_t count)
 {
-    return isBitTable(entry.table) ? (uint64_t{entry.count} + 7) / 8 : uint64_t{entry.count} * 2;
+    return isBitTable(table) ? (uint64_t{count} + 7) / 8 : uint64_t{count} * 2;
 }
 
-/// The rules one entry keeps on its own; the sizes are summed in 64 bits,
-/// so that no offset or count near 2^32 can wrap around into a fit.
-constexpr ConfigurationError checkMapEntry(const Application& application, const ModbusMapEntry& entry)
+/// Page bytes a publisher entry takes.
+constexpr uint64_t pageBytesOf(const ModbusMapEntry& entry) { return pageBytesOf(entry.table, entry.count); }
+
+/// The rules every Modbus item bound to a range of addresses keeps: a count
+/// of at least 1 and a last address at most 65535.
+template <class Entry>
+constexpr ConfigurationError checkAddressRange(const Entry& entry, ObjectKind kind)
 {
-    constexpr ObjectKind kind = ObjectKind::ModbusMapEntry;
     if (entry.count == 0) {
         return broken(ConfigurationRule::MapRangeEmpty, kind, entry.name);
     }
@@ -397,6 +433,26 @@ constexpr ConfigurationError checkMapEntry(const Application& application, const
     if (last > kLastModbusAddress) {
         return broken(ConfigurationRule::MapAddressPastEnd, kind, entry.name,
                       last > SIZE_MAX ? SIZE_MAX : static_cast<size_t>(last), kLastModbusAddress);
+    }
+    return {};
+}
+
+/// A Modbus line's baud rate.
+constexpr ConfigurationError checkBaud(uint32_t baud, ObjectKind kind, const char* name)
+{
+    if (baud < kLowestModbusBaud || baud > kHighestModbusBaud) {
+        return broken(ConfigurationRule::BaudOutOfRange, kind, name, baud, kHighestModbusBaud);
+    }
+    return {};
+}
+
+/// The rules one entry keeps on its own; the sizes are summed in 64 bits,
+/// so that no offset or count near 2^32 can wrap around into a fit.
+constexpr ConfigurationError checkMapEntry(const Application& application, const ModbusMapEntry& entry)
+{
+    constexpr ObjectKind kind = ObjectKind::ModbusMapEntry;
+    if (ConfigurationError range = checkAddressRange(entry, kind); !range.ok()) {
+        return range;
     }
     uint64_t needed = 0;
     uint64_t available = 0;
@@ -470,6 +526,106 @@ constexpr ConfigurationError checkModbusMap(const Application& application)
     return {};
 }
 
+/// Whether the slave's map writes @p publisher (a coil or holding register entry names it).
+constexpr bool mapWrites(const Application& application, const char* publisher)
+{
+    for (const ModbusMapEntry& entry : application.modbusMap) {
+        if (entry.source == ModbusSource::Publisher && isWritable(entry.table) && textEquals(entry.object, publisher)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/// One poll entry's rules.
+constexpr ConfigurationError checkPollEntry(const Application& application, const ModbusPollEntry& entry)
+{
+    constexpr ObjectKind kind = ObjectKind::ModbusPollEntry;
+    if (entry.unit == 0 || entry.unit > kMaxModbusSlaveAddress) {
+        return broken(ConfigurationRule::SlaveAddressOutOfRange, kind, entry.name, entry.unit, kMaxModbusSlaveAddress);
+    }
+    if (ConfigurationError range = checkAddressRange(entry, kind); !range.ok()) {
+        return range;
+    }
+    if (entry.periodMs == 0 || entry.periodMs > kLongestModbusPollMs) {
+        return broken(ConfigurationRule::PollPeriodOutOfRange, kind, entry.name, entry.periodMs, kLongestModbusPollMs);
+    }
+    if (entry.write && !isWritable(entry.table)) {
+        return broken(ConfigurationRule::PollWritesReadOnlyTable, kind, entry.name);
+    }
+    const PublisherDeclaration* publisher = findPublisher(application, entry.object);
+    if (publisher == nullptr) {
+        return broken(ConfigurationRule::MapObjectNotDeclared, kind, entry.name);
+    }
+    const uint64_t needed = uint64_t{entry.offset} + pageBytesOf(entry.table, entry.count);
+    if (needed > kDsmPageSize) {
+        return broken(ConfigurationRule::MapTooLarge, kind, entry.name,
+                      needed > SIZE_MAX ? SIZE_MAX : static_cast<size_t>(needed), kDsmPageSize);
+    }
+    // A publisher has one writer (seed 7.10): what a read publishes, the master's line writes alone.
+    if (!entry.write && (publisher->writer != nullptr || mapWrites(application, entry.object))) {
+        return broken(ConfigurationRule::PollPublisherHasWriter, kind, entry.name);
+    }
+    return {};
+}
+
+/// The polling schedule and its master's line.
+constexpr ConfigurationError checkModbusPolls(const Application& application)
+{
+    const DeclarationList<ModbusPollEntry>& polls = application.modbusPolls;
+    if (polls.count == 0) {
+        return {};
+    }
+    if (ConfigurationError names = checkNames(polls, ObjectKind::ModbusPollEntry); !names.ok()) {
+        return names;
+    }
+    if (ConfigurationError count = checkCount(polls, ObjectKind::ModbusPollEntry, kMaximumModbusPollEntries);
+        !count.ok()) {
+        return count;
+    }
+    for (const ModbusPollEntry& entry : polls) {
+        if (ConfigurationError error = checkPollEntry(application, entry); !error.ok()) {
+            return error;
+        }
+    }
+    const ModbusMasterDeclaration& master = application.modbusMaster;
+    constexpr ObjectKind kind = ObjectKind::ModbusMaster;
+    if (ConfigurationError baud = checkBaud(master.baud, kind, application.name); !baud.ok()) {
+        return baud;
+    }
+    if (master.timeoutMs == 0 || master.timeoutMs > kLongestModbusTimeoutMs) {
+        return broken(ConfigurationRule::TimeoutOutOfRange, kind, application.name, master.timeoutMs,
+                      kLongestModbusTimeoutMs);
+    }
+    if (master.retries > kMostModbusRetries) {
+        return broken(ConfigurationRule::RetriesOutOfRange, kind, application.name, master.retries,
+                      kMostModbusRetries);
+    }
+    return {};
+}
+
+/// The declared slave's line settings. The error names the application,
+/// since an application declares at most one slave.
+constexpr ConfigurationError checkModbusSlave(const Application& application)
+{
+    const ModbusSlaveDeclaration& slave = application.modbusSlave;
+    constexpr ObjectKind kind = ObjectKind::ModbusSlave;
+    if (slave.address == 0) {
+        return {};
+    }
+    if (slave.address > kMaxModbusSlaveAddress) {
+        return broken(ConfigurationRule::SlaveAddressOutOfRange, kind, application.name, slave.address,
+                      kMaxModbusSlaveAddress);
+    }
+    if (ConfigurationError baud = checkBaud(slave.baud, kind, application.name); !baud.ok()) {
+        return baud;
+    }
+    if (application.modbusMap.count == 0) {
+        return broken(ConfigurationRule::SlaveWithoutMap, kind, application.name);
+    }
+    return {};
+}
+
 } // namespace rules
 
 /// The first rule @p application breaks, or an error with rule None.
@@ -495,6 +651,8 @@ constexpr ConfigurationError findConfigurationError(const Application& applicati
     if (error.ok()) error = rules::checkMemoryAreas(application);
     if (error.ok()) error = rules::checkTotals(application);
     if (error.ok()) error = rules::checkModbusMap(application);
+    if (error.ok()) error = rules::checkModbusSlave(application);
+    if (error.ok()) error = rules::checkModbusPolls(application);
     return error;
 }
 

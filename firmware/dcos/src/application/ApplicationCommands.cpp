@@ -36,17 +36,30 @@ const char* modbusTableName(app::ModbusTable table)
     return "?";
 }
 
-// The declared Modbus map, checked at build and boot. The line does not
-// serve it yet, and the listing says so rather than let an engineer think
-// a master reaches these addresses.
-void listModbusMap(shell::Shell& shell, const app::DeclarationList<app::ModbusMapEntry>& map)
+// The declared Modbus map, checked at build and boot, and the slave that
+// serves it from boot on. Without a declared slave the listing says the map
+// is not served, rather than let an engineer think a master reaches these
+// addresses; `modbus state` says what the line serves now.
+void listModbusMap(shell::Shell& shell, const app::Application& application)
 {
+    const app::DeclarationList<app::ModbusMapEntry>& map = application.modbusMap;
     if (map.count == 0) {
         return;
     }
-    shell.print("  modbus map, %u entries, checked; not served yet: 'modbus slave' serves the console's data "
-                "model (docs/protocols/modbus.md)\r\n",
-                static_cast<unsigned>(map.count));
+    const app::ModbusSlaveDeclaration& slave = application.modbusSlave;
+    if (slave.address == 0) {
+        shell.print("  modbus map, %u entries, checked; not served: no modbusSlave declared ('modbus slave' "
+                    "serves the console's data model)\r\n",
+                    static_cast<unsigned>(map.count));
+    } else {
+        shell.print("  modbus map, %u entries, checked; served by slave %lu on the RS-485 port at %lu baud 8%c%c\r\n",
+                    static_cast<unsigned>(map.count), static_cast<unsigned long>(slave.address),
+                    static_cast<unsigned long>(slave.baud),
+                    slave.parity == app::ModbusParity::None  ? 'N'
+                    : slave.parity == app::ModbusParity::Odd ? 'O'
+                                                             : 'E',
+                    slave.parity == app::ModbusParity::None ? '2' : '1');
+    }
     for (const app::ModbusMapEntry& entry : map) {
         shell.print("    %-15s %-15s %5lu-%-5lu ", entry.name, modbusTableName(entry.table),
                     static_cast<unsigned long>(entry.address),
@@ -88,7 +101,7 @@ shell::CommandResult showApplication(shell::Shell& shell, int argc, char**)
     listObjects(shell, app::ObjectKind::Publisher, application->publishers);
     listObjects(shell, app::ObjectKind::BufferPool, application->bufferPools);
     listObjects(shell, app::ObjectKind::Heap, application->heaps);
-    listModbusMap(shell, application->modbusMap);
+    listModbusMap(shell, *application);
     return shell::CommandResult::Ok;
 }
 

@@ -1,5 +1,6 @@
 // The application loader: all of an application's objects, or none of them.
 #include <dcos/internal/ApplicationLoader.hpp>
+#include <dcos/internal/ApplicationService.hpp>
 
 #include <dcos/BufferPoolAgent.hpp>
 #include <dcos/DsmAgent.hpp>
@@ -14,7 +15,14 @@
 
 #include <bsp/Board.hpp>
 
+// Provided by the linker: the bounds of the dcos_application_services section.
+extern const dcos::internal::ApplicationService __start_dcos_application_services[];
+extern const dcos::internal::ApplicationService __stop_dcos_application_services[];
+
 namespace dcos::internal {
+
+const ApplicationService* applicationServicesBegin() { return __start_dcos_application_services; }
+const ApplicationService* applicationServicesEnd() { return __stop_dcos_application_services; }
 
 ApplicationLoader::State ApplicationLoader::state_ = ApplicationLoader::State::None;
 app::ConfigurationError ApplicationLoader::lastError_{};
@@ -266,6 +274,28 @@ void printCount(runtime::CharacterSink& console, size_t count, const char* kind,
     first = false;
 }
 
+// Stops the services before @p end, last first.
+void stopServices(const app::Application& application, const ApplicationService* end)
+{
+    for (const ApplicationService* service = end; service-- != applicationServicesBegin();) {
+        service->stop(application);
+    }
+}
+
+// Starts every driver's service; when one refuses, those before it are
+// stopped again and its error is the application's.
+ConfigurationError startServices(const app::Application& application)
+{
+    for (const ApplicationService* service = applicationServicesBegin(); service != applicationServicesEnd();
+         ++service) {
+        if (ConfigurationError error = service->start(application); !error.ok()) {
+            stopServices(application, service);
+            return error;
+        }
+    }
+    return {};
+}
+
 } // namespace
 
 app::ConfigurationError ApplicationLoader::start(const app::Application& application)
@@ -282,6 +312,9 @@ app::ConfigurationError ApplicationLoader::start(const app::Application& applica
     Scheduler::holdDispatch();
     Progress progress;
     ConfigurationError error = createEverything(application, progress);
+    if (error.ok()) {
+        error = startServices(application);
+    }
     if (!error.ok()) {
         rollBack(application, progress);
     }
@@ -299,6 +332,7 @@ unsigned ApplicationLoader::stop(const app::Application& application)
     all.pools = application.bufferPools.count;
     all.heaps = application.heaps.count;
     Scheduler::holdDispatch();
+    stopServices(application, applicationServicesEnd());
     const unsigned removed = rollBack(application, all);
     Scheduler::releaseDispatch();
     return removed;
@@ -314,7 +348,10 @@ Result<ObjectId> ApplicationLoader::find(app::ObjectKind kind, const char* name)
     case ObjectKind::BufferPool: return kindServices<app::BufferPoolDeclaration>.nameToObject(name);
     case ObjectKind::Heap: return kindServices<app::HeapDeclaration>.nameToObject(name);
     case ObjectKind::Application:
-    case ObjectKind::ModbusMapEntry: break; // Neither is an object of the node.
+    case ObjectKind::ModbusMapEntry:
+    case ObjectKind::ModbusSlave:
+    case ObjectKind::ModbusPollEntry:
+    case ObjectKind::ModbusMaster: break; // None is an object of the node.
     }
     return Status::InvalidArgument;
 }

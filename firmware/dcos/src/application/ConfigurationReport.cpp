@@ -23,6 +23,11 @@ bool showsValueAndLimit(ConfigurationRule rule)
     case ConfigurationRule::MapAddressPastEnd:
     case ConfigurationRule::MapTooLarge:
     case ConfigurationRule::MapOverlap:
+    case ConfigurationRule::SlaveAddressOutOfRange:
+    case ConfigurationRule::BaudOutOfRange:
+    case ConfigurationRule::PollPeriodOutOfRange:
+    case ConfigurationRule::TimeoutOutOfRange:
+    case ConfigurationRule::RetriesOutOfRange:
         return true;
     default:
         return false;

@@ -9,8 +9,10 @@
 // rules again and that no declared name is already used on the node, then
 // creates semaphores, ports, publishers, pools and heaps, then the tasks,
 // with dispatching held so that no new task runs before every object exists
-// and every id is stored. When any step fails it deletes what it created, in
-// reverse, and reports the object that failed. These are configuration
+// and every id is stored. Then, still before any task runs, the drivers that
+// serve declarations of their own (the Modbus map and schedule) take them
+// up (internal/ApplicationService.hpp). When any step fails it deletes what
+// it created, in reverse, and reports the object that failed. These are configuration
 // services: O(N) in the declarations (O(N^2) for the name checks), at boot.
 #pragma once
 

@@ -73,6 +73,22 @@ struct ConfigurationRejected {
     static_assert(rule != Rule::MapOverlap,
                   "the Modbus map entry overlaps an earlier entry of its table (value: the first shared address, "
                   "limit: the last)");
+    static_assert(rule != Rule::SlaveAddressOutOfRange,
+                  "a Modbus slave address must be 1 to 247 (the declared slave's may be 0 for none; value: the "
+                  "address, limit: 247)");
+    static_assert(rule != Rule::BaudOutOfRange,
+                  "the Modbus line's baud rate must be 300 to 115200 (value: the rate, limit: the highest)");
+    static_assert(rule != Rule::SlaveWithoutMap, "a Modbus slave is declared but the register map is empty");
+    static_assert(rule != Rule::PollPeriodOutOfRange,
+                  "a Modbus poll entry's period must be 1 to 3600000 ms (value: the period, limit: the longest)");
+    static_assert(rule != Rule::PollWritesReadOnlyTable,
+                  "a Modbus poll entry writes only coils or holding registers");
+    static_assert(rule != Rule::PollPublisherHasWriter,
+                  "a Modbus poll read publishes on a publisher with no writer task that the slave's map does not "
+                  "write either (one writer per publisher)");
+    static_assert(rule != Rule::TimeoutOutOfRange,
+                  "the Modbus master's time-out must be 1 to 60000 ms (value: the time-out, limit: the longest)");
+    static_assert(rule != Rule::RetriesOutOfRange, "the Modbus master retries at most 15 times (value, limit)");
     // NameInUse and CreateFailed come from the running node only.
     static constexpr bool passed = rule == Rule::None;
 };
