@@ -27,11 +27,13 @@ socket, is a master of the controller's slave too: it writes each request
 in one write(), so its frames arrive whole as well.
 
 What these tests cannot show is the exact timing of a real line (a silence
-just over t1.5 inside a frame, a frame started just before t3.5): the
-emulated UART does not pace received bytes at the baud rate. The host unit
+just over t1.5 inside a frame, a frame started just before t3.5): QEMU's
+stock UART does not pace received bytes at the baud rate. The host unit
 tests of fieldbus/modbus's receiver and of drivers/modbus's LineRunner
-prove that with a simulated clock; interop at exact timing comes with the
-lab's emulated RS-485 line.
+prove that with a simulated clock, and tests_renode/test_modbus_line.py
+with the board's COM2 on the lab's RS-485 line (the isa-rs485-uart model,
+characters at their exact emulated times, collisions), against pymodbus,
+libmodbus and a second board.
 """
 
 import json
