@@ -22,9 +22,10 @@
  *    time; driver enable changes go there too, since an enabled driver holds
  *    the line even between characters;
  *  - a character from the line reaches the receive FIFO (or RBR) at the
- *    emulated time its last stop bit ends, with a framing error if the hub
- *    says it was garbled (two drivers at once) or if it was sent at another
- *    bit time or format than this receiver's;
+ *    emulated time its last stop bit ends, sampled in the middle of each
+ *    of this receiver's bits, so one sent at another bit time or format
+ *    arrives with wrong bits and the parity or framing error they give; one
+ *    the hub says was garbled (two drivers at once) has a framing error;
  *  - the character time-out interrupt comes after four character times
  *    without a character received or read, as the datasheet gives it.
  *
@@ -56,6 +57,7 @@
 #include "qemu/osdep.h"
 #include "qemu/cutils.h"
 #include "qemu/error-report.h"
+#include "qemu/host-utils.h"
 #include "qemu/log.h"
 #include "qemu/module.h"
 #include "qemu/timer.h"
@@ -191,6 +193,8 @@ typedef struct UartPending {
     char format[UART_FORMAT_MAX];
     uint8_t byte;
     bool garbled;
+    /* Sent by this UART in loopback, not received from the line. */
+    bool looped;
 } UartPending;
 
 struct IsaRs485UartState {
@@ -503,30 +507,101 @@ static bool uart_fifo_has_errors(IsaRs485UartState *s)
     return false;
 }
 
+/* The parity bit a format's letter gives for these data bits (DS 8.1, Table VI). */
+static unsigned uart_parity_bit(char parity, unsigned data)
+{
+    unsigned ones = ctpop32(data) & 1;
+
+    switch (parity) {
+    case 'E':
+        return ones;
+    case 'O':
+        return ones ^ 1;
+    case 'M':
+        return 1;
+    default:
+        return 0;
+    }
+}
+
 /*
- * A character from the line is due: this receiver takes it with a framing
- * error if the hub saw it garbled, or if it was sent at another bit time
- * or format, which the receiver samples wrongly. Real UARTs tolerate a few
- * percent of rate difference; a difference of more than 2 % counts here.
+ * The level a character drives offset_ps after its start bit began: the
+ * start bit (0), the data bits from the least significant, the parity bit,
+ * then the stop bits and the idle line (1).
+ */
+static unsigned uart_char_level(const UartPending *c, uint64_t offset_ps)
+{
+    unsigned data_bits = c->format[0] - '0';
+    char parity = c->format[1];
+    uint64_t bit = offset_ps / c->bit_ps;
+
+    if (bit == 0) {
+        return 0;
+    }
+    if (bit <= data_bits) {
+        return (c->byte >> (bit - 1)) & 1;
+    }
+    if (parity != 'N' && bit == data_bits + 1) {
+        return uart_parity_bit(parity, c->byte & ((1u << data_bits) - 1));
+    }
+    return 1;
+}
+
+/*
+ * A character from the line is due. The receiver samples it in the middle
+ * of each of its own bits, at its own bit time and format (DS 8.0: the
+ * receiver checks the first stop bit only), so a character sent at another
+ * rate or format arrives with wrong bits, and with a parity or framing
+ * error when those bits say so, as on a real line; one sent at the
+ * receiver's own settings arrives intact. A garbled character (two
+ * drivers at once, the hub says) carries a framing error and the data the
+ * hub gives: the receiver could not tell the bits apart.
  */
 static void uart_deliver(IsaRs485UartState *s, const UartPending *c)
 {
-    char format[UART_FORMAT_MAX];
     uint64_t bit_ps = uart_bit_ps(s);
-    uint64_t difference = c->bit_ps > bit_ps ? c->bit_ps - bit_ps :
-                                                bit_ps - c->bit_ps;
+    unsigned data_bits = uart_data_bits(s);
+    unsigned position = 1;
+    unsigned byte = 0;
     uint8_t errors = 0;
+    unsigned i;
 
-    if (s->mcr & MCR_LOOP) {
-        /* In loopback the serial input is disconnected (DS 8.8). */
+    if (!(s->mcr & MCR_LOOP) != !c->looped) {
+        /*
+         * In loopback the serial input is disconnected (DS 8.8), and a
+         * looped character whose loopback ended before its stop bit is
+         * lost with it.
+         */
         return;
     }
-    uart_format(s, format, sizeof(format));
-    if (c->garbled || difference * 50 > bit_ps || strcmp(format, c->format)) {
+    if (c->format[0] < '5' || c->format[0] > '8') {
+        labbus_link_fatal(s->link, "a character with the format %s", c->format);
+    }
+    for (i = 0; i < data_bits; i++, position++) {
+        byte |= uart_char_level(c, position * bit_ps + bit_ps / 2) << i;
+    }
+    if (s->lcr & LCR_PEN) {
+        char parity = (s->lcr & LCR_STICK) ?
+            ((s->lcr & LCR_EPS) ? 'S' : 'M') :
+            ((s->lcr & LCR_EPS) ? 'E' : 'O');
+
+        if (uart_char_level(c, position * bit_ps + bit_ps / 2) !=
+            uart_parity_bit(parity, byte)) {
+            errors |= LSR_PE;
+        }
+        position++;
+    }
+    if (!uart_char_level(c, position * bit_ps + bit_ps / 2)) {
         errors |= LSR_FE;
+    }
+    if (c->garbled) {
+        errors |= LSR_FE;
+        byte = c->byte;
+    }
+    if (errors) {
         s->chars_garbled++;
     }
-    uart_receive_char(s, c->byte, errors);
+    uart_receive_char(s, byte, errors);
 }
 
 static void uart_arm_rx_timer(IsaRs485UartState *s)
@@ -625,6 +700,7 @@ static void uart_start_char(IsaRs485UartState *s, int64_t start)
             uart_format(s, c->format, sizeof(c->format));
             c->byte = byte & mask;
             c->garbled = false;
+            c->looped = true;
             s->pending_count++;
             uart_arm_rx_timer(s);
         }
@@ -865,7 +941,8 @@ static void uart_link_event(void *opaque, int argc, char **argv)
     if (argc != 8 || strcmp(argv[0], "RX") ||
         !labbus_parse_u64(argv[3], &time) ||
         !labbus_parse_u64(argv[4], &bit_ps) ||
-        strlen(argv[5]) >= UART_FORMAT_MAX ||
+        strlen(argv[5]) >= UART_FORMAT_MAX || bit_ps == 0 ||
+        argv[5][0] < '5' || argv[5][0] > '8' ||
         qemu_strtou64(argv[6], &end, 16, &byte) || *end || byte > 0xff ||
         (strcmp(argv[7], "-") && strcmp(argv[7], "garbled"))) {
         labbus_link_fatal(s->link, "the hub sent a malformed %s event for "
@@ -894,6 +971,7 @@ static void uart_link_event(void *opaque, int argc, char **argv)
     pstrcpy(c->format, sizeof(c->format), argv[5]);
     c->byte = byte;
     c->garbled = !strcmp(argv[7], "garbled");
+    c->looped = false;
     s->pending_count++;
     if ((int64_t)time <= uart_now()) {
         uart_run_pending(s);
