@@ -25,6 +25,7 @@ import pytest
 
 from dcoslab.canbus import (
     BUS_FREE_BITS, Client, Frame, Hub, RECOVERY_SIGNALS, completion_bits, crc_delimiter_index, frame_bits, parse_log,
+    sync_together,
 )
 from dcoslab.target import run_target_test
 
@@ -96,15 +97,8 @@ def parse_event(line):
 def run(boards, until_ns):
     """Every fake board syncs at each boundary up to until_ns (inclusive)."""
     while boards[0].client.boundary <= until_ns:
-        for board in boards:
-            board.client.send_line(f"SYNC {board.client.boundary}")
-        for board in boards:
-            while True:
-                line = board.client.read_line()
-                if line.startswith("GO "):
-                    board.client.boundary = int(line.split()[1])
-                    break
-                board.events.append(parse_event(line))
+        for board, lines in zip(boards, sync_together([board.client for board in boards])):
+            board.events += [parse_event(line) for line in lines]
 
 
 @pytest.fixture

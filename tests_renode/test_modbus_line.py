@@ -20,7 +20,7 @@ import time
 
 import pytest
 
-from dcoslab.canbus import Client, Hub
+from dcoslab.canbus import Client, Hub, sync_together
 from dcoslab.rs485 import baud_bit_ps, char_ns, parse_line_log, sample_offset_ns
 
 TIMEOUT = 60.0
@@ -65,15 +65,8 @@ class FakeUart:
 def run(stations, until_ns):
     """Every fake station syncs at each boundary up to until_ns."""
     while stations[0].client.boundary <= until_ns:
-        for station in stations:
-            station.client.send_line(f"SYNC {station.client.boundary}")
-        for station in stations:
-            while True:
-                line = station.client.read_line()
-                if line.startswith("GO "):
-                    station.client.boundary = int(line.split()[1])
-                    break
-                station.events.append(line)
+        for station, lines in zip(stations, sync_together([station.client for station in stations])):
+            station.events += lines
 
 
 @pytest.fixture
@@ -218,6 +211,7 @@ from pymodbus.register_read_message import (  # noqa: E402
 from pymodbus.register_write_message import WriteSingleRegisterRequest  # noqa: E402
 
 from dcoslab.board import REPOSITORY  # noqa: E402
+from dcoslab.modbus_console import modbus_state, wait_for_state  # noqa: E402
 from dcoslab.rs485 import LinePty  # noqa: E402
 
 UNIT = 17
@@ -240,36 +234,17 @@ def response_bytes(response):
     return ModbusRtuFramer(ServerDecoder()).buildPacket(response)
 
 
-def modbus_state(board):
-    """The `modbus state` counters as {"frames.crc-errors": 0, ..., "frames.receiver": "idle"}, and t1.5/t3.5 in ns."""
-    result = {}
-    for text in board.command("modbus state").splitlines():
-        group, _, rest = text.partition(":")
-        words = rest.split()
-        if group == "modbus":
-            # The console prints whole microseconds; the controller keeps nanoseconds (T15_NS, T35_NS).
-            for name, exact in (("t1.5", T15_NS), ("t3.5", T35_NS)):
-                if name in words:
-                    assert int(words[words.index(name) + 1]) == exact // 1000, text
-                    result[name] = exact
-            continue
-        if group not in ("line", "frames", "slave", "master"):
-            continue
-        for name, value in zip(words[0::2], words[1::2]):
-            result[f"{group}.{name}"] = int(value) if value.isdigit() else value
-    return result
+def timing_and_state(board):
+    """`modbus state`'s counters, and t1.5 and t3.5 in ns (the console prints whole microseconds of T15_NS, T35_NS)."""
+    output = board.command("modbus state")
+    for name, exact in (("t1.5", T15_NS), ("t3.5", T35_NS)):
+        assert f"{name} {exact // 1000} us" in output, output
+    return {**modbus_state(board), "t1.5": T15_NS, "t3.5": T35_NS}
 
 
 def wait_state(board, predicate, what):
     """Runs `modbus state` until predicate(state) holds: a wait in the controller's own time."""
-    deadline = time.monotonic() + WAIT
-    while True:
-        seen = modbus_state(board)
-        if predicate(seen):
-            return seen
-        if time.monotonic() > deadline:
-            raise AssertionError(f"{board.name} never reached: {what}; last state {seen}")
-        time.sleep(0.05)
+    return wait_for_state(board, predicate, what, WAIT)
 
 
 def wait_idle(board):
@@ -331,7 +306,7 @@ def send_and_answer(lab, board, frame, gaps_ns=None):
 
 def test_pymodbus_frames_are_answered_at_exact_rtu_timing(slave_on_line):
     lab, board = slave_on_line
-    timing = modbus_state(board)
+    timing = timing_and_state(board)
     t15, t35 = timing["t1.5"], timing["t3.5"]
     request, answer = send_and_answer(lab, board, request_bytes(WriteSingleRegisterRequest(3, 4321, unit=UNIT)))
     assert decode_answer(answer).value == 4321
@@ -354,7 +329,7 @@ def test_pymodbus_frames_are_answered_at_exact_rtu_timing(slave_on_line):
 
 def test_a_silence_just_over_t15_inside_a_frame_gets_no_answer_and_just_under_gets_one(slave_on_line):
     lab, board = slave_on_line
-    t15 = modbus_state(board)["t1.5"]
+    t15 = timing_and_state(board)["t1.5"]
     frame = request_bytes(ReadHoldingRegistersRequest(0, 1, unit=UNIT))
     # The silence is from one character's last stop bit to the next one's start bit.
     margin = 60_000
@@ -377,7 +352,7 @@ def test_a_silence_just_over_t15_inside_a_frame_gets_no_answer_and_just_under_ge
 
 def test_a_frame_started_before_t35_of_silence_is_ignored(slave_on_line):
     lab, board = slave_on_line
-    timing = modbus_state(board)
+    timing = timing_and_state(board)
     t15, t35 = timing["t1.5"], timing["t3.5"]
     other = request_bytes(ReadHoldingRegistersRequest(0, 1, unit=UNIT + 1))
     mine = request_bytes(ReadHoldingRegistersRequest(0, 1, unit=UNIT))
@@ -553,7 +528,7 @@ def test_the_controller_as_master_against_a_pymodbus_slave_on_the_pty_station(ma
 
 def test_libmodbus_master_against_the_controllers_slave_over_the_line(slave_on_line):
     lab, board = slave_on_line
-    t35 = modbus_state(board)["t3.5"]
+    t35 = timing_and_state(board)["t3.5"]
     with LinePty(lab.socket_path, LINE, "libmodbus") as station:
         for arguments, check in ((["read-input-registers", "5", "3"], lambda a: a["values"] == [0x1005, 0x1006, 0x1007]),
                                  (["write-registers", "40=7,8,65535"], lambda a: True),
@@ -590,3 +565,25 @@ def test_two_boards_on_one_line_master_and_slave(canlab):
     assert {r.rx for r in from_port(records, "board1.rs485")} == {("board2.rs485",)}
     assert {r.rx for r in from_port(records, "board2.rs485")} == {("board1.rs485",)}
     assert modbus_state(master)["master.timeouts"] == 0
+
+
+def test_a_station_at_another_baud_rate_is_heard_as_damaged_characters_and_no_frame(canlab):
+    # The line's stations send at 9600 baud; the controller listens at 19200 and samples each
+    # character at its own rate: wrong bits, framing errors where it finds a stop bit low.
+    lab = canlab({}, {"board1": {"rs485": LINE}}, lines={LINE: (9600, FORMAT)}, kind="production", append=APPEND)
+    board = lab.board("board1")
+    assert f"slave {UNIT} on COM2" in board.command(f"modbus slave {UNIT} {BAUD}")
+    wait_idle(board)
+    before = modbus_state(board)
+    frame = request_bytes(ReadHoldingRegistersRequest(0, 1, unit=UNIT))
+    lab.hub.line_send(LINE, "lab", frame)
+    after = wait_state(board, lambda s: s["frames.seen"] > before["frames.seen"], "the damaged frame counted")
+    wait_idle(board)
+    assert after["line.characters"] == before["line.characters"] + len(frame)
+    assert after["line.framing-errors"] + after["line.parity-errors"] > \
+        before["line.framing-errors"] + before["line.parity-errors"], (before, after)
+    assert after["frames.delivered"] == before["frames.delivered"]
+    assert modbus_state(board)["slave.messages"] == before["slave.messages"]
+    assert from_port(lab.hub.line_records(), "board1.rs485") == [], lab.hub.log_text()
+    # The hub logs them as sent well: the damage is the receiver's, at its own rate.
+    assert all(r.outcome == "ok" for r in lab.hub.line_records())

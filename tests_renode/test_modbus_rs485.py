@@ -66,6 +66,7 @@ from pymodbus.register_write_message import WriteMultipleRegistersRequest, Write
 from pymodbus.utilities import computeCRC  # noqa: E402
 
 from dcoslab.board import REPOSITORY  # noqa: E402
+from dcoslab.modbus_console import modbus_state, wait_for_state  # noqa: E402
 from dcoslab.serial_line import SerialLine  # noqa: E402
 
 UNIT = 17
@@ -127,26 +128,12 @@ def read_message(line, framer, what, timeout=WAIT):
 
 def state(emulator):
     """The `modbus state` counters as {"frames.crc-errors": 0, ..., "frames.receiver": "idle"}."""
-    result = {}
-    for text in emulator.command("modbus state").splitlines():
-        group, _, rest = text.partition(":")
-        if group not in ("line", "frames", "slave", "master"):
-            continue
-        words = rest.split()
-        for name, value in zip(words[0::2], words[1::2]):
-            result[f"{group}.{name}"] = int(value) if value.isdigit() else value
-    return result
+    return modbus_state(emulator)
 
 
 def wait_for(emulator, predicate, what):
     """Runs `modbus state` until predicate(state) holds: a wait in the controller's time."""
-    deadline = time.monotonic() + WAIT
-    while True:
-        seen = state(emulator)
-        if predicate(seen):
-            return seen
-        if time.monotonic() > deadline:
-            raise AssertionError(f"the controller never reached: {what}; last state {seen}\n{emulator.transcript}")
+    return wait_for_state(emulator, predicate, what, WAIT)
 
 
 def wait_line_idle(emulator):

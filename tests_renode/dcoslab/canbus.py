@@ -1072,16 +1072,18 @@ class Hub:
             port.drop_ack_from = boundary if drop else None
         self._comment(f"fault {name} dropack {'on' if drop else 'off'}", boundary)
 
-    def _hub_port(self, bus_name, name):
-        bus = self.buses.get(bus_name)
+    def _hub_port(self, bus_name, name, kind="bus"):
+        """The hub's own node `name` on a CAN bus (kind "bus") or an RS-485 line (kind "line"), made on first use."""
+        media, port_class = (self.buses, Port) if kind == "bus" else (self.lines, LinePort)
+        bus = media.get(bus_name)
         if bus is None:
-            raise HubError(f"no bus {bus_name!r}")
+            raise HubError(f"no {kind} {bus_name!r}")
         if "." in name or " " in name:
             raise HubError(f"hub node name {name!r} must be one word without dots")
         key = f"{name}@{bus_name}"
         port = self.hub_nodes.ports.get(key)
         if port is None:
-            port = Port(self.hub_nodes, name, bus)
+            port = port_class(self.hub_nodes, name, bus)
             self.hub_nodes.ports[key] = port
             bus.ports[port.name] = port
         return port
@@ -1115,27 +1117,13 @@ class Hub:
         self._add_request(port, at, frame, once, False)
         self._comment(f"inject {port.name} {frame} at {at}", boundary)
 
-    def _line_port(self, line_name, name):
-        line = self.lines.get(line_name)
-        if line is None:
-            raise HubError(f"no line {line_name!r}")
-        if "." in name or " " in name:
-            raise HubError(f"hub station name {name!r} must be one word without dots")
-        key = f"{name}@{line_name}"
-        port = self.hub_nodes.ports.get(key)
-        if port is None:
-            port = LinePort(self.hub_nodes, name, line)
-            self.hub_nodes.ports[key] = port
-            line.ports[port.name] = port
-        return port
-
     def _line_send(self, line_name, sends, at_ns, boundary=None):
         boundary = self.boundary if boundary is None else boundary
         at = boundary if at_ns is None else at_ns
         if at < boundary:
             raise HubError(f"cannot send on {line_name} at {at} ns: the boards are already at {boundary} ns")
         for name, data, gaps in sends:
-            port = self._line_port(line_name, name)
+            port = self._hub_port(line_name, name, "line")
             line = port.line
             t = max(at, port.next_start)
             for byte, gap in zip(data, gaps):
@@ -1812,14 +1800,7 @@ class Client:
 
     def sync(self):
         """Emulated participants: reports the boundary, returns the events up to GO."""
-        self.send_line(f"SYNC {self.boundary}")
-        events = []
-        while True:
-            line = self.read_line()
-            if line.startswith("GO "):
-                self.boundary = int(line.split()[1])
-                return events
-            events.append(line)
+        return sync_together([self])[0]
 
     def events(self, until, timeout=None):
         """Host participants: reads event lines until until(lines) is true."""
@@ -1837,6 +1818,28 @@ class Client:
         except OSError:
             pass
         self.sock.close()
+
+
+def sync_together(clients):
+    """Several emulated participants of one process pass a boundary together.
+
+    Each reports its boundary first and only then reads its events up to
+    GO, since the hub answers a boundary only once every participant is
+    there. Returns each client's event lines, in the clients' order.
+    """
+    for client in clients:
+        client.send_line(f"SYNC {client.boundary}")
+    events = []
+    for client in clients:
+        lines = []
+        while True:
+            line = client.read_line()
+            if line.startswith("GO "):
+                client.boundary = int(line.split()[1])
+                break
+            lines.append(line)
+        events.append(lines)
+    return events
 
 
 # -- command line ------------------------------------------------------------------
