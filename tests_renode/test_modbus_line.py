@@ -15,12 +15,11 @@ counters; every wait has a time-out that only bounds a hung run.
 
 import json
 import os
-import tempfile
 import time
 
 import pytest
 
-from dcoslab.canbus import Client, Hub, sync_together
+from dcoslab.canbus import Client, sync_together
 from dcoslab.rs485 import baud_bit_ps, char_ns, parse_line_log, sample_offset_ns
 
 TIMEOUT = 60.0
@@ -70,20 +69,11 @@ def run(stations, until_ns):
 
 
 @pytest.fixture
-def line_hub():
-    hubs = []
-    directory = tempfile.TemporaryDirectory(prefix="dcos-linehub-")
+def line_hub(hub_factory):
+    def make(expect):
+        return hub_factory({}, expect=expect, lines={"line0": (BAUD, FORMAT)})
 
-    def make(expect, lines=None):
-        hub = Hub(os.path.join(directory.name, f"hub{len(hubs)}.sock"), {}, expect=expect, timeout=TIMEOUT,
-                  lines=lines or {"line0": (BAUD, FORMAT)})
-        hubs.append(hub)
-        return hub.start()
-
-    yield make
-    for hub in hubs:
-        hub.stop()
-    directory.cleanup()
+    return make
 
 
 def test_characters_take_their_length_and_arrive_at_the_end_of_the_stop_bit(line_hub):
@@ -587,3 +577,12 @@ def test_a_station_at_another_baud_rate_is_heard_as_damaged_characters_and_no_fr
     assert from_port(lab.hub.line_records(), "board1.rs485") == [], lab.hub.log_text()
     # The hub logs them as sent well: the damage is the receiver's, at its own rate.
     assert all(r.outcome == "ok" for r in lab.hub.line_records())
+
+
+def test_the_uart_model_register_by_register(boot, isa486):
+    """The isa-rs485-uart alone (no line), from the test image: registers, loopback character timing,
+    THRE/TEMT, trigger level and character time-out interrupts, overrun (tests_renode/target/
+    Rs485UartModelTest.cpp)."""
+    from dcoslab.target import run_target_test
+
+    run_target_test(boot(isa486, "test", icount=True, line_ports={"rs485": {}}), "rs485uart")

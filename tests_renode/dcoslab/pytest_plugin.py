@@ -13,6 +13,8 @@ Fixtures:
 - `application`: a booted emulator running --dcos-image on --dcos-board
   (built with the kernel configuration --dcos-kernel-config, default full),
   with exact emulated time (-icount), at its first shell prompt;
+- `hub_factory(buses, expect=(), pace=None, **options)`: a lab hub alone,
+  for tests that play the boards themselves;
 - `canlab(buses, wiring, pace=None, kind="test")`: the CAN bus hub with
   the named buses and bit rates, and the boards wired to them, booted in
   step (dcoslab/canlab.py).
@@ -23,10 +25,12 @@ always printed with the failure.
 """
 
 import os
+import tempfile
 
 import pytest
 
 from .board import load_board
+from .canbus import Hub
 from .canlab import CanLab
 from .emulator import Emulator
 from .symbolize import explain
@@ -38,6 +42,10 @@ def pytest_addoption(parser):
     group.addoption("--dcos-board", default="isa486", help="board the `application` fixture boots (default isa486)")
     group.addoption("--dcos-kernel-config", default="full", choices=("full", "minimal"),
                     help="the kernel configuration the image was built with (default full)")
+
+
+# How long a hub of hub_factory waits for a silent participant: it bounds a hung test only.
+HUB_TIMEOUT = 60.0
 
 
 @pytest.fixture
@@ -110,6 +118,25 @@ def canlab(request, boot, isa486):
     yield start
     for lab in labs:
         lab.close()
+
+
+@pytest.fixture
+def hub_factory():
+    """hub_factory(buses, expect=(), pace=None, **options) -> a started lab hub (dcoslab/canbus.py's Hub)
+    on a socket of its own, stopped after the test; options go to Hub (e.g. lines=, quantum_ns=)."""
+    hubs = []
+    directory = tempfile.TemporaryDirectory(prefix="dcos-canhub-")
+
+    def make(buses, expect=(), pace=None, **options):
+        options.setdefault("timeout", HUB_TIMEOUT)
+        hub = Hub(os.path.join(directory.name, f"hub{len(hubs)}.sock"), buses, expect=expect, pace=pace, **options)
+        hubs.append(hub)
+        return hub.start()
+
+    yield make
+    for hub in hubs:
+        hub.stop()
+    directory.cleanup()
 
 
 @pytest.fixture
