@@ -97,22 +97,20 @@ void labbus_link_fatal(LabBusLink *link, const char *format, ...)
     exit(EXIT_FAILURE);
 }
 
-static int64_t labbus_remaining_ms(int64_t deadline_ms)
+int64_t labbus_remaining_ms(int64_t deadline_ms)
 {
     int64_t remaining = deadline_ms - qemu_clock_get_ms(QEMU_CLOCK_REALTIME);
 
     return remaining > 0 ? remaining : 0;
 }
 
-/* Sends one whole line; false if the hub is gone or took none in time. */
-static bool labbus_send_raw(LabBusLink *link, const char *text, size_t length)
+bool labbus_send_all(int fd, const char *text, size_t length,
+                     int64_t deadline_ms)
 {
-    int64_t deadline_ms = qemu_clock_get_ms(QEMU_CLOCK_REALTIME) +
-                          (int64_t)link->timeout_s * 1000;
     size_t sent = 0;
 
     while (sent < length) {
-        ssize_t count = send(link->fd, text + sent, length - sent,
+        ssize_t count = send(fd, text + sent, length - sent,
                              MSG_NOSIGNAL | MSG_DONTWAIT);
 
         if (count > 0) {
@@ -120,7 +118,7 @@ static bool labbus_send_raw(LabBusLink *link, const char *text, size_t length)
         } else if (count < 0 && errno == EINTR) {
             continue;
         } else if (count < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-            struct pollfd pfd = { .fd = link->fd, .events = POLLOUT };
+            struct pollfd pfd = { .fd = fd, .events = POLLOUT };
             int64_t remaining = labbus_remaining_ms(deadline_ms);
 
             if (remaining == 0 || poll(&pfd, 1, remaining) <= 0) {
@@ -131,6 +129,14 @@ static bool labbus_send_raw(LabBusLink *link, const char *text, size_t length)
         }
     }
     return true;
+}
+
+/* Sends one whole line; false if the hub is gone or took none in time. */
+static bool labbus_send_raw(LabBusLink *link, const char *text, size_t length)
+{
+    return labbus_send_all(link->fd, text, length,
+                           qemu_clock_get_ms(QEMU_CLOCK_REALTIME) +
+                           (int64_t)link->timeout_s * 1000);
 }
 
 void labbus_link_send(LabBusLink *link, const char *format, ...)

@@ -72,6 +72,20 @@ const char *labbus_link_time(LabBusLink *link, int64_t now, char *buffer,
 G_NORETURN void labbus_link_fatal(LabBusLink *link, const char *format, ...)
     G_GNUC_PRINTF(2, 3);
 
+/*
+ * Milliseconds of QEMU_CLOCK_REALTIME left until deadline_ms, 0 when past:
+ * the lab's sockets (the hub, the I/O board's plant) wait at most that.
+ */
+int64_t labbus_remaining_ms(int64_t deadline_ms);
+
+/*
+ * Sends length bytes on a stream socket without blocking the board for
+ * longer than until deadline_ms (QEMU_CLOCK_REALTIME); false if the peer is
+ * gone or took nothing in time.
+ */
+bool labbus_send_all(int fd, const char *text, size_t length,
+                     int64_t deadline_ms);
+
 /* Whether the link is a real-time participant's (hub-realtime=on). */
 bool labbus_link_realtime(LabBusLink *link);
 
