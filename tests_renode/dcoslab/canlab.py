@@ -247,9 +247,14 @@ class CanLab:
                         line_ports["rs485"] = {"hub": self.socket_path, "hub-name": name, "line": value}
                     else:
                         properties[key] = value
-                emulator = boot(board_definition, kind, icount=True, name=name, append=append,
-                                device_properties={"isa-sja1000": properties}, line_ports=line_ports,
-                                extra_args=["-rtc", f"base={RTC_BASE}"])
+                # Only what is asked for goes to boot: a world's own boot (dcoslab/vmworld.py)
+                # knows no kernel command line or line ports.
+                options = {"append": append} if append else {}
+                if line_ports:
+                    options["line_ports"] = line_ports
+                emulator = boot(board_definition, kind, icount=True, name=name,
+                                device_properties={"isa-sja1000": properties},
+                                extra_args=["-rtc", f"base={RTC_BASE}"], **options)
                 self.boards[name] = LabBoard(name, emulator, self.hub)
             for board in self.boards.values():
                 board.emulator.expect(r"dcos> ", timeout=timeout)
