@@ -586,3 +586,35 @@ def test_the_uart_model_register_by_register(boot, isa486):
     from dcoslab.target import run_target_test
 
     run_target_test(boot(isa486, "test", icount=True, line_ports={"rs485": {}}), "rs485uart")
+
+
+def test_pymodbus_serial_client_as_master_of_the_controllers_slave(slave_on_line):
+    """pymodbus's own serial client (pyserial on the pty station), paced by the station to keep t3.5
+    before each request, which the client itself does not ([SL] 2.5.1.1)."""
+    from pymodbus.client import ModbusSerialClient
+
+    lab, board = slave_on_line
+    with LinePty(lab.socket_path, LINE, "pymodbus", silence_ns=HOST_TURNAROUND_NS) as station:
+        # strict=False: pymodbus's strict mode times t1.5 between received bytes with pyserial's
+        # inter-byte time-out, in wall time, which a pseudo-terminal refuses (tcsetattr EINVAL).
+        client = ModbusSerialClient(station.pty_path, baudrate=BAUD, parity="E", timeout=WAIT, strict=False)
+        assert client.connect()
+        try:
+            written = client.write_registers(20, [11, 22, 33], slave=UNIT)
+            assert not written.isError(), (written, lab.hub.log_text())
+            answer = client.read_holding_registers(20, 3, slave=UNIT)
+            assert not answer.isError() and answer.registers == [11, 22, 33], (answer, lab.hub.log_text())
+            answer = client.read_input_registers(7, 2, slave=UNIT)
+            assert answer.registers == [0x1007, 0x1008], (answer, lab.hub.log_text())
+        finally:
+            client.close()
+    assert "data: 11 22 33" in board.command("modbus data holding 20 3")
+    records = lab.hub.line_records()
+    requests = from_port(records, "pymodbus.0")
+    answers = from_port(records, "board1.rs485")
+    # Every request starts t3.5 or more after the answer before it, and every answer t3.5 after its request.
+    # Requests of 15 (10), 8 (03) and 8 (04) characters; answers of 8, 11 and 9.
+    assert len(requests) == 15 + 8 + 8 and len(answers) == 8 + 11 + 9, lab.hub.log_text()
+    assert requests[15].start - answers[7].end >= T35_NS and requests[23].start - answers[18].end >= T35_NS
+    assert answers[0].start - requests[14].end >= T35_NS and answers[8].start - requests[22].end >= T35_NS
+    assert modbus_state(board)["slave.messages"] == 3
