@@ -41,6 +41,10 @@ def main():
     parser.add_argument("--serial", action="append", default=[], metavar="PORT=BACKEND",
                         help="connect a serial port of the board other than the console, e.g. rs485=pty "
                              "(QEMU -serial syntax; unconnected ports are null)")
+    parser.add_argument("--line", action="append", default=[], metavar="PORT=SOCKET,LINE,NAME",
+                        help="put a serial port on a line of a running lab hub (dcoslab/canbus.py --line), e.g. "
+                             "rs485=/tmp/lab.sock,line0,board1; the board then runs under -icount, in step "
+                             "with the hub (docs/protocols/labbus.md, \"The RS-485 line\")")
     parser.add_argument("--print-command", action="store_true", help="print the emulator command and exit")
     arguments = parser.parse_args()
     properties = {}
@@ -53,6 +57,13 @@ def main():
         if not equals or not port or not backend or port == "console":
             sys.exit(f"error: --serial {text}: expected PORT=BACKEND for a port other than the console, e.g. rs485=pty")
         backends[port] = backend
+    line_ports = {}
+    for text in arguments.line:
+        port, equals, rest = text.partition("=")
+        fields = rest.split(",")
+        if not equals or not port or len(fields) != 3 or not all(fields):
+            sys.exit(f"error: --line {text}: expected PORT=SOCKET,LINE,NAME, e.g. rs485=/tmp/lab.sock,line0,board1")
+        line_ports[port] = {"hub": fields[0], "line": fields[1], "hub-name": fields[2]}
     board = load_board(arguments.board)
     for port in backends:
         if port not in board.serial_ports:
@@ -64,7 +75,8 @@ def main():
     try:
         command = board.emulator_command(image, backends, append=" ".join(arguments.append),
                                          device_properties=properties, without_devices=arguments.without,
-                                         extra_args=arguments.emulator_arg)
+                                         extra_args=arguments.emulator_arg, line_ports=line_ports,
+                                         icount=bool(line_ports))
     except (EmulatorNotBuilt, ValueError) as error:
         sys.exit(f"error: {error}")
     if arguments.print_command:

@@ -18,13 +18,13 @@ import os
 import re
 import subprocess
 import sys
-import tempfile
 import time
 
 import pytest
 
 from dcoslab.canbus import (
-    BUS_FREE_BITS, Client, Frame, Hub, RECOVERY_SIGNALS, completion_bits, crc_delimiter_index, frame_bits, parse_log,
+    BUS_FREE_BITS, Client, Frame, RECOVERY_SIGNALS, completion_bits, crc_delimiter_index, frame_bits, parse_log,
+    sync_together,
 )
 from dcoslab.target import run_target_test
 
@@ -96,32 +96,8 @@ def parse_event(line):
 def run(boards, until_ns):
     """Every fake board syncs at each boundary up to until_ns (inclusive)."""
     while boards[0].client.boundary <= until_ns:
-        for board in boards:
-            board.client.send_line(f"SYNC {board.client.boundary}")
-        for board in boards:
-            while True:
-                line = board.client.read_line()
-                if line.startswith("GO "):
-                    board.client.boundary = int(line.split()[1])
-                    break
-                board.events.append(parse_event(line))
-
-
-@pytest.fixture
-def hub_factory():
-    hubs = []
-    directory = tempfile.TemporaryDirectory(prefix="dcos-canhub-")
-
-    def make(buses, expect=(), pace=None, **options):
-        hub = Hub(os.path.join(directory.name, f"hub{len(hubs)}.sock"), buses, expect=expect, pace=pace,
-                  timeout=TIMEOUT, **options)
-        hubs.append(hub)
-        return hub.start()
-
-    yield make
-    for hub in hubs:
-        hub.stop()
-    directory.cleanup()
+        for board, lines in zip(boards, sync_together([board.client for board in boards])):
+            board.events += [parse_event(line) for line in lines]
 
 
 def test_host_participant_sends_and_receives_without_emulated_time(hub_factory):

@@ -27,11 +27,13 @@ socket, is a master of the controller's slave too: it writes each request
 in one write(), so its frames arrive whole as well.
 
 What these tests cannot show is the exact timing of a real line (a silence
-just over t1.5 inside a frame, a frame started just before t3.5): the
-emulated UART does not pace received bytes at the baud rate. The host unit
+just over t1.5 inside a frame, a frame started just before t3.5): QEMU's
+stock UART does not pace received bytes at the baud rate. The host unit
 tests of fieldbus/modbus's receiver and of drivers/modbus's LineRunner
-prove that with a simulated clock; interop at exact timing comes with the
-lab's emulated RS-485 line.
+prove that with a simulated clock, and tests_renode/test_modbus_line.py
+with the board's COM2 on the lab's RS-485 line (the isa-rs485-uart model,
+characters at their exact emulated times, collisions), against pymodbus,
+libmodbus and a second board.
 """
 
 import json
@@ -64,8 +66,8 @@ from pymodbus.register_write_message import WriteMultipleRegistersRequest, Write
 from pymodbus.utilities import computeCRC  # noqa: E402
 
 from dcoslab.board import REPOSITORY  # noqa: E402
+from dcoslab.modbus_console import modbus_state, wait_for_state  # noqa: E402
 from dcoslab.serial_line import SerialLine  # noqa: E402
-from dcoslab.waiting import wait_until  # noqa: E402
 
 UNIT = 17
 # 19200 baud 8E1, the default line of [SL] 2.5.1.
@@ -126,20 +128,12 @@ def read_message(line, framer, what, timeout=WAIT):
 
 def state(emulator):
     """The `modbus state` counters as {"frames.crc-errors": 0, ..., "frames.receiver": "idle"}."""
-    result = {}
-    for text in emulator.command("modbus state").splitlines():
-        group, _, rest = text.partition(":")
-        if group not in ("line", "frames", "slave", "master"):
-            continue
-        words = rest.split()
-        for name, value in zip(words[0::2], words[1::2]):
-            result[f"{group}.{name}"] = int(value) if value.isdigit() else value
-    return result
+    return modbus_state(emulator)
 
 
 def wait_for(emulator, predicate, what):
     """Runs `modbus state` until predicate(state) holds: a wait in the controller's time."""
-    return wait_until(lambda: state(emulator), predicate, what, emulator, timeout=WAIT, pause=0)
+    return wait_for_state(emulator, predicate, what, WAIT, pause=0)
 
 
 def wait_line_idle(emulator):

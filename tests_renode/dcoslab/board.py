@@ -44,6 +44,10 @@ class Board:
     # Emulator arguments every run of the board takes, e.g. ["-nic", "none"]:
     # the isapc machine otherwise adds an NE2000 at 0x300, the I/O board's port.
     emulator_args: list = field(default_factory=list)
+    # Serial ports that can be wired to a lab line instead (dcoslab/rs485.py):
+    # port name -> {"driver": ..., "properties": {...}}, the device that then
+    # takes the port's place (the isa486's RS-485 port: isa-rs485-uart).
+    line_ports: dict = field(default_factory=dict)
 
     def image(self, kind="production"):
         """Absolute path of the board's firmware image of the given kind."""
@@ -58,7 +62,7 @@ class Board:
         return [device["driver"] for device in self.devices]
 
     def emulator_command(self, image, serial_backends, append="", icount=False, cpu=None, memory_mib=None,
-                         accel=None, device_properties=None, without_devices=(), extra_args=()):
+                         accel=None, device_properties=None, without_devices=(), extra_args=(), line_ports=None):
         """The emulator argv for image, with one chardev argument per serial port.
 
         serial_backends maps names in serial_ports to a QEMU -serial value
@@ -79,7 +83,18 @@ class Board:
         {"isa-mfio": {"no-irq": "on"}}); without_devices names drivers to
         leave out (a board that is absent); extra_args go to the emulator as
         they are (e.g. the -chardev a device property refers to).
+
+        line_ports maps serial ports named in the board's line_ports to the
+        properties that join them to a lab line (hub, hub-name, line): such a
+        port is left out of the machine's own UARTs ("-serial none" keeps the
+        other ports' numbers) and its line device takes its place, at the
+        same I/O ports and interrupt.
         """
+        line_ports = line_ports or {}
+        for port in line_ports:
+            if port not in self.line_ports:
+                raise ValueError(f"board {self.name} has no serial port '{port}' that can join a line; "
+                                 f"those that can: {', '.join(self.line_ports) or 'none'}")
         drivers = self.device_drivers()
         for driver in list(device_properties or {}) + list(without_devices):
             if driver not in drivers:
@@ -126,10 +141,21 @@ class Board:
                                      f"it takes null, pty or chardev:ID, not {backend!r}")
             properties = "".join(f",{key}={value}" for key, value in merged.items())
             command += ["-device", device["driver"] + properties]
+        for port, properties in line_ports.items():
+            device = self.line_ports[port]
+            merged = dict(device.get("properties", {}))
+            merged.update(properties)
+            command += ["-device", device["driver"] + "".join(f",{key}={value}" for key, value in merged.items())]
         command += list(extra_args)
         device_ports = {device.get("serial_port") for device in self.devices}
         for port in self.serial_ports:
-            if port not in device_ports:
+            if port in device_ports:
+                continue
+            if port in line_ports:
+                if port in serial_backends:
+                    raise ValueError(f"serial port '{port}' cannot be both on a line and on {serial_backends[port]}")
+                command += ["-serial", "none"]
+            else:
                 command += ["-serial", serial_backends.get(port, "null")]
         return command
 

@@ -38,6 +38,11 @@ import sys
 import threading
 import time
 
+try:
+    from .rs485 import Line, LineError, LinePort, LineRecord, parse_format
+except ImportError:  # run as a program: tests_renode/dcoslab/canbus.py
+    from rs485 import Line, LineError, LinePort, LineRecord, parse_format
+
 PROTOCOL_VERSION = 1
 
 # The quantum is this many bit times of the fastest bus (docs/protocols/
@@ -449,16 +454,25 @@ class Hub:
     """The hub, run in a thread of this process (start/stop) or in the foreground (serve_forever)."""
 
     def __init__(self, socket_path, buses, expect=(), quantum_ns=None, pace=None, timeout=DEFAULT_TIMEOUT,
-                 log_path=None, echo_log=False, candump_path=None):
-        if not buses:
-            raise ValueError("the hub needs at least one bus")
+                 log_path=None, echo_log=False, candump_path=None, lines=None):
+        """buses maps CAN bus names to bit rates; lines maps RS-485 line names to a baud rate or a
+        (baud, format) pair, e.g. {"rs485": (19200, "8E1")} (dcoslab/rs485.py)."""
+        if not buses and not lines:
+            raise ValueError("the hub needs at least one bus or line")
         self.socket_path = socket_path
         self.buses = {name: Bus(name, rate) for name, rate in sorted(buses.items())}
-        fastest = min(bus.bit_ns for bus in self.buses.values())
-        limit = QUANTUM_BITS * fastest
+        self.lines = {}
+        for name, spec in sorted((lines or {}).items()):
+            if name in self.buses:
+                raise ValueError(f"{name} names both a bus and a line")
+            self.lines[name] = Line(name, *(spec if isinstance(spec, tuple) else (spec,)))
+        limits = [QUANTUM_BITS * bus.bit_ns for bus in self.buses.values()]
+        limits += [line.quantum_limit_ns() for line in self.lines.values()]
+        limit = min(limits)
         if quantum_ns is not None and not 0 < quantum_ns <= limit:
             raise ValueError(f"a quantum of {quantum_ns} ns is not in 1..{limit} ns ({QUANTUM_BITS} bit times of the "
-                             f"fastest bus); a longer one would announce frame ends in the boards' past")
+                             f"fastest bus, half a bit time of the fastest line); a longer one would announce "
+                             f"frame and character ends in the boards' past")
         self.quantum_ns = quantum_ns or limit
         self.expect = set(expect)
         self.pace = pace
@@ -472,6 +486,8 @@ class Hub:
         self.participants = {}
         self.hub_nodes = Participant("hub", "hub")
         self.records = []
+        # The RS-485 lines' characters (dcoslab/rs485.py, LineRecord).
+        self._line_records = []
         self._log_lines = []
         self.errors = []
         # Boundaries a board reached late: (name, boundary, nanoseconds).
@@ -662,6 +678,38 @@ class Hub:
     def stop_babble(self, name):
         self._command(self._stop_babble, name)
 
+    def line_send(self, line, name, data, at_ns=None, gaps_ns=None):
+        """A hub station `name` on RS-485 line `line` sends data at exact emulated times.
+
+        The first character starts at at_ns (default: the next boundary);
+        each one follows the one before it after gaps_ns[i] ns of silence
+        (gaps_ns[0] is added to the start), at the line's bit rate and
+        format. So a test puts a silence of its choice inside a frame, or
+        starts a frame a chosen time after the last one.
+        """
+        self.line_send_together(line, [(name, data, gaps_ns)], at_ns)
+
+    def line_send_together(self, line, sends, at_ns=None):
+        """Several hub stations send from the same instant: sends is [(name, data, gaps_ns)], each as line_send."""
+        checked = []
+        for name, data, gaps_ns in sends:
+            data = bytes(data)
+            gaps = list(gaps_ns) if gaps_ns is not None else [0] * len(data)
+            if len(gaps) != len(data):
+                raise HubError(f"{len(data)} bytes need {len(data)} gaps, not {len(gaps)}")
+            checked.append((name, data, gaps))
+        self._command(self._line_send, line, checked, at_ns)
+
+    def line_records(self, line=None):
+        """The characters on the RS-485 lines so far (LineRecord), in order of start."""
+        with self._lock:
+            return [r for r in self._line_records if line is None or r.line == line]
+
+    def wait_for_line_records(self, predicate, timeout, what="the characters asked for"):
+        """Waits until predicate(line records) is true; returns the records."""
+        self.wait_for(lambda: predicate(self._line_records), timeout, what)
+        return self.line_records()
+
     def inject(self, bus, name, frame, at_ns=None, once=False):
         """A hub node `name` requests `frame` at emulated time at_ns (default: the next boundary)."""
         self._command(self._inject, bus, name, frame, at_ns, once)
@@ -806,7 +854,7 @@ class Hub:
             return
         if verb == "SYNC":
             self._sync(participant, words)
-        elif verb in ("STATE", "TX", "ABORT"):
+        elif verb in ("STATE", "TX", "ABORT", "CHAR", "DRIVE", "SILENCE"):
             participant.inbox.append((participant.seq, words))
             participant.seq += 1
         elif verb == "ATTACH":
@@ -842,14 +890,15 @@ class Hub:
             raise ProtocolError("ATTACH is 'ATTACH <port> <bus> [<label>]'")
         port_id, bus_name = words[1], words[2]
         label = words[3] if len(words) == 4 else port_id
-        bus = self.buses.get(bus_name)
+        bus = self.buses.get(bus_name) or self.lines.get(bus_name)
         if bus is None:
-            participant.queue(f"REFUSED {port_id} no bus {bus_name}; the buses are {', '.join(self.buses)}")
+            participant.queue(f"REFUSED {port_id} no bus {bus_name}; the buses are {', '.join(self.buses)}"
+                              + (f"; the lines are {', '.join(self.lines)}" if self.lines else ""))
         elif port_id in participant.ports or any(p.label == label for p in participant.ports.values()):
             participant.queue(f"REFUSED {port_id} port {port_id} ({label}) is attached already")
         else:
-            port = Port(participant, label, bus)
-            if participant.kind == "host":
+            port = (LinePort if isinstance(bus, Line) else Port)(participant, label, bus)
+            if participant.kind == "host" and isinstance(port, Port):
                 port.timeline[0].time = self.boundary
             participant.ports[port_id] = port
             bus.ports[port.name] = port
@@ -935,6 +984,8 @@ class Hub:
         self._ingest(boundary)
         for bus in self.buses.values():
             self._simulate(bus, boundary)
+        for line in self.lines.values():
+            self._simulate_line(line, boundary)
         self._send_events(boundary)
         if self.pace and self._emulated():
             delay = self._wall_deadline(boundary + self.quantum_ns) - time.monotonic()
@@ -964,6 +1015,8 @@ class Hub:
         if self._emulated() or self._commands or self._events or self._babblers or self._wall_origin is None:
             return
         if any(port.pending for bus in self.buses.values() for port in bus.ports.values()):
+            return
+        if any(line.chars for line in self.lines.values()):
             return
         pace = self.pace or 1.0
         behind = int((time.monotonic() - self._wall_origin) * 1e9 * pace) // self.quantum_ns * self.quantum_ns
@@ -1019,16 +1072,18 @@ class Hub:
             port.drop_ack_from = boundary if drop else None
         self._comment(f"fault {name} dropack {'on' if drop else 'off'}", boundary)
 
-    def _hub_port(self, bus_name, name):
-        bus = self.buses.get(bus_name)
+    def _hub_port(self, bus_name, name, kind="bus"):
+        """The hub's own node `name` on a CAN bus (kind "bus") or an RS-485 line (kind "line"), made on first use."""
+        media, port_class = (self.buses, Port) if kind == "bus" else (self.lines, LinePort)
+        bus = media.get(bus_name)
         if bus is None:
-            raise HubError(f"no bus {bus_name!r}")
+            raise HubError(f"no {kind} {bus_name!r}")
         if "." in name or " " in name:
             raise HubError(f"hub node name {name!r} must be one word without dots")
         key = f"{name}@{bus_name}"
         port = self.hub_nodes.ports.get(key)
         if port is None:
-            port = Port(self.hub_nodes, name, bus)
+            port = port_class(self.hub_nodes, name, bus)
             self.hub_nodes.ports[key] = port
             bus.ports[port.name] = port
         return port
@@ -1061,6 +1116,74 @@ class Hub:
         port = self._hub_port(bus_name, name)
         self._add_request(port, at, frame, once, False)
         self._comment(f"inject {port.name} {frame} at {at}", boundary)
+
+    def _line_send(self, line_name, sends, at_ns, boundary=None):
+        boundary = self.boundary if boundary is None else boundary
+        at = boundary if at_ns is None else at_ns
+        if at < boundary:
+            raise HubError(f"cannot send on {line_name} at {at} ns: the boards are already at {boundary} ns")
+        for name, data, gaps in sends:
+            port = self._hub_port(line_name, name, "line")
+            line = port.line
+            t = max(at, port.next_start)
+            for byte, gap in zip(data, gaps):
+                char = line.add_char(port, t + gap, line.bit_ps, line.format, byte)
+                t = char.end
+            self._comment(f"{port.name} sends {data.hex()} from {at} ns", boundary)
+
+    def _apply_line_message(self, participant, port, t, words, boundary):
+        """CHAR and DRIVE from a station of an RS-485 line (docs/protocols/labbus.md, "The RS-485 line")."""
+        verb = words[0]
+        if not isinstance(port, LinePort):
+            raise ProtocolError(f"{verb} is for a port on an RS-485 line; {port.name} is on a CAN bus")
+        line = port.line
+        if verb == "CHAR":
+            if len(words) != 6:
+                raise ProtocolError("CHAR is 'CHAR <port> <time> <bit ps> <format> <byte hex>'")
+            bit_ps = line.bit_ps if words[3] == "-" else int(words[3])
+            fmt = line.format if words[4] == "-" else words[4]
+            try:
+                byte = int(words[5], 16)
+                if participant.kind != "emulated":
+                    # A host's bytes follow each other at the line's rate from the boundary they came at;
+                    # the first of a burst waits for the silence the station asked for (SILENCE).
+                    if t > port.next_start and port.min_silence_ns:
+                        t = max(t, line.last_end + port.min_silence_ns)
+                    t = max(t, port.next_start)
+                line.add_char(port, t, bit_ps, fmt, byte)
+            except LineError as error:
+                raise ProtocolError(str(error)) from None
+        elif verb == "SILENCE":
+            if len(words) != 4 or not words[3].isdigit() or participant.kind == "emulated":
+                raise ProtocolError("SILENCE is 'SILENCE <port> - <ns>', from a host station")
+            port.min_silence_ns = int(words[3])
+        elif verb == "DRIVE":
+            if len(words) != 4 or words[3] not in ("on", "off"):
+                raise ProtocolError("DRIVE is 'DRIVE <port> <time> on|off'")
+            if participant.kind != "emulated":
+                raise ProtocolError("only a board's UART has a driver enable; a host drives the line while it sends")
+            on = words[3] == "on"
+            if port.drive_on_at(t) != on:
+                port.drive.append((t, on))
+        else:
+            raise ProtocolError(f"{verb} is not a message for an RS-485 line")
+
+    def _simulate_line(self, line, boundary):
+        """Announces every character whose end lies before the next boundary, to its receivers."""
+        for char, garbled, byte, receivers in line.decide(boundary, self.quantum_ns):
+            at = max(char.end, boundary)
+            flags = "garbled" if garbled else "-"
+            for port in receivers:
+                self._events.append((at, self._event_seq, port,
+                                     f"RX {{port}} 0 {{time}} {char.bit_ps} {char.format} {byte:02x} {flags}"))
+                self._event_seq += 1
+            record = LineRecord(char.start, char.end, line.name, byte, char.format, char.sender,
+                                "garbled" if garbled else "ok", tuple(p.name for p in receivers))
+            with self._lock:
+                self._line_records.append(record)
+                self._log_lines.append(record.text())
+            self._write_log(record.text())
+        line.prune(boundary)
 
     def _add_request(self, port, t, frame, once, self_rx):
         request = TxRequest(port, t, frame, once, self_rx, self._request_seq)
@@ -1109,7 +1232,9 @@ class Hub:
         port = participant.ports.get(words[1]) if len(words) > 1 else None
         if port is None:
             raise ProtocolError(f"{verb} names port {words[1] if len(words) > 1 else '?'}, which is not attached")
-        if verb == "STATE":
+        if isinstance(port, LinePort) or verb in ("CHAR", "DRIVE"):
+            self._apply_line_message(participant, port, t, words, boundary)
+        elif verb == "STATE":
             if len(words) != 8 or words[4] not in MODES:
                 raise ProtocolError("STATE is 'STATE <port> <time> <epoch> <mode> <bit_ns> <sample_permille> <flags>'")
             flags = set() if words[7] == "-" else set(words[7].split(","))
@@ -1560,6 +1685,13 @@ class Hub:
         """statistics() as the bus log's closing comment lines."""
         stats = self.statistics()
         lines = [f"# {stats['time_ns']} statistics"]
+        with self._lock:
+            line_records = list(self._line_records)
+        for line in self.lines.values():
+            records = [r for r in line_records if r.line == line.name]
+            garbled = sum(1 for r in records if r.outcome == "garbled")
+            lines.append(f"# {stats['time_ns']} line {line.name} {line.baud} baud {line.format} "
+                         f"characters={len(records)} garbled={garbled}")
         for name, bus in stats["buses"].items():
             lines.append(f"# {stats['time_ns']} bus {name} {bus['bitrate']} bit/s frames={bus['frames']} "
                          f"errors={bus['errors']} load={100 * bus['load']:.2f}%")
@@ -1668,14 +1800,7 @@ class Client:
 
     def sync(self):
         """Emulated participants: reports the boundary, returns the events up to GO."""
-        self.send_line(f"SYNC {self.boundary}")
-        events = []
-        while True:
-            line = self.read_line()
-            if line.startswith("GO "):
-                self.boundary = int(line.split()[1])
-                return events
-            events.append(line)
+        return sync_together([self])[0]
 
     def events(self, until, timeout=None):
         """Host participants: reads event lines until until(lines) is true."""
@@ -1695,6 +1820,28 @@ class Client:
         self.sock.close()
 
 
+def sync_together(clients):
+    """Several emulated participants of one process pass a boundary together.
+
+    Each reports its boundary first and only then reads its events up to
+    GO, since the hub answers a boundary only once every participant is
+    there. Returns each client's event lines, in the clients' order.
+    """
+    for client in clients:
+        client.send_line(f"SYNC {client.boundary}")
+    events = []
+    for client in clients:
+        lines = []
+        while True:
+            line = client.read_line()
+            if line.startswith("GO "):
+                client.boundary = int(line.split()[1])
+                break
+            lines.append(line)
+        events.append(lines)
+    return events
+
+
 # -- command line ------------------------------------------------------------------
 
 
@@ -1705,11 +1852,26 @@ def _bus_argument(text):
     return name, int(rate)
 
 
+def _line_argument(text):
+    name, equals, spec = text.partition("=")
+    baud, _, fmt = spec.partition(",")
+    try:
+        if not equals or not name or not baud.isdigit():
+            raise LineError("expected NAME=BAUD[,FORMAT]")
+        parse_format(fmt or "8E1")
+    except LineError as error:
+        raise argparse.ArgumentTypeError(f"'{text}': {error}, e.g. rs485=19200,8E1") from None
+    return name, (int(baud), fmt or "8E1")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description="The DCOS lab's CAN bus hub (docs/protocols/labbus.md).")
     parser.add_argument("--socket", required=True, help="unix socket the boards' cards connect to (isa-sja1000 hub=)")
-    parser.add_argument("--bus", type=_bus_argument, action="append", required=True, metavar="NAME=BITRATE",
+    parser.add_argument("--bus", type=_bus_argument, action="append", default=[], metavar="NAME=BITRATE",
                         help="a bus and its bit rate in bit/s, e.g. can0=500000 (repeatable)")
+    parser.add_argument("--line", type=_line_argument, action="append", default=[], metavar="NAME=BAUD[,FORMAT]",
+                        help="an RS-485 line, its baud rate and the format of host stations, e.g. rs485=19200,8E1 "
+                             "(repeatable)")
     parser.add_argument("--expect", action="append", default=[], metavar="NAME",
                         help="hold the clock until this board has joined (repeatable)")
     parser.add_argument("--pace", type=float, default=None,
@@ -1720,10 +1882,14 @@ def main(argv=None):
     parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT,
                         help="seconds to wait for a silent board before dropping it")
     arguments = parser.parse_args(argv)
+    if not arguments.bus and not arguments.line:
+        parser.error("name at least one --bus or --line")
     hub = Hub(arguments.socket, dict(arguments.bus), expect=arguments.expect, pace=arguments.pace,
-              timeout=arguments.timeout, log_path=arguments.log, echo_log=True, candump_path=arguments.candump)
+              timeout=arguments.timeout, log_path=arguments.log, echo_log=True, candump_path=arguments.candump,
+              lines=dict(arguments.line))
     print(f"# hub on {arguments.socket}: "
-          + ", ".join(f"{bus.name} {bus.bitrate} bit/s" for bus in hub.buses.values())
+          + ", ".join([f"{bus.name} {bus.bitrate} bit/s" for bus in hub.buses.values()]
+                      + [f"{line.name} {line.baud} baud {line.format}" for line in hub.lines.values()])
           + f", quantum {hub.quantum_ns} ns", flush=True)
     try:
         hub.serve_forever()

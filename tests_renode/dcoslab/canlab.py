@@ -224,23 +224,37 @@ class LabBoard:
 class CanLab:
     """A hub with named buses and the boards joined to it."""
 
-    def __init__(self, boot, board_definition, buses, wiring, pace=None, kind="test", timeout=DEFAULT_TIMEOUT):
+    def __init__(self, boot, board_definition, buses, wiring, pace=None, kind="test", timeout=DEFAULT_TIMEOUT,
+                 lines=None, append=""):
         """buses maps bus names to bit rates; wiring maps board names to the
-        card's channel wiring, e.g. {"board1": {"bus0": "can0", "bus1": "can1"}}.
-        The hub holds the clock until every board has joined, so all boot in
-        step from emulated time 0."""
+        card's channel wiring, e.g. {"board1": {"bus0": "can0", "bus1": "can1"}},
+        where the key "rs485" names the lab RS-485 line the board's RS-485
+        port is on (lines maps line names to a baud rate and format, see
+        dcoslab/rs485.py). The hub holds the clock until every board has
+        joined, so all boot in step from emulated time 0. append is the
+        kernel command line of every board."""
         self._directory = tempfile.TemporaryDirectory(prefix="dcos-canlab-")
         self.socket_path = os.path.join(self._directory.name, "hub.sock")
-        self.hub = Hub(self.socket_path, buses, expect=list(wiring), pace=pace, timeout=timeout)
+        self.hub = Hub(self.socket_path, buses, expect=list(wiring), pace=pace, timeout=timeout, lines=lines)
         self.hub.start()
         self.boards = {}
         try:
             for name, channels in wiring.items():
                 properties = {"hub": self.socket_path, "hub-name": name}
-                properties.update(channels)
+                line_ports = {}
+                for key, value in channels.items():
+                    if key == "rs485":
+                        line_ports["rs485"] = {"hub": self.socket_path, "hub-name": name, "line": value}
+                    else:
+                        properties[key] = value
+                # Only what is asked for goes to boot: a world's own boot (dcoslab/vmworld.py)
+                # knows no kernel command line or line ports.
+                options = {"append": append} if append else {}
+                if line_ports:
+                    options["line_ports"] = line_ports
                 emulator = boot(board_definition, kind, icount=True, name=name,
                                 device_properties={"isa-sja1000": properties},
-                                extra_args=["-rtc", f"base={RTC_BASE}"])
+                                extra_args=["-rtc", f"base={RTC_BASE}"], **options)
                 self.boards[name] = LabBoard(name, emulator, self.hub)
             for board in self.boards.values():
                 board.emulator.expect(r"dcos> ", timeout=timeout)

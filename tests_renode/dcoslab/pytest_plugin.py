@@ -13,6 +13,8 @@ Fixtures:
 - `application`: a booted emulator running --dcos-image on --dcos-board
   (built with the kernel configuration --dcos-kernel-config, default full),
   with exact emulated time (-icount), at its first shell prompt;
+- `hub_factory(buses, expect=(), pace=None, **options)`: a lab hub alone,
+  for tests that play the boards themselves;
 - `canlab(buses, wiring, pace=None, kind="test")`: the CAN bus hub with
   the named buses and bit rates, and the boards wired to them, booted in
   step (dcoslab/canlab.py).
@@ -23,10 +25,12 @@ always printed with the failure.
 """
 
 import os
+import tempfile
 
 import pytest
 
 from .board import load_board
+from .canbus import Hub
 from .canlab import CanLab
 from .emulator import Emulator
 from .symbolize import explain
@@ -38,6 +42,10 @@ def pytest_addoption(parser):
     group.addoption("--dcos-board", default="isa486", help="board the `application` fixture boots (default isa486)")
     group.addoption("--dcos-kernel-config", default="full", choices=("full", "minimal"),
                     help="the kernel configuration the image was built with (default full)")
+
+
+# How long a hub of hub_factory waits for a silent participant: it bounds a hung test only.
+HUB_TIMEOUT = 60.0
 
 
 @pytest.fixture
@@ -69,17 +77,18 @@ def boot(request):
     {"no-irq": "on"}} adds or replaces device properties, without_devices=
     ["isa-mfio"] leaves devices out, extra_args=[...] go to the emulator as
     they are, serial_sockets=["rs485"] joins serial ports to Unix sockets
-    (Emulator.serial_socket_path).
+    (Emulator.serial_socket_path), line_ports={"rs485": {"hub": ..., "hub-name":
+    ..., "line": ...}} puts serial ports on a lab line (dcoslab/rs485.py).
     """
     started = []
     request.node.dcos_emulators = started
 
     def start(board, kind="production", append="", icount=False, device_properties=None, without_devices=(),
-              extra_args=(), name=None, serial_sockets=()):
+              extra_args=(), name=None, serial_sockets=(), line_ports=None):
         image = kind if os.path.sep in kind else board.image(kind)
         emulator = Emulator(board, image, append=append, icount=icount, device_properties=device_properties,
                             without_devices=without_devices, extra_args=extra_args, name=name,
-                            serial_sockets=serial_sockets)
+                            serial_sockets=serial_sockets, line_ports=line_ports)
         started.append(emulator)
         return emulator.start()
 
@@ -90,23 +99,44 @@ def boot(request):
 
 @pytest.fixture
 def canlab(request, boot, isa486):
-    """canlab(buses, wiring, pace=None, kind="test") -> CanLab, stopped after the test.
+    """canlab(buses, wiring, pace=None, kind="test", lines=None, append="") -> CanLab, stopped after the test.
 
     buses maps bus names to bit rates ({"can0": 500_000}); wiring maps board
-    names to their card's channels ({"board1": {"bus0": "can0"}}). The ISA
+    names to their card's channels ({"board1": {"bus0": "can0"}}) and, with
+    the key "rs485", to the RS-485 line their COM2 is on; lines maps line
+    names to a baud rate and format ({"line0": (19200, "8E1")}). The ISA
     486 board is booted once per name, in step with the others.
     """
     labs = []
     request.node.dcos_canlabs = labs
 
-    def start(buses, wiring, pace=None, kind="test"):
-        lab = CanLab(boot, isa486, buses, wiring, pace=pace, kind=kind)
+    def start(buses, wiring, pace=None, kind="test", lines=None, append=""):
+        lab = CanLab(boot, isa486, buses, wiring, pace=pace, kind=kind, lines=lines, append=append)
         labs.append(lab)
         return lab
 
     yield start
     for lab in labs:
         lab.close()
+
+
+@pytest.fixture
+def hub_factory():
+    """hub_factory(buses, expect=(), pace=None, **options) -> a started lab hub (dcoslab/canbus.py's Hub)
+    on a socket of its own, stopped after the test; options go to Hub (e.g. lines=, quantum_ns=)."""
+    hubs = []
+    directory = tempfile.TemporaryDirectory(prefix="dcos-canhub-")
+
+    def make(buses, expect=(), pace=None, **options):
+        options.setdefault("timeout", HUB_TIMEOUT)
+        hub = Hub(os.path.join(directory.name, f"hub{len(hubs)}.sock"), buses, expect=expect, pace=pace, **options)
+        hubs.append(hub)
+        return hub.start()
+
+    yield make
+    for hub in hubs:
+        hub.stop()
+    directory.cleanup()
 
 
 @pytest.fixture
@@ -141,5 +171,7 @@ def pytest_runtest_makereport(item, call):
         for index, lab in enumerate(getattr(item, "dcos_canlabs", [])):
             hub = lab.hub
             problems = "".join(f"hub error: {error}\n" for error in hub.errors)
-            report.sections.append((f"CAN bus log of lab {index + 1} ({', '.join(f'{bus.name} {bus.bitrate} bit/s' for bus in hub.buses.values())}, "
+            media = [f"{bus.name} {bus.bitrate} bit/s" for bus in hub.buses.values()]
+            media += [f"{line.name} {line.baud} baud {line.format}" for line in hub.lines.values()]
+            report.sections.append((f"CAN bus and RS-485 line log of lab {index + 1} ({', '.join(media)}, "
                                     f"quantum {hub.quantum_ns} ns)", problems + hub.log_text()))

@@ -10,8 +10,11 @@ that expects a serial device (pymodbus's serial client, libmodbus) opens
 characters is the host's, not the emulated line's: one that writes each
 frame in one write(), as libmodbus does, reaches the controller as one
 frame (test_libmodbus_master_reads_and_writes_the_controllers_slave), but
-nothing at the emulated line's exact timing comes through the bridge; that
-waits for the lab's RS-485 line, which paces the bytes.
+nothing at the emulated line's exact timing comes through the bridge. For
+exact timing the port goes on the lab's RS-485 line instead
+(dcoslab/rs485.py, docs/protocols/labbus.md "The RS-485 line"), where a
+host program joins through rs485.LinePty and its bytes are paced at the
+line's baud rate in emulated time.
 """
 
 import os

@@ -25,5 +25,8 @@ def wait_until(read, predicate, what, emulator, timeout=DEFAULT_WAIT, pause=0.05
         if predicate(value):
             return value
         if time.monotonic() > deadline:
-            raise AssertionError(f"never reached: {what}; last seen {value}\n{emulator.transcript}")
+            # A lab board's console has no transcript of its own; the lab's
+            # failure report prints every board's.
+            transcript = getattr(emulator, "transcript", "")
+            raise AssertionError(f"never reached: {what}; last seen {value}\n{transcript}")
         time.sleep(pause)

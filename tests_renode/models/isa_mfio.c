@@ -45,6 +45,8 @@
 #include "io/channel-socket.h"
 #include "qom/object.h"
 
+#include "labbus_link.h"
+
 #include <math.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -272,40 +274,6 @@ static int mfio_plant_fd(IsaMfioState *s)
     return socket_chr->sioc->fd;
 }
 
-static int64_t mfio_plant_remaining_ms(int64_t deadline_ms)
-{
-    int64_t remaining = deadline_ms - qemu_clock_get_ms(QEMU_CLOCK_REALTIME);
-
-    return remaining > 0 ? remaining : 0;
-}
-
-static bool mfio_plant_send(int fd, const char *text, int64_t deadline_ms)
-{
-    size_t length = strlen(text);
-    size_t sent = 0;
-
-    while (sent < length) {
-        ssize_t count = send(fd, text + sent, length - sent,
-                             MSG_NOSIGNAL | MSG_DONTWAIT);
-
-        if (count > 0) {
-            sent += count;
-        } else if (count < 0 && errno == EINTR) {
-            continue;
-        } else if (count < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-            struct pollfd pfd = { .fd = fd, .events = POLLOUT };
-            int64_t remaining = mfio_plant_remaining_ms(deadline_ms);
-
-            if (remaining == 0 || poll(&pfd, 1, remaining) <= 0) {
-                return false;
-            }
-        } else {
-            return false;
-        }
-    }
-    return true;
-}
-
 /*
  * Reads one line into s->plant_line (without the newline). Returns false on
  * time-out, on a closed connection and on a line that is too long.
@@ -334,7 +302,7 @@ static bool mfio_plant_receive_line(IsaMfioState *s, int fd,
             continue;
         } else if (count < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
             struct pollfd pfd = { .fd = fd, .events = POLLIN };
-            int64_t remaining = mfio_plant_remaining_ms(deadline_ms);
+            int64_t remaining = labbus_remaining_ms(deadline_ms);
 
             if (remaining == 0 || poll(&pfd, 1, remaining) <= 0) {
                 return false;
@@ -424,7 +392,7 @@ static void mfio_plant_exchange(IsaMfioState *s)
         mfio_plant_missed(s, "no plant connected");
     } else {
         mfio_plant_drain(s, fd);
-        if (!mfio_plant_send(fd, sample->str, deadline_ms)) {
+        if (!labbus_send_all(fd, sample->str, strlen(sample->str), deadline_ms)) {
             mfio_plant_missed(s, "could not send SAMPLE");
         } else if (!mfio_plant_receive_line(s, fd, deadline_ms)) {
             mfio_plant_missed(s, "no INPUT line within 1 s");

@@ -146,22 +146,28 @@ fi
 say "source: $tree (QEMU $(cat "$tree/VERSION"), Debian $(head -n 1 "$tree/debian/changelog" | sed 's/.*(\(.*\)).*/\1/'))"
 
 # -- our models ---------------------------------------------------------------
-# Every C file in tests_renode/models/ goes to hw/misc/dcos/ and is listed in
-# hw/misc/meson.build, for ISA machines. Stale copies are removed, and files
-# are only rewritten when they change, so ninja recompiles only what changed.
+# Every C file and header in tests_renode/models/ goes to hw/misc/dcos/
+# (the models include their shared headers, e.g. labbus_link.h, from their
+# own folder), and every C file is listed in hw/misc/meson.build, for ISA
+# machines. Stale copies are removed, and files are only rewritten when they
+# change, so ninja recompiles only what changed.
 model_tree="$tree/hw/misc/dcos"
 mkdir -p "$model_tree"
-for copied in "$model_tree"/*.c; do
+for copied in "$model_tree"/*.c "$model_tree"/*.h; do
     [ -e "$copied" ] || continue
     [ -e "$models_dir/$(basename "$copied")" ] || rm -f "$copied"
 done
 meson_lines=""
-for model in "$models_dir"/*.c; do
+for model in "$models_dir"/*.c "$models_dir"/*.h; do
     [ -e "$model" ] || continue
     name=$(basename "$model")
     cmp -s "$model" "$model_tree/$name" || cp "$model" "$model_tree/$name"
-    meson_lines="${meson_lines}softmmu_ss.add(when: 'CONFIG_ISA_BUS', if_true: files('dcos/$name')) # dcos model
+    case "$name" in
+    *.c)
+        meson_lines="${meson_lines}softmmu_ss.add(when: 'CONFIG_ISA_BUS', if_true: files('dcos/$name')) # dcos model
 "
+        ;;
+    esac
 done
 misc_meson="$tree/hw/misc/meson.build"
 grep -v '# dcos model$' "$misc_meson" >"$misc_meson.new" || true
