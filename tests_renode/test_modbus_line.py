@@ -280,6 +280,11 @@ def slave_on_line(canlab):
     board = lab.board("board1")
     out = board.command(f"modbus slave {UNIT} {BAUD}")
     assert f"slave {UNIT} on COM2 at {BAUD} baud 8E1" in out, out
+    # A receiver just started ignores a frame until the line has been silent
+    # for t3.5 ([SL] 2.5.1.1); a host program on a pty station writes its
+    # first request at once, which a loaded host can make sooner than that
+    # in the controller's time.
+    wait_idle(board)
     return lab, board
 
 
