@@ -419,6 +419,20 @@ def test_libmodbus_master_reads_and_writes_the_controllers_slave(bridged_slave):
     assert status == 0, (answer, errors)
     status, answer, errors = dcos_modbus(emulator, line, "read-coils", "0", "5")
     assert status == 0 and answer["values"] == [False, False, False, True, False], (answer, errors)
+    # 02: the console slave's pattern, discrete input n on for multiples of 3.
+    status, answer, errors = dcos_modbus(emulator, line, "read-discrete-inputs", "0", "7")
+    assert status == 0 and answer["values"] == [i % 3 == 0 for i in range(7)], (answer, errors)
+    # 06 and 0F, each read back by the controller's own console.
+    status, answer, errors = dcos_modbus(emulator, line, "write-register", "3", "4321")
+    assert status == 0, (answer, errors)
+    assert "data: 4321" in emulator.command("modbus data holding 3 1"), emulator.transcript
+    status, answer, errors = dcos_modbus(emulator, line, "write-coils", "20=1,0,1,1")
+    assert status == 0, (answer, errors)
+    assert "data: 1 0 1 1" in emulator.command("modbus data coils 20 4"), emulator.transcript
+    # 17: the write lands before the read ([AP] 6.17).
+    status, answer, errors = dcos_modbus(emulator, line, "write-read", "41=77,88", "40:3")
+    assert status == 0 and answer["values"] == [7, 77, 88], (answer, errors)
+    assert "data: 7 77 88" in emulator.command("modbus data holding 40 3"), emulator.transcript
     # Device identification (2B/0E), which libmodbus cannot frame: dcos-modbus frames it itself.
     status, answer, errors = dcos_modbus(emulator, line, "identify", "--code", "basic")
     assert status == 0, (answer, errors)
