@@ -662,13 +662,18 @@ def test_a_station_at_another_baud_rate_is_heard_as_damaged_characters_and_no_fr
     assert all(r.outcome == "ok" for r in lab.hub.line_records())
 
 
-def test_the_uart_model_register_by_register(boot, isa486):
+# The on-target tests this module runs (test_kernel_core.py checks that every one in the image is run somewhere).
+LINE_TARGET_TESTS = ["rs485uart"]
+
+
+@pytest.mark.parametrize("name", LINE_TARGET_TESTS)
+def test_the_uart_model_register_by_register(boot, isa486, name):
     """The isa-rs485-uart alone (no line), from the test image: registers, loopback character timing,
     THRE/TEMT, trigger level and character time-out interrupts, overrun (tests_renode/target/
     Rs485UartModelTest.cpp)."""
     from dcoslab.target import run_target_test
 
-    run_target_test(boot(isa486, "test", icount=True, line_ports={"rs485": {}}), "rs485uart")
+    run_target_test(boot(isa486, "test", icount=True, line_ports={"rs485": {}}), name)
 
 
 def test_pymodbus_serial_client_as_master_of_the_controllers_slave(slave_on_line):
