@@ -31,11 +31,11 @@ CHAR_NS = char_ns(BIT_PS, FORMAT)
 # fieldbus/modbus's RtuTiming rounds them.
 T15_NS = -(-15 * 11 * 1_000_000_000 // (10 * BAUD))
 T35_NS = -(-35 * 11 * 1_000_000_000 // (10 * BAUD))
-# A host slave station's turnaround: t3.5 and 100 us. The controller's master counts the silence
-# after its request from the THRE interrupt plus one character time (drivers/modbus LineRunner::
-# finishIfSent), a few microseconds of interrupt latency after the real last stop bit, so it takes
-# an answer that starts exactly t3.5 after the request for one started too early, and drops it.
-HOST_TURNAROUND_NS = T35_NS + 100_000
+# A host station's turnaround: exactly t3.5, the shortest [SL] 2.5.1.1 allows. Its station starts a
+# burst at the first boundary after that much silence, so a fast program's answer begins at t3.5 or
+# within a quantum after it, which the controller must take although its transmit interrupt stamped
+# the end of its request a little late (drivers/modbus LineRunner::finishIfSent).
+HOST_TURNAROUND_NS = T35_NS
 
 
 # -- the line model, with stations in Python ------------------------------------------

@@ -160,10 +160,17 @@ void LineRunner::finishIfSent(uint64_t nowNs)
         ++counters_.temtPolls;
         return;
     }
-    // The last stop bit left at most one character time after the FIFO ran
-    // dry; that, not the moment this task noticed, is when the line fell
-    // silent, so a fast answer's first byte is not taken for an echo.
-    uint64_t doneNs = fifoEmptiedAtNs_ + timing_.characterNs;
+    // The last stop bit left one character time after the FIFO ran dry;
+    // that, not the moment this task noticed, is when the line fell silent.
+    // The interrupt stamped the FIFO's end when its handler ran, up to
+    // kTransmitInterruptAllowanceNs later, and a silence counted from that
+    // stamp would come out short by as much: an answer begun exactly t3.5
+    // after the request ([SL] 2.5.1.1 allows it) would be taken for one begun
+    // within the silence and ignored. The line is counted silent from the
+    // earliest the stop bit can have left; taking an answer that began a few
+    // microseconds early costs nothing, as nobody else talks after a request.
+    const uint64_t stampedDoneNs = fifoEmptiedAtNs_ + timing_.characterNs;
+    uint64_t doneNs = stampedDoneNs > kTransmitInterruptAllowanceNs ? stampedDoneNs - kTransmitInterruptAllowanceNs : 0;
     doneNs = doneNs < nowNs ? doneNs : nowNs;
     transmitting_ = false;
     fifoEmptied_ = false;

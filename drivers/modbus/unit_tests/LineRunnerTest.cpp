@@ -35,6 +35,7 @@ using modbus::Request;
 using Bytes = std::vector<uint8_t>;
 
 constexpr uint64_t kMillisecond = 1000000;
+constexpr uint64_t kMicrosecond = 1000;
 constexpr uint8_t kUnit = 17;
 constexpr uint64_t kNever = ~0ull;
 // How long after a request was submitted the tests' slave answers: past the
@@ -134,7 +135,10 @@ protected:
     {
         for (int rounds = 0; rounds < 100000; ++rounds) {
             const uint64_t wanted = runner_.service(now_);
-            uint64_t next = std::min(wanted, port_.fifoInterruptNs());
+            // The task runs taskLatencyNs_ after the time it asked for (a
+            // timer tick's granularity, other tasks).
+            const uint64_t woken = wanted == kNever ? kNever : wanted + taskLatencyNs_;
+            uint64_t next = std::min(woken, port_.fifoInterruptNs());
             if (next <= now_) {
                 // A deadline the runner asks for again at once would spin the task.
                 ADD_FAILURE() << "service() asked to run again at " << next << " at " << now_;
@@ -148,7 +152,9 @@ protected:
             now_ = next;
             if (now_ == port_.fifoInterruptNs()) {
                 port_.fifoInterruptTaken();
-                runner_.fifoEmptied(now_);
+                // The handler stamps the time it runs, interruptLatencyNs_
+                // after the FIFO ran dry.
+                runner_.fifoEmptied(now_ + interruptLatencyNs_);
             }
         }
         ADD_FAILURE() << "the line never went quiet";
@@ -182,6 +188,8 @@ protected:
     }
 
     uint64_t now_ = 0;
+    uint64_t interruptLatencyNs_ = 0;
+    uint64_t taskLatencyNs_ = 0;
     modbus::RtuTiming timing_;
     FakePort port_;
     LineRunner runner_;
@@ -360,6 +368,44 @@ TEST_F(LineRunnerTest, MasterGetsACorrectAnswer)
     EXPECT_EQ(runner_.counters().charactersReceived, kTwoHoldingAnswer.size());
 }
 
+// A slave may answer exactly t3.5 after the request's last stop bit
+// ([SL] 2.5.1.1). The master learns when its request left from the transmit
+// interrupt, whose handler runs some microseconds late; the answer must not
+// be taken for one begun within the silence.
+TEST_F(LineRunnerTest, MasterTakesAnAnswerBegunExactlyT35AfterItsRequestThoughItsInterruptRanLate)
+{
+    interruptLatencyNs_ = 20 * kMicrosecond;
+    taskLatencyNs_ = 60 * kMicrosecond;
+    startMaster(0);
+    runUntil(10 * kMillisecond);
+    ASSERT_EQ(runner_.submit(Request::readHoldingRegisters(kUnit, 0, 2).value(), now_), ModbusError::Ok);
+    const uint64_t requestEndNs = port_.startedNs.back() + kReadTwoHolding.size() * timing_.characterNs;
+    // The answer's first character starts t3.5 after the request's last stop
+    // bit, so its own stop bit arrives one character time later.
+    const uint64_t last = receive(kTwoHoldingAnswer, requestEndNs + timing_.t35Ns + timing_.characterNs);
+    runUntil(frameEndNs(last) + taskLatencyNs_);
+    Completion completion;
+    ASSERT_TRUE(runner_.takeCompletion(completion));
+    EXPECT_EQ(completion.error, ModbusError::Ok);
+    EXPECT_EQ(runner_.master().counters().transmissions, 1u);
+}
+
+// The same for a slave: a master's next request may begin exactly t3.5 after
+// the slave's answer left.
+TEST_F(LineRunnerTest, SlaveServesARequestBegunExactlyT35AfterItsAnswerThoughItsInterruptRanLate)
+{
+    interruptLatencyNs_ = 20 * kMicrosecond;
+    taskLatencyNs_ = 60 * kMicrosecond;
+    startSlave();
+    runUntil(10 * kMillisecond);
+    exchange(kReadTwoHolding, now_);
+    ASSERT_EQ(port_.frames.size(), 1u);
+    const uint64_t answerEndNs = port_.startedNs.back() + port_.frames.back().size() * timing_.characterNs;
+    const uint64_t last = receive(kReadTwoHolding, answerEndNs + timing_.t35Ns + timing_.characterNs);
+    runUntil(last + 20 * kMillisecond);
+    EXPECT_EQ(port_.frames.size(), 2u);
+}
+
 TEST_F(LineRunnerTest, MasterTimesOutAfterEveryRetry)
 {
     startMaster(2);
@@ -367,13 +413,16 @@ TEST_F(LineRunnerTest, MasterTimesOutAfterEveryRetry)
     ASSERT_EQ(runner_.submit(Request::readHoldingRegisters(kUnit, 0, 2).value(), now_), ModbusError::Ok);
     runUntil(now_ + 1000 * kMillisecond);
     // The first transmission and two retries of the same ADU, each a
-    // time-out after the previous one left the line.
+    // time-out after the previous one left the line, counted from the
+    // earliest the interrupt says it can have left
+    // (LineRunner::kTransmitInterruptAllowanceNs before its stamp).
     ASSERT_EQ(port_.frames.size(), 3u);
     for (size_t i = 0; i < 3; ++i) {
         EXPECT_EQ(port_.frames[i], kReadTwoHolding);
     }
     for (size_t i = 1; i < 3; ++i) {
-        EXPECT_EQ(port_.startedNs[i], port_.releasedNs[i - 1] + 100 * kMillisecond + timing_.characterNs);
+        EXPECT_EQ(port_.startedNs[i], port_.releasedNs[i - 1] + 100 * kMillisecond + timing_.characterNs -
+                                          LineRunner::kTransmitInterruptAllowanceNs);
     }
     Completion completion;
     ASSERT_TRUE(runner_.takeCompletion(completion));
