@@ -389,7 +389,8 @@ def test_two_talkers_at_once_are_dropped_and_counted_and_nothing_is_delivered_wr
     assert len(records) == 16 and all(r.outcome == "garbled" for r in records), lab.hub.log_text()
     # The UART saw framing errors; the damaged frame was dropped and counted, nothing executed or answered.
     assert after["line.framing-errors"] >= before["line.framing-errors"] + 8, (before, after)
-    dropped = sum(after[k] - before[k] for k in ("frames.crc-errors", "frames.gap-errors", "frames.short"))
+    dropped = sum(after[k] - before[k]
+                  for k in ("frames.crc-errors", "frames.gap-errors", "frames.damaged", "frames.short"))
     assert dropped >= 1, (before, after)
     assert after["frames.delivered"] == before["frames.delivered"]
     assert after["slave.messages"] == before["slave.messages"]

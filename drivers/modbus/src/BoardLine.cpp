@@ -22,11 +22,11 @@ void BoardLine::interrupt(void* self)
 
 void BoardLine::fifoEmptied(void* self) { static_cast<BoardLine*>(self)->runner_.fifoEmptied(timerAgent.Uptime()); }
 
-void stampReceivedByte(void* runner, uint8_t byte)
+void stampReceivedByte(void* runner, uint8_t byte, bool damaged)
 {
     // A full queue counts the byte as lost (TimedByteQueue::push); the
     // frame it belonged to then fails its CRC and is discarded.
-    (void)static_cast<LineRunner*>(runner)->queue().push(byte, timerAgent.Uptime());
+    (void)static_cast<LineRunner*>(runner)->queue().push(byte, timerAgent.Uptime(), damaged);
 }
 
 bsp::UartSettings lineSettings(uint32_t baud, dcos::app::ModbusParity parity)

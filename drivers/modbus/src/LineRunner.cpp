@@ -196,6 +196,12 @@ void LineRunner::feedReceived()
         } else if (role_ == Role::Master) {
             apply(master_.onBytes(&received.byte, 1, received.timeNs), received.timeNs);
         }
+        if (received.damaged) {
+            // A frame with a damaged character is not OK whatever its CRC
+            // says (a CRC misses one error pattern in 65,536).
+            ++counters_.damagedCharacters;
+            transport_.markLastCharacterDamaged();
+        }
     }
 }
 

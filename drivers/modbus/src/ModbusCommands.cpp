@@ -406,13 +406,13 @@ CommandResult state(shell::Shell& shell, int, char**)
                 static_cast<unsigned long>(errors.overrunErrors), static_cast<unsigned long>(errors.parityErrors),
                 static_cast<unsigned long>(errors.framingErrors));
     const modbus::RtuReceiver::Counters& r = runner.transport().receiver().counters();
-    shell.print("frames: seen %lu delivered %lu crc-errors %lu gap-errors %lu overruns %lu short %lu lost %lu "
-                "ignored-characters %lu receiver %s\r\n",
+    shell.print("frames: seen %lu delivered %lu crc-errors %lu gap-errors %lu damaged %lu overruns %lu short %lu "
+                "lost %lu ignored-characters %lu receiver %s\r\n",
                 static_cast<unsigned long>(r.busMessages), static_cast<unsigned long>(r.framesDelivered),
                 static_cast<unsigned long>(r.crcErrors), static_cast<unsigned long>(r.gapErrors),
-                static_cast<unsigned long>(r.overruns), static_cast<unsigned long>(r.shortFrames),
-                static_cast<unsigned long>(r.framesLost), static_cast<unsigned long>(r.ignoredCharacters),
-                receiverStateName(runner.transport().receiver().state()));
+                static_cast<unsigned long>(r.damagedFrames), static_cast<unsigned long>(r.overruns),
+                static_cast<unsigned long>(r.shortFrames), static_cast<unsigned long>(r.framesLost),
+                static_cast<unsigned long>(r.ignoredCharacters), receiverStateName(runner.transport().receiver().state()));
     const modbus::Slave::Counters& s = runner.slave().counters();
     shell.print("slave: messages %lu exceptions %lu no-responses %lu other-addresses %lu dropped %lu\r\n",
                 static_cast<unsigned long>(s.messages), static_cast<unsigned long>(s.exceptions),

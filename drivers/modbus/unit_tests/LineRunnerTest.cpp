@@ -250,6 +250,26 @@ TEST_F(LineRunnerTest, SlaveAnswersAnUnknownFunctionWithException01)
     EXPECT_EQ(runner_.slave().counters().exceptions, 1u);
 }
 
+// A request one of whose characters the UART flagged (a parity error) gets no
+// answer though its CRC is right; the next, clean one is answered.
+TEST_F(LineRunnerTest, NoAnswerToARequestWithADamagedCharacter)
+{
+    startSlave();
+    uint64_t at = 10 * kMillisecond;
+    for (size_t i = 0; i < kReadTwoHolding.size(); ++i) {
+        runUntil(at);
+        EXPECT_TRUE(runner_.queue().push(kReadTwoHolding[i], at, i == 2));
+        at += timing_.characterNs;
+    }
+    runUntil(at + 20 * kMillisecond);
+    EXPECT_TRUE(port_.frames.empty());
+    EXPECT_EQ(runner_.counters().damagedCharacters, 1u);
+    EXPECT_EQ(runner_.transport().receiver().counters().damagedFrames, 1u);
+    EXPECT_EQ(runner_.slave().counters().messages, 0u);
+    exchange(kReadTwoHolding, now_ + timing_.characterNs);
+    EXPECT_EQ(port_.frames.size(), 1u);
+}
+
 TEST_F(LineRunnerTest, NoAnswerToABadCrc)
 {
     startSlave();

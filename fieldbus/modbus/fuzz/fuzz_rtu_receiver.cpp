@@ -7,7 +7,8 @@
 // The checks: a delivered frame is 4..256 bytes with a good CRC and equals
 // the last bytes fed before the call that delivered it; every frame seen is
 // counted exactly once in one category; a poll at the deadline always ends
-// in Idle; an idle receiver has no deadline.
+// in Idle; an idle receiver has no deadline; a frame that took a character
+// marked damaged is never delivered.
 #include "../../can/fuzz/FuzzCheck.hpp"
 
 #include <modbus/Crc16.hpp>
@@ -26,7 +27,8 @@ constexpr uint32_t kBauds[4] = {1200, 9600, 19200, 115200};
 void checkCounters(const RtuReceiver& receiver)
 {
     const RtuReceiver::Counters& c = receiver.counters();
-    FUZZ_CHECK(c.busMessages == c.crcErrors + c.overruns + c.gapErrors + c.shortFrames + c.framesDelivered);
+    FUZZ_CHECK(c.busMessages ==
+               c.crcErrors + c.overruns + c.gapErrors + c.damagedFrames + c.shortFrames + c.framesDelivered);
     FUZZ_CHECK(c.framesLost <= c.framesDelivered);
     FUZZ_CHECK(receiver.state() != RtuReceiver::State::Idle || receiver.nextDeadlineNs() == RtuReceiver::kNoDeadline);
     FUZZ_CHECK(receiver.state() == RtuReceiver::State::Idle || receiver.nextDeadlineNs() != RtuReceiver::kNoDeadline);
@@ -61,6 +63,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     RtuReceiver receiver(timing.value());
     std::vector<uint8_t> fed;
     uint64_t now = 0;
+    // The frame under reception took a damaged character: it ends as frame
+    // number `messages` + 1 and must not be delivered.
+    struct {
+        bool pending = false;
+        uint32_t messages = 0;
+        uint32_t delivered = 0;
+    } damaged;
 
     while (!input.empty()) {
         const uint8_t operation = input.byte();
@@ -77,6 +86,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
             const uint8_t byte = input.byte();
             fed.push_back(byte);
             receiver.onByte(byte, now);
+            if ((operation & 0x40) != 0) {
+                // The UART flagged it: its frame, if it is in one, must not
+                // be delivered (checked at the frame's end below).
+                receiver.markLastCharacterDamaged();
+                if (receiver.state() == RtuReceiver::State::Reception && !damaged.pending) {
+                    damaged = {true, receiver.counters().busMessages, receiver.counters().framesDelivered};
+                }
+            }
             break;
         }
         case 2: {
@@ -90,12 +107,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         case 3:
             if ((operation & 4) != 0) {
                 receiver.restartSilence(now);
+                damaged.pending = false; // The frame is dropped uncounted.
                 FUZZ_CHECK(receiver.state() == RtuReceiver::State::Initial);
             } else if (receiver.frameReady()) {
                 receiver.takeFrame();
                 FUZZ_CHECK(!receiver.frameReady());
             }
             break;
+        }
+        if (damaged.pending && receiver.counters().busMessages > damaged.messages) {
+            // One call ends at most one frame, so this is the damaged one.
+            FUZZ_CHECK(receiver.counters().busMessages == damaged.messages + 1);
+            FUZZ_CHECK(receiver.counters().framesDelivered == damaged.delivered);
+            damaged.pending = false;
         }
         checkDelivery(receiver, deliveredBefore, fed, fedBefore);
         checkCounters(receiver);

@@ -28,6 +28,7 @@ void RtuReceiver::onByte(uint8_t byte, uint64_t nowNs)
     case State::Idle:
         state_ = State::Reception;
         notOk_ = false;
+        damaged_ = false;
         overrun_ = false;
         length_ = 0;
         [[fallthrough]];
@@ -48,6 +49,13 @@ void RtuReceiver::onByte(uint8_t byte, uint64_t nowNs)
     }
     if (nowNs > lastNs_) {
         lastNs_ = nowNs;
+    }
+}
+
+void RtuReceiver::markLastCharacterDamaged()
+{
+    if (state_ == State::Reception) {
+        damaged_ = true;
     }
 }
 
@@ -111,6 +119,8 @@ void RtuReceiver::finishFrame()
     ++counters_.busMessages;
     if (notOk_) {
         ++counters_.gapErrors;
+    } else if (damaged_) {
+        ++counters_.damagedFrames;
     } else if (overrun_) {
         ++counters_.overruns;
     } else if (length_ < kMinRtuAduLength) {

@@ -114,6 +114,44 @@ TEST_F(RtuReceiverTest, GapAboveOnePointFiveCharactersMakesTheFrameNotOk)
     EXPECT_EQ(receiver_.state(), State::Idle);
 }
 
+// A character the UART flagged (parity, framing, break) makes its frame "not
+// OK" even when the CRC happens to match ([SL] Figure 14 controls parity with
+// the CRC); the next frame is delivered again.
+TEST_F(RtuReceiverTest, AFrameWithADamagedCharacterIsDiscardedWhateverItsCrc)
+{
+    uint64_t now = send(Bytes(request_.begin(), request_.begin() + 3), kStart);
+    receiver_.markLastCharacterDamaged();
+    now = send(Bytes(request_.begin() + 3, request_.end()), now + kChar);
+    receiver_.poll(now + kT35);
+    EXPECT_FALSE(receiver_.frameReady());
+    EXPECT_EQ(receiver_.counters().damagedFrames, 1u);
+    EXPECT_EQ(receiver_.counters().crcErrors, 0u);
+    EXPECT_EQ(receiver_.counters().busMessages, 1u);
+    now = send(request_, now + kT35 + kChar);
+    receiver_.poll(now + kT35);
+    EXPECT_EQ(delivered(), request_);
+    EXPECT_EQ(receiver_.counters().damagedFrames, 1u);
+}
+
+// A damaged character the receiver ignored (the Initial state) marks nothing.
+TEST(RtuReceiverInitialTest, ADamagedCharacterBeforeTheLineWasIdleMarksNothing)
+{
+    RtuReceiver receiver(timing19200());
+    receiver.onByte(0x55, kT35 - 1);
+    receiver.markLastCharacterDamaged();
+    receiver.poll(2 * kT35 - 1);
+    EXPECT_TRUE(receiver.idle());
+    const Bytes request = withCrc({0x01, 0x03, 0x00, 0x00, 0x00, 0x0A});
+    uint64_t now = 3 * kT35;
+    for (uint8_t byte : request) {
+        receiver.onByte(byte, now);
+        now += kChar;
+    }
+    receiver.poll(now + kT35);
+    EXPECT_TRUE(receiver.frameReady());
+    EXPECT_EQ(receiver.counters().damagedFrames, 0u);
+}
+
 TEST_F(RtuReceiverTest, CharacterDuringControlAndWaitingWithoutPollIsDetected)
 {
     // The same, with a poll that puts the machine in Control and waiting first.

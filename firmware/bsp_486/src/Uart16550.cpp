@@ -111,11 +111,15 @@ void Uart16550::disableInterruptBits(uint8_t bits)
 void Uart16550::serviceReceive()
 {
     for (unsigned i = 0; i < transmitFifoDepth; ++i) {
-        if ((window_.read8(lineStatusRegister) & lsrDataReady) == 0) {
+        const uint8_t status = window_.read8(lineStatusRegister);
+        if ((status & lsrDataReady) == 0) {
             return;
         }
         if (receiveSink_ != nullptr) {
-            receiveSink_(receiveSinkContext_, window_.read8(receiveBufferRegister));
+            // The error bits describe the character at the top of the FIFO,
+            // the one read next (PC16550D 8.6.3); with the line status
+            // interrupt enabled they were taken there already.
+            receiveSink_(receiveSinkContext_, window_.read8(receiveBufferRegister), (status & lsrCharacterErrors) != 0);
             continue;
         }
         if (receiveRing_.full()) {
@@ -234,6 +238,12 @@ void Uart16550::serviceEvents()
             statistics_.parityErrors += (status & lsrParityError) != 0 ? 1 : 0;
             statistics_.framingErrors += (status & lsrFramingError) != 0 ? 1 : 0;
             statistics_.breaks += (status & lsrBreak) != 0 ? 1 : 0;
+            // Reading the line status cleared its error bits, which belong to
+            // the character at the top of the FIFO: a sink gets that character
+            // now, flagged, or it would later read as good.
+            if (receiveSink_ != nullptr && (status & lsrDataReady) != 0 && (status & lsrCharacterErrors) != 0) {
+                receiveSink_(receiveSinkContext_, window_.read8(receiveBufferRegister), true);
+            }
             break;
         }
         case iirReceivedData:

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -383,7 +384,7 @@ TEST(Uart16550Rs485, ReceivedBytesGoToTheSinkNotTheRing)
     Uart uart(arch_x86::IoWindow::ports(com2, 8));
     bringUpRs485(uart);
     std::string sunk;
-    uart.setReceiveSink([](void* text, uint8_t byte) { *static_cast<std::string*>(text) += static_cast<char>(byte); },
+    uart.setReceiveSink([](void* text, uint8_t byte, bool) { *static_cast<std::string*>(text) += static_cast<char>(byte); },
                         &sunk);
     port_io_mock::queueRead(com2Iir, Uart::iirReceivedData);
     for (char c : std::string("\x11\x03")) {
@@ -395,6 +396,36 @@ TEST(Uart16550Rs485, ReceivedBytesGoToTheSinkNotTheRing)
     uart.handleInterrupt();
     EXPECT_EQ(sunk, "\x11\x03");
     EXPECT_FALSE(uart.hasInput());
+}
+
+// The line status interrupt comes first for a damaged character, and reading
+// the status clears its error bits: the sink gets that character flagged
+// there, and the next, good one unflagged; a damaged character met while
+// draining the FIFO is flagged too.
+TEST(Uart16550Rs485, DamagedCharactersReachTheSinkFlagged)
+{
+    Uart uart(arch_x86::IoWindow::ports(com2, 8));
+    bringUpRs485(uart);
+    std::vector<std::pair<uint8_t, bool>> sunk;
+    uart.setReceiveSink(
+        [](void* into, uint8_t byte, bool damaged) {
+            static_cast<std::vector<std::pair<uint8_t, bool>>*>(into)->emplace_back(byte, damaged);
+        },
+        &sunk);
+    port_io_mock::queueRead(com2Iir, Uart::iirLineStatus);
+    port_io_mock::queueRead(com2Lsr, 0x61 | Uart::lsrParityError);
+    port_io_mock::queueRead(com2 + Uart::receiveBufferRegister, 0x11);
+    port_io_mock::queueRead(com2Iir, Uart::iirReceivedData);
+    port_io_mock::queueRead(com2Lsr, 0x61);
+    port_io_mock::queueRead(com2 + Uart::receiveBufferRegister, 0x03);
+    port_io_mock::queueRead(com2Lsr, 0x61 | Uart::lsrFramingError);
+    port_io_mock::queueRead(com2 + Uart::receiveBufferRegister, 0xFF);
+    port_io_mock::queueRead(com2Lsr, 0x60);
+    port_io_mock::queueRead(com2Iir, Uart::iirNoInterruptPending);
+    uart.handleInterrupt();
+    const std::vector<std::pair<uint8_t, bool>> expected{{0x11, true}, {0x03, false}, {0xFF, true}};
+    EXPECT_EQ(sunk, expected);
+    EXPECT_EQ(uart.statistics().parityErrors, 1u);
 }
 
 TEST(Uart16550Rs485, ShutdownSilencesThePortAndReleasesTheDriver)

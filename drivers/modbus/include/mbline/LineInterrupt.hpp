@@ -12,8 +12,9 @@ namespace mbline {
 /// The receive sink the line gives the RS-485 port's 16550
 /// (bsp::Uart16550::setReceiveSink), called in its interrupt for every byte
 /// taken from the FIFO: stamps @p byte with the uptime (the end of its stop
-/// bit, within the interrupt's latency) and queues the pair for @p runner, a
-/// LineRunner*, whose task feeds it to the RTU receiver.
-void stampReceivedByte(void* runner, uint8_t byte);
+/// bit, within the interrupt's latency) and queues it, with whether the UART
+/// flagged it @p damaged, for @p runner, a LineRunner*, whose task feeds it
+/// to the RTU receiver.
+void stampReceivedByte(void* runner, uint8_t byte, bool damaged);
 
 } // namespace mbline

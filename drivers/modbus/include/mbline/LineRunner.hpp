@@ -61,6 +61,7 @@ struct LineCounters {
     uint32_t framesSent = 0;
     uint32_t transmitRefused = 0;  ///< The port refused a frame (it was still sending).
     uint32_t temtPolls = 0;        ///< Checks of the shift register that found it still busy.
+    uint32_t damagedCharacters = 0; ///< Characters the UART flagged (parity, framing, break).
 };
 
 /// How a master transaction ended, for the one who submitted it.

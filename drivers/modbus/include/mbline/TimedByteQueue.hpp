@@ -20,7 +20,8 @@ namespace mbline {
 
 struct TimedByte {
     uint8_t byte = 0;
-    uint64_t timeNs = 0; ///< When the UART delivered it (uptime, ns).
+    bool damaged = false; ///< The UART flagged it: parity or framing error, or a break.
+    uint64_t timeNs = 0;  ///< When the UART delivered it (uptime, ns).
 };
 
 template <size_t Capacity>
@@ -29,14 +30,14 @@ public:
     static_assert(Capacity >= 2 && (Capacity & (Capacity - 1)) == 0, "the capacity is a power of two");
 
     /// From the interrupt: false (and counted) when the queue is full.
-    bool push(uint8_t byte, uint64_t timeNs)
+    bool push(uint8_t byte, uint64_t timeNs, bool damaged = false)
     {
         const uint32_t head = head_;
         if (head - tail_ == Capacity) {
             overflows_ = overflows_ + 1;
             return false;
         }
-        slots_[head & (Capacity - 1)] = TimedByte{byte, timeNs};
+        slots_[head & (Capacity - 1)] = TimedByte{byte, damaged, timeNs};
         // The slot is written before the index that publishes it.
         __atomic_store_n(&head_, head + 1, __ATOMIC_RELEASE);
         return true;

@@ -53,6 +53,7 @@ public:
         uint32_t framesDelivered = 0;    ///< Frames delivered whole and checked.
         uint32_t framesLost = 0;         ///< Delivered frames replaced by the next before takeFrame().
         uint32_t ignoredCharacters = 0;  ///< Characters received before the line was idle (Initial).
+        uint32_t damagedFrames = 0;      ///< Frames discarded for a character with a parity or framing error.
     };
 
     /// A receiver for a line with @p timing, in the Initial state since time 0.
@@ -65,6 +66,12 @@ public:
     void onBytes(const uint8_t* bytes, size_t count, uint64_t nowNs);
 
     /// Lets time pass: applies the t1.5 and t3.5 timers up to @p nowNs.
+    /// The UART said the character just given to onByte() arrived with a
+    /// parity or framing error (or as a break): the frame it belongs to is
+    /// "not OK" and is discarded at its end ([SL] Figure 14 checks parity
+    /// with the CRC). A character that was ignored (Initial) changes nothing.
+    void markLastCharacterDamaged();
+
     void poll(uint64_t nowNs);
 
     /// The time from which the line has been silent: the station calls it
@@ -101,6 +108,7 @@ private:
     State state_ = State::Initial;
     uint64_t lastNs_ = 0;      // when the last character ended (or the silence began)
     bool notOk_ = false;       // a character arrived in Control and waiting
+    bool damaged_ = false;     // a character of the frame came with a parity or framing error
     bool overrun_ = false;     // the frame ran past kMaxRtuAduLength
     size_t length_ = 0;        // bytes stored of the frame being received
     size_t readyLength_ = 0;   // bytes of the delivered frame, 0 when none

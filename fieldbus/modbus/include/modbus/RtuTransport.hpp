@@ -26,6 +26,9 @@ public:
                || receiver_.state() == RtuReceiver::State::ControlAndWaiting;
     }
     void onTransmitDone(uint64_t nowNs) override { receiver_.restartSilence(nowNs); }
+    /// See RtuReceiver::markLastCharacterDamaged(); the line's driver calls it
+    /// for a character its UART flagged, right after the station was given it.
+    void markLastCharacterDamaged() { receiver_.markLastCharacterDamaged(); }
 
     /// The receive state machine, for its counters and state.
     const RtuReceiver& receiver() const { return receiver_; }

@@ -102,6 +102,8 @@ public:
     static constexpr uint8_t lsrParityError = 1u << 2;
     static constexpr uint8_t lsrFramingError = 1u << 3;
     static constexpr uint8_t lsrBreak = 1u << 4;
+    /// The bits that say the character at the top of the FIFO is damaged.
+    static constexpr uint8_t lsrCharacterErrors = lsrParityError | lsrFramingError | lsrBreak;
     static constexpr uint8_t lsrTransmitterHoldingEmpty = 1u << 5; // THRE
     static constexpr uint8_t lsrTransmitterEmpty = 1u << 6;        // TEMT
     /// Bound on polls of the line status while flushing: far longer than a
@@ -131,8 +133,11 @@ public:
         uint32_t receiveThrottled; ///< Times the receive ring filled up.
     };
 
-    /// Receives each byte in the interrupt, on a port with a receive sink.
-    using ReceiveSink = void (*)(void* context, uint8_t byte);
+    /// Receives each byte in the interrupt, on a port with a receive sink;
+    /// @p damaged: the line status said it came with a parity or framing
+    /// error or as a break (PC16550D 8.6.3, LSR bits 2 to 4), which a
+    /// protocol must not take as good data.
+    using ReceiveSink = void (*)(void* context, uint8_t byte, bool damaged);
 
     explicit Uart16550(arch_x86::IoWindow window) : window_(window) {}
 
