@@ -801,6 +801,10 @@ def test_a_babbling_node_occupies_the_bus(canlab):
         board.init(0, 500_000)
     chatter = Frame.data_frame(0x010, bytes(range(8)))
     lab.hub.babble("can0", "babbler", chatter)
+    # The babble starts at the hub's next boundary; a board given its frame
+    # before then could still send it in the quantum it is running (seen once
+    # in a loaded run), so board1 asks only once the babbler holds the bus.
+    lab.hub.wait_for_records(lambda records: any(r.sender == "hub.babbler" for r in records), TIMEOUT)
     send_frame(sender, Frame.data_frame(0x100, b"\x01"))
     lab.hub.wait_for_records(lambda records: len(records) >= 50, TIMEOUT)
     T = lab.bit_ns("can0")
