@@ -116,3 +116,56 @@ TEST(SortedListTest, WideKeysSortAsUnsigned64)
     EXPECT_EQ(list.popFront()->id, 1);
     EXPECT_TRUE(list.isEmpty());
 }
+
+// The insertion walk stops at the sentinel, whose key is zero: keys of zero,
+// lists emptied and refilled, removals from the middle and pops must keep the
+// order a stable sort of the live entries gives.
+TEST(SortedListTest, RandomInsertRemovePopMatchesModelAcrossEmptyLists)
+{
+    std::mt19937 random(99);
+    Waiter waiters[64];
+    std::vector<std::pair<uint8_t, int>> model; // (key, id) in list order
+    WaitList<Waiter> list;
+    int sequence = 0;
+    for (int step = 0; step < 20000; ++step) {
+        const unsigned action = random() % 8;
+        if (action < 4) {
+            const int index = static_cast<int>(random() % 64);
+            if (waiters[index].isLinked()) {
+                continue;
+            }
+            // Small keys, zero among them, so that equal keys and the smallest key are frequent.
+            const uint8_t key = static_cast<uint8_t>(random() % 4);
+            waiters[index].id = index;
+            list.insert(waiters[index], key);
+            auto position = std::upper_bound(model.begin(), model.end(), key,
+                                             [](uint8_t k, const auto& entry) { return k < entry.first; });
+            model.insert(position, {key, index});
+        } else if (action < 6) {
+            Waiter* const front = list.popFront();
+            if (model.empty()) {
+                ASSERT_EQ(front, nullptr);
+            } else {
+                ASSERT_NE(front, nullptr);
+                ASSERT_EQ(front->id, model.front().second);
+                model.erase(model.begin());
+            }
+        } else {
+            const int index = static_cast<int>(random() % 64);
+            if (!waiters[index].isLinked()) {
+                continue;
+            }
+            list.remove(waiters[index]);
+            model.erase(std::find_if(model.begin(), model.end(),
+                                     [index](const auto& entry) { return entry.second == index; }));
+        }
+        ++sequence;
+        std::vector<int> expected;
+        for (const auto& entry : model) {
+            expected.push_back(entry.second);
+        }
+        ASSERT_EQ(ids(list), expected) << "after step " << step;
+        ASSERT_EQ(list.isEmpty(), model.empty());
+    }
+    EXPECT_GT(sequence, 10000);
+}

@@ -10,8 +10,11 @@
 
 namespace dcos::internal {
 
-template <typename T, typename Tag>
+template <typename T, typename Tag, typename Sentinel>
 class IntrusiveList;
+
+template <typename T, typename Key, typename Tag>
+class SortedList;
 
 /// The links an object embeds, by deriving from it, to be put in an IntrusiveList.
 ///
@@ -40,8 +43,10 @@ public:
     }
 
 private:
-    template <typename, typename>
+    template <typename, typename, typename>
     friend class IntrusiveList;
+    template <typename, typename, typename>
+    friend class SortedList;
 
     // Links this unlinked node in front of @p position.
     void insertBefore(IntrusiveListNode* position)
@@ -60,8 +65,11 @@ private:
 ///
 /// Insertion and removal at either end and removal of any element cost O(1).
 /// The list object must not move while it holds elements, because the
-/// elements point at its sentinel; copying is therefore deleted.
-template <typename T, typename Tag = void>
+/// elements point at its sentinel; copying is therefore deleted. The
+/// sentinel is a plain node unless a list needs it to carry more: a
+/// SortedList gives it the smallest key, so its insertion walk stops there
+/// without a test for the list's end.
+template <typename T, typename Tag = void, typename Sentinel = IntrusiveListNode<Tag>>
 class IntrusiveList {
 public:
     /// The node type T must derive from.
@@ -171,9 +179,12 @@ public:
     }
 
 private:
+    template <typename, typename, typename>
+    friend class SortedList;
+
     static Node& node(T& item) { return static_cast<Node&>(item); }
 
-    Node head_;
+    Sentinel head_;
 };
 
 } // namespace dcos::internal

@@ -9,6 +9,7 @@
 #include <dcos/internal/IntrusiveList.hpp>
 
 #include <stddef.h>
+#include <type_traits>
 
 namespace dcos::internal {
 
@@ -42,7 +43,7 @@ public:
     /// The node type T must derive from.
     using Node = SortedListNode<Key, Tag>;
     /// Iterator over the elements in ascending key order.
-    using Iterator = typename IntrusiveList<T, Tag>::Iterator;
+    using Iterator = typename IntrusiveList<T, Tag, Node>::Iterator;
 
     /// Creates an empty list.
     SortedList() = default;
@@ -61,16 +62,18 @@ public:
     /// Cost O(number of elements with a larger key).
     void insert(T& item, Key key)
     {
-        static_cast<Node&>(item).key_ = key;
-        T* position = list_.isEmpty() ? nullptr : &list_.back();
-        while (position != nullptr && key < keyOf(*position)) {
-            position = list_.previous(*position);
+        Node& inserted = item;
+        inserted.key_ = key;
+        // The walk starts at the last element, or at the sentinel of an
+        // empty list, and stops at the first key not above @p key. The
+        // sentinel holds the smallest key, so the walk needs no test for
+        // the list's front, and inserting into an empty list costs what
+        // inserting behind a smaller last key does.
+        IntrusiveListNode<Tag>* position = list_.head_.prev_;
+        while (key < static_cast<Node*>(position)->key_) {
+            position = position->prev_;
         }
-        if (position == nullptr) {
-            list_.pushFront(item);
-        } else {
-            list_.insertAfter(*position, item);
-        }
+        inserted.insertBefore(position->next_);
     }
 
     /// Removes @p item, which must be on this list. Cost O(1).
@@ -99,7 +102,9 @@ public:
     Iterator end() { return list_.end(); }
 
 private:
-    IntrusiveList<T, Tag> list_;
+    static_assert(std::is_unsigned_v<Key>, "the sentinel's key, zero, must be the smallest key");
+
+    IntrusiveList<T, Tag, Node> list_;
 };
 
 } // namespace dcos::internal
