@@ -15,7 +15,7 @@ unsigned Scheduler::dispatchHolds_ = 0;
 uint32_t Scheduler::quantumTicks_ = 10;
 uint32_t Scheduler::switchCount_ = 0;
 ReadyBitmap Scheduler::readyBitmap_;
-IntrusiveList<Task, ReadyQueueTag> Scheduler::readyQueues_[32];
+IntrusiveRing<Task, ReadyQueueTag> Scheduler::readyQueues_[32];
 DeadlineQueue<Task, kTaskCapacity> Scheduler::deadlineQueue_;
 
 void Scheduler::setIdleTask(Task& idle)
@@ -96,8 +96,7 @@ void Scheduler::makeUnready(Task& task)
         (void)deadlineQueue_.remove(task); // Cannot fail: it is queued.
     }
     if (static_cast<IntrusiveListNode<ReadyQueueTag>&>(task).isLinked()) {
-        readyQueues_[task.priority].remove(task);
-        if (readyQueues_[task.priority].isEmpty()) {
+        if (readyQueues_[task.priority].remove(task)) {
             readyBitmap_.clear(task.priority);
         }
     }
@@ -174,11 +173,17 @@ bool Scheduler::rotateCurrent()
         return false;
     }
     auto& queue = readyQueues_[task.priority];
-    if (&queue.front() == &task && &queue.back() == &task) {
-        return false;
+    if (queue.isFront(task)) {
+        // The usual case: the runner heads its queue, and the ring's step
+        // puts it behind its equals.
+        if (queue.rotate() == nullptr) {
+            return false; // Alone at its priority.
+        }
+    } else {
+        // A hold let a task of its priority get ahead of it.
+        (void)queue.remove(task);
+        queue.pushBack(task);
     }
-    queue.remove(task);
-    queue.pushBack(task);
     requestDispatch();
     return true;
 }

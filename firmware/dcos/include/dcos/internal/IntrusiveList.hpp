@@ -16,6 +16,9 @@ class IntrusiveList;
 template <typename T, typename Key, typename Tag>
 class SortedList;
 
+template <typename T, typename Tag>
+class IntrusiveRing;
+
 /// The links an object embeds, by deriving from it, to be put in an IntrusiveList.
 ///
 /// The list is circular around a sentinel, so a node can unlink itself in
@@ -47,6 +50,8 @@ private:
     friend class IntrusiveList;
     template <typename, typename, typename>
     friend class SortedList;
+    template <typename, typename>
+    friend class IntrusiveRing;
 
     // Links this unlinked node in front of @p position.
     void insertBefore(IntrusiveListNode* position)

@@ -5,7 +5,8 @@
 // seed's tie-breaks, and run before every other task; all other tasks sit in
 // 32 FIFO ready queues under a ready bitmap, so selecting the next one is a
 // single bit scan. The running task stays at the head of its queue, so a
-// preempted task resumes before its equals.
+// preempted task resumes before its equals. Each queue is a ring known by
+// its head, so the round-robin step of Yield moves one pointer.
 //
 // Task switches happen in two places. A task that blocks, yields or readies
 // a more urgent task switches at once, from task context, through
@@ -19,7 +20,7 @@
 #pragma once
 
 #include <dcos/internal/DeadlineQueue.hpp>
-#include <dcos/internal/IntrusiveList.hpp>
+#include <dcos/internal/IntrusiveRing.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/ReadyBitmap.hpp>
 #include <dcos/internal/Task.hpp>
@@ -94,7 +95,7 @@ public:
         // The common case: a static-priority task at the head of its queue,
         // no hold. With no hold, the running task is the most urgent one, so
         // the next is the new head of its queue.
-        if (!task->rotatesOnYield || dispatchHolds_ != 0 || &queue.front() != task) {
+        if (!task->rotatesOnYield || dispatchHolds_ != 0 || !queue.isFront(*task)) {
             (void)rotateCurrent(); // The general rotation and dispatch.
         } else if (Task* const next = queue.rotate(); next == nullptr) {
             // Nobody of its priority waits: it runs on.
@@ -169,7 +170,7 @@ private:
     static uint32_t quantumTicks_;
     static uint32_t switchCount_;
     static ReadyBitmap readyBitmap_;
-    static IntrusiveList<Task, ReadyQueueTag> readyQueues_[32];
+    static IntrusiveRing<Task, ReadyQueueTag> readyQueues_[32];
     static DeadlineQueue<Task, kTaskCapacity> deadlineQueue_;
 };
 
