@@ -17,6 +17,7 @@ from dcoslab.target import run_target_test
 KERNEL_TARGET_TESTS = [
     "preempt",      # a task readied in a nested ISR runs at the outermost exit
     "roundrobin",   # Yield among equal priorities
+    "yieldcases",   # Yield to a partner preempted at a tick, and to one with a signal pending
     "timeslice",    # time-sliced tasks alternate; plain ones do not
     "priority",     # ChangePriority
     "deadline",     # deadline ordering with every tie-break, before static tasks

@@ -26,7 +26,7 @@ DCOS_TARGET_SRCS := \
 	firmware/dcos/src/kernel/ConsoleRoot.cpp \
 	firmware/dcos/src/kernel/KernelCommands.cpp \
 	$(wildcard firmware/dcos/src/task/*.cpp firmware/dcos/src/task/*.S) \
-	$(wildcard firmware/dcos/src/scheduler/*.cpp) \
+	$(wildcard firmware/dcos/src/scheduler/*.cpp firmware/dcos/src/scheduler/*.S) \
 	$(wildcard firmware/dcos/src/timer/*.cpp) \
 	$(wildcard firmware/dcos/src/memory/*Manager.cpp firmware/dcos/src/memory/*Agent.cpp) \
 	$(wildcard firmware/dcos/src/memory/MemoryCommands.cpp) \
@@ -51,7 +51,7 @@ DCOS_CORE_SRCS := \
 	firmware/dcos/src/system/DeviceManager.cpp \
 	firmware/dcos/src/system/InterruptManager.cpp \
 	$(wildcard firmware/dcos/src/task/*.cpp firmware/dcos/src/task/*.S) \
-	$(wildcard firmware/dcos/src/scheduler/*.cpp) \
+	$(wildcard firmware/dcos/src/scheduler/*.cpp firmware/dcos/src/scheduler/*.S) \
 	$(wildcard firmware/dcos/src/timer/*.cpp)
 
 # The minimal configuration's kernel: the core, in the full one's order, and its root task.

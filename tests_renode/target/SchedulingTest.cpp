@@ -98,6 +98,94 @@ bool roundRobin(shell::Shell& shell)
 
 DCOS_TARGET_TEST(roundRobinTest, "roundrobin", "Yield passes the CPU among equal priorities", roundRobin);
 
+// --- Yield's general cases ---------------------------------------------------------
+//
+// Yield's fast path (scheduler/YieldFastPath.S) takes only a next task that
+// left through a direct switch and has nothing to be delivered. These two
+// cases must go the general way: a next task preempted at an interrupt's
+// exit, which resumes from its interrupt frame, and a next task with a
+// signal pending, whose handler runs before it continues.
+
+volatile bool yieldPhase = false;
+
+// Spins, time-sliced, until the yielding partner has seen it run; it can
+// only have lost the CPU at a tick, so it is parked with an interrupt frame.
+void preemptedPartnerEntry(uintptr_t)
+{
+    Trace::record('b');
+    while (!yieldPhase) {
+    }
+    Trace::record('B');
+    finished();
+}
+
+void yieldToPreemptedEntry(uintptr_t)
+{
+    Trace::record('a');
+    for (;;) {
+        const char* text = Trace::text();
+        if (text[0] != '\0' && text[1] == 'b') {
+            break; // The partner ran, and the tick that ended its slice gave the CPU back.
+        }
+    }
+    yieldPhase = true;
+    (void)schedulerAgent.Yield();
+    Trace::record('A');
+    finished();
+}
+
+void yieldSignalHandler(unsigned) { Trace::record('h'); }
+
+void signalledPartnerEntry(uintptr_t)
+{
+    (void)taskAgent.SetSignalHandler(yieldSignalHandler);
+    Trace::record('b');
+    (void)schedulerAgent.Yield(); // Parked by the fast path.
+    Trace::record('B');
+    finished();
+}
+
+ObjectId signalledPartner;
+
+void yieldToSignalledEntry(uintptr_t)
+{
+    Trace::record('a');
+    (void)schedulerAgent.Yield(); // The partner runs and installs its handler.
+    (void)taskAgent.SendSignal(signalledPartner, 4);
+    (void)schedulerAgent.Yield(); // Its handler runs before it continues.
+    Trace::record('A');
+    finished();
+}
+
+bool yieldGeneralCases(shell::Shell& shell)
+{
+    bool ok = checkStatus(shell, schedulerAgent.SetTimeSliceQuantum(2 * kMillisecond), Status::Ok, "quantum 2 ms");
+    Trace::clear();
+    yieldPhase = false;
+    {
+        HoldScheduling hold;
+        ok = ok && !spawn("yield-a", 10, yieldToPreemptedEntry, 0, true).isNull();
+        ok = ok && !spawn("yield-b", 10, preemptedPartnerEntry, 0, true).isNull();
+    }
+    ok = ok && waitForDone(shell, 2);
+    ok = Trace::expect(shell, "abBA") && ok;
+    (void)schedulerAgent.SetTimeSliceQuantum(10 * kMillisecond);
+
+    Trace::clear();
+    {
+        HoldScheduling hold;
+        ok = ok && !spawn("yield-c", 10, yieldToSignalledEntry).isNull();
+        signalledPartner = spawn("yield-d", 10, signalledPartnerEntry);
+        ok = ok && !signalledPartner.isNull();
+    }
+    ok = ok && waitForDone(shell, 2);
+    return Trace::expect(shell, "abhBA") && ok;
+}
+
+DCOS_TARGET_TEST(yieldGeneralCasesTest, "yieldcases",
+                 "Yield resumes a partner preempted at a tick and delivers a partner's pending signal",
+                 yieldGeneralCases);
+
 // --- Time slicing --------------------------------------------------------------
 
 volatile bool slicingStop = false;

@@ -1,5 +1,8 @@
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/YieldFastPath.h>
+
+#include <boot/Panic.hpp>
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/Gdt.hpp>
@@ -7,6 +10,31 @@
 #include <arch_x86/TaskSwitch.hpp>
 
 namespace dcos::internal {
+
+// The layout YieldFastPath.S relies on, checked against the C++ one.
+// offsetof on Task, which has several bases, is conditionally supported;
+// GCC supports it and computes the offsets the assembler needs.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Winvalid-offsetof"
+struct TaskAssemblyLayout {
+    static_assert(offsetof(Task, priority) == TASK_PRIORITY);
+    static_assert(offsetof(Task, resumeStack) == TASK_RESUME_STACK);
+    static_assert(offsetof(Task, switchWork) == TASK_SWITCH_WORK);
+    static_assert(offsetof(Task, rotatesOnYield) == TASK_ROTATES_ON_YIELD);
+    static_assert(offsetof(Task, deliveryPending) == TASK_DELIVERY_PENDING);
+    // The two-byte and masked four-byte tests read these as one word.
+    static_assert(TASK_ROTATES_ON_YIELD == TASK_SWITCH_WORK + 1 && TASK_DELIVERY_PENDING == TASK_SWITCH_WORK + 2);
+    static_assert(sizeof(bool) == 1 && sizeof(Task::priority) == 1);
+    // A ring is its head pointer alone; the next link's place in the node.
+    // That the node is the first base, so that a Task* is its node's
+    // address, cannot be asked at compile time: setIdleTask checks it.
+    static_assert(sizeof(IntrusiveRing<Task, ReadyQueueTag>) == 4);
+    static_assert(offsetof(IntrusiveListNode<ReadyQueueTag>, next_) == TASK_READY_NEXT);
+    static_assert(sizeof(Task*) == 4 && sizeof(uint32_t*) == 4);
+    static_assert(static_cast<uint8_t>(Status::Ok) == STATUS_OK && STATUS_OK == 0);
+    static_assert(static_cast<uint8_t>(Status::InInterrupt) == STATUS_IN_INTERRUPT);
+};
+#pragma GCC diagnostic pop
 
 Task* Scheduler::current_ = nullptr;
 Task* Scheduler::idle_ = nullptr;
@@ -20,6 +48,12 @@ DeadlineQueue<Task, kTaskCapacity> Scheduler::deadlineQueue_;
 
 void Scheduler::setIdleTask(Task& idle)
 {
+    // YieldFastPath.S compares a task's address with its ring's head, which
+    // points at the task's ready node: the node must be the first base.
+    if (reinterpret_cast<uintptr_t>(static_cast<IntrusiveListNode<ReadyQueueTag>*>(&idle)) !=
+        reinterpret_cast<uintptr_t>(&idle)) {
+        dcosPanic("scheduler: the ready node is not at the start of a task");
+    }
     idle.idle = true;
     idle.refreshRotatesOnYield();
     idle_ = &idle;

@@ -14,7 +14,9 @@ using internal::Task;
 using internal::TaskManager;
 using internal::TimerManager;
 
-Status SchedulerAgent::Yield() const
+// SchedulerAgent::Yield is scheduler/YieldFastPath.S, which handles the
+// common case itself and jumps here for every other one.
+extern "C" Status dcosYieldGeneral()
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;

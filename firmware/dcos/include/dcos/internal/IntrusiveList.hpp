@@ -52,6 +52,7 @@ private:
     friend class SortedList;
     template <typename, typename>
     friend class IntrusiveRing;
+    friend struct TaskAssemblyLayout; // Checks the link offset the scheduler's assembly uses.
 
     // Links this unlinked node in front of @p position.
     void insertBefore(IntrusiveListNode* position)

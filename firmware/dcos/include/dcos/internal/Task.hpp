@@ -214,6 +214,8 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     }
 
 private:
+    friend struct TaskAssemblyLayout; // Checks the offsets scheduler/YieldFastPath.S uses.
+
     bool deliveryPending = false;
 
     void refreshDeliveryPending() { deliveryPending = exceptionPending || (pendingSignals & ~signalMask) != 0; }

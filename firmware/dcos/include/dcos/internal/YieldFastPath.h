@@ -1,0 +1,36 @@
+/*
+ * What the assembly fast path of Yield (scheduler/YieldFastPath.S) knows of
+ * the kernel's C++ objects: field offsets in a Task, the scheduler's and the
+ * interrupt table's static members by their linkage names, and status
+ * codes. Plain defines, so that the assembler and the compiler read the
+ * same file; Scheduler.cpp checks every value against the C++ layout at
+ * compile time, and a wrong name fails the link.
+ */
+#pragma once
+
+/* Offsets in dcos::internal::Task. */
+#define TASK_READY_NEXT 4          /* IntrusiveListNode<ReadyQueueTag>::next_ (the node is the first base) */
+#define TASK_PRIORITY 71
+#define TASK_RESUME_STACK 88
+/*
+ * Three adjacent bytes, so that one compare tests two of them:
+ * switchWork, rotatesOnYield, deliveryPending.
+ */
+#define TASK_SWITCH_WORK 668
+#define TASK_ROTATES_ON_YIELD 669
+#define TASK_DELIVERY_PENDING 670
+
+/* Static members, by their mangled names. */
+#define SCHEDULER_CURRENT _ZN4dcos8internal9Scheduler8current_E
+#define SCHEDULER_DISPATCH_HOLDS _ZN4dcos8internal9Scheduler14dispatchHolds_E
+#define SCHEDULER_SWITCH_COUNT _ZN4dcos8internal9Scheduler12switchCount_E
+#define SCHEDULER_READY_QUEUES _ZN4dcos8internal9Scheduler12readyQueues_E
+#define IDT_NESTING_DEPTH _ZN8arch_x863Idt6depth_E
+
+/* dcos::SchedulerAgent::Yield() const, and the C++ general path it falls back to. */
+#define SCHEDULER_AGENT_YIELD _ZNK4dcos14SchedulerAgent5YieldEv
+#define SCHEDULER_YIELD_GENERAL dcosYieldGeneral
+
+/* dcos::Status values. */
+#define STATUS_OK 0
+#define STATUS_IN_INTERRUPT 11
