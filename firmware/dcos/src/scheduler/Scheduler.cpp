@@ -88,24 +88,51 @@ DeadlineKey Scheduler::urgencyKey(const Task& task)
 
 void Scheduler::makeReady(Task& task)
 {
-    if (task.idle) {
-        return;
-    }
-    if (task.schedulesByDeadline()) {
-        makeReadyByDeadline(task);
+    // rotatesOnYield: neither the idle task nor ordered by a deadline.
+    if (!task.rotatesOnYield) {
+        if (!task.idle) {
+            makeReadyByDeadline(task);
+        }
         return;
     }
     readyQueues_[task.priority].pushBack(task);
     readyBitmap_.set(task.priority);
     // A task ordered by priority alone displaces the runner when that is the
     // idle task or of a lower priority; never one ordered by a deadline.
-    const Task* const running = current_;
+    Task* const running = current_;
     if (running == nullptr || &task == running) {
         return;
     }
-    if (running->idle || (!running->schedulesByDeadline() && task.priority < running->priority)) {
+    if (running->rotatesOnYield) {
+        if (task.priority < running->priority) {
+            dispatchToMoreUrgent(*running, task);
+        }
+    } else if (running->idle) {
         requestDispatch();
     }
+}
+
+void Scheduler::dispatchToMoreUrgent(Task& running, Task& task)
+{
+    if (arch_x86::Idt::nestingDepth() != 0) {
+        dispatchPending_ = true; // The switch happens at the outermost interrupt's exit.
+        return;
+    }
+    const uint32_t flags = arch_x86::readEflags();
+    arch_x86::disableInterrupts();
+    // With no hold, no interrupt nesting and no dispatch already pending,
+    // the runner was the most urgent task, so the deadline heap is empty
+    // (asked anyway: it costs two instructions) and a task more urgent than
+    // the runner is the one pickNext() would choose. The switch then needs
+    // no choice; a delivery on the way or a dying runner takes the general
+    // path, which uses the dispatch trap.
+    if (dispatchHolds_ == 0 && !dispatchPending_ && deadlineQueue_.isEmpty() && !task.hasDeliveryPending() &&
+        running.state != TaskState::Terminating) {
+        switchDirectly(running, task);
+    } else {
+        requestDispatch();
+    }
+    restoreInterrupts(flags);
 }
 
 void Scheduler::makeReadyByDeadline(Task& task)

@@ -128,6 +128,10 @@ private:
     static Task* pickNext();
     /// makeReady for a task in a deadline scope, or lent a deadline.
     static void makeReadyByDeadline(Task& task);
+    /// makeReady's dispatch when @p task, ordered by priority alone, is
+    /// more urgent than @p running, ordered the same way: straight to it
+    /// from task context, else requestDispatch().
+    [[gnu::always_inline]] static inline void dispatchToMoreUrgent(Task& running, Task& task);
 
     /// The switch from task context (requestDispatch with no interrupt
     /// nesting and no hold): directly to the next task when nothing has to be
