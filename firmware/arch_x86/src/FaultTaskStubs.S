@@ -34,7 +34,7 @@ doubleFaultTaskEntry:
  */
     .globl faultRecoveryEntry
 faultRecoveryEntry:
-    pushl %esp                  /* InterruptFrame* argument */
+    movl %esp, %eax             /* InterruptFrame* argument, in EAX (regparm) */
     call interruptEntry
     pushl %eax                  /* the frame to resume */
     call faultRecoveryFinished

@@ -74,10 +74,12 @@ void Idt::setOutermostExitHook(Handler hook) { outermostExitHook = hook; }
 
 } // namespace arch_x86
 
-DCOS_ASM_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame)
+DCOS_ASM_REGISTER_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame)
 {
     using namespace arch_x86;
-    Idt::depth_ = Idt::depth_ + 1;
+    // One read-modify-write instruction each way (interrupts are off): the
+    // volatile's load, add and store would be three.
+    asm volatile("incl %0" : "+m"(Idt::depth_));
     const uint32_t vector = frame->vector;
     InterruptFrame* resume;
     // Device requests first: they are the frequent ones and the ones whose
@@ -94,6 +96,6 @@ DCOS_ASM_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFra
     if (Idt::depth_ == 1) {
         resume = outermostExitHook(resume);
     }
-    Idt::depth_ = Idt::depth_ - 1;
+    asm volatile("decl %0" : "+m"(Idt::depth_));
     return resume;
 }

@@ -45,7 +45,7 @@ interrupt_common:
     movl %eax, %fs
     movl %eax, %gs
 1:  cld                         /* The C++ ABI expects DF clear. */
-    pushl %esp                  /* InterruptFrame* argument */
+    movl %esp, %eax             /* InterruptFrame* argument, in EAX (regparm) */
     call interruptEntry
     movl %eax, %esp             /* Resume the frame the dispatcher chose. */
 interrupt_return:

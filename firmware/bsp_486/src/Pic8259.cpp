@@ -77,14 +77,4 @@ bool Pic8259::isGenuineLowestLine(unsigned line) const
     return (readInServiceRegister() & (1u << line)) != 0;
 }
 
-void Pic8259::endOfInterrupt(unsigned line)
-{
-    if (line >= 8) {
-        slave_.write8(commandRegister, static_cast<uint8_t>(ocw2SpecificEoi | (line - 8)));
-        master_.write8(commandRegister, static_cast<uint8_t>(ocw2SpecificEoi | cascadeLine));
-    } else {
-        master_.write8(commandRegister, static_cast<uint8_t>(ocw2SpecificEoi | line));
-    }
-}
-
 } // namespace bsp

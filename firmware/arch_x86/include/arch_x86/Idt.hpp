@@ -11,7 +11,7 @@
 #include <arch_x86/InterruptFrame.hpp>
 
 /// The single C++ entry for every vector, called from interrupt_common.
-DCOS_ASM_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame);
+DCOS_ASM_REGISTER_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame);
 
 namespace arch_x86 {
 

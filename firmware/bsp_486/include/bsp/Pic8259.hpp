@@ -72,8 +72,18 @@ public:
     /// be spurious, so only they cost a register read.
     bool isGenuine(unsigned line) const { return (line & 7u) != 7u || isGenuineLowestLine(line); }
 
-    /// Ends the interrupt on line with specific EOIs, slave first.
-    void endOfInterrupt(unsigned line);
+    /// Ends the interrupt on line with specific EOIs, slave first. Inline:
+    /// every interrupt ends here, and the call would cost more than the
+    /// one or two port writes.
+    void endOfInterrupt(unsigned line)
+    {
+        if (line >= 8) {
+            slave_.write8(commandRegister, static_cast<uint8_t>(ocw2SpecificEoi | (line - 8)));
+            master_.write8(commandRegister, static_cast<uint8_t>(ocw2SpecificEoi | cascadeLine));
+        } else {
+            master_.write8(commandRegister, static_cast<uint8_t>(ocw2SpecificEoi | line));
+        }
+    }
 
 private:
     void writeMask();
