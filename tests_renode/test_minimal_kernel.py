@@ -213,7 +213,7 @@ def test_a_call_to_an_agent_the_minimal_kernel_leaves_out_does_not_link(tmp_path
     result = build_minimal(locking)
     output = result.stdout + result.stderr
     assert result.returncode != 0, output
-    assert "undefined reference to `dcos::SemaphoreAgent::Create(dcos::SemaphoreAttributes const&) const'" in output
+    assert "undefined reference to `dcos::SemaphoreAgent::Create(dcos::SemaphoreAttributes const&)'" in output
     assert not os.path.exists(os.path.join(locking, "build", "locking-486-minimal.elf"))
 
 

@@ -64,7 +64,7 @@ bool raise(unsigned line)
 
 namespace dcos {
 
-Status SystemAgent::InstallISR(unsigned line, InterruptServiceRoutine isr, void* context) const
+Status SystemAgent::InstallISR(unsigned line, InterruptServiceRoutine isr, void* context)
 {
     if (iobus_fake::nextInstall != Status::Ok) {
         const Status status = iobus_fake::nextInstall;
@@ -80,7 +80,7 @@ Status SystemAgent::InstallISR(unsigned line, InterruptServiceRoutine isr, void*
     return Status::Ok;
 }
 
-Status SystemAgent::RemoveISR(unsigned line) const
+Status SystemAgent::RemoveISR(unsigned line)
 {
     for (auto it = iobus_fake::isrs.begin(); it != iobus_fake::isrs.end(); ++it) {
         if (it->line == line) {
@@ -91,15 +91,15 @@ Status SystemAgent::RemoveISR(unsigned line) const
     return Status::InvalidArgument;
 }
 
-Status TaskAgent::PostEvent(ObjectId task, uint32_t posted) const
+Status TaskAgent::PostEvent(ObjectId task, uint32_t posted)
 {
     iobus_fake::events.push_back({task, posted});
     return Status::Ok;
 }
 
-ObjectId TaskAgent::IdOfSelf() const { return internal::currentTaskId(); }
+ObjectId TaskAgent::IdOfSelf() { return internal::currentTaskId(); }
 
-Result<uint32_t> TaskAgent::ReceiveEvent(uint32_t wanted, EventWait, uint64_t timeout) const
+Result<uint32_t> TaskAgent::ReceiveEvent(uint32_t wanted, EventWait, uint64_t timeout)
 {
     if (!iobus_fake::receiveHandler) {
         iobus_fake::receiveHandler = iobus_fake::timeOut;
@@ -107,7 +107,7 @@ Result<uint32_t> TaskAgent::ReceiveEvent(uint32_t wanted, EventWait, uint64_t ti
     return iobus_fake::receiveHandler(wanted, timeout);
 }
 
-uint64_t TimerAgent::Uptime() const
+uint64_t TimerAgent::Uptime()
 {
     const uint64_t now = iobus_fake::clock;
     iobus_fake::clock += iobus_fake::step;

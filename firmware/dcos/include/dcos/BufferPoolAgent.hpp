@@ -110,8 +110,8 @@ public:
     /// than kMaximumBuffers, a null area, a bad name or visibility;
     /// AlreadyExists when the area overlaps another pool's or heap's area;
     /// TableFull when every active slot is used; InInterrupt in an interrupt handler.
-    Result<ObjectId> Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
-                            Visibility visibility) const;
+    static Result<ObjectId> Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
+                            Visibility visibility);
 
     /// Deletes the pool; every copy of its id turns stale and the area is the application's again. O(1).
     ///
@@ -120,7 +120,7 @@ public:
     /// writing into an area that is being reused; a corrupted pool can
     /// always be deleted, since that is the only way out (seed 7.7). Also
     /// fails with InInterrupt and the id errors.
-    Status Delete(ObjectId pool) const;
+    static Status Delete(ObjectId pool);
 
     /// Takes a free buffer from the pool, held by the calling task (by the
     /// system in an interrupt handler). O(1); never blocks.
@@ -128,7 +128,7 @@ public:
     /// Fails with NoMemory when no buffer is free (counted in the
     /// statistics; poll again or use a bigger pool), Corrupted when the
     /// pool is or turns out to be corrupted, and the id errors.
-    Result<void*> Allocate(ObjectId pool) const;
+    static Result<void*> Allocate(ObjectId pool);
 
     /// Gives the buffer @p buffer back to the pool. O(1).
     ///
@@ -137,17 +137,17 @@ public:
     /// Corrupted, disabling the pool, for a buffer that is already free (a
     /// double return), a pointer inside the pool that is not the start of a
     /// buffer, or overwritten bookkeeping; and the id errors.
-    Status Return(ObjectId pool, void* buffer) const;
+    static Status Return(ObjectId pool, void* buffer);
 
     /// Reports the pool's usage (the seed's GetUsageInfo). O(1).
     ///
     /// Fails with Corrupted for a corrupted pool, and the id errors.
-    Result<BufferPoolStatistics> GetStatistics(ObjectId pool) const;
+    static Result<BufferPoolStatistics> GetStatistics(ObjectId pool);
 
     /// Configuration service: returns the id of the pool named @p name on this node. O(N).
     ///
     /// Fails with NotFound, and InInterrupt in an interrupt handler.
-    Result<ObjectId> NameToObject(const char* name) const;
+    static Result<ObjectId> NameToObject(const char* name);
 
     /// Configuration service: activates @p count more pool slots. Privileged. O(count).
     ///
@@ -155,7 +155,7 @@ public:
     /// multiple of eight (InvalidArgument) and the total may not exceed the
     /// capacity built into the kernel (TableFull). Also fails with
     /// NotPermitted and InInterrupt.
-    Status AddObjects(size_t count) const;
+    static Status AddObjects(size_t count);
 
     /// Gives the pool @p pool to the task @p newOwner, or to the system when
     /// @p newOwner is the null id. O(1).
@@ -163,7 +163,7 @@ public:
     /// The owner or a super user may transfer a pool (NotOwner). The buffers
     /// allocated from it keep their holders. Fails with the id errors of
     /// @p newOwner when it is not a live local task, InInterrupt, and the id errors.
-    Status XferOwnership(ObjectId pool, ObjectId newOwner) const;
+    static Status XferOwnership(ObjectId pool, ObjectId newOwner);
 
     /// Hands the allocated buffer @p buffer, held by the calling task, to
     /// the task @p newOwner, or to the system when @p newOwner is the null
@@ -175,7 +175,7 @@ public:
     /// with NotOwner when another task holds the buffer, InvalidArgument for
     /// a pointer outside the pool, Corrupted as Return does, the id errors of
     /// @p newOwner when it is not a live local task, InInterrupt, and the id errors.
-    Status XferOwnership(ObjectId pool, void* buffer, ObjectId newOwner) const;
+    static Status XferOwnership(ObjectId pool, void* buffer, ObjectId newOwner);
 };
 
 /// The object through which applications call the buffer pool memory agent.

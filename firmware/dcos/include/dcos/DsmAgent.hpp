@@ -47,7 +47,7 @@ public:
     ///
     /// Fails with InvalidArgument (name longer than 15 characters), TableFull
     /// (see AddObjects) or InInterrupt. Cost O(1).
-    Result<ObjectId> Create(const char* name, Visibility visibility) const;
+    static Result<ObjectId> Create(const char* name, Visibility visibility);
 
     /// Deletes a publisher the caller owns (a super user may delete any).
     ///
@@ -55,7 +55,7 @@ public:
     /// subscription to it is invalidated: Read on one then fails with
     /// Deleted, and only Close is left to do. Cost O(1) plus O(1) per
     /// waiting reader.
-    Status Delete(ObjectId publisher) const;
+    static Status Delete(ObjectId publisher);
 
     /// Publishes @p page with a new data identifier, which it returns.
     ///
@@ -65,18 +65,18 @@ public:
     /// system, typically for the driver that produces the data. Every reader
     /// waiting for newer data receives this page and is woken. Cost O(1)
     /// plus O(1) per waiting reader.
-    Result<uint32_t> Write(ObjectId publisher, const DsmPage& page) const;
+    static Result<uint32_t> Write(ObjectId publisher, const DsmPage& page);
 
     /// Opens a subscription to @p publisher for the caller, which owns it.
     ///
     /// Any task may subscribe to any publisher it has the id of. Fails with
     /// TableFull (see AddSubscribers), InInterrupt and the id errors. Cost O(1).
-    Result<ObjectId> Open(ObjectId publisher) const;
+    static Result<ObjectId> Open(ObjectId publisher);
 
     /// Closes a subscription the caller owns; only its owner may, so no
     /// reader can be waiting through it meanwhile. A subscription whose
     /// publisher was deleted is closed the same way. Cost O(1).
-    Status Close(ObjectId subscription) const;
+    static Status Close(ObjectId subscription);
 
     /// Reads the page through @p subscription when its data identifier
     /// differs from @p lastSeenDataId, and returns the new identifier.
@@ -88,24 +88,24 @@ public:
     /// not come; kWaitForever for no limit). Only the subscription's owner
     /// reads (NotOwner); Deleted when the publisher is gone; InInterrupt for
     /// a wait in an interrupt handler. Cost O(1).
-    Result<uint32_t> Read(ObjectId subscription, uint32_t lastSeenDataId, DsmPage& page, uint64_t timeoutNs) const;
+    static Result<uint32_t> Read(ObjectId subscription, uint32_t lastSeenDataId, DsmPage& page, uint64_t timeoutNs);
 
     /// Finds a publisher by name among local publishers. Fails with NotFound. Cost O(N).
-    Result<ObjectId> NameToObject(const char* name) const;
+    static Result<ObjectId> NameToObject(const char* name);
 
     /// Activates @p count more publisher slots, a multiple of eight
     /// (privileged configuration service). Cost O(count).
-    Status AddObjects(size_t count) const;
+    static Status AddObjects(size_t count);
 
     /// Activates @p count more subscription slots, a multiple of eight
     /// (privileged configuration service). Cost O(count).
-    Status AddSubscribers(size_t count) const;
+    static Status AddSubscribers(size_t count);
 
     /// Hands a publisher or a subscription the caller owns to another local
     /// task (or to the system, with the null id), which then writes or reads
     /// it and owns it for resource recovery. Only the owner may give an
     /// object away. Cost O(1).
-    Status XferOwnership(ObjectId object, ObjectId newOwner) const;
+    static Status XferOwnership(ObjectId object, ObjectId newOwner);
 };
 
 inline constexpr DsmAgent dsmAgent{};

@@ -107,14 +107,14 @@ public:
     /// bytes after alignment (one smallest segment), more than 1 GiB, a bad
     /// name or visibility; AlreadyExists when the area overlaps another
     /// pool's or heap's area; TableFull; InInterrupt.
-    Result<ObjectId> Create(void* area, size_t areaBytes, const char* name, Visibility visibility) const;
+    static Result<ObjectId> Create(void* area, size_t areaBytes, const char* name, Visibility visibility);
 
     /// Deletes the heap; every copy of its id turns stale. O(1).
     ///
     /// Only the owner or a super user may delete a heap (NotOwner). Fails
     /// with Busy while any segment is allocated, unless the heap is
     /// corrupted. Also fails with InInterrupt and the id errors.
-    Status Delete(ObjectId heap) const;
+    static Status Delete(ObjectId heap);
 
     /// Allocates a segment of at least @p bytes, held by the calling task
     /// (by the system in an interrupt handler). O(1); never blocks.
@@ -124,7 +124,7 @@ public:
     /// to 8 more. Fails with InvalidArgument for 0 bytes, NoMemory when
     /// @p bytes is more than GetStatistics' largestFreeSegment (counted in
     /// the statistics), Corrupted, and the id errors.
-    Result<void*> Allocate(ObjectId heap, size_t bytes) const;
+    static Result<void*> Allocate(ObjectId heap, size_t bytes);
 
     /// Returns the segment @p segment to the heap and merges it with its free neighbours. O(1).
     ///
@@ -133,34 +133,34 @@ public:
     /// Corrupted, disabling the heap, for a segment already free (a double
     /// return), a pointer that is not the start of a segment, or overwritten
     /// bookkeeping; and the id errors.
-    Status Return(ObjectId heap, void* segment) const;
+    static Status Return(ObjectId heap, void* segment);
 
     /// Reports the heap's usage, including the largest request that can
     /// succeed (the seed's GetUsageInfo). O(1): Allocate and Return keep the
     /// counters.
     ///
     /// Fails with Corrupted for a corrupted heap, and the id errors.
-    Result<HeapStatistics> GetStatistics(ObjectId heap) const;
+    static Result<HeapStatistics> GetStatistics(ObjectId heap);
 
     /// Configuration service: returns the id of the heap named @p name on this node. O(N).
-    Result<ObjectId> NameToObject(const char* name) const;
+    static Result<ObjectId> NameToObject(const char* name);
 
     /// Configuration service: activates @p count more heap slots, a
     /// non-zero multiple of eight. Privileged. O(count).
-    Status AddObjects(size_t count) const;
+    static Status AddObjects(size_t count);
 
     /// Gives the heap to the task @p newOwner, or to the system for the null id. O(1).
     ///
     /// The owner or a super user may transfer a heap (NotOwner); its
     /// segments keep their holders.
-    Status XferOwnership(ObjectId heap, ObjectId newOwner) const;
+    static Status XferOwnership(ObjectId heap, ObjectId newOwner);
 
     /// Hands the allocated segment @p segment, held by the calling task, to
     /// the task @p newOwner, or to the system for the null id. O(1).
     ///
     /// A segment held by the system may be taken by any task. Fails like
     /// Return, and with the id errors of @p newOwner when it is not a live local task.
-    Status XferOwnership(ObjectId heap, void* segment, ObjectId newOwner) const;
+    static Status XferOwnership(ObjectId heap, void* segment, ObjectId newOwner);
 };
 
 /// The object through which applications call the segmented heap memory agent.

@@ -55,14 +55,14 @@ public:
     /// @p name may be null (an unnamed port cannot be found by name) or at
     /// most 15 characters. Fails with InvalidArgument, TableFull (see
     /// AddObjects) or InInterrupt. Cost O(1).
-    Result<ObjectId> Create(const char* name, Visibility visibility, PortOrder order = PortOrder::Priority) const;
+    static Result<ObjectId> Create(const char* name, Visibility visibility, PortOrder order = PortOrder::Priority);
 
     /// Deletes a port the caller owns (a super user may delete any port).
     ///
     /// A task waiting in Receive is woken with Status::Deleted, and the
     /// messages still queued are discarded, their buffers going back to the
     /// free area. Cost O(1): each of the 32 levels is handed back whole.
-    Status Delete(ObjectId port) const;
+    static Status Delete(ObjectId port);
 
     /// Queues @p message on @p port; never blocks, and is allowed in
     /// interrupt handlers.
@@ -75,7 +75,7 @@ public:
     /// InvalidArgument for a priority out of range, NoMemory when no message
     /// buffer is free (the message is then not queued), and the id errors.
     /// Cost O(1).
-    Status Send(ObjectId port, const Message& message, int priority) const;
+    static Status Send(ObjectId port, const Message& message, int priority);
 
     /// Takes the first message of a port the caller owns into @p message.
     ///
@@ -85,7 +85,7 @@ public:
     /// deleted meanwhile. Only the owner receives (NotOwner otherwise, even
     /// for a super user), which makes a port N-to-1. Waiting is refused in
     /// an interrupt handler with InInterrupt. Cost O(1).
-    Status Receive(ObjectId port, Message& message, uint64_t timeoutNs) const;
+    static Status Receive(ObjectId port, Message& message, uint64_t timeoutNs);
 
     /// Activates @p count more message buffers from the static reserve
     /// (privileged configuration service).
@@ -93,20 +93,20 @@ public:
     /// Fails with InvalidArgument for 0, NoMemory when the reserve has fewer
     /// than @p count left (nothing is then activated), NotPermitted for a
     /// task that is not a super user. Cost O(count).
-    Status AddMsgBufs(size_t count) const;
+    static Status AddMsgBufs(size_t count);
 
     /// Finds a port by name among local ports. Fails with NotFound. Cost O(N).
-    Result<ObjectId> NameToObject(const char* name) const;
+    static Result<ObjectId> NameToObject(const char* name);
 
     /// Activates @p count more port slots, a multiple of eight (privileged
     /// configuration service). Cost O(count).
-    Status AddObjects(size_t count) const;
+    static Status AddObjects(size_t count);
 
     /// Hands a port the caller owns to another local task (or to the system,
     /// with the null id), which then receives from it and owns it for
     /// resource recovery. Only the owner may give a port away, so no
     /// receiver can be waiting on it meanwhile. Cost O(1).
-    Status XferOwnership(ObjectId port, ObjectId newOwner) const;
+    static Status XferOwnership(ObjectId port, ObjectId newOwner);
 };
 
 inline constexpr MessagePortAgent messagePortAgent{};

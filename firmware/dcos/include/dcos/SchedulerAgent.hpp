@@ -19,21 +19,21 @@ enum class DeadlineStart : uint8_t {
 class SchedulerAgent {
 public:
     /// Gives the CPU to the next ready task of the same priority (round robin).
-    Status Yield() const;
+    static Status Yield();
     /// Enters the deadline-driven real-time scope: the task is scheduled by
     /// static priority, then latest start time (deadline - execution
     /// period), before every task outside a scope. A deadline passed before
     /// ClearDeadline raises a timing exception.
-    Status SetDeadline(DeadlineStart start, uint64_t executionPeriodNs, uint64_t deadlinePeriodNs) const;
+    static Status SetDeadline(DeadlineStart start, uint64_t executionPeriodNs, uint64_t deadlinePeriodNs);
     /// Leaves the real-time scope.
-    Status ClearDeadline() const;
+    static Status ClearDeadline();
     /// Sets the time-slice quantum for time-sliced tasks (privileged).
-    Status SetTimeSliceQuantum(uint64_t nanoseconds) const;
+    static Status SetTimeSliceQuantum(uint64_t nanoseconds);
     /// Starts measuring the execution time of a task, excluding preemption.
-    Status StartProfiling(ObjectId task) const;
+    static Status StartProfiling(ObjectId task);
     /// Ends one measurement interval and records it.
-    Status StopProfiling(ObjectId task) const;
-    Result<TimingInfo> GetTimingInfo(ObjectId task) const;
+    static Status StopProfiling(ObjectId task);
+    static Result<TimingInfo> GetTimingInfo(ObjectId task);
 };
 
 inline constexpr SchedulerAgent schedulerAgent{};

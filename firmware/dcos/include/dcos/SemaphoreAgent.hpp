@@ -39,24 +39,24 @@ struct SemaphoreAttributes {
 /// The semaphore agent interface object.
 class SemaphoreAgent {
 public:
-    Result<ObjectId> Create(const SemaphoreAttributes& attributes) const;
+    static Result<ObjectId> Create(const SemaphoreAttributes& attributes);
     /// Deletes a semaphore; every waiter wakes with Status::Deleted.
-    Status Delete(ObjectId semaphore) const;
+    static Status Delete(ObjectId semaphore);
     /// Takes a unit: at once, polling (kPoll gives WouldBlock), or waiting
     /// with a time-out. A binary semaphore's holder asking again gets
     /// Status::Deadlock instead of waiting for itself. A wait ends with
     /// Deleted if the semaphore is deleted, Abandoned if its holder ends.
-    Status Acquire(ObjectId semaphore, uint64_t timeout) const;
+    static Status Acquire(ObjectId semaphore, uint64_t timeout);
     /// Gives a unit back. A binary semaphore passes straight to its first
     /// waiter; only the holder may release it (NotOwner).
-    Status Release(ObjectId semaphore) const;
+    static Status Release(ObjectId semaphore);
     /// Units available now.
-    Result<uint32_t> GetCount(ObjectId semaphore) const;
+    static Result<uint32_t> GetCount(ObjectId semaphore);
     /// The task holding a binary semaphore (null when free).
-    Result<ObjectId> GetHolder(ObjectId semaphore) const;
-    Result<ObjectId> NameToObject(const char* name) const;
-    Status XferOwnership(ObjectId semaphore, ObjectId newOwner) const;
-    Status AddObjects(size_t count) const;
+    static Result<ObjectId> GetHolder(ObjectId semaphore);
+    static Result<ObjectId> NameToObject(const char* name);
+    static Status XferOwnership(ObjectId semaphore, ObjectId newOwner);
+    static Status AddObjects(size_t count);
 };
 
 inline constexpr SemaphoreAgent semaphoreAgent{};

@@ -65,7 +65,7 @@ public:
     /// already installed, InvalidArgument for a name that is too long or a
     /// bad visibility, and TableFull when every active slot is used (see
     /// AddObjects). The driver is not called; use Probe to check the hardware.
-    Result<ObjectId> Create(Device& device, const char* name, Visibility visibility) const;
+    static Result<ObjectId> Create(Device& device, const char* name, Visibility visibility);
 
     /// Removes the device @p device; every copy of its id turns stale. Privileged. O(1).
     ///
@@ -73,13 +73,13 @@ public:
     /// is the super user's role (seed 7.3). The driver is not called. Fails
     /// with NotPermitted, InInterrupt, the id errors, and Busy while the
     /// device is open or a call into its driver is in progress.
-    Status Delete(ObjectId device) const;
+    static Status Delete(ObjectId device);
 
     /// Asks the driver whether its hardware is present and usable. O(1) plus the driver.
     ///
     /// Allowed whether the device is open or not. Returns the driver's own
     /// status when the id is valid.
-    Status Probe(ObjectId device) const;
+    static Status Probe(ObjectId device);
 
     /// Opens the device for transfers. O(1) plus the driver.
     ///
@@ -87,14 +87,14 @@ public:
     /// the device stays open until as many Close calls have succeeded. Opens
     /// are counted per device, not per task. Returns the driver's status, or
     /// Busy when 65535 opens are already counted.
-    Status Open(ObjectId device) const;
+    static Status Open(ObjectId device);
 
     /// Undoes one Open. O(1) plus the driver.
     ///
     /// Fails with NotOpen when no Open is counted (the driver is not
     /// called), or with the driver's status, in which case the open stays
     /// counted.
-    Status Close(ObjectId device) const;
+    static Status Close(ObjectId device);
 
     /// Reads up to @p length bytes from channel @p channel into @p buffer. O(1) plus the driver.
     ///
@@ -105,12 +105,12 @@ public:
     /// @p length, NotOpen when the device is not open, the driver's status,
     /// and Corrupted when the driver reports more bytes than @p length (a
     /// driver bug that overran the buffer).
-    Result<size_t> Read(ObjectId device, uint32_t channel, void* buffer, size_t length) const;
+    static Result<size_t> Read(ObjectId device, uint32_t channel, void* buffer, size_t length);
 
     /// Writes up to @p length bytes from @p buffer to channel @p channel. O(1) plus the driver.
     ///
     /// Returns the number of bytes the device accepted. Fails like Read.
-    Result<size_t> Write(ObjectId device, uint32_t channel, const void* buffer, size_t length) const;
+    static Result<size_t> Write(ObjectId device, uint32_t channel, const void* buffer, size_t length);
 
     /// Sends the device-specific command @p command. O(1) plus the driver.
     ///
@@ -120,12 +120,12 @@ public:
     /// InvalidArgument for a null @p argument with a non-zero @p length,
     /// NotOpen when the device is not open, and the driver's status
     /// (NotSupported for an unknown command).
-    Status Control(ObjectId device, uint32_t command, void* argument, size_t length) const;
+    static Status Control(ObjectId device, uint32_t command, void* argument, size_t length);
 
     /// Configuration service: returns the id of the device named @p name on this node. O(N).
     ///
     /// Fails with NotFound, and InInterrupt in an interrupt handler.
-    Result<ObjectId> NameToObject(const char* name) const;
+    static Result<ObjectId> NameToObject(const char* name);
 
     /// Configuration service: activates @p count more device slots. Privileged. O(count).
     ///
@@ -133,7 +133,7 @@ public:
     /// multiple of eight (InvalidArgument), and the total may not exceed the
     /// capacity built into the kernel, 64 (TableFull); a refused request
     /// changes nothing. Also fails with NotPermitted and InInterrupt.
-    Status AddObjects(size_t count) const;
+    static Status AddObjects(size_t count);
 
     /// Gives the device @p device to the task @p newOwner, or to the system
     /// when @p newOwner is the null id. O(1).
@@ -142,7 +142,7 @@ public:
     /// installs drivers gives them to the system so that they survive its
     /// end. Fails with InvalidArgument when @p newOwner is neither a task id
     /// nor null, InInterrupt, and the id errors.
-    Status XferOwnership(ObjectId device, ObjectId newOwner) const;
+    static Status XferOwnership(ObjectId device, ObjectId newOwner);
 
     // Interrupt management (seed 7.3.3).
 
@@ -154,17 +154,17 @@ public:
     /// Attaches isr(context) to a hardware interrupt line (privileged). A
     /// task the routine readies runs when the outermost interrupt returns.
     /// Busy when the line already has a routine. O(1).
-    Status InstallISR(unsigned line, InterruptServiceRoutine isr, void* context) const;
+    static Status InstallISR(unsigned line, InterruptServiceRoutine isr, void* context);
     /// Detaches the routine of a line installed with InstallISR (privileged). O(1).
-    Status RemoveISR(unsigned line) const;
+    static Status RemoveISR(unsigned line);
     /// Holds off interrupts of this level and below while the calling task
     /// runs (level 0, the tick, cannot be held off; 0xFF holds off none).
     /// A level more urgent than the legal limit of the task's priority is
     /// lowered to that limit. Returns the level in force. O(1).
-    Result<uint8_t> SetInterruptLevel(uint8_t level) const;
+    static Result<uint8_t> SetInterruptLevel(uint8_t level);
     /// Sets the legal limit: the most urgent level a task of the given
     /// priority may set (privileged). O(1).
-    Status SetInterruptLevel(uint8_t priority, uint8_t legalLimit) const;
+    static Status SetInterruptLevel(uint8_t priority, uint8_t legalLimit);
 };
 
 /// The object through which applications call the system agent.

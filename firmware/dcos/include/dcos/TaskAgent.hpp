@@ -105,41 +105,41 @@ class TaskAgent {
 public:
     /// Creates a task running entry(argument). Returns its id. O(1) except
     /// for the stack allocation, which is a configuration-class O(N).
-    Result<ObjectId> Create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument) const;
+    static Result<ObjectId> Create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument);
     /// Ends the calling task (suicide); does not return on success.
-    Status Delete() const;
+    static Status Delete();
     /// Ends another task, blocked, suspended or ready, and recovers its objects.
-    Status KillTask(ObjectId task) const;
-    Status Suspend(ObjectId task) const;
-    Status Resume(ObjectId task) const;
-    Status ChangePriority(ObjectId task, uint8_t priority) const;
+    static Status KillTask(ObjectId task);
+    static Status Suspend(ObjectId task);
+    static Status Resume(ObjectId task);
+    static Status ChangePriority(ObjectId task, uint8_t priority);
     /// Blocks the caller for an interval.
-    Status SleepFor(uint64_t nanoseconds) const;
+    static Status SleepFor(uint64_t nanoseconds);
     /// Blocks the caller until a time of day.
-    Status SleepTill(const DateTime& time) const;
+    static Status SleepTill(const DateTime& time);
     /// Sets event flags of a task; allowed from interrupt handlers.
-    Status PostEvent(ObjectId task, uint32_t events) const;
+    static Status PostEvent(ObjectId task, uint32_t events);
     /// Waits for any or all of events, polling (kPoll) or with a time-out.
     /// Returns the events received, which are cleared.
-    Result<uint32_t> ReceiveEvent(uint32_t events, EventWait mode, uint64_t timeout) const;
+    static Result<uint32_t> ReceiveEvent(uint32_t events, EventWait mode, uint64_t timeout);
     /// Sends signal 0-31 to a task; allowed from interrupt handlers.
-    Status SendSignal(ObjectId task, unsigned signal) const;
-    Status SetSignalHandler(SignalHandler handler) const;
+    static Status SendSignal(ObjectId task, unsigned signal);
+    static Status SetSignalHandler(SignalHandler handler);
     /// Sets the caller's signal mask (bit n set = signal n held); returns the previous mask.
-    Result<uint32_t> SetSignalMask(uint32_t mask) const;
-    Status SetExceptionHandler(ExceptionHandler handler) const;
+    static Result<uint32_t> SetSignalMask(uint32_t mask);
+    static Status SetExceptionHandler(ExceptionHandler handler);
     /// Raises an exception of the given class in a task.
-    Status ThrowException(ObjectId task, ExceptionClass exceptionClass, uint32_t code) const;
+    static Status ThrowException(ObjectId task, ExceptionClass exceptionClass, uint32_t code);
     /// The caller's own id.
-    ObjectId IdOfSelf() const;
+    static ObjectId IdOfSelf();
     /// Looks a task up by name (O(N)).
-    Result<ObjectId> NameToObject(const char* name) const;
+    static Result<ObjectId> NameToObject(const char* name);
     /// The state of a task, as the seed names it.
-    Result<TaskState> GetState(ObjectId task) const;
+    static Result<TaskState> GetState(ObjectId task);
     /// The static priority of a task.
-    Result<uint8_t> GetPriority(ObjectId task) const;
+    static Result<uint8_t> GetPriority(ObjectId task);
     /// Activates count more task slots (privileged configuration service).
-    Status AddObjects(size_t count) const;
+    static Status AddObjects(size_t count);
 };
 
 inline constexpr TaskAgent taskAgent{};

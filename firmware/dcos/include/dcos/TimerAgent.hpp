@@ -28,7 +28,7 @@ struct AlarmNotification {
 class TimerAgent {
 public:
     /// The time of day in the Gregorian calendar.
-    Result<DateTime> GetSystemClock() const;
+    static Result<DateTime> GetSystemClock();
     /// The last year SetSystemClock accepts. The clock counts nanoseconds
     /// since 1970 in 64 bits, which end in July 2554; stopping at the end
     /// of 2399 leaves the clock more than 150 years to run from any time it
@@ -40,26 +40,26 @@ public:
     /// SleepTill move with the clock, in time that does not depend on how
     /// many there are. InvalidArgument for a time before the node started or
     /// after kLastClockYear.
-    Status SetSystemClock(const DateTime& time) const;
+    static Status SetSystemClock(const DateTime& time);
     /// Nanoseconds since the system tick started (monotonic).
-    uint64_t Uptime() const;
+    static uint64_t Uptime();
     /// Creates a software timer owned by the caller.
-    Result<ObjectId> Create(const char* name, Visibility visibility) const;
-    Status Delete(ObjectId timer) const;
+    static Result<ObjectId> Create(const char* name, Visibility visibility);
+    static Status Delete(ObjectId timer);
     /// Goes off once, after an interval.
-    Status SetWatchDogAlarm(ObjectId timer, uint64_t intervalNs, AlarmNotification notification) const;
+    static Status SetWatchDogAlarm(ObjectId timer, uint64_t intervalNs, AlarmNotification notification);
     /// Goes off once, at a time of day.
-    Status SetDayClockAlarm(ObjectId timer, const DateTime& time, AlarmNotification notification) const;
+    static Status SetDayClockAlarm(ObjectId timer, const DateTime& time, AlarmNotification notification);
     /// Goes off every period, first one period from now.
-    Status SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNotification notification) const;
+    static Status SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNotification notification);
     /// Disarms a set alarm.
-    Status CancelAlarm(ObjectId timer) const;
-    Result<ObjectId> NameToObject(const char* name) const;
+    static Status CancelAlarm(ObjectId timer);
+    static Result<ObjectId> NameToObject(const char* name);
     /// Hands a timer the caller owns to another task (or to the system, with
     /// the null id), which then receives its alarms and owns it for recovery.
-    Status XferOwnership(ObjectId timer, ObjectId newOwner) const;
+    static Status XferOwnership(ObjectId timer, ObjectId newOwner);
     /// Activates count more timer slots (privileged configuration service).
-    Status AddObjects(size_t count) const;
+    static Status AddObjects(size_t count);
 };
 
 inline constexpr TimerAgent timerAgent{};

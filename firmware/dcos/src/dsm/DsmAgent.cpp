@@ -190,7 +190,7 @@ using internal::SubscriptionObject;
 using internal::subscriptionTable;
 using internal::TaskManager;
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Create(const char* name, Visibility visibility) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Create(const char* name, Visibility visibility)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt; // The publisher would belong to whichever task was interrupted.
@@ -209,7 +209,7 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Create(const char* name, V
     return id.value();
 }
 
-DCOS_CONFIGURATION_SERVICE Status DsmAgent::Delete(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::Delete(ObjectId id)
 {
     arch_x86::InterruptGuard guard;
     start();
@@ -273,7 +273,7 @@ uint32_t nextDataId(uint32_t dataId) { return dataId + 1 == kNoDsmData ? dataId 
 
 } // namespace
 
-Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page) const
+Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page)
 {
     // The fast path: the table's inline lookup, with the owner, for a live
     // publisher written by its owner (or by an interrupt handler) with no
@@ -298,7 +298,7 @@ Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page) const
     return writeFull(id, &page);
 }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Open(ObjectId publisherId) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Open(ObjectId publisherId)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -318,7 +318,7 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Open(ObjectId publisherId)
     return id.value();
 }
 
-DCOS_CONFIGURATION_SERVICE Status DsmAgent::Close(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::Close(ObjectId id)
 {
     arch_x86::InterruptGuard guard;
     const Result<SubscriptionObject*> subscription = internal::resolveOwnSubscription(id);
@@ -376,7 +376,7 @@ namespace {
 
 } // namespace
 
-Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& page, uint64_t timeoutNs) const
+Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& page, uint64_t timeoutNs)
 {
     // The fast path: the table's inline lookup, with the owner, for the
     // subscription's owner, when the publisher holds data newer than
@@ -400,14 +400,14 @@ Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& p
     return readFull(id, lastSeenDataId, &page, timeoutNs);
 }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::NameToObject(const char* name)
 {
     arch_x86::InterruptGuard guard;
     start();
     return publisherTable.NameToObject(name, Visibility::Local);
 }
 
-DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddObjects(size_t count)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -417,7 +417,7 @@ DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddObjects(size_t count) const
     return publisherTable.AddObjects(count);
 }
 
-DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddSubscribers(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddSubscribers(size_t count)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -427,7 +427,7 @@ DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddSubscribers(size_t count) const
     return subscriptionTable.AddObjects(count);
 }
 
-DCOS_CONFIGURATION_SERVICE Status DsmAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status DsmAgent::XferOwnership(ObjectId id, ObjectId newOwner)
 {
     const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
     if (newOwnerStatus != Status::Ok) {

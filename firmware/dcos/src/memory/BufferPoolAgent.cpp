@@ -9,33 +9,33 @@ namespace dcos {
 using internal::BufferPoolManager;
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolAgent::Create(void* area, size_t areaBytes, size_t bufferSize, const char* name,
-                                         Visibility visibility) const
+                                         Visibility visibility)
 {
     return BufferPoolManager::Create(area, areaBytes, bufferSize, name, visibility);
 }
 
-DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::Delete(ObjectId pool) const { return BufferPoolManager::Delete(pool); }
+DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::Delete(ObjectId pool) { return BufferPoolManager::Delete(pool); }
 
 // Allocate and Return, with their fast paths, are in BufferPoolManager.cpp.
 
-Result<BufferPoolStatistics> BufferPoolAgent::GetStatistics(ObjectId pool) const
+Result<BufferPoolStatistics> BufferPoolAgent::GetStatistics(ObjectId pool)
 {
     return BufferPoolManager::GetStatistics(pool);
 }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolAgent::NameToObject(const char* name)
 {
     return BufferPoolManager::NameToObject(name, Visibility::Local);
 }
 
-DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::AddObjects(size_t count) const { return BufferPoolManager::AddObjects(count); }
+DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::AddObjects(size_t count) { return BufferPoolManager::AddObjects(count); }
 
-DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::XferOwnership(ObjectId pool, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::XferOwnership(ObjectId pool, ObjectId newOwner)
 {
     return BufferPoolManager::XferOwnership(pool, newOwner);
 }
 
-DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::XferOwnership(ObjectId pool, void* buffer, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::XferOwnership(ObjectId pool, void* buffer, ObjectId newOwner)
 {
     return BufferPoolManager::XferOwnership(pool, buffer, newOwner);
 }

@@ -306,7 +306,7 @@ using internal::BufferPoolManager;
 // resolves the id again under its own guard and gives the precise status.
 // callerHolder() never gives kFreeMark, as tryAllocate requires.
 
-Result<void*> BufferPoolAgent::Allocate(ObjectId id) const
+Result<void*> BufferPoolAgent::Allocate(ObjectId id)
 {
     {
         const internal::Lock lock;
@@ -320,7 +320,7 @@ Result<void*> BufferPoolAgent::Allocate(ObjectId id) const
     return BufferPoolManager::Allocate(id);
 }
 
-Status BufferPoolAgent::Return(ObjectId id, void* buffer) const
+Status BufferPoolAgent::Return(ObjectId id, void* buffer)
 {
     {
         const internal::Lock lock;

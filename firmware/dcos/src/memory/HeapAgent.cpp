@@ -8,30 +8,30 @@ namespace dcos {
 
 using internal::HeapManager;
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> HeapAgent::Create(void* area, size_t areaBytes, const char* name, Visibility visibility) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> HeapAgent::Create(void* area, size_t areaBytes, const char* name, Visibility visibility)
 {
     return HeapManager::Create(area, areaBytes, name, visibility);
 }
 
-DCOS_CONFIGURATION_SERVICE Status HeapAgent::Delete(ObjectId heap) const { return HeapManager::Delete(heap); }
+DCOS_CONFIGURATION_SERVICE Status HeapAgent::Delete(ObjectId heap) { return HeapManager::Delete(heap); }
 
 // Allocate and Return, with the table's inline lookup, are in HeapManager.cpp.
 
-Result<HeapStatistics> HeapAgent::GetStatistics(ObjectId heap) const { return HeapManager::GetStatistics(heap); }
+Result<HeapStatistics> HeapAgent::GetStatistics(ObjectId heap) { return HeapManager::GetStatistics(heap); }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> HeapAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> HeapAgent::NameToObject(const char* name)
 {
     return HeapManager::NameToObject(name, Visibility::Local);
 }
 
-DCOS_CONFIGURATION_SERVICE Status HeapAgent::AddObjects(size_t count) const { return HeapManager::AddObjects(count); }
+DCOS_CONFIGURATION_SERVICE Status HeapAgent::AddObjects(size_t count) { return HeapManager::AddObjects(count); }
 
-DCOS_CONFIGURATION_SERVICE Status HeapAgent::XferOwnership(ObjectId heap, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status HeapAgent::XferOwnership(ObjectId heap, ObjectId newOwner)
 {
     return HeapManager::XferOwnership(heap, newOwner);
 }
 
-DCOS_CONFIGURATION_SERVICE Status HeapAgent::XferOwnership(ObjectId heap, void* segment, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status HeapAgent::XferOwnership(ObjectId heap, void* segment, ObjectId newOwner)
 {
     return HeapManager::XferOwnership(heap, segment, newOwner);
 }

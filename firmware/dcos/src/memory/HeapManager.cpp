@@ -286,7 +286,7 @@ using internal::SegmentedHeap;
 // that lookup refuses goes to the manager's complete service, which
 // resolves it again and gives the precise status.
 
-Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes) const
+Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes)
 {
     {
         const internal::Lock lock;
@@ -297,7 +297,7 @@ Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes) const
     return HeapManager::Allocate(id, bytes);
 }
 
-Status HeapAgent::Return(ObjectId id, void* segment) const
+Status HeapAgent::Return(ObjectId id, void* segment)
 {
     {
         const internal::Lock lock;

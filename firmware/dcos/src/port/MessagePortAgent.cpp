@@ -234,7 +234,7 @@ namespace {
 
 } // namespace
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> MessagePortAgent::Create(const char* name, Visibility visibility, PortOrder order) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> MessagePortAgent::Create(const char* name, Visibility visibility, PortOrder order)
 {
     if (order != PortOrder::Priority && order != PortOrder::Fifo) {
         return Status::InvalidArgument;
@@ -255,7 +255,7 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> MessagePortAgent::Create(const char*
     return id.value();
 }
 
-DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::Delete(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::Delete(ObjectId id)
 {
     arch_x86::InterruptGuard guard;
     start();
@@ -272,7 +272,7 @@ DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::Delete(ObjectId id) const
     return Status::Ok;
 }
 
-Status MessagePortAgent::Send(ObjectId id, const Message& message, int priority) const
+Status MessagePortAgent::Send(ObjectId id, const Message& message, int priority)
 {
     // The fast path queues a message on a live port no receiver waits at;
     // a hand-over to a waiting receiver, an error or a wrong id goes the full way.
@@ -290,7 +290,7 @@ Status MessagePortAgent::Send(ObjectId id, const Message& message, int priority)
     return sendFull(id, message, priority);
 }
 
-Status MessagePortAgent::Receive(ObjectId id, Message& message, uint64_t timeoutNs) const
+Status MessagePortAgent::Receive(ObjectId id, Message& message, uint64_t timeoutNs)
 {
     // The fast path takes a queued message for the port's owner; an empty
     // queue (a wait), an error or a wrong id goes the full way.
@@ -310,7 +310,7 @@ Status MessagePortAgent::Receive(ObjectId id, Message& message, uint64_t timeout
     return internal::callSlowPath(receiveFull, id, &message, &timeoutNs);
 }
 
-DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddMsgBufs(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddMsgBufs(size_t count)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -320,14 +320,14 @@ DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddMsgBufs(size_t count) con
     return bufferPool.AddMsgBufs(count);
 }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> MessagePortAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> MessagePortAgent::NameToObject(const char* name)
 {
     arch_x86::InterruptGuard guard;
     start();
     return portTable.NameToObject(name, Visibility::Local);
 }
 
-DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddObjects(size_t count)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -337,7 +337,7 @@ DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddObjects(size_t count) con
     return portTable.AddObjects(count);
 }
 
-DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::XferOwnership(ObjectId id, ObjectId newOwner)
 {
     const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
     if (newOwnerStatus != Status::Ok) {

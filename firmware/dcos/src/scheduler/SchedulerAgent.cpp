@@ -25,7 +25,7 @@ extern "C" Status dcosYieldGeneral()
     return Status::Ok;
 }
 
-Status SchedulerAgent::SetDeadline(DeadlineStart start, uint64_t executionPeriodNs, uint64_t deadlinePeriodNs) const
+Status SchedulerAgent::SetDeadline(DeadlineStart start, uint64_t executionPeriodNs, uint64_t deadlinePeriodNs)
 {
     if (deadlinePeriodNs == 0 || executionPeriodNs > deadlinePeriodNs ||
         static_cast<uint8_t>(start) > static_cast<uint8_t>(DeadlineStart::AtNextBlock)) {
@@ -54,7 +54,7 @@ Status SchedulerAgent::SetDeadline(DeadlineStart start, uint64_t executionPeriod
     return Status::Ok;
 }
 
-Status SchedulerAgent::ClearDeadline() const
+Status SchedulerAgent::ClearDeadline()
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -72,7 +72,7 @@ Status SchedulerAgent::ClearDeadline() const
     return Status::Ok;
 }
 
-Status SchedulerAgent::SetTimeSliceQuantum(uint64_t nanoseconds) const
+Status SchedulerAgent::SetTimeSliceQuantum(uint64_t nanoseconds)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -85,7 +85,7 @@ Status SchedulerAgent::SetTimeSliceQuantum(uint64_t nanoseconds) const
     return Status::Ok;
 }
 
-Status SchedulerAgent::StartProfiling(ObjectId id) const
+Status SchedulerAgent::StartProfiling(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -100,7 +100,7 @@ Status SchedulerAgent::StartProfiling(ObjectId id) const
     return Status::Ok;
 }
 
-Status SchedulerAgent::StopProfiling(ObjectId id) const
+Status SchedulerAgent::StopProfiling(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -128,7 +128,7 @@ Status SchedulerAgent::StopProfiling(ObjectId id) const
     return Status::Ok;
 }
 
-Result<TimingInfo> SchedulerAgent::GetTimingInfo(ObjectId id) const
+Result<TimingInfo> SchedulerAgent::GetTimingInfo(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {

@@ -1,5 +1,5 @@
 /*
- * Status SchedulerAgent::Yield() const (seed 7.4): the round-robin step and
+ * Status SchedulerAgent::Yield() (seed 7.4): the round-robin step and
  * the switch to the next task of the same priority, in one pass.
  *
  * Yield is the primitive that is nothing but a context switch, so it is
@@ -18,13 +18,13 @@
  * restores the flags saved at entry, so a task resumed from an interrupt's
  * exit (frameForDirectResume, interrupts off) gets its own flags back.
  *
- * Calling convention: -mregparm=3; EAX holds `this`, unused; the Status is
+ * Calling convention: -mregparm=3, no arguments (a static member); the Status is
  * returned in AL.
  */
 #include <dcos/internal/YieldFastPath.h>
 
     /* The section name the linker script keeps for the agents' interface. */
-    .section .text._ZNK4dcos14SchedulerAgent5YieldEv, "ax", @progbits
+    .section .text._ZN4dcos14SchedulerAgent5YieldEv, "ax", @progbits
     .code32
 
     .globl SCHEDULER_AGENT_YIELD

@@ -249,7 +249,7 @@ using internal::Semaphore;
 using internal::Task;
 using internal::TaskManager;
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::Create(const SemaphoreAttributes& attributes) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::Create(const SemaphoreAttributes& attributes)
 {
     const bool binary = attributes.kind == SemaphoreKind::Binary;
     if ((attributes.kind != SemaphoreKind::Binary && attributes.kind != SemaphoreKind::Counting) ||
@@ -289,7 +289,7 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::Create(const Semapho
     return semaphore.id;
 }
 
-DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::Delete(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::Delete(ObjectId id)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -308,7 +308,7 @@ DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::Delete(ObjectId id) const
     return Status::Ok;
 }
 
-Status SemaphoreAgent::Acquire(ObjectId id, uint64_t timeout) const
+Status SemaphoreAgent::Acquire(ObjectId id, uint64_t timeout)
 {
     // The fast path takes a free binary semaphore without inheritance from
     // a task, or a unit of a counting one; everything else, a wrong id and
@@ -335,7 +335,7 @@ Status SemaphoreAgent::Acquire(ObjectId id, uint64_t timeout) const
     return internal::callSlowPath(internal::acquireFull, id, &timeout);
 }
 
-Status SemaphoreAgent::Release(ObjectId id) const
+Status SemaphoreAgent::Release(ObjectId id)
 {
     // The fast path gives back what no task waits for; a hand-over to a
     // waiter, a semaphore with inheritance, an error or a wrong id goes the
@@ -365,7 +365,7 @@ Status SemaphoreAgent::Release(ObjectId id) const
     return internal::callSlowPath(internal::releaseFull, id);
 }
 
-Result<uint32_t> SemaphoreAgent::GetCount(ObjectId id) const
+Result<uint32_t> SemaphoreAgent::GetCount(ObjectId id)
 {
     arch_x86::InterruptGuard guard;
     const Result<Semaphore*> semaphore = internal::resolve(id);
@@ -375,7 +375,7 @@ Result<uint32_t> SemaphoreAgent::GetCount(ObjectId id) const
     return semaphore.value()->count;
 }
 
-Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id) const
+Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id)
 {
     arch_x86::InterruptGuard guard;
     const Result<Semaphore*> semaphore = internal::resolve(id);
@@ -385,14 +385,14 @@ Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id) const
     return semaphore.value()->holder != nullptr ? semaphore.value()->holder->id : ObjectId::null();
 }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::NameToObject(const char* name)
 {
     arch_x86::InterruptGuard guard;
     internal::ensureTable();
     return internal::table.NameToObject(name, Visibility::Local);
 }
 
-DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::XferOwnership(ObjectId id, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::XferOwnership(ObjectId id, ObjectId newOwner)
 {
     arch_x86::InterruptGuard guard;
     const Result<Semaphore*> semaphore = internal::resolve(id);
@@ -411,7 +411,7 @@ DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::XferOwnership(ObjectId id, Obj
     return internal::table.XferOwnership(id, internal::table.ownerOf(id).value(), newOwner);
 }
 
-DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::AddObjects(size_t count)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;

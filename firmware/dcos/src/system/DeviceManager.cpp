@@ -333,57 +333,57 @@ namespace dcos {
 // ring 3 these become the trap stubs, and ids of other nodes will be routed
 // to the network manager here instead of being refused with Remote.
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> SystemAgent::Create(Device& device, const char* name, Visibility visibility) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> SystemAgent::Create(Device& device, const char* name, Visibility visibility)
 {
     return internal::deviceManager().Create(device, name, visibility);
 }
 
-DCOS_CONFIGURATION_SERVICE Status SystemAgent::Delete(ObjectId device) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::Delete(ObjectId device)
 {
     return internal::deviceManager().Delete(device);
 }
 
-Status SystemAgent::Probe(ObjectId device) const
+Status SystemAgent::Probe(ObjectId device)
 {
     return internal::deviceManager().Probe(device);
 }
 
-DCOS_CONFIGURATION_SERVICE Status SystemAgent::Open(ObjectId device) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::Open(ObjectId device)
 {
     return internal::deviceManager().Open(device);
 }
 
-DCOS_CONFIGURATION_SERVICE Status SystemAgent::Close(ObjectId device) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::Close(ObjectId device)
 {
     return internal::deviceManager().Close(device);
 }
 
-Result<size_t> SystemAgent::Read(ObjectId device, uint32_t channel, void* buffer, size_t length) const
+Result<size_t> SystemAgent::Read(ObjectId device, uint32_t channel, void* buffer, size_t length)
 {
     return internal::deviceManager().Read(device, channel, buffer, length);
 }
 
-Result<size_t> SystemAgent::Write(ObjectId device, uint32_t channel, const void* buffer, size_t length) const
+Result<size_t> SystemAgent::Write(ObjectId device, uint32_t channel, const void* buffer, size_t length)
 {
     return internal::deviceManager().Write(device, channel, buffer, length);
 }
 
-Status SystemAgent::Control(ObjectId device, uint32_t command, void* argument, size_t length) const
+Status SystemAgent::Control(ObjectId device, uint32_t command, void* argument, size_t length)
 {
     return internal::deviceManager().Control(device, command, argument, length);
 }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> SystemAgent::NameToObject(const char* name) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> SystemAgent::NameToObject(const char* name)
 {
     return internal::deviceManager().NameToObject(name, Visibility::Local);
 }
 
-DCOS_CONFIGURATION_SERVICE Status SystemAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::AddObjects(size_t count)
 {
     return internal::deviceManager().AddObjects(count);
 }
 
-DCOS_CONFIGURATION_SERVICE Status SystemAgent::XferOwnership(ObjectId device, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status SystemAgent::XferOwnership(ObjectId device, ObjectId newOwner)
 {
     return internal::deviceManager().XferOwnership(device, newOwner);
 }

@@ -91,19 +91,19 @@ namespace dcos {
 // The interrupt half of the system agent's interface object; the device
 // half is in DeviceManager.cpp.
 
-Status SystemAgent::InstallISR(unsigned line, InterruptServiceRoutine isr, void* context) const
+Status SystemAgent::InstallISR(unsigned line, InterruptServiceRoutine isr, void* context)
 {
     return internal::InterruptManager::installIsr(line, isr, context);
 }
 
-Status SystemAgent::RemoveISR(unsigned line) const { return internal::InterruptManager::removeIsr(line); }
+Status SystemAgent::RemoveISR(unsigned line) { return internal::InterruptManager::removeIsr(line); }
 
-Result<uint8_t> SystemAgent::SetInterruptLevel(uint8_t level) const
+Result<uint8_t> SystemAgent::SetInterruptLevel(uint8_t level)
 {
     return internal::InterruptManager::setInterruptLevel(level);
 }
 
-Status SystemAgent::SetInterruptLevel(uint8_t priority, uint8_t legalLimit) const
+Status SystemAgent::SetInterruptLevel(uint8_t priority, uint8_t legalLimit)
 {
     return internal::InterruptManager::setLegalLimit(priority, legalLimit);
 }

@@ -43,7 +43,7 @@ Status checkLifeControl(const Task& target)
 
 } // namespace
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::Create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::Create(const TaskAttributes& attributes, TaskEntry entry, uintptr_t argument)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -51,7 +51,7 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::Create(const TaskAttribut
     return TaskManager::create(attributes, entry, argument);
 }
 
-DCOS_CONFIGURATION_SERVICE Status TaskAgent::Delete() const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::Delete()
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -59,7 +59,7 @@ DCOS_CONFIGURATION_SERVICE Status TaskAgent::Delete() const
     TaskManager::exitCurrent();
 }
 
-DCOS_CONFIGURATION_SERVICE Status TaskAgent::KillTask(ObjectId id) const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::KillTask(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -69,7 +69,7 @@ DCOS_CONFIGURATION_SERVICE Status TaskAgent::KillTask(ObjectId id) const
     return allowed != Status::Ok ? allowed : TaskManager::kill(*task.value());
 }
 
-Status TaskAgent::Suspend(ObjectId id) const
+Status TaskAgent::Suspend(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -79,7 +79,7 @@ Status TaskAgent::Suspend(ObjectId id) const
     return allowed != Status::Ok ? allowed : TaskManager::suspend(*task.value());
 }
 
-Status TaskAgent::Resume(ObjectId id) const
+Status TaskAgent::Resume(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -89,7 +89,7 @@ Status TaskAgent::Resume(ObjectId id) const
     return allowed != Status::Ok ? allowed : TaskManager::resume(*task.value());
 }
 
-Status TaskAgent::ChangePriority(ObjectId id, uint8_t priority) const
+Status TaskAgent::ChangePriority(ObjectId id, uint8_t priority)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -99,7 +99,7 @@ Status TaskAgent::ChangePriority(ObjectId id, uint8_t priority) const
     return allowed != Status::Ok ? allowed : TaskManager::changePriority(*task.value(), priority);
 }
 
-Status TaskAgent::SleepFor(uint64_t nanoseconds) const
+Status TaskAgent::SleepFor(uint64_t nanoseconds)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -112,7 +112,7 @@ Status TaskAgent::SleepFor(uint64_t nanoseconds) const
     return status == Status::Timeout ? Status::Ok : status;
 }
 
-Status TaskAgent::SleepTill(const DateTime& time) const
+Status TaskAgent::SleepTill(const DateTime& time)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -128,7 +128,7 @@ Status TaskAgent::SleepTill(const DateTime& time) const
     return status == Status::Timeout ? Status::Ok : status;
 }
 
-Status TaskAgent::PostEvent(ObjectId id, uint32_t events) const
+Status TaskAgent::PostEvent(ObjectId id, uint32_t events)
 {
     if (events == 0) {
         return Status::InvalidArgument;
@@ -136,7 +136,7 @@ Status TaskAgent::PostEvent(ObjectId id, uint32_t events) const
     return TaskManager::postEvent(id, events);
 }
 
-Result<uint32_t> TaskAgent::ReceiveEvent(uint32_t events, EventWait mode, uint64_t timeout) const
+Result<uint32_t> TaskAgent::ReceiveEvent(uint32_t events, EventWait mode, uint64_t timeout)
 {
     if (events == 0) {
         return Status::InvalidArgument;
@@ -163,7 +163,7 @@ Result<uint32_t> TaskAgent::ReceiveEvent(uint32_t events, EventWait mode, uint64
     return task.receivedEvents;
 }
 
-Status TaskAgent::SendSignal(ObjectId id, unsigned signal) const
+Status TaskAgent::SendSignal(ObjectId id, unsigned signal)
 {
     if (signal >= 32) {
         return Status::InvalidArgument;
@@ -176,7 +176,7 @@ Status TaskAgent::SendSignal(ObjectId id, unsigned signal) const
     return Status::Ok;
 }
 
-DCOS_CONFIGURATION_SERVICE Status TaskAgent::SetSignalHandler(SignalHandler handler) const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::SetSignalHandler(SignalHandler handler)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -190,7 +190,7 @@ DCOS_CONFIGURATION_SERVICE Status TaskAgent::SetSignalHandler(SignalHandler hand
     return Status::Ok;
 }
 
-Result<uint32_t> TaskAgent::SetSignalMask(uint32_t mask) const
+Result<uint32_t> TaskAgent::SetSignalMask(uint32_t mask)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -205,7 +205,7 @@ Result<uint32_t> TaskAgent::SetSignalMask(uint32_t mask) const
     return previous;
 }
 
-DCOS_CONFIGURATION_SERVICE Status TaskAgent::SetExceptionHandler(ExceptionHandler handler) const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::SetExceptionHandler(ExceptionHandler handler)
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
@@ -215,7 +215,7 @@ DCOS_CONFIGURATION_SERVICE Status TaskAgent::SetExceptionHandler(ExceptionHandle
     return Status::Ok;
 }
 
-Status TaskAgent::ThrowException(ObjectId id, ExceptionClass exceptionClass, uint32_t code) const
+Status TaskAgent::ThrowException(ObjectId id, ExceptionClass exceptionClass, uint32_t code)
 {
     if (static_cast<uint8_t>(exceptionClass) > static_cast<uint8_t>(ExceptionClass::Fatal)) {
         return Status::InvalidArgument;
@@ -235,11 +235,11 @@ Status TaskAgent::ThrowException(ObjectId id, ExceptionClass exceptionClass, uin
     return Status::Ok;
 }
 
-ObjectId TaskAgent::IdOfSelf() const { return internal::currentTaskId(); }
+ObjectId TaskAgent::IdOfSelf() { return internal::currentTaskId(); }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::NameToObject(const char* name) const { return TaskManager::nameToObject(name); }
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::NameToObject(const char* name) { return TaskManager::nameToObject(name); }
 
-Result<TaskState> TaskAgent::GetState(ObjectId id) const
+Result<TaskState> TaskAgent::GetState(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -253,7 +253,7 @@ Result<TaskState> TaskAgent::GetState(ObjectId id) const
     return t.suspended && t.state != TaskState::Terminating ? TaskState::Suspended : t.state;
 }
 
-Result<uint8_t> TaskAgent::GetPriority(ObjectId id) const
+Result<uint8_t> TaskAgent::GetPriority(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
@@ -262,7 +262,7 @@ Result<uint8_t> TaskAgent::GetPriority(ObjectId id) const
     return task.value()->basePriority;
 }
 
-DCOS_CONFIGURATION_SERVICE Status TaskAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status TaskAgent::AddObjects(size_t count)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;

@@ -8,7 +8,7 @@ namespace dcos {
 
 using internal::TimerManager;
 
-Status TimerAgent::SetSystemClock(const DateTime& time) const
+Status TimerAgent::SetSystemClock(const DateTime& time)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;
@@ -16,40 +16,40 @@ Status TimerAgent::SetSystemClock(const DateTime& time) const
     return TimerManager::setSystemClock(time);
 }
 
-uint64_t TimerAgent::Uptime() const { return TimerManager::preciseUptimeNs(); }
+uint64_t TimerAgent::Uptime() { return TimerManager::preciseUptimeNs(); }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::Create(const char* name, Visibility visibility) const
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::Create(const char* name, Visibility visibility)
 {
     return TimerManager::createTimer(internal::currentTaskId(), name, visibility);
 }
 
-DCOS_CONFIGURATION_SERVICE Status TimerAgent::Delete(ObjectId timer) const { return TimerManager::deleteTimer(timer, internal::currentTaskId()); }
+DCOS_CONFIGURATION_SERVICE Status TimerAgent::Delete(ObjectId timer) { return TimerManager::deleteTimer(timer, internal::currentTaskId()); }
 
-Status TimerAgent::SetWatchDogAlarm(ObjectId timer, uint64_t intervalNs, AlarmNotification notification) const
+Status TimerAgent::SetWatchDogAlarm(ObjectId timer, uint64_t intervalNs, AlarmNotification notification)
 {
     return TimerManager::setWatchDogAlarm(timer, internal::currentTaskId(), intervalNs, notification);
 }
 
-Status TimerAgent::SetDayClockAlarm(ObjectId timer, const DateTime& time, AlarmNotification notification) const
+Status TimerAgent::SetDayClockAlarm(ObjectId timer, const DateTime& time, AlarmNotification notification)
 {
     return TimerManager::setDayClockAlarm(timer, internal::currentTaskId(), time, notification);
 }
 
-Status TimerAgent::SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNotification notification) const
+Status TimerAgent::SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNotification notification)
 {
     return TimerManager::setPeriodicAlarm(timer, internal::currentTaskId(), periodNs, notification);
 }
 
-Status TimerAgent::CancelAlarm(ObjectId timer) const { return TimerManager::cancelAlarm(timer, internal::currentTaskId()); }
+Status TimerAgent::CancelAlarm(ObjectId timer) { return TimerManager::cancelAlarm(timer, internal::currentTaskId()); }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::NameToObject(const char* name) const { return TimerManager::timerNameToObject(name); }
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::NameToObject(const char* name) { return TimerManager::timerNameToObject(name); }
 
-DCOS_CONFIGURATION_SERVICE Status TimerAgent::XferOwnership(ObjectId timer, ObjectId newOwner) const
+DCOS_CONFIGURATION_SERVICE Status TimerAgent::XferOwnership(ObjectId timer, ObjectId newOwner)
 {
     return TimerManager::xferOwnership(timer, internal::currentTaskId(), newOwner);
 }
 
-DCOS_CONFIGURATION_SERVICE Status TimerAgent::AddObjects(size_t count) const
+DCOS_CONFIGURATION_SERVICE Status TimerAgent::AddObjects(size_t count)
 {
     if (!internal::currentTaskIsSuperUser()) {
         return Status::NotPermitted;

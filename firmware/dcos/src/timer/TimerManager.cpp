@@ -494,6 +494,6 @@ namespace dcos {
 // TimerAgent.cpp so that the clock read is inlined into it: the call and
 // frame of a forwarding function would take a fifth of the primitive's
 // instruction budget.
-Result<DateTime> TimerAgent::GetSystemClock() const { return internal::readSystemClock(); }
+Result<DateTime> TimerAgent::GetSystemClock() { return internal::readSystemClock(); }
 
 } // namespace dcos

@@ -27,8 +27,8 @@
 #define SCHEDULER_READY_QUEUES _ZN4dcos8internal9Scheduler12readyQueues_E
 #define IDT_NESTING_DEPTH _ZN8arch_x863Idt6depth_E
 
-/* dcos::SchedulerAgent::Yield() const, and the C++ general path it falls back to. */
-#define SCHEDULER_AGENT_YIELD _ZNK4dcos14SchedulerAgent5YieldEv
+/* dcos::SchedulerAgent::Yield(), a static member, and the C++ general path it falls back to. */
+#define SCHEDULER_AGENT_YIELD _ZN4dcos14SchedulerAgent5YieldEv
 #define SCHEDULER_YIELD_GENERAL dcosYieldGeneral
 
 /* dcos::Status values. */
