@@ -76,15 +76,6 @@ bool Scheduler::isMoreUrgent(const Task& a, const Task& b)
     return a.priority < b.priority;
 }
 
-DeadlineKey Scheduler::urgencyKey(const Task& task)
-{
-    if (!task.inDeadlineScope) {
-        return task.inheritedDeadline;
-    }
-    const DeadlineKey own = DeadlineKey::make(task.priority, task.deadlineNs - task.deadlinePeriodNs,
-                                              task.deadlinePeriodNs, task.executionPeriodNs);
-    return task.inheritsDeadline && task.inheritedDeadline.precedes(own) ? task.inheritedDeadline : own;
-}
 
 void Scheduler::makeReady(Task& task)
 {

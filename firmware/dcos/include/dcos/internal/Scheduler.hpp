@@ -59,7 +59,17 @@ public:
     static bool isMoreUrgent(const Task& a, const Task& b);
     /// The key a deadline-scheduled task is ordered by: its own scope's,
     /// or the one a waiter lends it when that is more urgent.
-    static DeadlineKey urgencyKey(const Task& task);
+    /// Inline: makeReadyByDeadline then builds the key in the heap node's
+    /// place instead of building it, returning it and copying it twice.
+    [[gnu::always_inline]] static DeadlineKey urgencyKey(const Task& task)
+    {
+        if (!task.inDeadlineScope) {
+            return task.inheritedDeadline;
+        }
+        const DeadlineKey own = DeadlineKey::make(task.priority, task.deadlineNs - task.deadlinePeriodNs,
+                                                  task.deadlinePeriodNs, task.executionPeriodNs);
+        return task.inheritsDeadline && task.inheritedDeadline.precedes(own) ? task.inheritedDeadline : own;
+    }
 
     /// Asks for a task switch: at once from task context (through the
     /// dispatch trap), or at the outermost interrupt exit from a handler.
