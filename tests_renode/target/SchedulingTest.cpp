@@ -79,7 +79,10 @@ void yieldingEntry(uintptr_t mark)
 {
     for (int i = 0; i < 3; ++i) {
         Trace::record(static_cast<char>(mark));
-        (void)schedulerAgent.Yield();
+        // Whichever path resumed the task, Yield reports Ok.
+        if (schedulerAgent.Yield() != Status::Ok) {
+            Trace::record('!');
+        }
     }
     finished();
 }
@@ -100,7 +103,7 @@ DCOS_TARGET_TEST(roundRobinTest, "roundrobin", "Yield passes the CPU among equal
 
 // --- Yield's general cases ---------------------------------------------------------
 //
-// Yield's fast path (scheduler/YieldFastPath.S) takes only a next task that
+// Yield's fast path (scheduler/TaskContextSwitch.S) takes only a next task that
 // left through a direct switch and has nothing to be delivered. These two
 // cases must go the general way: a next task preempted at an interrupt's
 // exit, which resumes from its interrupt frame, and a next task with a
@@ -129,7 +132,9 @@ void yieldToPreemptedEntry(uintptr_t)
         }
     }
     yieldPhase = true;
-    (void)schedulerAgent.Yield();
+    if (schedulerAgent.Yield() != Status::Ok) {
+        Trace::record('!');
+    }
     Trace::record('A');
     finished();
 }
@@ -140,7 +145,9 @@ void signalledPartnerEntry(uintptr_t)
 {
     (void)taskAgent.SetSignalHandler(yieldSignalHandler);
     Trace::record('b');
-    (void)schedulerAgent.Yield(); // Parked by the fast path.
+    if (schedulerAgent.Yield() != Status::Ok) { // Parked by the fast path.
+        Trace::record('!');
+    }
     Trace::record('B');
     finished();
 }
@@ -152,7 +159,9 @@ void yieldToSignalledEntry(uintptr_t)
     Trace::record('a');
     (void)schedulerAgent.Yield(); // The partner runs and installs its handler.
     (void)taskAgent.SendSignal(signalledPartner, 4);
-    (void)schedulerAgent.Yield(); // Its handler runs before it continues.
+    if (schedulerAgent.Yield() != Status::Ok) { // Its handler runs before it continues.
+        Trace::record('!');
+    }
     Trace::record('A');
     finished();
 }

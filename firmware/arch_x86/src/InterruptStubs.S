@@ -48,6 +48,7 @@ interrupt_common:
     movl %esp, %eax             /* InterruptFrame* argument, in EAX (regparm) */
     call interruptEntry
     movl %eax, %esp             /* Resume the frame the dispatcher chose. */
+    .globl interrupt_return     /* Also the way into a frame for the scheduler's switch. */
 interrupt_return:
     /* The same rule on the way back: a return to ring 0 finds the kernel's
        segments loaded and skips the four segment loads. */

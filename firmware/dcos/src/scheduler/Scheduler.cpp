@@ -1,6 +1,6 @@
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
-#include <dcos/internal/YieldFastPath.h>
+#include <dcos/internal/TaskContextSwitch.h>
 
 #include <boot/Panic.hpp>
 
@@ -11,7 +11,7 @@
 
 namespace dcos::internal {
 
-// The layout YieldFastPath.S relies on, checked against the C++ one.
+// The layout TaskContextSwitch.S relies on, checked against the C++ one.
 // offsetof on Task, which has several bases, is conditionally supported;
 // GCC supports it and computes the offsets the assembler needs.
 #pragma GCC diagnostic push
@@ -19,6 +19,7 @@ namespace dcos::internal {
 struct TaskAssemblyLayout {
     static_assert(offsetof(Task, priority) == TASK_PRIORITY);
     static_assert(offsetof(Task, resumeStack) == TASK_RESUME_STACK);
+    static_assert(offsetof(Task, savedFrame) == TASK_SAVED_FRAME);
     static_assert(offsetof(Task, switchWork) == TASK_SWITCH_WORK);
     static_assert(offsetof(Task, rotatesOnYield) == TASK_ROTATES_ON_YIELD);
     static_assert(offsetof(Task, deliveryPending) == TASK_DELIVERY_PENDING);
@@ -48,7 +49,7 @@ DeadlineQueue<Task, kTaskCapacity> Scheduler::deadlineQueue_;
 
 void Scheduler::setIdleTask(Task& idle)
 {
-    // YieldFastPath.S compares a task's address with its ring's head, which
+    // TaskContextSwitch.S compares a task's address with its ring's head, which
     // points at the task's ready node: the node must be the first base.
     if (reinterpret_cast<uintptr_t>(static_cast<IntrusiveListNode<ReadyQueueTag>*>(&idle)) !=
         reinterpret_cast<uintptr_t>(&idle)) {
@@ -119,10 +120,10 @@ void Scheduler::dispatchToMoreUrgent(Task& running, Task& task)
     // path, which uses the dispatch trap.
     if (dispatchHolds_ == 0 && !dispatchPending_ && deadlineQueue_.isEmpty() && !task.hasDeliveryPending() &&
         running.state != TaskState::Terminating) {
-        switchDirectly(running, task);
-    } else {
-        requestDispatch();
+        switchDirectly(running, task, flags);
+        return;
     }
+    requestDispatch();
     restoreInterrupts(flags);
 }
 
@@ -185,7 +186,8 @@ void Scheduler::switchFromTask()
     } else {
         dispatchPending_ = false;
         if (next != previous) {
-            switchDirectly(*previous, *next);
+            switchDirectly(*previous, *next, flags);
+            return;
         }
     }
     restoreInterrupts(flags);

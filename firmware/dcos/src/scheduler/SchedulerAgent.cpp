@@ -14,7 +14,7 @@ using internal::Task;
 using internal::TaskManager;
 using internal::TimerManager;
 
-// SchedulerAgent::Yield is scheduler/YieldFastPath.S, which handles the
+// SchedulerAgent::Yield is scheduler/TaskContextSwitch.S, which handles the
 // common case itself and jumps here for every other one.
 extern "C" Status dcosYieldGeneral()
 {

@@ -10,7 +10,8 @@
 //
 // Task switches happen in two places. A task that blocks, yields or readies
 // a more urgent task switches at once, from task context, through
-// directSwitch (switchFromTask): it saves only its callee-saved registers.
+// dcosSwitchFromTask (switchFromTask, scheduler/TaskContextSwitch.S): it
+// saves only its callee-saved registers and its flags.
 // An interrupt handler that readies a task only marks a dispatch as pending,
 // and the switch happens at the exit of the outermost interrupt
 // (onOutermostExit), from the interrupted frame. Either side resumes either
@@ -29,6 +30,10 @@
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/InterruptFrame.hpp>
 #include <arch_x86/TaskSwitch.hpp>
+
+/// The switch from task context (scheduler/TaskContextSwitch.S): parks the
+/// caller with @p flags to restore, at *save, and resumes @p next.
+extern "C" [[gnu::regparm(3)]] void dcosSwitchFromTask(uint32_t** save, dcos::internal::Task* next, uint32_t flags);
 
 namespace dcos::internal {
 
@@ -112,7 +117,8 @@ public:
         } else if (next->hasDeliveryPending()) {
             requestDispatch(); // Rotated; the general switch delivers on the way.
         } else {
-            switchDirectly(*task, *next);
+            switchDirectly(*task, *next, flags);
+            return;
         }
         restoreInterrupts(flags);
     }
@@ -158,20 +164,21 @@ private:
         }
     }
 
-    /// The direct switch itself, for both callers (yieldCurrent and
-    /// switchFromTask): next becomes the runner, what the two tasks carry
-    /// beyond registers is saved and restored, and the stacks change.
-    /// Interrupts are disabled; returns when previous runs again.
-    [[gnu::always_inline]] static void switchDirectly(Task& previous, Task& next)
+    /// The direct switch itself, for its three callers (yieldCurrent,
+    /// switchFromTask, dispatchToMoreUrgent): next becomes the runner, what
+    /// the two tasks carry beyond registers is saved and restored, and the
+    /// stacks change (dcosSwitchFromTask, TaskContextSwitch.S). Interrupts
+    /// are disabled; @p flags are the caller's, restored when previous runs
+    /// again. It is the caller's last act, so GCC jumps to the assembly
+    /// rather than calling it, and no C++ frame stays behind on the stack.
+    [[gnu::always_inline]] static void switchDirectly(Task& previous, Task& next, uint32_t flags)
     {
         current_ = &next;
         ++switchCount_;
         if (previous.switchWork || next.switchWork) {
             TaskManager::switchContext(previous, next);
         }
-        uint32_t* const resumeStack = next.resumeStack;
-        next.resumeStack = nullptr;
-        directSwitch(&previous.resumeStack, resumeStack, next.savedFrame);
+        dcosSwitchFromTask(&previous.resumeStack, &next, flags);
     }
 
     /// EFLAGS bit 1, always set (Intel SDM Vol. 1, 3.4.3).

@@ -214,7 +214,7 @@ struct Task : IntrusiveListNode<ReadyQueueTag>, DeadlineQueueNode, WaitListNode<
     }
 
 private:
-    friend struct TaskAssemblyLayout; // Checks the offsets scheduler/YieldFastPath.S uses.
+    friend struct TaskAssemblyLayout; // Checks the offsets scheduler/TaskContextSwitch.S uses.
 
     bool deliveryPending = false;
 

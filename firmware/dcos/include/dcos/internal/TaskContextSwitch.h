@@ -1,6 +1,6 @@
 /*
- * What the assembly fast path of Yield (scheduler/YieldFastPath.S) knows of
- * the kernel's C++ objects: field offsets in a Task, the scheduler's and the
+ * What the scheduler's assembly (scheduler/TaskContextSwitch.S: the switch
+ * from task context and Yield's fast path) knows of the kernel's C++ objects: field offsets in a Task, the scheduler's and the
  * interrupt table's static members by their linkage names, and status
  * codes. Plain defines, so that the assembler and the compiler read the
  * same file; Scheduler.cpp checks every value against the C++ layout at
@@ -11,6 +11,7 @@
 /* Offsets in dcos::internal::Task. */
 #define TASK_READY_NEXT 4          /* IntrusiveListNode<ReadyQueueTag>::next_ (the node is the first base) */
 #define TASK_PRIORITY 71
+#define TASK_SAVED_FRAME 84
 #define TASK_RESUME_STACK 88
 /*
  * Three adjacent bytes, so that one compare tests two of them:
@@ -30,6 +31,9 @@
 /* dcos::SchedulerAgent::Yield(), a static member, and the C++ general path it falls back to. */
 #define SCHEDULER_AGENT_YIELD _ZN4dcos14SchedulerAgent5YieldEv
 #define SCHEDULER_YIELD_GENERAL dcosYieldGeneral
+
+/* The switch from task context, called from C++ (Scheduler::switchDirectly). */
+#define SCHEDULER_SWITCH_FROM_TASK dcosSwitchFromTask
 
 /* dcos::Status values. */
 #define STATUS_OK 0
