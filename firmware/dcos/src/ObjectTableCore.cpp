@@ -137,6 +137,12 @@ Result<ObjectId> ObjectTableCore<SlotNumber>::nameToObject(const char* name, Vis
     return idOf(found);
 }
 
+template <typename SlotNumber>
+Status ObjectTableCore<SlotNumber>::missReason(ObjectId id) const
+{
+    return missReasonInline(id);
+}
+
 // FNV-1a over at most kObjectNameCapacity characters, in the pass that
 // measures the name, so that an unterminated name cannot run away.
 template <typename SlotNumber>

@@ -125,6 +125,34 @@ public:
     DCOS_CONFIGURATION_SERVICE [[gnu::noinline]] Result<ObjectId> nameToObject(
         const char* name, Visibility askingScope) const;
 
+    /// Why @p id names no live object of this table: InvalidId for the null
+    /// id or an index never handed out, WrongType, Remote, or StaleId. The
+    /// typed table's lookups check the hit inline and call this only on a
+    /// miss, so the rules are compiled once and a hit costs two compares.
+    DCOS_CONFIGURATION_SERVICE [[gnu::noinline]] Status missReason(ObjectId id) const;
+
+    /// missReason's rules, inline, for the one lookup that must not call out
+    /// (ObjectTable::resolve, see there).
+    Status missReasonInline(ObjectId id) const
+    {
+        if (id.isNull()) {
+            return Status::InvalidId;
+        }
+        if (id.type() != type_) {
+            return Status::WrongType;
+        }
+        if (id.node() != node_) {
+            // An object of this type on another node: the agents will hand
+            // such ids to the network interfaces manager; until it exists
+            // the object is unreachable.
+            return Status::Remote;
+        }
+        if (id.index() >= issued_) {
+            return Status::InvalidId; // Never handed out: forged.
+        }
+        return Status::StaleId; // Handed out once; its object is gone.
+    }
+
     static bool isValidOwner(ObjectId owner) { return owner.isNull() || owner.type() == ObjectType::Task; }
 
 private:
