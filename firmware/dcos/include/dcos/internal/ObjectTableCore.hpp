@@ -52,9 +52,10 @@ struct ObjectEntryHeader {
 /// every list starts empty in zero-initialised storage.
 ///
 /// Sixteen bits for every table, though one byte would link a table of at
-/// most 128 slots: one width for all lets every table below 4097 slots share
-/// one compiled core, which saves more code (about 1.6 KB) than the wider
-/// links cost data (at most 3 bytes a slot and one per owner list).
+/// most 128 slots: one width for all lets every table of the production
+/// kernel share one compiled core, which saves more code (about 1.7 KB) than
+/// the wider links cost data (five bytes a slot and one per owner list in a
+/// table of at most 128 slots).
 using ObjectLink = uint16_t;
 
 /// The links of a used slot, kept apart from the entries so that the
