@@ -10,6 +10,7 @@
 # Kernel sources with no hardware access: built for the host tests and the firmware.
 DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/GregorianCalendar.cpp \
+	firmware/dcos/src/ObjectTableCore.cpp \
 	firmware/dcos/src/ResourceRecovery.cpp \
 	firmware/dcos/src/StackArena.cpp \
 	firmware/dcos/src/memory/BufferPool.cpp \
@@ -46,6 +47,7 @@ DCOS_FULL_SRCS := $(DCOS_PORTABLE_SRCS) $(DCOS_TARGET_SRCS)
 DCOS_CORE_SRCS := \
 	firmware/dcos/src/kernel/Kernel.cpp \
 	firmware/dcos/src/GregorianCalendar.cpp \
+	firmware/dcos/src/ObjectTableCore.cpp \
 	firmware/dcos/src/ResourceRecovery.cpp \
 	firmware/dcos/src/StackArena.cpp \
 	firmware/dcos/src/system/DeviceManager.cpp \

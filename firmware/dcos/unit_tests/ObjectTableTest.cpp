@@ -7,6 +7,7 @@
 #include <deque>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <random>
 #include <set>
 #include <string>
@@ -773,4 +774,36 @@ TEST(ObjectTableTest, RandomOperationsAgreeWithAModelInAFullSizeTable)
     ObjectTableModelTest<Table> model(table, 4096, 1);
     model.run(30000, 97);
     EXPECT_GT(model.maxLive(), 1000u);
+}
+
+namespace {
+
+// An object of an odd size, so that its entries' stride is no power of two
+// and its bookkeeping sits at another offset than a Semaphore's.
+struct OddObject {
+    char bytes[13] = {};
+};
+
+} // namespace
+
+TEST(ObjectTableTest, TablesOfDifferentTypesShareACompiledCoreAndKeepTheirOwnState)
+{
+    // The configuration services run in ObjectTableCore, compiled once per
+    // slot width and reaching the entries through a stride: two tables of
+    // different object types and sizes but the same width, worked on in
+    // turns, must each still agree with their own model.
+    using SemaphoreTable = ObjectTable<Semaphore, 64, FewOwnerKeys>;
+    using OddTable = ObjectTable<OddObject, 256>;
+    for (uint32_t seed = 200; seed <= 205; ++seed) {
+        SCOPED_TRACE(seed);
+        const auto semaphores = std::make_unique<SemaphoreTable>(ObjectType::Semaphore, kNode);
+        const auto odd = std::make_unique<OddTable>(ObjectType::Semaphore, kNode);
+        ObjectTableModelTest<SemaphoreTable> semaphoreModel(*semaphores, seed);
+        ObjectTableModelTest<OddTable> oddModel(*odd, seed + 1000, 20);
+        for (int round = 0; round < 40; ++round) {
+            semaphoreModel.run(50, 5);
+            oddModel.run(50, 5);
+            ASSERT_FALSE(::testing::Test::HasFailure());
+        }
+    }
 }

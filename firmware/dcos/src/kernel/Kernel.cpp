@@ -105,7 +105,10 @@ uintptr_t firstFreeMemory() { return firstFreeAddress; }
 
 } // namespace dcos
 
-[[noreturn]] void kernelMain(const boot::BootInfo& bootInfo)
+// Cold: it runs once, at boot, so it and what only it calls are compiled for
+// size (the tick handler beside it stays -O2, which is why this file is not
+// in FW_COLD_SRCS).
+[[noreturn, gnu::cold]] void kernelMain(const boot::BootInfo& bootInfo)
 {
     using namespace dcos;
     bootInfoCopy = bootInfo;

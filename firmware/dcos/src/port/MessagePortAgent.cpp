@@ -124,7 +124,8 @@ size_t PortManager::portCount()
     return portTable.usedCount();
 }
 
-bool PortManager::snapshot(size_t slot, PortInfo& info)
+// Cold: only the console's port listing reads it.
+[[gnu::cold]] bool PortManager::snapshot(size_t slot, PortInfo& info)
 {
     arch_x86::InterruptGuard guard;
     start();

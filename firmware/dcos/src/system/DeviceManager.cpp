@@ -280,7 +280,8 @@ DCOS_CONFIGURATION_SERVICE unsigned DeviceManager::recoverDevicesOf(ObjectId dea
     return static_cast<unsigned>(recovered);
 }
 
-bool DeviceManager::snapshot(size_t slot, DeviceInfo& info)
+// Cold: only the console's device listing reads it.
+[[gnu::cold]] bool DeviceManager::snapshot(size_t slot, DeviceInfo& info)
 {
     if (slot >= kCapacity) {
         return false;

@@ -252,7 +252,9 @@ void terminate(Task& task)
     Scheduler::releaseDispatch();
 }
 
-void reportTermination(Task& task, const ExceptionInfo& info)
+// Cold: it prints a task's death on the console, and no real-time path
+// goes through it.
+[[gnu::cold]] void reportTermination(Task& task, const ExceptionInfo& info)
 {
     const char* name = TaskManager::nameOf(task.id);
     if (info.vector != 0xFF) {
@@ -746,7 +748,11 @@ arch_x86::InterruptFrame* TaskManager::prepareReturnWithWork(Task& task, arch_x8
     return frame;
 }
 
-arch_x86::InterruptFrame* TaskManager::onCpuException(arch_x86::InterruptFrame* frame)
+// Cold: a CPU exception is a task's error (a fault, a divide error, a
+// bound), which it ends with or handles in its exception handler; no
+// real-time path takes it (the FPU context is switched eagerly, so device
+// not available never occurs), so it is compiled for size.
+[[gnu::cold]] arch_x86::InterruptFrame* TaskManager::onCpuException(arch_x86::InterruptFrame* frame)
 {
     // Exceptions in interrupt handlers, before scheduling starts, or in the
     // idle task are kernel faults.

@@ -18,10 +18,9 @@
 // costs in proportion to what the owner holds, which is what lets a task's
 // death be recovered without a walk over every table.
 //
-// The chains cost, per slot, a 32-bit hash and four links of one byte (a
-// table of at most 128 slots) or two, plus one link per bucket and one per
-// owner key, and the free-slot ring: about 4 KiB for a kernel table of 256
-// slots.
+// The chains cost, per slot, a 32-bit hash and four links of two bytes,
+// plus one link per bucket and one per owner key, and the free-slot ring:
+// about 4 KiB for a kernel table of 256 slots.
 //
 // Stale id detection: the 12-bit index field of an ObjectId is not a slot
 // number. Every table hands out all 4096 index values, each naming at most
@@ -35,12 +34,17 @@
 // is two arrays of 4096 entries per table (12 KiB for a table of at most 256
 // slots, 16 KiB above), and Create and Delete stay O(1).
 //
+// The configuration services' work is done by ObjectTableCore, compiled
+// once for every table of the same slot width, not once per object type;
+// this class keeps the typed storage and the real-time lookups, inline.
+//
 // The table does no locking; the owning agent serialises access to it.
 #pragma once
 
 #include <dcos/ObjectId.hpp>
 #include <dcos/Status.hpp>
 #include <dcos/Visibility.hpp>
+#include <dcos/internal/ObjectTableCore.hpp>
 
 #include <bit>
 #include <stddef.h>
@@ -79,70 +83,60 @@ class ObjectTable {
     static_assert(Capacity % 8 == 0, "objects are added in groups of eight");
     static_assert(OwnerKeys::kCount >= 1 && OwnerKeys::kCount < UINT16_MAX, "owner keys fit 16 bits with one to spare");
 
+    // The smallest type that numbers every slot.
+    using SlotNumber = std::conditional_t<(Capacity <= 256), uint8_t, uint16_t>;
+    // The configuration services' work, shared by every table of the same width.
+    using Core = ObjectTableCore<SlotNumber>;
+    using Link = ObjectLink;
+
 public:
     /// Objects are activated by AddObjects in multiples of this count.
-    static constexpr size_t kGroupSize = 8;
+    static constexpr size_t kGroupSize = Core::kGroupSize;
     /// Bytes reserved for a name, including the terminating NUL.
-    static constexpr size_t kNameCapacity = 16;
+    static constexpr size_t kNameCapacity = kObjectNameCapacity;
     /// Longest name accepted by Create.
     static constexpr size_t kMaxNameLength = kNameCapacity - 1;
     /// Index values a table hands out: every value the 12-bit field holds.
-    static constexpr size_t kIndexCount = size_t{1} << ObjectId::kIndexBits;
+    static constexpr size_t kIndexCount = Core::kIndexCount;
 
     /// Creates an empty table for objects of @p type on node @p node.
     ///
     /// The constructor is constexpr so that a static table is constant
     /// initialised and needs no start-up code before the agents run.
-    constexpr ObjectTable(ObjectType type, uint16_t node) : type_(type), node_(node) {}
+    constexpr ObjectTable(ObjectType type, uint16_t node)
+        : core_(type, node, Capacity, kSystemOwnerKey, &entries_[0].header, sizeof(Entry), chains_, buckets_,
+              ownerHeads_, freeSlots_, indexSlot_, freedIndices_)
+    {
+    }
 
     ObjectTable(const ObjectTable&) = delete;
     ObjectTable& operator=(const ObjectTable&) = delete;
 
     /// The object type this table manages; ids of other types are refused.
-    constexpr ObjectType type() const { return type_; }
+    constexpr ObjectType type() const { return core_.type_; }
     /// The node id stamped into every id this table issues.
-    constexpr uint16_t node() const { return node_; }
+    constexpr uint16_t node() const { return core_.node_; }
     /// Number of slots reserved at build time.
     static constexpr size_t capacity() { return Capacity; }
     /// Number of slots activated so far by AddObjects.
-    constexpr size_t activeCount() const { return active_; }
+    constexpr size_t activeCount() const { return core_.active_; }
     /// Number of slots that currently hold a created object.
-    constexpr size_t usedCount() const { return used_; }
+    constexpr size_t usedCount() const { return core_.used_; }
     /// Number of activated slots available to Create.
-    constexpr size_t freeCount() const { return active_ - used_; }
+    constexpr size_t freeCount() const { return core_.active_ - core_.used_; }
 
     /// Changes the node id, for boards that learn their logical address at boot.
     ///
     /// Refused with Busy while objects exist, because their ids already carry
     /// the old node id and would no longer resolve. Cost O(1).
-    Status setNode(uint16_t node)
-    {
-        if (used_ != 0) {
-            return Status::Busy;
-        }
-        node_ = node;
-        return Status::Ok;
-    }
+    Status setNode(uint16_t node) { return core_.setNode(node); }
 
     /// Configuration service: activates @p count more slots.
     ///
     /// @p count must be a non-zero multiple of eight (InvalidArgument), and
     /// the active count may not exceed Capacity (TableFull); a refused
     /// request changes nothing. Cost O(count).
-    Status AddObjects(size_t count)
-    {
-        if (count == 0 || count % kGroupSize != 0) {
-            return Status::InvalidArgument;
-        }
-        if (count > Capacity - active_) {
-            return Status::TableFull;
-        }
-        for (size_t i = 0; i < count; ++i) {
-            pushFree(static_cast<uint16_t>(active_));
-            ++active_;
-        }
-        return Status::Ok;
-    }
+    Status AddObjects(size_t count) { return core_.addObjects(count); }
 
     /// Allocates a free slot and returns the id of the new object.
     ///
@@ -156,30 +150,7 @@ public:
     /// owner's list.
     Result<ObjectId> Create(ObjectId owner, const char* name, Visibility visibility)
     {
-        const NameScan scan = scanName(name);
-        if (!isValidOwner(owner) || scan.length > kMaxNameLength
-            || static_cast<uint8_t>(visibility) > static_cast<uint8_t>(Visibility::Global)) {
-            return Status::InvalidArgument;
-        }
-        if (used_ == active_) {
-            return Status::TableFull;
-        }
-        const uint16_t slot = popFree();
-        Entry& entry = entries_[slot];
-        const uint16_t index = takeIndex();
-        indexSlot_[index] = static_cast<SlotNumber>(slot);
-        entry.key = ObjectId(node_, type_, index).raw();
-        entry.owner = owner;
-        entry.visibility = visibility;
-        copyName(entry.name, name);
-        ++used_;
-        Chain& chain = chains_[slot];
-        chain.nameHash = scan.hash;
-        if (scan.length != 0) {
-            linkName(slot);
-        }
-        linkOwner(slot, ownerKey(owner));
-        return idOf(slot);
+        return core_.create(owner, ownerKey(owner), name, visibility);
     }
 
     /// Deletes the object named by @p id and frees its slot.
@@ -194,19 +165,8 @@ public:
         if (!slot.ok()) {
             return slot.status();
         }
-        Entry& entry = entries_[slot.value()];
-        if (entry.name[0] != '\0') {
-            unlinkName(slot.value());
-        }
-        unlinkOwner(slot.value());
-        entry.object = T{};
-        const uint16_t index = entry.index();
-        entry.key = 0;
-        entry.owner = ObjectId::null();
-        entry.name[0] = '\0';
-        giveBackIndex(index);
-        pushFree(slot.value());
-        --used_;
+        core_.erase(slot.value());
+        entries_[slot.value()].object = T{};
         return Status::Ok;
     }
 
@@ -218,11 +178,15 @@ public:
     /// was deleted. Cost O(1).
     Result<T*> resolve(ObjectId id)
     {
-        const Result<uint16_t> slot = slotOf(id);
-        if (!slot.ok()) {
-            return slot.status();
+        // The reason of a miss is found inline here, not by the core: the
+        // task agent's real-time services resolve through this after find(),
+        // and a call, even one never taken, costs them two instructions of
+        // stack alignment on every hit.
+        Entry& entry = entries_[indexSlot_[id.index()]];
+        if (entry.header.key != id.raw() || id.isNull()) {
+            return core_.missReasonInline(id);
         }
-        return &entries_[slot.value()].object;
+        return &entry.object;
     }
 
     /// The real-time services' lookup: the object @p id names, or null
@@ -244,10 +208,10 @@ public:
     T* find(ObjectId id, ObjectId& owner)
     {
         Entry& entry = entries_[indexSlot_[id.index()]];
-        if (entry.key != id.raw() || id.isNull()) {
+        if (entry.header.key != id.raw() || id.isNull()) {
             return nullptr;
         }
-        owner = entry.owner;
+        owner = entry.header.owner;
         return &entry.object;
     }
 
@@ -262,7 +226,7 @@ public:
         if (!slot.ok()) {
             return slot.status();
         }
-        return entries_[slot.value()].owner;
+        return entries_[slot.value()].header.owner;
     }
 
     /// Succeeds when @p task owns @p id, and fails with NotOwner otherwise.
@@ -294,7 +258,7 @@ public:
         if (!slot.ok()) {
             return slot.status();
         }
-        return entries_[slot.value()].visibility;
+        return entries_[slot.value()].header.visibility;
     }
 
     /// Returns the NUL-terminated name of @p id; empty for unnamed objects. Cost O(1).
@@ -304,7 +268,7 @@ public:
         if (!slot.ok()) {
             return slot.status();
         }
-        return static_cast<const char*>(entries_[slot.value()].name);
+        return static_cast<const char*>(entries_[slot.value()].header.name);
     }
 
     /// Gives @p id the name @p name (null or empty: unnamed), with Create's
@@ -317,20 +281,7 @@ public:
         if (!slot.ok()) {
             return slot.status();
         }
-        const NameScan scan = scanName(name);
-        if (scan.length > kMaxNameLength) {
-            return Status::InvalidArgument;
-        }
-        Entry& entry = entries_[slot.value()];
-        if (entry.name[0] != '\0') {
-            unlinkName(slot.value());
-        }
-        copyName(entry.name, name);
-        chains_[slot.value()].nameHash = scan.hash;
-        if (scan.length != 0) {
-            linkName(slot.value());
-        }
-        return Status::Ok;
+        return core_.rename(slot.value(), name);
     }
 
     /// Transfers ownership of @p id from @p currentOwner to @p newOwner.
@@ -345,17 +296,9 @@ public:
         if (!slot.ok()) {
             return slot.status();
         }
-        Entry& entry = entries_[slot.value()];
-        if (entry.owner != currentOwner) {
-            return Status::NotOwner;
-        }
-        if (!isValidOwner(newOwner)) {
-            return Status::InvalidArgument;
-        }
-        unlinkOwner(slot.value());
-        entry.owner = newOwner;
-        linkOwner(slot.value(), ownerKey(newOwner));
-        return Status::Ok;
+        // The key of an owner the core refuses is computed and unused: every
+        // policy maps every id to some key.
+        return core_.xferOwnership(slot.value(), currentOwner, newOwner, ownerKey(newOwner));
     }
 
     /// Configuration service: finds the object named @p name.
@@ -369,26 +312,7 @@ public:
     /// hashes match; independent of how many objects the table holds.
     Result<ObjectId> NameToObject(const char* name, Visibility askingScope) const
     {
-        const NameScan scan = scanName(name);
-        if (scan.length == 0 || scan.length > kMaxNameLength) {
-            return Status::NotFound;
-        }
-        // The whole bucket is walked, because a duplicate name may sit in a
-        // lower slot than the first match and the lowest slot must win.
-        uint16_t found = kNoSlot;
-        for (Link link = buckets_[bucketOf(scan.hash)]; link != kNoLink; link = chains_[slotOfLink(link)].nameNext) {
-            const uint16_t slot = slotOfLink(link);
-            if (chains_[slot].nameHash == scan.hash && slot < found) {
-                const Entry& entry = entries_[slot];
-                if (isVisibleFrom(entry.visibility, askingScope) && namesEqual(entry.name, name)) {
-                    found = slot;
-                }
-            }
-        }
-        if (found == kNoSlot) {
-            return Status::NotFound;
-        }
-        return idOf(found);
+        return core_.nameToObject(name, askingScope);
     }
 
     /// Calls @p visit(ObjectId, T&) for every object owned by @p owner.
@@ -405,26 +329,19 @@ public:
     {
         size_t visited = 0;
         Link link = ownerHeads_[ownerKey(owner)];
-        while (link != kNoLink) {
-            const uint16_t slot = slotOfLink(link);
+        while (link != Core::kNoLink) {
+            const uint16_t slot = static_cast<uint16_t>(link - 1);
             link = chains_[slot].ownerNext;
             Entry& entry = entries_[slot];
-            if (entry.owner == owner) {
+            if (entry.header.owner == owner) {
                 ++visited;
-                visit(idOf(slot), entry.object);
+                visit(ObjectId::fromRaw(entry.header.key), entry.object);
             }
         }
         return visited;
     }
 
 private:
-    static constexpr uint16_t kNoSlot = 0xFFFF;
-    // The smallest type that numbers every slot.
-    using SlotNumber = std::conditional_t<(Capacity <= 256), uint8_t, uint16_t>;
-    // A slot number plus one, zero meaning none, so that every list starts
-    // empty in zero-initialised storage; the smallest type that holds it.
-    using Link = std::conditional_t<(Capacity < 256), uint8_t, uint16_t>;
-    static constexpr Link kNoLink = 0;
     // The key of the list of objects the system owns (the null owner).
     static constexpr size_t kSystemOwnerKey = OwnerKeys::kCount;
 
@@ -434,225 +351,43 @@ private:
     // paths' slot-to-entry arithmetic one shift.
     struct Entry {
         T object{};
-        ObjectId owner{};
-        /// The object's whole id while the slot is used, 0 (the null id) while
-        /// it is free; find() refuses the null id, so no id finds a free slot.
-        uint32_t key = 0;
-        uint16_t ownerKey = 0; ///< The owner list the object is on.
-        Visibility visibility = Visibility::Local;
-        char name[kNameCapacity] = {};
-
-        uint16_t index() const { return static_cast<uint16_t>(key & ObjectId::kMaxIndex); }
+        ObjectEntryHeader header{};
     };
-
-    // The links of a used slot, kept apart from Entry for the reason above.
-    struct Chain {
-        uint32_t nameHash = 0; ///< Hash of the name; meaningful only for a named object.
-        Link nameNext = kNoLink; ///< Next object in the same name bucket.
-        Link namePrev = kNoLink; ///< Previous one; none for the bucket's first.
-        Link ownerNext = kNoLink; ///< Next object on the same owner list.
-        Link ownerPrev = kNoLink; ///< Previous one; none for the list's first.
-    };
-
-    struct NameScan {
-        size_t length; ///< At most kNameCapacity, which marks a name too long.
-        uint32_t hash;
-    };
-
-    static Link linkOf(uint16_t slot) { return static_cast<Link>(slot + 1); }
-    static uint16_t slotOfLink(Link link) { return static_cast<uint16_t>(link - 1); }
-
-    ObjectId idOf(uint16_t slot) const { return ObjectId::fromRaw(entries_[slot].key); }
+    static_assert(!std::is_pointer_v<T> || sizeof(Entry) == 32, "a pointer's entry stays 32 bytes");
 
     // The null owner has a list of its own, so that a walk for it finds the
     // system's objects as the slot-by-slot walk did.
     static size_t ownerKey(ObjectId owner) { return owner.isNull() ? kSystemOwnerKey : OwnerKeys::keyOf(owner); }
 
-    // FNV-1a over at most kNameCapacity characters, in the pass that measures
-    // the name, so that an unterminated name cannot run away.
-    static NameScan scanName(const char* name)
-    {
-        uint32_t hash = 2166136261u;
-        size_t length = 0;
-        if (name != nullptr) {
-            while (length < kNameCapacity && name[length] != '\0') {
-                hash = (hash ^ static_cast<uint8_t>(name[length])) * 16777619u;
-                ++length;
-            }
-        }
-        return NameScan{length, hash};
-    }
-
-    // FNV-1a's low bits mix poorly for short names, so the high half is
-    // folded in before the mask.
-    static size_t bucketOf(uint32_t hash) { return (hash ^ (hash >> 16)) & (Capacity - 1); }
-
-    // Both lists a used slot is on (its name's bucket and its owner's list)
-    // are doubly linked through Chain: Next and Prev pick which.
-    template <Link Chain::*Next, Link Chain::*Prev>
-    void pushFront(uint16_t slot, Link& head)
-    {
-        Chain& chain = chains_[slot];
-        chain.*Prev = kNoLink;
-        chain.*Next = head;
-        if (head != kNoLink) {
-            chains_[slotOfLink(head)].*Prev = linkOf(slot);
-        }
-        head = linkOf(slot);
-    }
-
-    template <Link Chain::*Next, Link Chain::*Prev>
-    void unlink(uint16_t slot, Link& head)
-    {
-        Chain& chain = chains_[slot];
-        if (chain.*Next != kNoLink) {
-            chains_[slotOfLink(chain.*Next)].*Prev = chain.*Prev;
-        }
-        if (chain.*Prev != kNoLink) {
-            chains_[slotOfLink(chain.*Prev)].*Next = chain.*Next;
-        } else {
-            head = chain.*Next;
-        }
-        chain.*Next = chain.*Prev = kNoLink;
-    }
-
-    void linkName(uint16_t slot)
-    {
-        pushFront<&Chain::nameNext, &Chain::namePrev>(slot, buckets_[bucketOf(chains_[slot].nameHash)]);
-    }
-
-    void unlinkName(uint16_t slot)
-    {
-        unlink<&Chain::nameNext, &Chain::namePrev>(slot, buckets_[bucketOf(chains_[slot].nameHash)]);
-    }
-
-    void linkOwner(uint16_t slot, size_t key)
-    {
-        entries_[slot].ownerKey = static_cast<uint16_t>(key);
-        pushFront<&Chain::ownerNext, &Chain::ownerPrev>(slot, ownerHeads_[key]);
-    }
-
-    // Uses the key stored at link time, not the owner's key now: the key of
-    // a stale owner id may have changed since.
-    void unlinkOwner(uint16_t slot)
-    {
-        unlink<&Chain::ownerNext, &Chain::ownerPrev>(slot, ownerHeads_[entries_[slot].ownerKey]);
-    }
-
-    // The index freed longest ago; indices never handed out count as freed
-    // before any other. The ring starts full with every index in order, each
-    // stored as index ^ position so that zero-initialised storage holds it;
-    // Create thus takes the same path whether or not fresh indices remain,
-    // which keeps its cost flat. There is always one: at most Capacity
-    // objects live, and Capacity <= 4096.
-    uint16_t takeIndex()
-    {
-        const uint16_t index = static_cast<uint16_t>(freedIndices_[freedHead_] ^ freedHead_);
-        freedHead_ = (freedHead_ + 1) & (kIndexCount - 1);
-        --freedCount_;
-        // Indices come out of the ring in order until each was handed out
-        // once, so issued_ counts them; a comparison, not a branch.
-        issued_ += static_cast<size_t>(issued_ == index);
-        return index;
-    }
-
-    void giveBackIndex(uint16_t index)
-    {
-        const size_t position = (freedHead_ + freedCount_) & (kIndexCount - 1);
-        freedIndices_[position] = static_cast<uint16_t>(index ^ position);
-        ++freedCount_;
-    }
-
-    // Every accessor funnels through here so the rejection rules live in one place.
+    // Every accessor funnels through here. A hit is find()'s two compares:
+    // the slot the id's index last named keeps its live object's whole id,
+    // and a table's keys carry its own type and node (setNode is refused
+    // while objects exist), so a matching key is a live object of this
+    // table. A miss asks the core why, out of line, so the rejection rules
+    // live in one place.
     Result<uint16_t> slotOf(ObjectId id) const
     {
-        if (id.isNull()) {
-            return Status::InvalidId;
-        }
-        if (id.type() != type_) {
-            return Status::WrongType;
-        }
-        if (id.node() != node_) {
-            // An object of this type on another node: the agents will hand
-            // such ids to the network interfaces manager; until it exists
-            // the object is unreachable.
-            return Status::Remote;
-        }
-        if (id.index() >= issued_) {
-            return Status::InvalidId; // Never handed out: forged.
-        }
         const uint16_t slot = indexSlot_[id.index()];
-        const Entry& entry = entries_[slot];
-        if (entry.key != id.raw()) {
-            return Status::StaleId; // Handed out once; its object is gone.
+        if (entries_[slot].header.key != id.raw() || id.isNull()) {
+            return core_.missReason(id);
         }
         return slot;
-    }
-
-    // Free slots wait in a ring, so that the slot freed longest ago is
-    // reused first, which spreads wear of the slots' storage evenly. A ring,
-    // unlike a list, has no empty case to treat apart, so Create and Delete
-    // cost the same whether the table is nearly empty or nearly full.
-    // The ring holds freeCount() slots, so the caller counts the slot it
-    // adds (active_ or used_) only after the push.
-    void pushFree(uint16_t slot)
-    {
-        freeSlots_[(freeHead_ + active_ - used_) & (Capacity - 1)] = static_cast<SlotNumber>(slot);
-    }
-
-    uint16_t popFree()
-    {
-        const uint16_t slot = freeSlots_[freeHead_];
-        freeHead_ = (freeHead_ + 1) & (Capacity - 1);
-        return slot;
-    }
-
-    static bool isValidOwner(ObjectId owner) { return owner.isNull() || owner.type() == ObjectType::Task; }
-
-    static void copyName(char (&destination)[kNameCapacity], const char* source)
-    {
-        size_t i = 0;
-        if (source != nullptr) {
-            for (; i < kMaxNameLength && source[i] != '\0'; ++i) {
-                destination[i] = source[i];
-            }
-        }
-        destination[i] = '\0';
-    }
-
-    static bool namesEqual(const char (&stored)[kNameCapacity], const char* name)
-    {
-        size_t i = 0;
-        for (; i < kMaxNameLength && stored[i] != '\0'; ++i) {
-            if (stored[i] != name[i]) {
-                return false;
-            }
-        }
-        return name[i] == '\0';
     }
 
     Entry entries_[Capacity] = {};
-    Chain chains_[Capacity] = {};
+    typename Core::Chain chains_[Capacity] = {};
     // Name hash buckets: the first object of each chain, as a Link.
     Link buckets_[Capacity] = {};
     // Owner lists: the first object of each, as a Link; the last is the system's.
     Link ownerHeads_[OwnerKeys::kCount + 1] = {};
-    // Free slots, oldest first: a ring of active_ - used_ entries at freeHead_.
+    // Free slots, oldest first: a ring the core keeps.
     SlotNumber freeSlots_[Capacity] = {};
-    size_t freeHead_ = 0;
     // Index -> slot, for every index handed out (the slot it last named).
     SlotNumber indexSlot_[kIndexCount] = {};
-    // Freed indices, oldest first: a ring of freedCount_ entries at
-    // freedHead_, each stored as index ^ position (see takeIndex).
+    // Freed indices, oldest first: a ring the core keeps (see its takeIndex).
     uint16_t freedIndices_[kIndexCount] = {};
-    size_t freedHead_ = 0;
-    size_t freedCount_ = kIndexCount;
-    // Indices [issued_, 4096) were never handed out.
-    size_t issued_ = 0;
-    ObjectType type_;
-    uint16_t node_;
-    size_t active_ = 0;
-    size_t used_ = 0;
+    // Last, so that the arrays it points to are in place when it is built.
+    Core core_;
 };
 
 } // namespace dcos::internal
