@@ -25,11 +25,15 @@ FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
 # -mregparm=3 passes a call's first three arguments in registers: every
 # kernel service an application calls saves its pushes and loads. Kernel
 # and applications must agree on it, hence here; the assembly stubs keep the
-# stack convention (arch_x86/AssemblyLinkage.hpp). No alignment padding of
+# stack convention (arch_x86/AssemblyLinkage.hpp). -freg-struct-return
+# returns a structure of up to eight bytes in EAX:EDX, as the other i386
+# ABIs do, instead of through a hidden pointer to the caller's memory: a
+# Result<ObjectId>, Result<void*> or Result<uint32_t> (a value and a Status)
+# is most primitives' answer. No alignment padding of
 # functions, loops or jump targets: -mtune=i486 pads each to 16 bytes, a
 # tenth of the kernel's code, for a prefetch gain the 486's 8 KiB cache
 # gives back as misses; padding in a hot path is also executed as no-ops.
-FW_CODE_FLAGS := -std=c++20 $(FW_ARCH_FLAGS) -mregparm=3 -O2 \
+FW_CODE_FLAGS := -std=c++20 $(FW_ARCH_FLAGS) -mregparm=3 -freg-struct-return -O2 \
 	-falign-functions=1 -falign-jumps=1 -falign-loops=1 -falign-labels=1 -g \
 	-ffreestanding -fno-pic -fno-pie -fno-exceptions -fno-rtti -fno-threadsafe-statics \
 	-fno-stack-protector -fstack-clash-protection -fno-asynchronous-unwind-tables -fno-unwind-tables \
