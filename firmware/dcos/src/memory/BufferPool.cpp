@@ -54,8 +54,6 @@ Status BufferPool::initialise(void* area, size_t areaBytes, size_t bufferSize, u
 
     states_ = reinterpret_cast<uint8_t*>(aligned);
     base_ = aligned + roundUp8(count * 4);
-    areaBegin_ = begin;
-    areaEnd_ = begin + areaBytes;
     bufferSize_ = static_cast<uint32_t>(bufferSize);
     stride_ = static_cast<uint32_t>(stride);
     shift_ = std::countr_zero(stride);
@@ -74,7 +72,7 @@ Status BufferPool::initialise(void* area, size_t areaBytes, size_t bufferSize, u
 
 Result<void*> BufferPool::allocateSlowly(uint16_t holder)
 {
-    if (corrupted_) {
+    if (isCorrupted()) {
         return Status::Corrupted;
     }
     if (holder == kFreeMark) {
@@ -94,7 +92,7 @@ Result<void*> BufferPool::allocateSlowly(uint16_t holder)
 
 Status BufferPool::releaseSlowly(void* buffer, uint16_t holder)
 {
-    if (corrupted_) {
+    if (isCorrupted()) {
         return Status::Corrupted;
     }
     const Result<uint32_t> index = allocatedIndexOf(buffer, holder);
@@ -107,7 +105,7 @@ Status BufferPool::releaseSlowly(void* buffer, uint16_t holder)
 
 Status BufferPool::transfer(void* buffer, uint16_t from, uint16_t to)
 {
-    if (corrupted_) {
+    if (isCorrupted()) {
         return Status::Corrupted;
     }
     if (to == kFreeMark) {
@@ -124,7 +122,7 @@ Status BufferPool::transfer(void* buffer, uint16_t from, uint16_t to)
 size_t BufferPool::reclaimHeldBy(uint16_t holder)
 {
     size_t reclaimed = 0;
-    for (uint32_t index = 0; index < count_ && !corrupted_; ++index) {
+    for (uint32_t index = 0; index < count_ && !isCorrupted(); ++index) {
         uint16_t current;
         uint32_t next;
         const State state = stateOf(index, current, next);
@@ -140,7 +138,7 @@ size_t BufferPool::reclaimHeldBy(uint16_t holder)
 
 Status BufferPool::audit()
 {
-    if (corrupted_) {
+    if (isCorrupted()) {
         return Status::Corrupted;
     }
     uint32_t freeStates = 0;
@@ -238,8 +236,7 @@ Result<uint32_t> BufferPool::allocatedIndexOf(void* buffer, uint16_t holder)
 
 Status BufferPool::fail()
 {
-    corrupted_ = true;
-    limit_ = 0; // The fast paths' range test now fails for every index.
+    limit_ = 0; // The fast paths' range test now fails for every index, and isCorrupted() holds.
     return Status::Corrupted;
 }
 
