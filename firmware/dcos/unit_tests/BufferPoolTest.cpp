@@ -401,10 +401,12 @@ TEST(BufferPoolFastPathTest, RandomizedFastPathsMatchTheModel)
             const unsigned action = random() % 8;
             // The fast paths take the holder in a word's low half and must
             // ignore its high half (the kernel passes the whole task id).
-            const auto word = [&random](uint16_t tag) { return (static_cast<uint32_t>(random()) << 16) | tag; };
+            const auto word = [&random](uint16_t tag) {
+                const uint32_t holderWord = (static_cast<uint32_t>(random()) << 16) | tag;
+                return [holderWord] { return holderWord; };
+            };
             if (action < 4) {
-                const uint32_t holderWord = word(holder);
-                void* buffer = pool.tryAllocate([holderWord] { return holderWord; });
+                void* buffer = pool.tryAllocate(word(holder));
                 if (allocated.size() == count) {
                     ASSERT_EQ(buffer, nullptr);
                     ASSERT_EQ(pool.allocate(holder).status(), Status::NoMemory);
@@ -466,14 +468,14 @@ TEST(BufferPoolFastPathTest, OnlyABuffersStartIsABuffer)
         uint8_t* const begin = area.data();
         for (uint8_t* p = begin - 64; p < begin + area.size() + 64; ++p) {
             if (starts.count(p) == 0) {
-                ASSERT_FALSE(pool.tryRelease(p, kTaskA)) << "size " << size << " offset " << (p - begin);
+                ASSERT_FALSE(pool.tryRelease(p, [] { return uint32_t{kTaskA}; })) << "size " << size << " offset " << (p - begin);
             }
         }
         uint8_t elsewhere[16];
         EXPECT_EQ(pool.release(elsewhere, kTaskA), Status::InvalidArgument);
         EXPECT_EQ(pool.release(begin + area.size(), kTaskA), Status::InvalidArgument);
         for (uint8_t* start : starts) {
-            ASSERT_TRUE(pool.tryRelease(start, kTaskA));
+            ASSERT_TRUE(pool.tryRelease(start, [] { return uint32_t{kTaskA}; }));
         }
         EXPECT_EQ(pool.audit(), Status::Ok);
         EXPECT_EQ(pool.allocatedCount(), 0u);
@@ -490,7 +492,7 @@ TEST(BufferPoolFastPathTest, ACorruptedPoolDeclinesEveryFastPath)
     ASSERT_EQ(pool.release(b, kTaskA), Status::Ok);
     ASSERT_EQ(pool.release(b, kTaskA), Status::Corrupted); // Double return.
     EXPECT_EQ(pool.tryAllocate([] { return uint32_t{kTaskA}; }), nullptr);
-    EXPECT_FALSE(pool.tryRelease(a, kTaskA));
+    EXPECT_FALSE(pool.tryRelease(a, [] { return uint32_t{kTaskA}; }));
     expectDisabled(pool, a);
 }
 

@@ -23,8 +23,8 @@ using Lock = arch_x86::InterruptGuard;
 
 // A pool object: the algorithm's state and the pool's id, the null id
 // while the slot is free. The fast paths find the object from the id without
-// the table's entry (fastObjectOf()), so it is 64 bytes, and a slot's
-// address is one shift.
+// the table's entry (fastObjectOf()); it is 64 bytes, so that a slot's
+// offset is one shift where Create records it.
 struct PoolObject {
     BufferPool pool;
     ObjectId id;
@@ -33,7 +33,7 @@ struct PoolObject {
 };
 
 #if !defined(DCOS_HOST_BUILD)
-static_assert(sizeof(PoolObject) == 64, "the fast paths find a pool object with one shift");
+static_assert(sizeof(PoolObject) == 64, "a pool object's offset is its slot shifted by six");
 #endif
 
 // The area reserved for the pool in the same slot, from the start of Create
@@ -55,22 +55,32 @@ constinit uint32_t poolsCreated = 0;
 
 size_t slotOf(ObjectId id) { return poolTable.slotNumber(id); }
 
-// The fast paths' lookup: the object in the slot @p id's index last named,
+// Where the pool object of each id index is, as a byte offset into pools:
+// set by Create for the index its id got, so it is right for every live
+// pool, and left as it is by Delete (the object it leads to is cleared, so
+// it leads nowhere but to an object out of service). 0, pools[0], for an
+// index never used. The table's own map (ObjectTable::slotNumber) holds
+// slot numbers of 8 or 16 bits, which the i486 loads with a zero
+// extension of two instructions and then scales; this one is a single load
+// (4 bytes a possible index, 16 KiB, in .bss).
+constinit uint32_t poolOffsets[ObjectId::kMaxIndex + 1];
+
+// The fast paths' lookup: the object poolOffsets gives for @p id's index,
 // which is the pool @p id names exactly when the object's whole id equals
 // @p id (one compare checks node, type and index, as ObjectTable::find
 // does). A free slot's object is all zero: it keeps the null id, which a
 // null @p id does equal, but also a pool out of service (limit 0), whose
 // fast paths decline every call, so the complete service gives InvalidId.
 // Create sets the id and Delete clears the object under the lock, while
-// the table's entry changes, so both always agree on which id is live.
-// The empty asm hands the address over as one value in a register: without
-// it GCC addresses each field as pools + slot * 96 + offset and rebuilds
-// that index (and spills it) at every use.
+// the table's entry changes, so both always agree on which id is live. The
+// empty asm keeps the offset in a register that every field is addressed
+// from (pools + offset + field, one displacement): without it GCC rebuilds
+// the address at each use and spills it.
 [[gnu::always_inline]] inline PoolObject* fastObjectOf(ObjectId id)
 {
-    PoolObject* object = &pools[poolTable.slotNumber(id)];
-    asm("" : "+r"(object));
-    return object;
+    uint32_t offset = poolOffsets[id.index()];
+    asm("" : "+r"(offset));
+    return reinterpret_cast<PoolObject*>(reinterpret_cast<uintptr_t>(pools) + offset);
 }
 
 // Activates the first slots on first use; call with interrupts disabled.
@@ -155,6 +165,7 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolManager::Create(void* area
         object = PoolObject{};
         object.id = id;
         poolAreas[slotOf(id)] = PoolArea{begin, end};
+        poolOffsets[id.index()] = static_cast<uint32_t>(slotOf(id) * sizeof(PoolObject));
         *poolTable.resolve(id).value() = &object;
         ++poolsCreated;
         salt = mixBits(static_cast<uint32_t>(begin) ^ (poolsCreated * 0x9E3779B9u));
@@ -361,8 +372,8 @@ Status BufferPoolAgent::Return(ObjectId id, void* buffer) const
         const internal::FlagsRestoringGuard guard;
         internal::PoolObject* const object = internal::fastObjectOf(id);
         if (object->id == id) [[likely]] {
-            if (object->pool.tryRelease(buffer, internal::memory_area::callerHolderWord(BufferPool::kSystemHolder)))
-                [[likely]] {
+            if (object->pool.tryRelease(
+                    buffer, [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); })) [[likely]] {
                 return Status::Ok;
             }
         }

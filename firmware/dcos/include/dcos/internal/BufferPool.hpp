@@ -114,17 +114,22 @@ public:
     }
 
     /// The fast path of release(): gives back @p buffer if it is the start
-    /// of a buffer that the holder in the low half of @p holderWord itself
-    /// holds (the high half is ignored, as for tryAllocate()); false in every
-    /// other case (release() then decides). O(1).
-    [[gnu::always_inline]] bool tryRelease(void* buffer, uint32_t holderWord)
+    /// of a buffer that the holder in the low half of what @p holderWord()
+    /// returns itself holds (the high half is ignored, as for
+    /// tryAllocate()); false in every other case (release() then decides).
+    /// The holder is asked for once the address is known to be a buffer's,
+    /// for the reason tryAllocate() gives. O(1).
+    template <typename HolderWord>
+    [[gnu::always_inline]] bool tryRelease(void* buffer, HolderWord holderWord)
     {
         const uintptr_t index = indexOf(buffer);
         if (index >= limit_) {
             return false; // Not a buffer's start, not this pool's, or corrupted.
         }
-        if (loadState(static_cast<uint32_t>(index))
-            != (((holderWord << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_)) {
+        // The word it must hold, built before the load, so that no address
+        // waits in a register while the holder is asked for.
+        const uint32_t expected = ((static_cast<uint32_t>(holderWord()) << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_;
+        if (loadState(static_cast<uint32_t>(index)) != expected) {
             return false; // Free already, another holder's, the system's, or overwritten.
         }
         pushFree(static_cast<uint32_t>(index));
@@ -154,7 +159,7 @@ public:
     /// not a buffer's start, or a state word that fails its check.
     Status release(void* buffer, uint16_t holder)
     {
-        if (tryRelease(buffer, holder)) [[likely]] {
+        if (tryRelease(buffer, [holder] { return uint32_t{holder}; })) [[likely]] {
             return Status::Ok;
         }
         return releaseSlowly(buffer, holder);

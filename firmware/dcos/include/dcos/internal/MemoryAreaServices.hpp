@@ -38,7 +38,9 @@ static_assert(static_cast<uint16_t>(ObjectId(0xFFFF, ObjectType::Task, ObjectId:
 /// reload, or a mask.
 [[gnu::always_inline]] inline uint32_t callerHolderWord(uint16_t systemHolder)
 {
-    if (inInterruptContext() || !Scheduler::started()) {
+    // Unlikely: the task's case then runs straight through, without the jump
+    // over the system's that GCC would otherwise place on it.
+    if (inInterruptContext() || !Scheduler::started()) [[unlikely]] {
         return systemHolder;
     }
     return Scheduler::current().id.raw();
