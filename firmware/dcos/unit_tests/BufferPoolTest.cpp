@@ -436,6 +436,12 @@ TEST(BufferPoolFastPathTest, RandomizedFastPathsMatchTheModel)
                 allocated.erase(it);
             }
             ASSERT_EQ(pool.allocatedCount(), allocated.size());
+            // The free count is kept as the low-water mark plus the buffers
+            // above it: both must match the model after every step.
+            const dcos::BufferPoolStatistics now = pool.statistics();
+            ASSERT_EQ(now.freeBuffers, count - allocated.size());
+            ASSERT_EQ(now.lowWaterMark, lowWater);
+            ASSERT_EQ(now.allocations, allocations);
             if (step % 101 == 0) {
                 ASSERT_EQ(pool.audit(), Status::Ok);
             }

@@ -66,7 +66,8 @@ Status BufferPool::initialise(void* area, size_t areaBytes, size_t bufferSize, u
     for (uint32_t index = count_; index-- > 0;) {
         pushFree(index);
     }
-    lowWater_ = count_;
+    lowWater_ = count_; // All free: the mark is the count, none above it.
+    aboveLowWater_ = 0;
     return Status::Ok;
 }
 
@@ -79,7 +80,7 @@ Result<void*> BufferPool::allocateSlowly(uint16_t holder)
         return Status::InvalidArgument;
     }
     if (head_ == kEndOfList) {
-        if (free_ != 0) {
+        if (freeCount() != 0) {
             return fail(); // Free buffers that no list reaches: a state word was overwritten.
         }
         ++failedAllocations_;
@@ -151,21 +152,22 @@ Status BufferPool::audit()
         }
         freeStates += state == State::Free ? 1 : 0;
     }
-    if (freeStates != free_) {
+    const uint32_t free = freeCount();
+    if (freeStates != free) {
         return fail();
     }
-    // A list that ends within free_ steps visits distinct buffers, because
-    // each buffer has one link; with free_ steps it visits them all.
+    // A list that ends within free steps visits distinct buffers, because
+    // each buffer has one link; with free steps it visits them all.
     uint32_t steps = 0;
     for (uint32_t index = head_; index != kEndOfList;) {
         uint16_t holder;
         uint32_t next;
-        if (index >= count_ || ++steps > free_ || stateOf(index, holder, next) != State::Free) {
+        if (index >= count_ || ++steps > free || stateOf(index, holder, next) != State::Free) {
             return fail();
         }
         index = next;
     }
-    return steps == free_ ? Status::Ok : fail();
+    return steps == free ? Status::Ok : fail();
 }
 
 BufferPoolStatistics BufferPool::statistics() const
@@ -173,13 +175,13 @@ BufferPoolStatistics BufferPool::statistics() const
     BufferPoolStatistics statistics;
     statistics.bufferSize = bufferSize_;
     statistics.totalBuffers = count_;
-    statistics.freeBuffers = free_;
+    statistics.freeBuffers = freeCount();
     statistics.lowWaterMark = lowWater_;
     statistics.allocations = allocations_;
     statistics.failedAllocations = failedAllocations_;
     // Every buffer allocated is either still out or was returned (by Return
     // or by recovery), so the returns need no counter of their own.
-    statistics.returns = allocations_ - (count_ - free_);
+    statistics.returns = allocations_ - (count_ - freeCount());
     return statistics;
 }
 

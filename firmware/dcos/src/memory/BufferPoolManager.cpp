@@ -72,15 +72,10 @@ constinit uint32_t poolOffsets[ObjectId::kMaxIndex + 1];
 // null @p id does equal, but also a pool out of service (limit 0), whose
 // fast paths decline every call, so the complete service gives InvalidId.
 // Create sets the id and Delete clears the object under the lock, while
-// the table's entry changes, so both always agree on which id is live. The
-// empty asm keeps the offset in a register that every field is addressed
-// from (pools + offset + field, one displacement): without it GCC rebuilds
-// the address at each use and spills it.
+// the table's entry changes, so both always agree on which id is live.
 [[gnu::always_inline]] inline PoolObject* fastObjectOf(ObjectId id)
 {
-    uint32_t offset = poolOffsets[id.index()];
-    asm("" : "+r"(offset));
-    return reinterpret_cast<PoolObject*>(reinterpret_cast<uintptr_t>(pools) + offset);
+    return reinterpret_cast<PoolObject*>(reinterpret_cast<uintptr_t>(pools) + poolOffsets[id.index()]);
 }
 
 // Activates the first slots on first use; call with interrupts disabled.

@@ -100,8 +100,14 @@ public:
         }
         head_ = word >> 16; // Checked when it is the head: below limit_, or the end.
         storeState(index, ((static_cast<uint32_t>(holderWord()) << 16) | index) ^ allocatedKey_);
-        if (--free_ < lowWater_) {
-            lowWater_ = free_;
+        // One subtraction in memory keeps both counts: the free buffers are
+        // the low-water mark plus those above it, and only when none is
+        // above it does the mark move (the borrow says so).
+        uint32_t above;
+        if (__builtin_sub_overflow(aboveLowWater_, 1u, &above)) [[unlikely]] {
+            --lowWater_;
+        } else {
+            aboveLowWater_ = above;
         }
         ++allocations_;
         void* const buffer = reinterpret_cast<void*>(base_ + index * stride_);
@@ -187,7 +193,7 @@ public:
     BufferPoolStatistics statistics() const;
 
     /// Number of buffers currently allocated. O(1).
-    size_t allocatedCount() const { return count_ - free_; }
+    size_t allocatedCount() const { return count_ - freeCount(); }
     /// Whether a check failed; a corrupted pool refuses every call.
     bool isCorrupted() const { return limit_ == 0 && count_ != 0; }
     /// Whether initialise() succeeded and the pool has buffers.
@@ -232,8 +238,12 @@ private:
     {
         storeState(index, ((head_ << 16) | index) ^ freeKey_);
         head_ = index;
-        ++free_;
+        ++aboveLowWater_;
     }
+
+    // The free buffers: the low-water mark and how many are above it
+    // (kept so, Allocate keeps the mark with one subtraction).
+    uint32_t freeCount() const { return lowWater_ + aboveLowWater_; }
 
     State stateOf(uint32_t index, uint16_t& holder, uint32_t& next) const;
     Result<void*> allocateSlowly(uint16_t holder);
@@ -252,8 +262,8 @@ private:
     // tells): the fast paths' one test.
     uint32_t limit_ = 0;
     uint32_t head_ = kEndOfList;
-    uint32_t free_ = 0;
-    uint32_t lowWater_ = 0;
+    uint32_t aboveLowWater_ = 0; // Free buffers above the low-water mark.
+    uint32_t lowWater_ = 0;      // The fewest free buffers there have been.
     uint32_t allocations_ = 0;
     uint32_t freeKey_ = 0;      // Every free buffer's state word is XORed with it,
     uint32_t allocatedKey_ = 0; // every allocated buffer's with this one.
