@@ -474,7 +474,8 @@ TEST(BufferPoolFastPathTest, OnlyABuffersStartIsABuffer)
         uint8_t* const begin = area.data();
         for (uint8_t* p = begin - 64; p < begin + area.size() + 64; ++p) {
             if (starts.count(p) == 0) {
-                ASSERT_FALSE(pool.tryRelease(p, [] { return uint32_t{kTaskA}; })) << "size " << size << " offset " << (p - begin);
+                ASSERT_FALSE(pool.tryRelease(p, [] { return uint32_t{kTaskA}; }))
+                    << "size " << size << " offset " << (p - begin);
             }
         }
         uint8_t elsewhere[16];

@@ -23,8 +23,8 @@ using Lock = arch_x86::InterruptGuard;
 
 // A pool object: the algorithm's state and the pool's id, the null id
 // while the slot is free. The fast paths find the object from the id without
-// the table's entry (fastObjectOf()); it is 64 bytes, so that a slot's
-// offset is one shift where Create records it.
+// the table's entry (fastObjectOf()) and read nothing else of the slot, so
+// what only Create reads (PoolArea) is kept apart and an object is 64 bytes.
 struct PoolObject {
     BufferPool pool;
     ObjectId id;
@@ -33,7 +33,7 @@ struct PoolObject {
 };
 
 #if !defined(DCOS_HOST_BUILD)
-static_assert(sizeof(PoolObject) == 64, "a pool object's offset is its slot shifted by six");
+static_assert(sizeof(PoolObject) == 64, "a pool object holds what the fast paths read, and no more");
 #endif
 
 // The area reserved for the pool in the same slot, from the start of Create

@@ -134,7 +134,8 @@ public:
         }
         // The word it must hold, built before the load, so that no address
         // waits in a register while the holder is asked for.
-        const uint32_t expected = ((static_cast<uint32_t>(holderWord()) << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_;
+        const uint32_t expected =
+            ((static_cast<uint32_t>(holderWord()) << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_;
         if (loadState(static_cast<uint32_t>(index)) != expected) {
             return false; // Free already, another holder's, the system's, or overwritten.
         }

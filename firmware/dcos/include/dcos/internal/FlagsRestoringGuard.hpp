@@ -26,10 +26,16 @@ public:
 #if defined(DCOS_HOST_BUILD)
     FlagsRestoringGuard() = default;
 #else
-    [[gnu::always_inline]] FlagsRestoringGuard() { asm volatile("pushfl\n\tpopl %0\n\tcli" : "=r"(savedFlags_)::"memory"); }
+    [[gnu::always_inline]] FlagsRestoringGuard()
+    {
+        asm volatile("pushfl\n\tpopl %0\n\tcli" : "=r"(savedFlags_)::"memory");
+    }
     // A memory operand based on ESP is addressed before PUSH moves ESP
     // (Intel SDM, PUSH), so any operand the compiler picks is read right.
-    [[gnu::always_inline]] ~FlagsRestoringGuard() { asm volatile("pushl %0\n\tpopfl" ::"g"(savedFlags_) : "memory", "cc"); }
+    [[gnu::always_inline]] ~FlagsRestoringGuard()
+    {
+        asm volatile("pushl %0\n\tpopfl" ::"g"(savedFlags_) : "memory", "cc");
+    }
 #endif
     FlagsRestoringGuard(const FlagsRestoringGuard&) = delete;
     FlagsRestoringGuard& operator=(const FlagsRestoringGuard&) = delete;
