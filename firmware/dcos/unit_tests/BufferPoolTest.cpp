@@ -399,8 +399,14 @@ TEST(BufferPoolFastPathTest, RandomizedFastPathsMatchTheModel)
             const unsigned pick = random() % 4;
             const uint16_t holder = pick == 3 ? BufferPool::kSystemHolder : static_cast<uint16_t>(pick);
             const unsigned action = random() % 8;
+            // The fast paths take the holder in a word's low half and must
+            // ignore its high half (the kernel passes the whole task id).
+            const auto word = [&random](uint16_t tag) {
+                const uint32_t holderWord = (static_cast<uint32_t>(random()) << 16) | tag;
+                return [holderWord] { return holderWord; };
+            };
             if (action < 4) {
-                void* buffer = pool.tryAllocate(holder);
+                void* buffer = pool.tryAllocate(word(holder));
                 if (allocated.size() == count) {
                     ASSERT_EQ(buffer, nullptr);
                     ASSERT_EQ(pool.allocate(holder).status(), Status::NoMemory);
@@ -418,18 +424,24 @@ TEST(BufferPoolFastPathTest, RandomizedFastPathsMatchTheModel)
                 auto it = allocated.begin();
                 std::advance(it, static_cast<long>(random() % allocated.size()));
                 // A pointer just inside the buffer, another holder, then the holder itself.
-                ASSERT_FALSE(pool.tryRelease(it->first + 1 + random() % (size - 1), it->second));
+                ASSERT_FALSE(pool.tryRelease(it->first + 1 + random() % (size - 1), word(it->second)));
                 const uint16_t other = static_cast<uint16_t>((it->second + 1) % 3);
-                ASSERT_FALSE(pool.tryRelease(it->first, other));
+                ASSERT_FALSE(pool.tryRelease(it->first, word(other)));
                 if (it->second == BufferPool::kSystemHolder) {
                     ASSERT_EQ(pool.release(it->first, other), Status::Ok); // Anyone returns system buffers.
                 } else {
-                    ASSERT_TRUE(pool.tryRelease(it->first, it->second));
-                    ASSERT_FALSE(pool.tryRelease(it->first, it->second)); // Now free: declined.
+                    ASSERT_TRUE(pool.tryRelease(it->first, word(it->second)));
+                    ASSERT_FALSE(pool.tryRelease(it->first, word(it->second))); // Now free: declined.
                 }
                 allocated.erase(it);
             }
             ASSERT_EQ(pool.allocatedCount(), allocated.size());
+            // The free count is kept as the low-water mark plus the buffers
+            // above it: both must match the model after every step.
+            const dcos::BufferPoolStatistics now = pool.statistics();
+            ASSERT_EQ(now.freeBuffers, count - allocated.size());
+            ASSERT_EQ(now.lowWaterMark, lowWater);
+            ASSERT_EQ(now.allocations, allocations);
             if (step % 101 == 0) {
                 ASSERT_EQ(pool.audit(), Status::Ok);
             }
@@ -462,14 +474,15 @@ TEST(BufferPoolFastPathTest, OnlyABuffersStartIsABuffer)
         uint8_t* const begin = area.data();
         for (uint8_t* p = begin - 64; p < begin + area.size() + 64; ++p) {
             if (starts.count(p) == 0) {
-                ASSERT_FALSE(pool.tryRelease(p, kTaskA)) << "size " << size << " offset " << (p - begin);
+                ASSERT_FALSE(pool.tryRelease(p, [] { return uint32_t{kTaskA}; }))
+                    << "size " << size << " offset " << (p - begin);
             }
         }
         uint8_t elsewhere[16];
         EXPECT_EQ(pool.release(elsewhere, kTaskA), Status::InvalidArgument);
         EXPECT_EQ(pool.release(begin + area.size(), kTaskA), Status::InvalidArgument);
         for (uint8_t* start : starts) {
-            ASSERT_TRUE(pool.tryRelease(start, kTaskA));
+            ASSERT_TRUE(pool.tryRelease(start, [] { return uint32_t{kTaskA}; }));
         }
         EXPECT_EQ(pool.audit(), Status::Ok);
         EXPECT_EQ(pool.allocatedCount(), 0u);
@@ -485,8 +498,8 @@ TEST(BufferPoolFastPathTest, ACorruptedPoolDeclinesEveryFastPath)
     void* b = pool.allocate(kTaskA).value();
     ASSERT_EQ(pool.release(b, kTaskA), Status::Ok);
     ASSERT_EQ(pool.release(b, kTaskA), Status::Corrupted); // Double return.
-    EXPECT_EQ(pool.tryAllocate(kTaskA), nullptr);
-    EXPECT_FALSE(pool.tryRelease(a, kTaskA));
+    EXPECT_EQ(pool.tryAllocate([] { return uint32_t{kTaskA}; }), nullptr);
+    EXPECT_FALSE(pool.tryRelease(a, [] { return uint32_t{kTaskA}; }));
     expectDisabled(pool, a);
 }
 

@@ -490,6 +490,43 @@ TEST_F(SegmentedHeapCorruptionTest, ForeignPointerIsRefusedAndTheHeapStaysInServ
     EXPECT_EQ(heap.audit(), Status::Ok);
 }
 
+// Allocate and Return test one bound first (the heap's size less a header,
+// 0 once corrupted) and tell the failures apart after it: each address
+// and size at the edges keeps the reason it had with separate tests.
+TEST(SegmentedHeapBoundsTest, TheFoldedBoundsKeepEveryReason)
+{
+    Area area{256};
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 0x5EED), Status::Ok);
+    const size_t size = heap.heapBytes();
+    uint8_t* const base = area.data(); // GuardedArea's data is 8-byte aligned.
+    // Requests: 0 is a bad argument; above the heap, or too big for its
+    // last 8 bytes, NoMemory, counted; the whole heap less a header fits.
+    EXPECT_EQ(heap.allocate(0, kTaskA).status(), Status::InvalidArgument);
+    EXPECT_EQ(heap.allocate(size + 1, kTaskA).status(), Status::NoMemory);
+    EXPECT_EQ(heap.allocate(size, kTaskA).status(), Status::NoMemory);
+    EXPECT_EQ(heap.allocate(size - 7, kTaskA).status(), Status::NoMemory);
+    EXPECT_EQ(heap.allocate(SIZE_MAX, kTaskA).status(), Status::NoMemory);
+    EXPECT_EQ(statisticsOf(heap).failedAllocations, 4u);
+    void* whole = heap.allocate(size - 8, kTaskA).value();
+    EXPECT_EQ(whole, base + 8);
+    // Addresses: one past the end and the 8 bytes below it, the bytes below
+    // the heap, and the heap's first 8 bytes.
+    EXPECT_EQ(heap.release(base + size, kTaskA), Status::InvalidArgument);
+    EXPECT_EQ(heap.release(base - 8, kTaskA), Status::InvalidArgument);
+    EXPECT_EQ(heap.release(base - 1, kTaskA), Status::InvalidArgument);
+    EXPECT_FALSE(heap.isCorrupted());
+    EXPECT_EQ(heap.release(base, kTaskA), Status::Corrupted); // Inside the heap, not a segment's data.
+    expectDisabled(heap, whole);
+    EXPECT_EQ(heap.release(base + size, kTaskA), Status::Corrupted); // Once corrupted, every call.
+
+    SegmentedHeap other;
+    ASSERT_EQ(other.initialise(area.data(), area.size(), 0x5EED), Status::Ok);
+    void* first = other.allocate(8, kTaskA).value();
+    EXPECT_EQ(other.release(base + size - 8, kTaskA), Status::Corrupted); // The last 8 bytes: inside.
+    EXPECT_EQ(other.release(first, kTaskA), Status::Corrupted);
+}
+
 TEST_F(SegmentedHeapCorruptionTest, OverrunIntoTheNextHeaderIsDetectedByBothSegments)
 {
     // segments[0] is lowest; writing past its end hits segments[1]'s header.

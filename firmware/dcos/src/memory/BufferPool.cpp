@@ -54,8 +54,6 @@ Status BufferPool::initialise(void* area, size_t areaBytes, size_t bufferSize, u
 
     states_ = reinterpret_cast<uint8_t*>(aligned);
     base_ = aligned + roundUp8(count * 4);
-    areaBegin_ = begin;
-    areaEnd_ = begin + areaBytes;
     bufferSize_ = static_cast<uint32_t>(bufferSize);
     stride_ = static_cast<uint32_t>(stride);
     shift_ = std::countr_zero(stride);
@@ -68,20 +66,21 @@ Status BufferPool::initialise(void* area, size_t areaBytes, size_t bufferSize, u
     for (uint32_t index = count_; index-- > 0;) {
         pushFree(index);
     }
-    lowWater_ = count_;
+    lowWater_ = count_; // All free: the mark is the count, none above it.
+    aboveLowWater_ = 0;
     return Status::Ok;
 }
 
 Result<void*> BufferPool::allocateSlowly(uint16_t holder)
 {
-    if (corrupted_) {
+    if (isCorrupted()) {
         return Status::Corrupted;
     }
     if (holder == kFreeMark) {
         return Status::InvalidArgument;
     }
     if (head_ == kEndOfList) {
-        if (free_ != 0) {
+        if (freeCount() != 0) {
             return fail(); // Free buffers that no list reaches: a state word was overwritten.
         }
         ++failedAllocations_;
@@ -94,7 +93,7 @@ Result<void*> BufferPool::allocateSlowly(uint16_t holder)
 
 Status BufferPool::releaseSlowly(void* buffer, uint16_t holder)
 {
-    if (corrupted_) {
+    if (isCorrupted()) {
         return Status::Corrupted;
     }
     const Result<uint32_t> index = allocatedIndexOf(buffer, holder);
@@ -107,7 +106,7 @@ Status BufferPool::releaseSlowly(void* buffer, uint16_t holder)
 
 Status BufferPool::transfer(void* buffer, uint16_t from, uint16_t to)
 {
-    if (corrupted_) {
+    if (isCorrupted()) {
         return Status::Corrupted;
     }
     if (to == kFreeMark) {
@@ -124,7 +123,7 @@ Status BufferPool::transfer(void* buffer, uint16_t from, uint16_t to)
 size_t BufferPool::reclaimHeldBy(uint16_t holder)
 {
     size_t reclaimed = 0;
-    for (uint32_t index = 0; index < count_ && !corrupted_; ++index) {
+    for (uint32_t index = 0; index < count_ && !isCorrupted(); ++index) {
         uint16_t current;
         uint32_t next;
         const State state = stateOf(index, current, next);
@@ -140,7 +139,7 @@ size_t BufferPool::reclaimHeldBy(uint16_t holder)
 
 Status BufferPool::audit()
 {
-    if (corrupted_) {
+    if (isCorrupted()) {
         return Status::Corrupted;
     }
     uint32_t freeStates = 0;
@@ -153,21 +152,22 @@ Status BufferPool::audit()
         }
         freeStates += state == State::Free ? 1 : 0;
     }
-    if (freeStates != free_) {
+    const uint32_t free = freeCount();
+    if (freeStates != free) {
         return fail();
     }
-    // A list that ends within free_ steps visits distinct buffers, because
-    // each buffer has one link; with free_ steps it visits them all.
+    // A list that ends within free steps visits distinct buffers, because
+    // each buffer has one link; with free steps it visits them all.
     uint32_t steps = 0;
     for (uint32_t index = head_; index != kEndOfList;) {
         uint16_t holder;
         uint32_t next;
-        if (index >= count_ || ++steps > free_ || stateOf(index, holder, next) != State::Free) {
+        if (index >= count_ || ++steps > free || stateOf(index, holder, next) != State::Free) {
             return fail();
         }
         index = next;
     }
-    return steps == free_ ? Status::Ok : fail();
+    return steps == free ? Status::Ok : fail();
 }
 
 BufferPoolStatistics BufferPool::statistics() const
@@ -175,13 +175,13 @@ BufferPoolStatistics BufferPool::statistics() const
     BufferPoolStatistics statistics;
     statistics.bufferSize = bufferSize_;
     statistics.totalBuffers = count_;
-    statistics.freeBuffers = free_;
+    statistics.freeBuffers = freeCount();
     statistics.lowWaterMark = lowWater_;
     statistics.allocations = allocations_;
     statistics.failedAllocations = failedAllocations_;
     // Every buffer allocated is either still out or was returned (by Return
     // or by recovery), so the returns need no counter of their own.
-    statistics.returns = allocations_ - (count_ - free_);
+    statistics.returns = allocations_ - (count_ - freeCount());
     return statistics;
 }
 
@@ -238,8 +238,7 @@ Result<uint32_t> BufferPool::allocatedIndexOf(void* buffer, uint16_t holder)
 
 Status BufferPool::fail()
 {
-    corrupted_ = true;
-    limit_ = 0; // The fast paths' range test now fails for every index.
+    limit_ = 0; // The fast paths' range test now fails for every index, and isCorrupted() holds.
     return Status::Corrupted;
 }
 

@@ -9,6 +9,7 @@
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
+#include <dcos/internal/FlagsRestoringGuard.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -20,25 +21,62 @@ namespace {
 // bookkeeping runs with interrupts disabled.
 using Lock = arch_x86::InterruptGuard;
 
-// A pool object: the algorithm's state plus the area reserved for it. The
-// area is reserved from the start of Create to Delete, including while
-// Create lays out the buffers with interrupts enabled.
+// A pool object: the algorithm's state and the pool's id, the null id
+// while the slot is free. The fast paths find the object from the id without
+// the table's entry (fastObjectOf()) and read nothing else of the slot, so
+// what only Create reads (PoolArea) is kept apart and an object is 64 bytes.
 struct PoolObject {
     BufferPool pool;
     ObjectId id;
-    uintptr_t reservedBegin = 0;
-    uintptr_t reservedEnd = 0;
-    bool inUse = false;
+
+    bool inUse() const { return !id.isNull(); }
+};
+
+#if !defined(DCOS_HOST_BUILD)
+static_assert(sizeof(PoolObject) == 64, "a pool object holds what the fast paths read, and no more");
+#endif
+
+// The area reserved for the pool in the same slot, from the start of Create
+// to Delete, including while Create lays out the buffers with interrupts
+// enabled. Only Create's overlap check reads it, so it is kept apart from
+// the objects the fast paths read.
+struct PoolArea {
+    uintptr_t begin = 0;
+    uintptr_t end = 0;
 };
 
 using PoolTable = ObjectTable<PoolObject*, kPoolCapacity, TaskOwnerKeys>;
 
 constinit PoolTable poolTable(ObjectType::BufferPool, 0);
 constinit PoolObject pools[kPoolCapacity];
+constinit PoolArea poolAreas[kPoolCapacity];
 constinit bool started = false;
 constinit uint32_t poolsCreated = 0;
 
 size_t slotOf(ObjectId id) { return poolTable.slotNumber(id); }
+
+// Where the pool object of each id index is, as a byte offset into pools:
+// set by Create for the index its id got, so it is right for every live
+// pool, and left as it is by Delete (the object it leads to is cleared, so
+// it leads nowhere but to an object out of service). 0, pools[0], for an
+// index never used. The table's own map (ObjectTable::slotNumber) holds
+// slot numbers of 8 or 16 bits, which the i486 loads with a zero
+// extension of two instructions and then scales; this one is a single load
+// (4 bytes a possible index, 16 KiB, in .bss).
+constinit uint32_t poolOffsets[ObjectId::kMaxIndex + 1];
+
+// The fast paths' lookup: the object poolOffsets gives for @p id's index,
+// which is the pool @p id names exactly when the object's whole id equals
+// @p id (one compare checks node, type and index, as ObjectTable::find
+// does). A free slot's object is all zero: it keeps the null id, which a
+// null @p id does equal, but also a pool out of service (limit 0), whose
+// fast paths decline every call, so the complete service gives InvalidId.
+// Create sets the id and Delete clears the object under the lock, while
+// the table's entry changes, so both always agree on which id is live.
+[[gnu::always_inline]] inline PoolObject* fastObjectOf(ObjectId id)
+{
+    return reinterpret_cast<PoolObject*>(reinterpret_cast<uintptr_t>(pools) + poolOffsets[id.index()]);
+}
 
 // Activates the first slots on first use; call with interrupts disabled.
 void start()
@@ -84,6 +122,7 @@ Status checkOwnerOrSuperUser(ObjectId id)
 void remove(ObjectId id, PoolObject& object)
 {
     (void)poolTable.Delete(id);
+    poolAreas[&object - pools] = PoolArea{};
     object = PoolObject{};
 }
 
@@ -120,9 +159,8 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolManager::Create(void* area
         PoolObject& object = pools[slotOf(id)];
         object = PoolObject{};
         object.id = id;
-        object.reservedBegin = begin;
-        object.reservedEnd = end;
-        object.inUse = true;
+        poolAreas[slotOf(id)] = PoolArea{begin, end};
+        poolOffsets[id.index()] = static_cast<uint32_t>(slotOf(id) * sizeof(PoolObject));
         *poolTable.resolve(id).value() = &object;
         ++poolsCreated;
         salt = mixBits(static_cast<uint32_t>(begin) ^ (poolsCreated * 0x9E3779B9u));
@@ -230,12 +268,12 @@ DCOS_CONFIGURATION_SERVICE unsigned BufferPoolManager::recoverResourcesOf(Object
     // Called by the task agent with interrupts already disabled; the walk
     // over every buffer is the O(N) cost of recovery.
     Lock lock;
-    const uint16_t holder = deadTask.index();
+    const uint16_t holder = memory_area::holderOfTask(deadTask);
     size_t recovered = 0;
     // Only active slots can hold an object: the walk is O(active slots), not O(capacity).
     const PoolObject* const activeEnd = pools + poolTable.activeCount();
     for (PoolObject* object = pools; object != activeEnd; ++object) {
-        if (object->inUse && object->pool.inService()) {
+        if (object->inUse() && object->pool.inService()) {
             recovered += object->pool.reclaimHeldBy(holder);
         }
     }
@@ -245,9 +283,10 @@ DCOS_CONFIGURATION_SERVICE unsigned BufferPoolManager::recoverResourcesOf(Object
 
 bool BufferPoolManager::overlapsArea(uintptr_t begin, uintptr_t end)
 {
-    const PoolObject* const activeEnd = pools + poolTable.activeCount();
-    for (const PoolObject* object = pools; object != activeEnd; ++object) {
-        if (object->inUse && begin < object->reservedEnd && object->reservedBegin < end) {
+    // A free slot's area is empty, [0, 0), and overlaps nothing.
+    const PoolArea* const activeEnd = poolAreas + poolTable.activeCount();
+    for (const PoolArea* area = poolAreas; area != activeEnd; ++area) {
+        if (begin < area->end && area->begin < end) {
             return true;
         }
     }
@@ -257,7 +296,7 @@ bool BufferPoolManager::overlapsArea(uintptr_t begin, uintptr_t end)
 bool BufferPoolManager::snapshot(size_t slot, PoolInfo& info)
 {
     Lock lock;
-    if (slot >= poolTable.activeCount() || !pools[slot].inUse || !pools[slot].pool.inService()) {
+    if (slot >= poolTable.activeCount() || !pools[slot].inUse() || !pools[slot].pool.inService()) {
         return false;
     }
     const PoolObject& object = pools[slot];
@@ -300,8 +339,9 @@ using internal::BufferPoolManager;
 
 // Allocate and Return are defined here rather than in BufferPoolAgent.cpp,
 // beside the pool table, so that the common case runs in the agent's own
-// call: under the interrupt guard, the table's inline lookup and the pool's
-// inline pop or push (BufferPool::tryAllocate, tryRelease). Every other
+// call: under the interrupt guard, the inline lookup of the pool object by
+// its id (fastObjectOf) and the pool's inline pop or push
+// (BufferPool::tryAllocate, tryRelease). Every other
 // case, errors included, goes to the manager's complete service, which
 // resolves the id again under its own guard and gives the precise status.
 // callerHolder() never gives kFreeMark, as tryAllocate requires.
@@ -309,10 +349,11 @@ using internal::BufferPoolManager;
 Result<void*> BufferPoolAgent::Allocate(ObjectId id)
 {
     {
-        const internal::Lock lock;
-        if (internal::PoolObject* const* found = internal::poolTable.find(id)) [[likely]] {
-            if (void* buffer = (*found)->pool.tryAllocate(internal::memory_area::callerHolder(BufferPool::kSystemHolder)))
-                [[likely]] {
+        const internal::FlagsRestoringGuard guard;
+        internal::PoolObject* const object = internal::fastObjectOf(id);
+        if (object->id == id) [[likely]] {
+            if (void* buffer = object->pool.tryAllocate(
+                    [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); })) [[likely]] {
                 return buffer;
             }
         }
@@ -323,10 +364,11 @@ Result<void*> BufferPoolAgent::Allocate(ObjectId id)
 Status BufferPoolAgent::Return(ObjectId id, void* buffer)
 {
     {
-        const internal::Lock lock;
-        if (internal::PoolObject* const* found = internal::poolTable.find(id)) [[likely]] {
-            if ((*found)->pool.tryRelease(buffer, internal::memory_area::callerHolder(BufferPool::kSystemHolder)))
-                [[likely]] {
+        const internal::FlagsRestoringGuard guard;
+        internal::PoolObject* const object = internal::fastObjectOf(id);
+        if (object->id == id) [[likely]] {
+            if (object->pool.tryRelease(
+                    buffer, [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); })) [[likely]] {
                 return Status::Ok;
             }
         }

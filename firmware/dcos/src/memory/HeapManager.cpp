@@ -11,6 +11,7 @@
 #include <dcos/internal/SegmentedHeap.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
+#include <dcos/internal/FlagsRestoringGuard.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -210,7 +211,7 @@ DCOS_CONFIGURATION_SERVICE unsigned HeapManager::recoverResourcesOf(ObjectId dea
     // Called by the task agent with interrupts already disabled; the walk
     // over every segment is the O(N) cost of recovery.
     Lock lock;
-    const uint16_t holder = deadTask.index();
+    const uint16_t holder = memory_area::holderOfTask(deadTask);
     size_t recovered = 0;
     // Only active slots can hold an object: the walk is O(active slots), not O(capacity).
     const HeapObject* const activeEnd = heaps + heapTable.activeCount();
@@ -289,7 +290,7 @@ using internal::SegmentedHeap;
 Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes)
 {
     {
-        const internal::Lock lock;
+        const internal::FlagsRestoringGuard guard;
         if (internal::HeapObject* const* found = internal::heapTable.find(id)) [[likely]] {
             return (*found)->heap.allocate(bytes, internal::memory_area::callerHolder(SegmentedHeap::kSystemHolder));
         }
@@ -300,7 +301,7 @@ Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes)
 Status HeapAgent::Return(ObjectId id, void* segment)
 {
     {
-        const internal::Lock lock;
+        const internal::FlagsRestoringGuard guard;
         if (internal::HeapObject* const* found = internal::heapTable.find(id)) [[likely]] {
             return (*found)->heap.release(segment, internal::memory_area::callerHolder(SegmentedHeap::kSystemHolder));
         }

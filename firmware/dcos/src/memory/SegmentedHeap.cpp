@@ -82,6 +82,7 @@ Status SegmentedHeap::initialise(void* area, size_t areaBytes, uint32_t salt)
     areaBegin_ = begin;
     areaEnd_ = begin + areaBytes;
     size_ = static_cast<uint32_t>(usable);
+    limit_ = size_ - static_cast<uint32_t>(kHeaderBytes);
     salt_ = salt;
     multiplier_ = mixBits(salt ^ 0x9E3779B9u) | 1;
     // One free segment spans the heap.
@@ -96,15 +97,21 @@ Status SegmentedHeap::initialise(void* area, size_t areaBytes, uint32_t salt)
 
 Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
 {
-    if (corrupted_) {
-        return Status::Corrupted;
-    }
-    if (bytes == 0) {
-        return Status::InvalidArgument;
-    }
-    if (bytes > size_) {
-        ++failedAllocations_;
-        return Status::NoMemory;
+    // One compare passes every request that can fit: not on a corrupted
+    // heap (limit_ 0), not 0 bytes (which wraps), and none of the heap's
+    // size less a header or more. The rest is told apart here; the few
+    // requests of the heap's last 8 bytes go on, and fail in the search.
+    if (bytes - 1 >= limit_) [[unlikely]] {
+        if (corrupted_) {
+            return Status::Corrupted;
+        }
+        if (bytes == 0) {
+            return Status::InvalidArgument;
+        }
+        if (bytes > size_) {
+            ++failedAllocations_;
+            return Status::NoMemory;
+        }
     }
     const uint32_t needed = static_cast<uint32_t>(HeapAgent::SegmentBytes(bytes));
 
@@ -180,9 +187,6 @@ Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
 
 Status SegmentedHeap::release(void* segment, uint16_t holder)
 {
-    if (corrupted_) {
-        return Status::Corrupted;
-    }
     Allocated header{};
     const Result<uint32_t> offset = allocatedOffsetOf(segment, holder, header);
     if (!offset.ok()) {
@@ -193,9 +197,6 @@ Status SegmentedHeap::release(void* segment, uint16_t holder)
 
 Status SegmentedHeap::transfer(void* segment, uint16_t from, uint16_t to)
 {
-    if (corrupted_) {
-        return Status::Corrupted;
-    }
     Allocated header{};
     const Result<uint32_t> offset = allocatedOffsetOf(segment, from, header);
     if (!offset.ok()) {
@@ -514,13 +515,20 @@ inline Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t
 {
     const uintptr_t address = reinterpret_cast<uintptr_t>(segment);
     const uintptr_t base = reinterpret_cast<uintptr_t>(base_);
-    if (size_ == 0 || address < base || address - base >= size_) {
-        return Status::InvalidArgument; // Not this heap's memory: the heap is unharmed.
-    }
-    if (((address - base) & kFlagMask) != 0 || address - base < kHeaderBytes) {
-        return fail(); // A wild pointer into the heap.
-    }
+    // A segment's data starts 8 bytes past a multiple of 8 inside the heap:
+    // one compare (against limit_, the heap's size less a header, 0 when
+    // corrupted; below the heap's start the offset wraps) and one mask
+    // accept it; anything else is told apart only then.
     const uintptr_t offset = address - base - kHeaderBytes;
+    if (offset >= limit_ || (offset & kFlagMask) != 0) [[unlikely]] {
+        if (corrupted_) {
+            return Status::Corrupted;
+        }
+        if (size_ == 0 || address < base || address - base >= size_) {
+            return Status::InvalidArgument; // Not this heap's memory: the heap is unharmed.
+        }
+        return fail(); // A wild pointer into the heap (its first 8 bytes included).
+    }
     // A free or merged segment (a double return) or an overwritten header fails here.
     if (!checkAllocated(static_cast<uint32_t>(offset), header)) {
         return fail();
@@ -624,6 +632,7 @@ uint32_t SegmentedHeap::releaseAt(uint32_t offset, uint32_t segmentSize, bool pr
 Status SegmentedHeap::fail()
 {
     corrupted_ = true;
+    limit_ = 0; // Allocate's and Return's first test now refuses every call.
     return Status::Corrupted;
 }
 

@@ -76,39 +76,67 @@ public:
     Status initialise(void* area, size_t areaBytes, size_t bufferSize, uint32_t salt);
 
     /// The fast path of allocate(): takes the head of the free list for
-    /// @p holder, or returns null when the list is empty, the pool is
+    /// the holder in the low half of what @p holderWord() returns (a
+    /// uint32_t whose high half is ignored, so the kernel may give a whole
+    /// task id), or returns null when the list is empty, the pool is
     /// corrupted or the head's state word fails its check (allocate() then
-    /// says which). @p holder must not be kFreeMark. O(1).
-    [[gnu::always_inline]] void* tryAllocate(uint16_t holder)
+    /// says which). The holder must not be kFreeMark. O(1).
+    ///
+    /// The holder is asked for only once the head passed its checks: while
+    /// they run, the kernel's fast path has no register to spare for it.
+    template <typename HolderWord>
+    [[gnu::always_inline]] void* tryAllocate(HolderWord holderWord)
     {
         const uint32_t index = head_;
         if (index >= limit_) {
             return nullptr; // Empty (kEndOfList), corrupted (limit_ 0) or a bad head.
         }
-        const uint32_t word = loadState(index) ^ freeKey_;
-        if (static_cast<uint16_t>(word) != index) {
+        // Decoded with the free key and XORed with its own index, the word
+        // of a free buffer has a zero low half and the next index above it:
+        // one XOR more saves isolating the half to compare it.
+        const uint32_t word = loadState(index) ^ freeKey_ ^ index;
+        if ((word & 0xFFFF) != 0) {
             return nullptr;
         }
-        storeState(index, ((static_cast<uint32_t>(holder) << 16) | index) ^ allocatedKey_);
         head_ = word >> 16; // Checked when it is the head: below limit_, or the end.
-        if (--free_ < lowWater_) {
-            lowWater_ = free_;
+        storeState(index, ((static_cast<uint32_t>(holderWord()) << 16) | index) ^ allocatedKey_);
+        // One subtraction in memory keeps both counts: the free buffers are
+        // the low-water mark plus those above it, and only when none is
+        // above it does the mark move (the borrow says so).
+        uint32_t above;
+        if (__builtin_sub_overflow(aboveLowWater_, 1u, &above)) [[unlikely]] {
+            --lowWater_;
+        } else {
+            aboveLowWater_ = above;
         }
         ++allocations_;
-        return reinterpret_cast<void*>(base_ + index * stride_);
+        void* const buffer = reinterpret_cast<void*>(base_ + index * stride_);
+        // A buffer lies inside a non-null area that does not wrap, so it is
+        // never null: the caller's test of the result then costs nothing.
+        if (buffer == nullptr) {
+            __builtin_unreachable();
+        }
+        return buffer;
     }
 
     /// The fast path of release(): gives back @p buffer if it is the start
-    /// of a buffer that @p holder itself holds; false in every other case
-    /// (release() then decides). O(1).
-    [[gnu::always_inline]] bool tryRelease(void* buffer, uint16_t holder)
+    /// of a buffer that the holder in the low half of what @p holderWord()
+    /// returns itself holds (the high half is ignored, as for
+    /// tryAllocate()); false in every other case (release() then decides).
+    /// The holder is asked for once the address is known to be a buffer's,
+    /// for the reason tryAllocate() gives. O(1).
+    template <typename HolderWord>
+    [[gnu::always_inline]] bool tryRelease(void* buffer, HolderWord holderWord)
     {
         const uintptr_t index = indexOf(buffer);
         if (index >= limit_) {
             return false; // Not a buffer's start, not this pool's, or corrupted.
         }
-        if (loadState(static_cast<uint32_t>(index))
-            != (((static_cast<uint32_t>(holder) << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_)) {
+        // The word it must hold, built before the load, so that no address
+        // waits in a register while the holder is asked for.
+        const uint32_t expected =
+            ((static_cast<uint32_t>(holderWord()) << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_;
+        if (loadState(static_cast<uint32_t>(index)) != expected) {
             return false; // Free already, another holder's, the system's, or overwritten.
         }
         pushFree(static_cast<uint32_t>(index));
@@ -123,7 +151,7 @@ public:
     Result<void*> allocate(uint16_t holder)
     {
         if (holder != kFreeMark) [[likely]] {
-            if (void* buffer = tryAllocate(holder)) [[likely]] {
+            if (void* buffer = tryAllocate([holder] { return uint32_t{holder}; })) [[likely]] {
                 return buffer;
             }
         }
@@ -138,7 +166,7 @@ public:
     /// not a buffer's start, or a state word that fails its check.
     Status release(void* buffer, uint16_t holder)
     {
-        if (tryRelease(buffer, holder)) [[likely]] {
+        if (tryRelease(buffer, [holder] { return uint32_t{holder}; })) [[likely]] {
             return Status::Ok;
         }
         return releaseSlowly(buffer, holder);
@@ -166,15 +194,11 @@ public:
     BufferPoolStatistics statistics() const;
 
     /// Number of buffers currently allocated. O(1).
-    size_t allocatedCount() const { return count_ - free_; }
+    size_t allocatedCount() const { return count_ - freeCount(); }
     /// Whether a check failed; a corrupted pool refuses every call.
-    bool isCorrupted() const { return corrupted_; }
+    bool isCorrupted() const { return limit_ == 0 && count_ != 0; }
     /// Whether initialise() succeeded and the pool has buffers.
     bool inService() const { return count_ != 0; }
-    /// The first byte of the area given to initialise().
-    uintptr_t areaBegin() const { return areaBegin_; }
-    /// One past the last byte of the area given to initialise().
-    uintptr_t areaEnd() const { return areaEnd_; }
     /// The holder of the buffer with index @p index, or kFreeMark when it is
     /// free; false when the index is out of range or its state word fails its check.
     bool holderOf(size_t index, uint16_t& holder) const;
@@ -215,8 +239,12 @@ private:
     {
         storeState(index, ((head_ << 16) | index) ^ freeKey_);
         head_ = index;
-        ++free_;
+        ++aboveLowWater_;
     }
+
+    // The free buffers: the low-water mark and how many are above it
+    // (kept so, Allocate keeps the mark with one subtraction).
+    uint32_t freeCount() const { return lowWater_ + aboveLowWater_; }
 
     State stateOf(uint32_t index, uint16_t& holder, uint32_t& next) const;
     Result<void*> allocateSlowly(uint16_t holder);
@@ -231,19 +259,21 @@ private:
     uint32_t stride_ = 0;
     uintptr_t inverse_ = 0;     // Of the stride's odd part, modulo 2^32 (2^64 on a 64-bit host).
     int shift_ = 0;             // The stride's trailing zero bits.
-    uint32_t limit_ = 0;        // count_ while in service, 0 once corrupted: the fast paths' one test.
+    // count_ while in service, 0 once corrupted (which is how isCorrupted()
+    // tells): the fast paths' one test.
+    uint32_t limit_ = 0;
     uint32_t head_ = kEndOfList;
-    uint32_t free_ = 0;
-    uint32_t lowWater_ = 0;
+    uint32_t aboveLowWater_ = 0; // Free buffers above the low-water mark.
+    uint32_t lowWater_ = 0;      // The fewest free buffers there have been.
     uint32_t allocations_ = 0;
     uint32_t freeKey_ = 0;      // Every free buffer's state word is XORed with it,
     uint32_t allocatedKey_ = 0; // every allocated buffer's with this one.
     uint32_t count_ = 0;
     uint32_t failedAllocations_ = 0;
     uint32_t bufferSize_ = 0;
-    uintptr_t areaBegin_ = 0;
-    uintptr_t areaEnd_ = 0;
-    bool corrupted_ = false;
+    // Sixty bytes on the board: with the kernel's id beside it, a pool slot
+    // is 64 bytes (BufferPoolManager.cpp). The area's bounds are the
+    // kernel's to keep.
 };
 
 /// value * factor, as one IMUL on the board. Tuned for the i486, GCC spells

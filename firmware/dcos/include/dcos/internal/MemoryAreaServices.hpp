@@ -22,16 +22,37 @@
 
 namespace dcos::internal::memory_area {
 
+/// The holder tag of the task @p task: the low half of its id, its type and
+/// index. The fast paths shift it into the high half of a state word or
+/// header, and the whole id's low half is that shift alone, where the index
+/// would need a mask first. The task type is 1, so a task's tag lies in
+/// [0x1000, 0x1FFF] and never meets the reserved tags at the top of the range.
+[[gnu::always_inline]] inline uint16_t holderOfTask(ObjectId task) { return static_cast<uint16_t>(task.raw()); }
+
+static_assert(static_cast<uint16_t>(ObjectId(0xFFFF, ObjectType::Task, ObjectId::kMaxIndex).raw()) < 0xFFFE,
+              "a task's holder tag must differ from the system's and from the free mark");
+
+/// callerHolder() in the low half of a word whose high half is left as it
+/// comes (the running task's node), for the pool's fast paths, which shift
+/// the holder into place: a 16-bit value would cost them a store and a
+/// reload, or a mask.
+[[gnu::always_inline]] inline uint32_t callerHolderWord(uint16_t systemHolder)
+{
+    // Unlikely: the task's case then runs straight through, without the jump
+    // over the system's that GCC would otherwise place on it.
+    if (inInterruptContext() || !Scheduler::started()) [[unlikely]] {
+        return systemHolder;
+    }
+    return Scheduler::current().id.raw();
+}
+
 /// The holder recorded for memory the caller takes: its task, or the system
 /// (systemHolder) in an interrupt handler and before the scheduler starts.
 /// Inline, from the scheduler's running task (what currentTaskId() gives),
 /// because Allocate and Return ask on their fast paths.
 [[gnu::always_inline]] inline uint16_t callerHolder(uint16_t systemHolder)
 {
-    if (inInterruptContext() || !Scheduler::started()) {
-        return systemHolder;
-    }
-    return Scheduler::current().id.index();
+    return static_cast<uint16_t>(callerHolderWord(systemHolder));
 }
 
 /// The holder for a new owner given as a task id; the null id is the system.
@@ -41,7 +62,7 @@ inline Result<uint16_t> holderFor(ObjectId newOwner, uint16_t systemHolder)
     if (status != Status::Ok) {
         return status;
     }
-    return newOwner.isNull() ? systemHolder : newOwner.index();
+    return newOwner.isNull() ? systemHolder : holderOfTask(newOwner);
 }
 
 /// NameToObject: refused in interrupt handlers; O(N) in the active slots.

@@ -197,6 +197,9 @@ private:
     uintptr_t areaBegin_ = 0;
     uintptr_t areaEnd_ = 0;
     uint32_t size_ = 0;
+    // size_ less a header while in service, 0 once corrupted: the one bound
+    // Allocate and Return test first.
+    uint32_t limit_ = 0;
     uint32_t freeBytes_ = 0;
     uint32_t freeSegments_ = 0;
     uint32_t allocatedSegments_ = 0;
