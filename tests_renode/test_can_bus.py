@@ -772,6 +772,7 @@ def test_corrupted_frames_are_counted_by_sender_and_receiver(canlab):
     for board in (sender, receiver):
         board.init(0, 500_000)
     lab.hub.corrupt("board1.0", 3)
+    lab.hub.sync_commands()  # The fault is armed before the frame starts.
     frame = Frame.data_frame(0x77, b"\xaa\xbb")
     send_frame(sender, frame)
     heard = receiver.wait_log(0, lambda log: log.frames(), what="the frame at last")

@@ -279,6 +279,7 @@ def test_corrupted_frames_are_counted_by_the_sending_and_the_receiving_driver(ca
     for each in (sender, receiver):
         up(each, 500_000)
     lab.hub.corrupt("board1.0", 3)
+    lab.hub.sync_commands()  # The fault is armed before the frame starts.
     assert "can0  077        [2]  AA BB  sent" in sender.command("can send can0 077#AA.BB")
     assert "can0  077        [2]  AA BB" in receiver.command("can dump can0 1 5000")
     assert [r.outcome for r in lab.hub.frames()] == ["form-error"] * 3 + ["ok"], lab.hub.log_text()

@@ -655,6 +655,22 @@ class Hub:
             self._commands.append((function, args))
         os.write(self._wake_w, b"x")
 
+    def sync_commands(self, timeout=30.0):
+        """Returns once every command given so far (a fault, a babbler, a line
+        send) is in effect: the hub applied it at a boundary and every board
+        has passed that boundary. A fault applies from the next boundary, and a
+        board runs up to that boundary meanwhile, so without this a frame the
+        test has a board send right after corrupt() can start in the quantum
+        before the fault."""
+        applied = []
+
+        def mark(boundary):
+            applied.append(boundary)
+
+        self._command(mark)
+        self.wait_for(lambda: bool(applied) and self.boundary - self.quantum_ns >= applied[0], timeout,
+                      "the hub's commands to take effect")
+
     def force_passive(self, port_name):
         """The port's TEC is raised to 128 at the next boundary: error passive."""
         self._command(self._fault_event, port_name, "passive")
