@@ -41,6 +41,23 @@ void blockForever(uintptr_t);
 dcos::Result<dcos::ObjectId> spawnTask(dcos::TaskEntry entry, uint8_t priority, uintptr_t argument = 0,
                                        const char* name = nullptr, bool floatingPoint = false);
 
+/// Calls create() and, when its table is full, grows the table by eight
+/// slots with addObjects(8) and calls create() once more: how a population
+/// reaches 4096 objects in tables that start small.
+template <typename Create, typename AddObjects>
+dcos::Result<dcos::ObjectId> createGrowing(Create create, AddObjects addObjects)
+{
+    dcos::Result<dcos::ObjectId> id = create();
+    if (id.status() == dcos::Status::TableFull) {
+        const dcos::Status grown = addObjects(8);
+        if (grown != dcos::Status::Ok) {
+            return grown;
+        }
+        id = create();
+    }
+    return id;
+}
+
 /// Adds filler tasks running blockForever until total tasks exist. The last
 /// one is named "target" and its id returned in target (null when none was
 /// added).

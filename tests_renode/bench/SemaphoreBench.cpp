@@ -36,15 +36,7 @@ SemaphoreAttributes binaryAttributes(const char* name)
 
 Result<ObjectId> createSemaphore(const SemaphoreAttributes& attributes)
 {
-    Result<ObjectId> id = semaphoreAgent.Create(attributes);
-    if (id.status() == Status::TableFull) {
-        const Status grown = semaphoreAgent.AddObjects(8);
-        if (grown != Status::Ok) {
-            return grown;
-        }
-        id = semaphoreAgent.Create(attributes);
-    }
-    return id;
+    return createGrowing([&] { return semaphoreAgent.Create(attributes); }, semaphoreAgent.AddObjects);
 }
 
 // Creates semaphores until count exist on the node, the last one "target" with @p last's attributes.

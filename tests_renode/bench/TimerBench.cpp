@@ -39,15 +39,7 @@ uint64_t timeOfDay() { return dcos::internal::TimerManager::timeOfDayNs(); }
 
 Result<ObjectId> createTimer(const char* name)
 {
-    Result<ObjectId> id = timerAgent.Create(name, dcos::Visibility::Local);
-    if (id.status() == Status::TableFull) {
-        const Status grown = timerAgent.AddObjects(8);
-        if (grown != Status::Ok) {
-            return grown;
-        }
-        id = timerAgent.Create(name, dcos::Visibility::Local);
-    }
-    return id;
+    return createGrowing([&] { return timerAgent.Create(name, dcos::Visibility::Local); }, timerAgent.AddObjects);
 }
 
 // Every benchmark here starts with the clock set to 2024-01-01 00:00: the

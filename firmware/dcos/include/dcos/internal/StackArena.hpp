@@ -1,10 +1,12 @@
 // The static memory task stacks are carved from.
 //
-// Creating and deleting tasks are configuration-class services (seed 6.4), so
-// a first-fit search over a free list is acceptable here; nothing on a
-// real-time path allocates. Free blocks are kept in address order and merged
-// with both neighbours when returned, so the arena does not fragment into
-// unusable slivers as tasks come and go.
+// Creating tasks is a configuration-class service (seed 6.4), so a first-fit
+// search over a free list is acceptable for allocate(); nothing on a
+// real-time path allocates. Returning a stack is part of a task's death,
+// whose recovery must cost what the task owned, never what the arena holds
+// (issue 12): release() finds a block's free neighbours through boundary
+// tags kept beside the arena, merges with both in constant time, and so
+// the arena does not fragment into unusable slivers as tasks come and go.
 //
 // Every stack is whole pages with a guard page below it that is not present
 // (arch_x86/Paging.hpp): a task that runs off the bottom of its stack faults
@@ -43,7 +45,7 @@ public:
     /// made not present, and returns its lowest byte; NoMemory when no free
     /// block is large enough.
     static Result<uint8_t*> allocate(size_t size);
-    /// Returns a stack from allocate(), with the size it was asked for.
+    /// Returns a stack from allocate(), with the size it was asked for. Cost O(1).
     static void release(uint8_t* stack, size_t size);
     /// Whether address lies in the guard page below stack.
     static bool isGuardOf(const uint8_t* stack, uintptr_t address);
