@@ -67,31 +67,12 @@ interrupt_return:
     iret
 
 /*
- * void directSwitch(uint32_t** save, uint32_t* resumeStack, InterruptFrame* frame)
- * with regparm(3): EAX = save, EDX = resumeStack, ECX = frame.
- *
- * The task-context switch (Scheduler::switchFromTask): a task that blocks,
- * yields or readies a more urgent task leaves through here instead of the
- * dispatch trap. It keeps only what the C++ ABI says a call preserves (EBX,
- * ESI, EDI, EBP and the return address; the caller has interrupts disabled
- * and restores its own flags once resumed) and stores its stack pointer at
- * *save. The next task resumes the same way when it left through here
- * (resumeStack not null), or from the interrupt frame it was preempted in.
- */
-    .globl directSwitch
-directSwitch:
-    pushl %ebp
-    pushl %ebx
-    pushl %esi
-    pushl %edi
-    movl %esp, (%eax)
-    testl %edx, %edx
-    jz 1f
-    movl %edx, %esp
-/*
- * A task saved by directSwitch resumes here: straight from the switch, or
- * through iret from the frame Scheduler::frameForDirectResume() builds when
- * an interrupt's exit is what picks it.
+ * Where a task parked from task context resumes when an interrupt's exit is
+ * what picks it: through iret from the frame Scheduler::frameForDirectResume()
+ * builds, whose EIP is this. The switch from task context
+ * (dcos/src/scheduler/TaskContextSwitch.S) left on the task's stack the four
+ * registers the C++ ABI has a call preserve, under a return address: they
+ * are popped, and the return goes where that switch would have returned.
  */
     .globl directResume
 directResume:
@@ -100,8 +81,6 @@ directResume:
     popl %ebx
     popl %ebp
     ret
-1:  movl %ecx, %esp
-    jmp interrupt_return
 
     /* .altmacro makes %vector pass the counter's value, not its name. */
     .altmacro

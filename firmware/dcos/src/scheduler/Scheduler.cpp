@@ -77,7 +77,6 @@ bool Scheduler::isMoreUrgent(const Task& a, const Task& b)
     return a.priority < b.priority;
 }
 
-
 void Scheduler::makeReady(Task& task)
 {
     // rotatesOnYield: neither the idle task nor ordered by a deadline.

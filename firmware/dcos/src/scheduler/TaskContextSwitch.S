@@ -6,15 +6,14 @@
  *
  * A task parked here leaves on its stack its caller's flags, then the
  * address of taskResumed, then the four registers the C++ ABI has a call
- * preserve. That is directSwitch's layout (InterruptStubs.S: four registers
- * and a return address), so any resume path resumes a task parked here:
- * this one pops the registers and returns into taskResumed, which restores
- * the flags the task had when it called; so does directResume, the entry
- * of a frame an interrupt's exit builds for it (frameForDirectResume).
+ * preserve. Either routine here resumes a task parked by either: it pops
+ * the registers and returns into taskResumed, which restores the flags the
+ * task had when it called; so does directResume (InterruptStubs.S), the
+ * entry of a frame an interrupt's exit builds for it (frameForDirectResume).
  * Saving the flags here, rather than in the C++ caller, lets that caller
- * jump here as its last act instead of calling, so neither keeps a frame of
- * its own across the switch: the C++ version saved the callee-saved
- * registers twice, in its prologue and in directSwitch.
+ * jump here as its last act instead of calling, so no C++ frame stays on a
+ * parked task's stack: the C++ version saved the callee-saved registers
+ * twice, in its own prologue and again in the assembly it called.
  */
 #include <dcos/internal/TaskContextSwitch.h>
 

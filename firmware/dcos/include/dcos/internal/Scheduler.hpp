@@ -154,7 +154,7 @@ private:
     /// delivered on the way, else through the dispatch trap.
     static void switchFromTask();
     /// An interrupt frame on a directly switched task's stack that resumes it
-    /// where directSwitch left it, for a switch made at an interrupt's exit.
+    /// where dcosSwitchFromTask left it, for a switch made at an interrupt's exit.
     static arch_x86::InterruptFrame* frameForDirectResume(Task& task);
 
     static void restoreInterrupts(uint32_t flags)
