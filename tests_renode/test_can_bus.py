@@ -750,6 +750,10 @@ def test_forced_bus_off_shows_in_the_status_register_and_interrupt(canlab):
     send_frame(other, Frame.data_frame(0x10, b"\x01"), once=True)
     records = lab.hub.wait_for_records(lambda records: records, TIMEOUT)
     assert records[0].outcome == "ack-error" and records[0].rx == ()
+    # The hub logs a frame as soon as it has decided it, before its last bit
+    # is on the bus; the recovery below counts from an idle bus, so it
+    # starts once every board has passed the frame's end.
+    lab.hub.wait_until(records[0].end, TIMEOUT)
     # Leaving reset mode starts the recovery: 128 bus-free signals of 11
     # bits on the idle bus, told by the hub at the next quantum boundary.
     started = board.start(0)
