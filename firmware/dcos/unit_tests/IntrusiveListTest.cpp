@@ -59,8 +59,6 @@ TEST(IntrusiveListTest, PushFrontInsertAfterAndInsertBefore)
     list.insertAfter(b, c);
     list.insertBefore(list.end(), e);
     EXPECT_EQ(values(list), (std::vector<int>{1, 2, 3, 4, 5}));
-    EXPECT_EQ(list.previous(a), nullptr);
-    EXPECT_EQ(list.previous(c), &b);
 }
 
 TEST(IntrusiveListTest, RemoveFromAnyPositionAndSelfUnlink)
@@ -94,26 +92,4 @@ TEST(IntrusiveListTest, ObjectCanSitOnTwoListsWithDifferentTags)
     ready.remove(a);
     EXPECT_EQ(values(ready), (std::vector<int>{2}));
     EXPECT_EQ(values(other), (std::vector<int>{2, 1}));
-}
-
-TEST(IntrusiveListTest, RotateMovesTheFrontBehindTheBack)
-{
-    IntrusiveList<Item, ReadyTag> list;
-    EXPECT_EQ(list.rotate(), nullptr); // Empty: nothing to do.
-    Item a(1), b(2), c(3);
-    list.pushBack(a);
-    EXPECT_EQ(list.rotate(), nullptr); // Alone: stays where it is.
-    EXPECT_EQ(values(list), (std::vector<int>{1}));
-    list.pushBack(b);
-    EXPECT_EQ(list.rotate(), &b);
-    EXPECT_EQ(values(list), (std::vector<int>{2, 1}));
-    list.pushBack(c);
-    EXPECT_EQ(list.rotate(), &a);
-    EXPECT_EQ(values(list), (std::vector<int>{1, 3, 2}));
-    EXPECT_EQ(&list.back(), &b);
-    // The links stay consistent both ways: removal and reverse order still work.
-    list.remove(c);
-    EXPECT_EQ(values(list), (std::vector<int>{1, 2}));
-    EXPECT_EQ(list.previous(b), &a);
-    EXPECT_EQ(list.previous(a), nullptr);
 }

@@ -1,4 +1,5 @@
-// Intrusive doubly linked list (the ready queues of dissertation 7.4.1).
+// Intrusive doubly linked list: the kernel's wait lists, time-wheel slots and
+// reap list (the ready queues of seed 7.4.1 are rings, IntrusiveRing.hpp).
 //
 // The kernel never allocates when a task becomes ready or blocks: the links
 // live inside the object itself. An object that must sit in several lists at
@@ -141,26 +142,6 @@ public:
     /// Removes @p item, which must be on this list. Cost O(1).
     void remove(T& item) { node(item).unlink(); }
 
-    /// Moves the first element behind the last and returns the new first
-    /// one; with fewer than two elements, changes nothing and returns null.
-    /// Cost O(1): the round-robin step of a ready queue.
-    T* rotate()
-    {
-        Node* const first = head_.next_;
-        Node* const second = first->next_;
-        if (second == &head_ || first == &head_) {
-            return nullptr;
-        }
-        head_.next_ = second;
-        second->prev_ = &head_;
-        Node* const last = head_.prev_;
-        first->prev_ = last;
-        first->next_ = &head_;
-        last->next_ = first;
-        head_.prev_ = first;
-        return static_cast<T*>(second);
-    }
-
     /// Number of elements. Cost O(N); kept off the hot paths on purpose, so
     /// that no counter has to be maintained when a node unlinks itself.
     size_t size() const
@@ -176,13 +157,6 @@ public:
     Iterator begin() { return Iterator(head_.next_); }
     /// Iterator past the last element.
     Iterator end() { return Iterator(&head_); }
-
-    /// The element in front of @p item, or null when @p item is first. Cost O(1).
-    T* previous(T& item)
-    {
-        Node* prev = node(item).prev_;
-        return prev == &head_ ? nullptr : static_cast<T*>(prev);
-    }
 
 private:
     template <typename, typename, typename>
