@@ -20,6 +20,8 @@ MEMORY_TARGET_TESTS = [
     "heapcorrupt",  # double return, overrun into a header, overwritten link: Corrupted until Delete
     "memisr",       # Allocate in an interrupt handler gives system-held memory any task may return
     "memrecovery",  # a killed or self-deleting task gives back its buffers, segments, pools and heaps
+    "heldlists",    # recovery finds a killed task's memory from its held lists, however it changed hands
+    "heldlost",     # a held list through a corrupted pool is lost; recovery walks every pool instead
 ]
 
 

@@ -1,7 +1,7 @@
 // Benchmarks of the buffer pool memory agent's primitives (seed 7.7, Table 9.6).
 //
 // The object count is the number of pools, all created by the shell, each
-// over its own 24-byte area of two 8-byte buffers (AreaBytes(8, 2)). The
+// over its own 40-byte area of two 8-byte buffers (AreaBytes(8, 2)). The
 // measured call acts on the newest pool, "target". BufferPool.AddObjects is
 // in ConfigurationBench.cpp. The seed's GetUsageInfo is DCOS's GetStatistics.
 #include "BenchSupport.hpp"

@@ -172,8 +172,8 @@ void deletePools()
 
 void addPoolSlots() { check(dcos::bufferPoolAgent.AddObjects(8)); }
 
-// Heaps of the smallest size, one 16-byte segment.
-alignas(8) uint8_t heapAreas[kSmallPopulation][16];
+// Heaps of the smallest size, one segment of the smallest size.
+alignas(8) uint8_t heapAreas[kSmallPopulation][dcos::HeapAgent::SegmentBytes(1)];
 ObjectId heaps[kSmallPopulation];
 uint32_t heapCount = 0;
 

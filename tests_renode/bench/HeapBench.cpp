@@ -13,7 +13,7 @@
 // DCOS's two-level segregated fit makes Allocate and GetUsageInfo (the
 // seed's name for GetStatistics) O(1), so they are Cost::Constant, and the
 // "...Fragmented" benchmarks show it: there the object count is not heaps
-// but free segments, one heap holding that many 16-byte free segments, every
+// but free segments, one heap holding that many 24-byte free segments, every
 // one too small for the request, besides the one that fits. First fit
 // walked them all. Heap.AddObjects is in ConfigurationBench.cpp.
 #include "BenchSupport.hpp"
@@ -31,7 +31,7 @@ using dcos::Status;
 
 constexpr size_t kSmallAreaBytes = 64;
 constexpr size_t kTargetAreaBytes = 4096;
-constexpr size_t kRequest = 64; // A request of 64 bytes takes a 72-byte segment.
+constexpr size_t kRequest = 64; // A request of 64 bytes takes an 80-byte segment.
 
 alignas(8) uint8_t smallAreas[maximumObjectCount][kSmallAreaBytes];
 alignas(8) uint8_t targetArea[kTargetAreaBytes];
@@ -197,17 +197,17 @@ void nameToObject()
 }
 
 // --- Heap.AllocateFragmented, Heap.GetUsageInfoFragmented: one heap that
-// holds count 16-byte free segments (8 usable bytes each, too small for the
+// holds count 24-byte free segments (8 usable bytes each, too small for the
 // 64-byte request) besides one large free segment.
 //
 // Fresh, the heap is one free segment R. 2 * count allocations of 8 bytes
 // are cut from R's start: s1 first, s2 after it, ... Returning s1, s3, s5,
 // ... (each before an allocated segment) leaves count small free segments,
-// all in the 16-byte class, and R. First fit had to walk the small ones;
+// all in the 24-byte class, and R. First fit had to walk the small ones;
 // the segregated fit goes straight to R's class. The allocation is cut from
 // R's start, and returning it merges it back into R.
 
-constexpr size_t kFragmentBytes = HeapAgent::SegmentBytes(8); // 16
+constexpr size_t kFragmentBytes = HeapAgent::SegmentBytes(8); // 24
 constexpr size_t kLargeBytes = 512;
 alignas(8) uint8_t fragmentedArea[2 * maximumObjectCount * kFragmentBytes + kLargeBytes];
 ObjectId fragmentedHeap;

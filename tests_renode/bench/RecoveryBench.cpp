@@ -12,6 +12,8 @@
 // flat figure shows that recovery walks what the task owns, not the tables.
 #include "BenchSupport.hpp"
 
+#include <dcos/BufferPoolAgent.hpp>
+#include <dcos/HeapAgent.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
@@ -142,9 +144,120 @@ void clearAll()
     victim = ObjectId::null();
 }
 
+// --- Task.KillTaskHolding: the victim holds one buffer and one heap
+// segment, taken from the newest pool and heap, while N pools and N heaps
+// exist and the shell holds one buffer or segment in each of the others.
+// Its recovery gives back those two, found from the victim's lists of held
+// memory; a walk over the pools and heaps (what recovery did before the
+// lists) would grow with N.
+
+constexpr size_t kBufferSize = 8;
+constexpr size_t kPoolAreaBytes = dcos::BufferPoolAgent::AreaBytes(kBufferSize, 2);
+constexpr size_t kHeapAreaBytes = 2 * dcos::HeapAgent::SegmentBytes(8);
+
+alignas(8) uint8_t poolAreas[maximumObjectCount][kPoolAreaBytes];
+alignas(8) uint8_t heapAreas[maximumObjectCount][kHeapAreaBytes];
+ObjectId pools[maximumObjectCount];
+ObjectId heaps[maximumObjectCount];
+void* shellBuffers[maximumObjectCount];
+void* shellSegments[maximumObjectCount];
+uint32_t memoryTotal = 0; // Pools and heaps alike.
+ObjectId holder;
+Status holderSetup = Status::Ok;
+
+// The victim: takes a buffer and a segment, then waits for ever. It runs
+// above the shell, so it holds both when spawnTask returns.
+void holdThenBlock(uintptr_t)
+{
+    const Result<void*> buffer = dcos::bufferPoolAgent.Allocate(pools[memoryTotal - 1]);
+    const Result<void*> segment = dcos::heapAgent.Allocate(heaps[memoryTotal - 1], 8);
+    holderSetup = buffer.ok() ? segment.status() : buffer.status();
+    blockForever(0);
+}
+
+Status spawnHolder()
+{
+    holderSetup = Status::NotFound; // Until the victim says otherwise.
+    const Result<ObjectId> id = spawnTask(holdThenBlock, kBlockedFillerPriority);
+    holder = id.ok() ? id.value() : ObjectId::null();
+    return id.ok() ? holderSetup : id.status();
+}
+
+// One more pool and heap; the shell holds a buffer and a segment of each
+// except the newest, which is the victim's.
+Status addPoolAndHeap(bool forVictim)
+{
+    const uint32_t slot = memoryTotal;
+    const Result<ObjectId> pool = createGrowing(
+        [slot] {
+            return dcos::bufferPoolAgent.Create(poolAreas[slot], kPoolAreaBytes, kBufferSize, nullptr,
+                                                dcos::Visibility::Local);
+        },
+        dcos::bufferPoolAgent.AddObjects);
+    if (!pool.ok()) {
+        return pool.status();
+    }
+    const Result<ObjectId> heap = createGrowing(
+        [slot] { return dcos::heapAgent.Create(heapAreas[slot], kHeapAreaBytes, nullptr, dcos::Visibility::Local); },
+        dcos::heapAgent.AddObjects);
+    if (!heap.ok()) {
+        (void)dcos::bufferPoolAgent.Delete(pool.value());
+        return heap.status();
+    }
+    pools[slot] = pool.value();
+    heaps[slot] = heap.value();
+    shellBuffers[slot] = nullptr;
+    shellSegments[slot] = nullptr;
+    ++memoryTotal;
+    if (forVictim) {
+        return Status::Ok;
+    }
+    const Result<void*> buffer = dcos::bufferPoolAgent.Allocate(pool.value());
+    shellBuffers[slot] = buffer.ok() ? buffer.value() : nullptr;
+    const Result<void*> segment = dcos::heapAgent.Allocate(heap.value(), 8);
+    shellSegments[slot] = segment.ok() ? segment.value() : nullptr;
+    return buffer.ok() ? segment.status() : buffer.status();
+}
+
+Status populateHolding(uint32_t count)
+{
+    Status status = Status::Ok;
+    while (status == Status::Ok && memoryTotal < count) {
+        status = addPoolAndHeap(memoryTotal + 1 == count);
+    }
+    return status == Status::Ok ? spawnHolder() : status;
+}
+
+void killHolder() { check(taskAgent.KillTask(holder)); }
+
+void replaceHolder()
+{
+    forgetTask(holder);
+    (void)spawnHolder();
+}
+
+void clearHolding()
+{
+    killTasks(); // The victim's buffer and segment go back with it.
+    while (memoryTotal > 0) {
+        --memoryTotal;
+        if (shellBuffers[memoryTotal] != nullptr) {
+            (void)dcos::bufferPoolAgent.Return(pools[memoryTotal], shellBuffers[memoryTotal]);
+        }
+        if (shellSegments[memoryTotal] != nullptr) {
+            (void)dcos::heapAgent.Return(heaps[memoryTotal], shellSegments[memoryTotal]);
+        }
+        (void)dcos::bufferPoolAgent.Delete(pools[memoryTotal]);
+        (void)dcos::heapAgent.Delete(heaps[memoryTotal]);
+    }
+    holder = ObjectId::null();
+}
+
 } // namespace
 
 DCOS_BENCHMARK(taskKillTaskOwningBench, "Task.KillTaskOwning", populate, killVictim, Cost::Constant,
                .restore = replaceVictim, .teardown = clearAll);
+DCOS_BENCHMARK(taskKillTaskHoldingBench, "Task.KillTaskHolding", populateHolding, killHolder, Cost::Constant,
+               .restore = replaceHolder, .teardown = clearHolding);
 
 } // namespace bench

@@ -35,13 +35,26 @@ using dcos::internal::HeapManager;
 // its vector (0x20 + line) by software.
 constexpr unsigned kSpareLine = 5;
 
-// Areas the application owns, as the agents' documentation describes.
+// The messages below state the heap's figures: a 16-byte header, so that
+// one byte takes 24.
+static_assert(HeapAgent::kHeaderBytes == 16 && HeapAgent::kMinimumSegment == 8,
+              "the heap's layout changed: update the figures in the checks' messages");
+
+// The smallest pool (one 4-byte buffer) and the smallest heap (one segment).
+constexpr size_t kSmallPoolBytes = BufferPoolAgent::AreaBytes(4, 1);
+constexpr size_t kSmallHeapBytes = HeapAgent::SegmentBytes(1);
+
+// Areas the application owns, as the agents' documentation describes. A
+// small area's row holds one 8-byte buffer, or the smallest pool or heap; it
+// is a multiple of 8 bytes, so every row starts aligned.
 alignas(8) uint8_t poolArea[BufferPoolAgent::AreaBytes(32, 8)];
 alignas(8) uint8_t otherPoolArea[BufferPoolAgent::AreaBytes(16, 4)];
-alignas(8) uint8_t smallAreas[24][16];
+alignas(8) uint8_t smallAreas[24][BufferPoolAgent::AreaBytes(8, 1)];
 alignas(8) uint8_t heapArea[4096];
 alignas(8) uint8_t otherHeapArea[1024];
-alignas(8) uint8_t smallHeapAreas[24][16];
+alignas(8) uint8_t smallHeapAreas[24][kSmallHeapBytes];
+static_assert(sizeof smallAreas[0] % 8 == 0 && sizeof smallAreas[0] >= kSmallPoolBytes
+              && sizeof smallHeapAreas[0] % 8 == 0);
 
 bool isInside(const void* pointer, const void* area, size_t bytes)
 {
@@ -142,15 +155,21 @@ bool pools(shell::Shell& shell)
                     "AreaBytes(32, 8) holds eight 32-byte buffers");
 
     // Create's errors.
-    ok = checkStatus(shell, bufferPoolAgent.Create(smallAreas[0], 16, 3, nullptr, Visibility::Local).status(),
+    ok = checkStatus(shell,
+                     bufferPoolAgent.Create(smallAreas[0], kSmallPoolBytes, 3, nullptr, Visibility::Local).status(),
                      Status::InvalidArgument, "buffers of 3 bytes") && ok;
     ok = checkStatus(shell, bufferPoolAgent.Create(nullptr, 64, 8, nullptr, Visibility::Local).status(),
                      Status::InvalidArgument, "no area") && ok;
-    ok = checkStatus(shell, bufferPoolAgent.Create(smallAreas[0], 8, 8, nullptr, Visibility::Local).status(),
+    ok = checkStatus(shell,
+                     bufferPoolAgent.Create(smallAreas[0], sizeof smallAreas[0] - 1, 8, nullptr, Visibility::Local)
+                         .status(),
                      Status::InvalidArgument, "an area too small for one buffer") && ok;
-    ok = checkStatus(shell, bufferPoolAgent.Create(poolArea + 40, 16, 4, nullptr, Visibility::Local).status(),
+    ok = checkStatus(shell,
+                     bufferPoolAgent.Create(poolArea + 40, kSmallPoolBytes, 4, nullptr, Visibility::Local).status(),
                      Status::AlreadyExists, "an area inside another pool's") && ok;
-    ok = checkStatus(shell, bufferPoolAgent.Create(smallAreas[0], 16, 4, "sixteen-letters!", Visibility::Local).status(),
+    ok = checkStatus(shell,
+                     bufferPoolAgent.Create(smallAreas[0], kSmallPoolBytes, 4, "sixteen-letters!", Visibility::Local)
+                         .status(),
                      Status::InvalidArgument, "a name of 16 characters") && ok;
 
     // Allocate until empty: distinct buffers inside the area, aligned.
@@ -257,15 +276,17 @@ bool heaps(shell::Shell& shell)
         return false;
     }
     const ObjectId heap = created.value();
+    // The largest request a heap of one free segment grants: all of it but a header.
+    constexpr size_t kLargest = sizeof heapArea - HeapAgent::kHeaderBytes;
     HeapStatistics statistics = heapStatistics(heap);
     bool ok = check(shell, statistics.heapBytes == 4096 && statistics.freeBytes == 4096 && statistics.freeSegments == 1
-                               && statistics.largestFreeSegment == 4088,
+                               && statistics.largestFreeSegment == kLargest,
                     "a fresh heap is one free segment of 4096 bytes");
 
     // Create's errors.
     ok = checkStatus(shell, heapAgent.Create(nullptr, 64, nullptr, Visibility::Local).status(), Status::InvalidArgument,
                      "no area") && ok;
-    ok = checkStatus(shell, heapAgent.Create(smallHeapAreas[0], 15, nullptr, Visibility::Local).status(),
+    ok = checkStatus(shell, heapAgent.Create(smallHeapAreas[0], kSmallHeapBytes - 1, nullptr, Visibility::Local).status(),
                      Status::InvalidArgument, "an area below one segment") && ok;
     ok = checkStatus(shell, heapAgent.Create(heapArea + 1000, 64, nullptr, Visibility::Local).status(),
                      Status::AlreadyExists, "an area inside another heap's") && ok;
@@ -276,19 +297,24 @@ bool heaps(shell::Shell& shell)
                      Status::AlreadyExists, "a pool in a heap's area") && ok;
     (void)bufferPoolAgent.Delete(pool);
 
-    // Sizes, alignment, the 8-byte header and minimum.
+    // Sizes, alignment, the 16-byte header and minimum.
     ok = checkStatus(shell, heapAgent.Allocate(heap, 0).status(), Status::InvalidArgument, "Allocate(0)") && ok;
-    ok = checkStatus(shell, heapAgent.Allocate(heap, 4089).status(), Status::NoMemory, "more than the heap") && ok;
+    ok = checkStatus(shell, heapAgent.Allocate(heap, kLargest + 1).status(), Status::NoMemory, "more than the heap") && ok;
     void* a = heapAgent.Allocate(heap, 1).value();
     ok = check(shell, isInside(a, heapArea, sizeof heapArea) && reinterpret_cast<uintptr_t>(a) % 8 == 0,
                "a segment is 8-byte aligned inside the area") && ok;
-    ok = check(shell, heapStatistics(heap).usedBytes == 16, "one byte takes 16: an 8-byte header and the 8-byte minimum")
-         && ok;
+    ok = check(shell, heapStatistics(heap).usedBytes == HeapAgent::kHeaderBytes + 8,
+               "one byte takes 24: a 16-byte header and the 8-byte minimum") && ok;
+    // c's segment, 192 bytes and a header (208), is the first size of its
+    // class: a request of the same size takes it back below.
     void* b = heapAgent.Allocate(heap, 100).value();
-    void* c = heapAgent.Allocate(heap, 200).value();
+    void* c = heapAgent.Allocate(heap, 192).value();
     void* d = heapAgent.Allocate(heap, 8).value();
     ok = check(shell, b != nullptr && c != nullptr && d != nullptr, "three more segments") && ok;
-    ok = check(shell, heapStatistics(heap).usedBytes == 16 + 112 + 208 + 16, "each costs its size plus 8, in 8s") && ok;
+    constexpr size_t kUsedByFour = (8 + HeapAgent::kHeaderBytes) + (104 + HeapAgent::kHeaderBytes)
+                                   + (192 + HeapAgent::kHeaderBytes) + (8 + HeapAgent::kHeaderBytes);
+    ok = check(shell, heapStatistics(heap).usedBytes == kUsedByFour,
+               "each costs its size rounded up to 8, plus the 16-byte header") && ok;
     for (size_t i = 0; i < 100; ++i) {
         static_cast<uint8_t*>(b)[i] = 0xB0;
     }
@@ -301,18 +327,19 @@ bool heaps(shell::Shell& shell)
                 static_cast<unsigned long>(statistics.freeSegments),
                 static_cast<unsigned long>(statistics.largestFreeSegment));
     ok = check(shell, statistics.freeSegments == 3, "a and c are separate free segments") && ok;
-    const dcos::Result<void*> fits = heapAgent.Allocate(heap, 200);
+    const dcos::Result<void*> fits = heapAgent.Allocate(heap, 192);
     ok = check(shell, fits.ok() && fits.value() == c, "the size class of c's segment gives it back for the same size") && ok;
     ok = checkStatus(shell, heapAgent.Return(heap, c), Status::Ok, "Return c again") && ok;
     ok = checkStatus(shell, heapAgent.Return(heap, b), Status::Ok, "Return b, between two free segments") && ok;
     ok = check(shell, heapStatistics(heap).freeSegments == 2, "b merged with both neighbours") && ok;
     ok = checkStatus(shell, heapAgent.Return(heap, d), Status::Ok, "Return d") && ok;
     statistics = heapStatistics(heap);
-    ok = check(shell, statistics.freeSegments == 1 && statistics.largestFreeSegment == 4088 && statistics.usedBytes == 0,
+    ok = check(shell,
+               statistics.freeSegments == 1 && statistics.largestFreeSegment == kLargest && statistics.usedBytes == 0,
                "everything merged back into one segment") && ok;
     ok = check(shell, statistics.allocations == 5 && statistics.failedAllocations == 1 && statistics.returns == 5,
                "statistics count 5 allocations, 1 failure, 5 returns") && ok;
-    ok = check(shell, statistics.lowWaterFreeBytes == 4096 - 352, "low-water mark of free bytes") && ok;
+    ok = check(shell, statistics.lowWaterFreeBytes == 4096 - kUsedByFour, "low-water mark of free bytes") && ok;
 
     // Names, holders and ownership between tasks.
     const dcos::Result<ObjectId> named = heapAgent.NameToObject("test-heap");
@@ -362,7 +389,8 @@ bool tables(shell::Shell& shell)
     Status last = Status::Ok;
     const size_t expected = BufferPoolManager::activeCount() - BufferPoolManager::usedCount();
     for (; count < 24; ++count) {
-        const dcos::Result<ObjectId> id = bufferPoolAgent.Create(smallAreas[count], 16, 4, nullptr, Visibility::Local);
+        const dcos::Result<ObjectId> id =
+            bufferPoolAgent.Create(smallAreas[count], kSmallPoolBytes, 4, nullptr, Visibility::Local);
         if (!id.ok()) {
             last = id.status();
             break;
@@ -376,7 +404,8 @@ bool tables(shell::Shell& shell)
     ok = checkStatus(shell, bufferPoolAgent.AddObjects(BufferPoolManager::capacity()), Status::TableFull,
                      "AddObjects beyond the capacity") && ok;
     ok = checkStatus(shell, bufferPoolAgent.AddObjects(8), Status::Ok, "AddObjects(8)") && ok;
-    const dcos::Result<ObjectId> more = bufferPoolAgent.Create(smallAreas[count], 16, 4, nullptr, Visibility::Local);
+    const dcos::Result<ObjectId> more =
+        bufferPoolAgent.Create(smallAreas[count], kSmallPoolBytes, 4, nullptr, Visibility::Local);
     ok = check(shell, more.ok(), "AddObjects made room") && ok;
     for (size_t i = 0; i < count; ++i) {
         ok = checkStatus(shell, bufferPoolAgent.Delete(created[i]), Status::Ok, "Delete a pool") && ok;
@@ -387,7 +416,8 @@ bool tables(shell::Shell& shell)
     last = Status::Ok;
     const size_t expectedHeaps = HeapManager::activeCount() - HeapManager::usedCount();
     for (; count < 24; ++count) {
-        const dcos::Result<ObjectId> id = heapAgent.Create(smallHeapAreas[count], 16, nullptr, Visibility::Local);
+        const dcos::Result<ObjectId> id =
+            heapAgent.Create(smallHeapAreas[count], kSmallHeapBytes, nullptr, Visibility::Local);
         if (!id.ok()) {
             last = id.status();
             break;
@@ -399,7 +429,8 @@ bool tables(shell::Shell& shell)
     ok = check(shell, count == expectedHeaps, "as many heaps as active free slots") && ok;
     ok = checkStatus(shell, heapAgent.AddObjects(0), Status::InvalidArgument, "AddObjects(0)") && ok;
     ok = checkStatus(shell, heapAgent.AddObjects(8), Status::Ok, "AddObjects(8)") && ok;
-    const dcos::Result<ObjectId> moreHeap = heapAgent.Create(smallHeapAreas[count], 16, nullptr, Visibility::Local);
+    const dcos::Result<ObjectId> moreHeap =
+        heapAgent.Create(smallHeapAreas[count], kSmallHeapBytes, nullptr, Visibility::Local);
     ok = check(shell, moreHeap.ok(), "AddObjects made room") && ok;
     for (size_t i = 0; i < count; ++i) {
         ok = checkStatus(shell, heapAgent.Delete(created[i]), Status::Ok, "Delete a heap") && ok;
@@ -477,8 +508,11 @@ bool heapCorruption(shell::Shell& shell)
     const ObjectId second = heapAgent.Create(otherHeapArea, sizeof otherHeapArea, nullptr, Visibility::Local).value();
     uint8_t* lower = static_cast<uint8_t*>(heapAgent.Allocate(second, 24).value());
     uint8_t* upper = static_cast<uint8_t*>(heapAgent.Allocate(second, 24).value());
-    ok = check(shell, lower + 32 == upper, "segments are cut from the start of the free segment") && ok;
-    for (size_t i = 0; i < 24 + 8; ++i) {
+    ok = check(shell, lower + HeapAgent::SegmentBytes(24) == upper, "segments are cut from the start of the free segment")
+         && ok;
+    // Its 24 bytes, then the next segment's whole header (size and flags,
+    // check and holder, the held-list links).
+    for (size_t i = 0; i < 24 + HeapAgent::kHeaderBytes; ++i) {
         static_cast<volatile uint8_t*>(lower)[i] = 0x55;
     }
     ok = checkStatus(shell, heapAgent.Return(second, upper), Status::Corrupted, "Return of the overwritten segment") && ok;
@@ -490,7 +524,11 @@ bool heapCorruption(shell::Shell& shell)
     void* freed = heapAgent.Allocate(third, 40).value();
     (void)heapAgent.Allocate(third, 40);
     ok = checkStatus(shell, heapAgent.Return(third, freed), Status::Ok, "Return") && ok;
-    static_cast<volatile uint32_t*>(freed)[0] = 0x00000010; // Its next link, now naming the middle of a segment.
+    // A free segment keeps its links at its start + 4 (previous) and + 8
+    // (next); its data began a header after its start.
+    uint8_t* const freedStart = static_cast<uint8_t*>(freed) - HeapAgent::kHeaderBytes;
+    // Its next link, now naming offset 16: the middle of kept's segment.
+    reinterpret_cast<volatile uint32_t*>(freedStart + 8)[0] = 0x00000010;
     // A request of the same size takes the first segment of that size class: the freed one.
     ok = checkStatus(shell, heapAgent.Allocate(third, 40).status(), Status::Corrupted,
                      "Allocate over an overwritten link") && ok;
@@ -530,7 +568,7 @@ void memoryIsr(void*)
     r.allocateSegment = segment.status();
     r.segment = segment.ok() ? segment.value() : nullptr;
     r.returnTaskBuffer = bufferPoolAgent.Return(r.pool, r.taskBuffer);
-    r.create = bufferPoolAgent.Create(smallAreas[0], 16, 4, nullptr, Visibility::Local).status();
+    r.create = bufferPoolAgent.Create(smallAreas[0], kSmallPoolBytes, 4, nullptr, Visibility::Local).status();
     r.nameToObject = heapAgent.NameToObject("isr-heap").status();
     r.statistics = bufferPoolAgent.GetStatistics(r.pool).status();
     isrRan = true;
@@ -645,7 +683,8 @@ bool memoryRecovery(shell::Shell& shell)
                     static_cast<unsigned long>(pool.totalBuffers), static_cast<unsigned long>(heap.allocatedSegments),
                     static_cast<unsigned long>(heap.freeSegments), static_cast<unsigned long>(heap.largestFreeSegment));
         ok = check(shell, pool.freeBuffers == 7, "its buffers came back, the handed-over one stayed out") && ok;
-        ok = check(shell, heap.allocatedSegments == 0 && heap.freeSegments == 1 && heap.largestFreeSegment == 4088,
+        ok = check(shell, heap.allocatedSegments == 0 && heap.freeSegments == 1
+                              && heap.largestFreeSegment == sizeof heapArea - HeapAgent::kHeaderBytes,
                    "its segments came back and merged into one") && ok;
         ok = check(shell, BufferPoolManager::usedCount() == poolsBefore && HeapManager::usedCount() == heapsBefore,
                    "its pool and heap were deleted") && ok;

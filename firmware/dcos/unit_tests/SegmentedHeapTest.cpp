@@ -25,6 +25,11 @@ using dcos::internal::SegmentedHeap;
 constexpr uint16_t kTaskA = 3;
 constexpr uint16_t kTaskB = 7;
 
+// A segment's header (size and flags, check and holder, two held-list
+// links) and the smallest segment: that header and 8 bytes of data.
+constexpr size_t kHeader = SegmentedHeap::kHeaderBytes;
+constexpr size_t kSmallest = SegmentedHeap::kSmallestSegment;
+
 using Area = dcos_test::GuardedArea;
 
 HeapStatistics statisticsOf(SegmentedHeap& heap)
@@ -36,10 +41,30 @@ HeapStatistics statisticsOf(SegmentedHeap& heap)
 
 TEST(SegmentedHeapTest, SegmentBytesHasAHeaderAndAnEightByteMinimum)
 {
-    EXPECT_EQ(HeapAgent::SegmentBytes(1), 16u);
-    EXPECT_EQ(HeapAgent::SegmentBytes(8), 16u);
-    EXPECT_EQ(HeapAgent::SegmentBytes(9), 24u);
-    EXPECT_EQ(HeapAgent::SegmentBytes(100), 112u);
+    EXPECT_EQ(HeapAgent::SegmentBytes(1), kHeader + 8);
+    EXPECT_EQ(HeapAgent::SegmentBytes(8), kHeader + 8);
+    EXPECT_EQ(HeapAgent::SegmentBytes(9), kHeader + 16);
+    EXPECT_EQ(HeapAgent::SegmentBytes(100), kHeader + 104);
+}
+
+TEST(SegmentedHeapTest, HeldLinksAreFoundOnlyBehindACheckedHeader)
+{
+    Area area(512);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 5), Status::Ok);
+    uint8_t* const data = static_cast<uint8_t*>(heap.allocate(64, kTaskA).value());
+    const uint32_t offset = heap.offsetOf(data);
+    EXPECT_EQ(heap.linksIfAllocated(offset), data - 8) << "the header's third and fourth words";
+    // A header forged inside the data (a size with the allocated flag, as a
+    // handle left from a deleted heap might find) is not taken for one.
+    const uint32_t forged = 64 | 1;
+    std::memcpy(data + 16, &forged, sizeof forged);
+    EXPECT_EQ(heap.linksIfAllocated(offset + 16), nullptr);
+    EXPECT_EQ(heap.linksIfAllocated(offset + 4), nullptr) << "not a segment's start";
+    EXPECT_EQ(heap.linksIfAllocated(offset + 80), nullptr) << "the free rest of the heap";
+    EXPECT_EQ(heap.linksIfAllocated(static_cast<uint32_t>(area.size())), nullptr) << "beyond the heap";
+    EXPECT_EQ(heap.release(data, kTaskA), Status::Ok);
+    EXPECT_EQ(heap.linksIfAllocated(offset), nullptr) << "a returned segment";
 }
 
 TEST(SegmentedHeapTest, AFreshHeapIsOneFreeSegment)
@@ -52,7 +77,7 @@ TEST(SegmentedHeapTest, AFreshHeapIsOneFreeSegment)
     EXPECT_EQ(statistics.freeBytes, 1024u);
     EXPECT_EQ(statistics.usedBytes, 0u);
     EXPECT_EQ(statistics.freeSegments, 1u);
-    EXPECT_EQ(statistics.largestFreeSegment, 1016u);
+    EXPECT_EQ(statistics.largestFreeSegment, 1024u - kHeader);
     EXPECT_EQ(heap.audit(), Status::Ok);
 }
 
@@ -61,12 +86,21 @@ TEST(SegmentedHeapTest, RefusesBadAreas)
     Area area(64);
     SegmentedHeap heap;
     EXPECT_EQ(heap.initialise(nullptr, 64, 1), Status::InvalidArgument);
-    EXPECT_EQ(heap.initialise(area.data(), 15, 1), Status::InvalidArgument);
-    EXPECT_EQ(heap.initialise(area.data() + 1, 22, 1), Status::InvalidArgument); // 15 usable after alignment.
+    EXPECT_EQ(heap.initialise(area.data(), kSmallest - 1, 1), Status::InvalidArgument);
+    EXPECT_EQ(heap.initialise(area.data() + 1, kSmallest + 6, 1),
+              Status::InvalidArgument); // kSmallest - 1 usable after alignment.
     EXPECT_FALSE(heap.inService());
+    ASSERT_EQ(heap.initialise(area.data(), kSmallest, 1), Status::Ok); // One smallest segment.
+    EXPECT_EQ(heap.heapBytes(), kSmallest);
     ASSERT_EQ(heap.initialise(area.data() + 3, 61, 1), Status::Ok); // Aligned to +8, 56 bytes.
     EXPECT_EQ(heap.heapBytes(), 56u);
     EXPECT_EQ(heap.initialise(area.data(), SegmentedHeap::kMaximumHeapBytes + 8, 1), Status::InvalidArgument);
+    // The largest heap itself is accepted, and its whole span is usable.
+    Area largest(SegmentedHeap::kMaximumHeapBytes);
+    ASSERT_EQ(heap.initialise(largest.data(), largest.size(), 1), Status::Ok);
+    EXPECT_EQ(heap.heapBytes(), HeapAgent::kMaximumHeapBytes);
+    EXPECT_EQ(heap.allocate(HeapAgent::kMaximumHeapBytes - kHeader, kTaskA).value(), largest.data() + kHeader);
+    EXPECT_EQ(heap.audit(), Status::Ok);
 }
 
 TEST(SegmentedHeapTest, SegmentsAreAlignedAndHoldTheRequest)
@@ -85,15 +119,16 @@ TEST(SegmentedHeapTest, SegmentsAreAlignedAndHoldTheRequest)
     EXPECT_TRUE(area.guardsIntact());
 }
 
-TEST(SegmentedHeapTest, OneByteCostsSixteenAndATooSmallRemainderIsGivenAway)
+TEST(SegmentedHeapTest, OneByteCostsTwentyFourAndATooSmallRemainderIsGivenAway)
 {
     Area area(64);
     SegmentedHeap heap;
     ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
     ASSERT_TRUE(heap.allocate(1, kTaskA).ok());
-    EXPECT_EQ(statisticsOf(heap).usedBytes, 16u);
-    // 48 free; a 32-byte request (40 with header) leaves 8, too small for a segment.
-    ASSERT_TRUE(heap.allocate(32, kTaskA).ok());
+    EXPECT_EQ(statisticsOf(heap).usedBytes, 24u); // A 16-byte header and 8 bytes of data.
+    // 40 free; an 8-byte request (24 with header) leaves 16, too small for a
+    // segment (the smallest is 24).
+    ASSERT_TRUE(heap.allocate(8, kTaskA).ok());
     const HeapStatistics statistics = statisticsOf(heap);
     EXPECT_EQ(statistics.usedBytes, 64u);
     EXPECT_EQ(statistics.freeSegments, 0u);
@@ -125,7 +160,7 @@ TEST(SegmentedHeapTest, ReturnMergesWithBothNeighbours)
     EXPECT_EQ(heap.release(d, kTaskA), Status::Ok); // Joins everything.
     statistics = statisticsOf(heap);
     EXPECT_EQ(statistics.freeSegments, 1u);
-    EXPECT_EQ(statistics.largestFreeSegment, area.size() - 8);
+    EXPECT_EQ(statistics.largestFreeSegment, area.size() - kHeader);
     EXPECT_EQ(heap.audit(), Status::Ok);
 }
 
@@ -136,16 +171,16 @@ TEST(SegmentedHeapTest, AllocationIsCutFromTheStartOfTheChosenSegment)
     ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
     void* first = heap.allocate(16, kTaskA).value();
     void* second = heap.allocate(100, kTaskA).value();
-    EXPECT_EQ(first, area.data() + 8);
-    EXPECT_EQ(second, area.data() + 24 + 8);
+    EXPECT_EQ(first, area.data() + kHeader);
+    EXPECT_EQ(second, area.data() + HeapAgent::SegmentBytes(16) + kHeader);
     EXPECT_EQ(heap.audit(), Status::Ok);
 }
 
 TEST(SegmentedHeapTest, SmallFreeSegmentsAreNotSearched)
 {
-    // Many free 16-byte segments and one large one: the request goes straight
-    // to the large one's class, whatever the number of small ones.
-    Area area(16 * 2 * 64 + 512);
+    // Many free smallest segments and one large one: the request goes
+    // straight to the large one's class, whatever the number of small ones.
+    Area area(kSmallest * 2 * 64 + 512);
     SegmentedHeap heap;
     ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
     std::vector<void*> small;
@@ -157,10 +192,10 @@ TEST(SegmentedHeapTest, SmallFreeSegmentsAreNotSearched)
     }
     EXPECT_EQ(statisticsOf(heap).freeSegments, 65u);
     uint8_t* large = static_cast<uint8_t*>(heap.allocate(64, kTaskB).value());
-    EXPECT_EQ(large, area.data() + 16 * 2 * 64 + 8);
-    // A 16-byte request takes one of the small ones.
+    EXPECT_EQ(large, area.data() + kSmallest * 2 * 64 + kHeader);
+    // A smallest-segment request takes one of the small ones.
     uint8_t* fits = static_cast<uint8_t*>(heap.allocate(8, kTaskB).value());
-    EXPECT_LT(fits, area.data() + 16 * 2 * 64);
+    EXPECT_LT(fits, area.data() + kSmallest * 2 * 64);
     EXPECT_EQ(heap.audit(), Status::Ok);
 }
 
@@ -171,9 +206,11 @@ TEST(SegmentedHeapTest, TheLargestFreeSegmentReportedIsTheLargestRequestThatSucc
     ASSERT_EQ(heap.initialise(area.data(), area.size(), 1), Status::Ok);
     // Free segments of 1,000 and 1,016 bytes (one class, [960, 1024)), kept
     // apart by allocated ones, and the remainder allocated.
-    void* a = heap.allocate(992, kTaskA).value();
+    const size_t aBytes = 1000 - kHeader;
+    const size_t bBytes = 1016 - kHeader;
+    void* a = heap.allocate(aBytes, kTaskA).value();
     void* keep1 = heap.allocate(8, kTaskA).value();
-    void* b = heap.allocate(1008, kTaskA).value();
+    void* b = heap.allocate(bBytes, kTaskA).value();
     void* keep2 = heap.allocate(8, kTaskA).value();
     const size_t rest = statisticsOf(heap).largestFreeSegment;
     void* keep3 = heap.allocate(rest, kTaskA).value();
@@ -182,14 +219,14 @@ TEST(SegmentedHeapTest, TheLargestFreeSegmentReportedIsTheLargestRequestThatSucc
     ASSERT_EQ(heap.release(a, kTaskA), Status::Ok); // First in the class list now.
     const HeapStatistics statistics = statisticsOf(heap);
     EXPECT_EQ(statistics.freeSegments, 2u);
-    EXPECT_EQ(statistics.largestFreeSegment, 992u); // The class's first segment.
-    // The rounded request for 1,000 bytes finds no higher class; its own
-    // class's first segment (992) is too small, so it fails, as reported.
-    EXPECT_EQ(heap.allocate(993, kTaskB).status(), Status::NoMemory);
-    // 992 bytes fit the first segment of their own class.
-    EXPECT_EQ(heap.allocate(992, kTaskB).value(), a);
-    EXPECT_EQ(statisticsOf(heap).largestFreeSegment, 1008u);
-    EXPECT_EQ(heap.allocate(1008, kTaskB).value(), b);
+    EXPECT_EQ(statistics.largestFreeSegment, aBytes); // The class's first segment.
+    // The rounded request for a 1,008-byte segment finds no higher class; its
+    // own class's first segment (1,000 bytes) is too small, so it fails, as reported.
+    EXPECT_EQ(heap.allocate(aBytes + 1, kTaskB).status(), Status::NoMemory);
+    // aBytes fit the first segment of their own class.
+    EXPECT_EQ(heap.allocate(aBytes, kTaskB).value(), a);
+    EXPECT_EQ(statisticsOf(heap).largestFreeSegment, bBytes);
+    EXPECT_EQ(heap.allocate(bBytes, kTaskB).value(), b);
     EXPECT_EQ(statisticsOf(heap).largestFreeSegment, 0u);
     EXPECT_EQ(heap.audit(), Status::Ok);
     (void)keep1;
@@ -219,7 +256,7 @@ TEST(SegmentedHeapTest, OnlyTheHolderOrAnyoneForSystemSegmentsMayReturn)
 struct Model {
     struct Segment {
         size_t requested;
-        size_t bytes; // Header included; the request's SegmentBytes, or 8 more when a remainder was too small.
+        size_t bytes; // Header included; the request's SegmentBytes, or 8 or 16 more when a remainder was too small.
         uint16_t holder;
         uint8_t pattern;
     };
@@ -251,20 +288,22 @@ void checkAgainstModel(SegmentedHeap& heap, const Model& model, uint8_t* base, s
         ASSERT_GE(nextStart, position) << "segments overlap";
         const size_t gap = static_cast<size_t>(nextStart - position);
         if (gap != 0) {
-            ASSERT_GE(gap, 16u) << "a hole too small to be a segment";
+            ASSERT_GE(gap, kSmallest) << "a hole too small to be a segment";
             ++gaps;
             gapBytes += gap;
             largestGap = std::max(largestGap, gap);
         }
     };
     for (const auto& [data, segment] : model.allocated) {
-        account(data - 8);
+        account(data - kHeader);
         for (size_t i = 0; i < segment.requested; ++i) {
             ASSERT_EQ(data[i], segment.pattern) << "the heap wrote into an allocated segment";
         }
-        ASSERT_TRUE(segment.bytes == HeapAgent::SegmentBytes(segment.requested)
-                    || segment.bytes == HeapAgent::SegmentBytes(segment.requested) + 8);
-        position = data - 8 + segment.bytes;
+        // A remainder under a smallest segment (0, 8 or 16 bytes) goes with the allocation.
+        const size_t requestBytes = HeapAgent::SegmentBytes(segment.requested);
+        ASSERT_TRUE(segment.bytes >= requestBytes && segment.bytes - requestBytes < kSmallest
+                    && (segment.bytes - requestBytes) % HeapAgent::kAlignment == 0);
+        position = data - kHeader + segment.bytes;
     }
     account(base + heapBytes);
     const dcos::Result<HeapStatistics> result = heap.statistics();
@@ -279,8 +318,8 @@ void checkAgainstModel(SegmentedHeap& heap, const Model& model, uint8_t* base, s
     if (largestGap == 0) {
         EXPECT_EQ(statistics.largestFreeSegment, 0u);
     } else {
-        EXPECT_LE(statistics.largestFreeSegment + 8, largestGap);
-        EXPECT_EQ(classFloor(statistics.largestFreeSegment + 8), classFloor(largestGap));
+        EXPECT_LE(statistics.largestFreeSegment + kHeader, largestGap);
+        EXPECT_EQ(classFloor(statistics.largestFreeSegment + kHeader), classFloor(largestGap));
     }
 }
 
@@ -323,14 +362,14 @@ TEST(SegmentedHeapTest, RandomizedSequencesMatchTheModel)
                 const uint32_t largestBefore = before.largestFreeSegment;
                 const dcos::Result<void*> segment = heap.allocate(bytes, holder);
                 // No loss: a request fails exactly when no free segment is large enough.
-                if (HeapAgent::SegmentBytes(bytes) - 8 > largestBefore) {
+                if (HeapAgent::SegmentBytes(bytes) - kHeader > largestBefore) {
                     ASSERT_EQ(segment.status(), Status::NoMemory);
                     ++failed;
                 } else {
                     ASSERT_TRUE(segment.ok());
                     uint8_t* data = static_cast<uint8_t*>(segment.value());
                     ASSERT_EQ(reinterpret_cast<uintptr_t>(data) % 8, 0u);
-                    ASSERT_GE(data, area.data() + 8);
+                    ASSERT_GE(data, area.data() + kHeader);
                     ASSERT_LE(data + bytes, area.data() + heapBytes);
                     const uint8_t pattern = static_cast<uint8_t>(random());
                     std::memset(data, pattern, bytes);
@@ -364,7 +403,7 @@ TEST(SegmentedHeapTest, RandomizedSequencesMatchTheModel)
                 } else if (kind == 1 && !model.allocated.empty()) {
                     auto it = model.allocated.begin();
                     std::advance(it, static_cast<long>(random() % model.allocated.size()));
-                    const size_t inside = HeapAgent::SegmentBytes(it->second.requested) - 8;
+                    const size_t inside = HeapAgent::SegmentBytes(it->second.requested) - kHeader;
                     if (inside > 8) {
                         uint8_t* pointer = it->first + 8 * (1 + random() % ((inside - 8) / 8 + 1));
                         if (pointer < it->first + inside) {
@@ -413,7 +452,7 @@ TEST(SegmentedHeapTest, RandomizedSequencesMatchTheModel)
             ASSERT_EQ(heap.release(data, segment.holder), Status::Ok);
         }
         EXPECT_EQ(heap.statistics().value().freeSegments, 1u);
-        EXPECT_EQ(heap.statistics().value().largestFreeSegment, heapBytes - 8);
+        EXPECT_EQ(heap.statistics().value().largestFreeSegment, heapBytes - kHeader);
         EXPECT_TRUE(area.guardsIntact());
     }
 }
@@ -436,15 +475,23 @@ protected:
     {
         ASSERT_EQ(heap.initialise(area.data(), area.size(), 0xBEEF), Status::Ok);
         for (uint8_t*& segment : segments) {
-            segment = static_cast<uint8_t*>(heap.allocate(24, kTaskA).value());
+            segment = static_cast<uint8_t*>(heap.allocate(kDataBytes, kTaskA).value());
         }
         // Segments are cut from the start: segments[0] is lowest, at offset 0,
-        // each 32 bytes. Free one in the middle.
+        // each kSegmentBytes (40) bytes. Free one in the middle.
         ASSERT_EQ(heap.release(segments[2], kTaskA), Status::Ok);
     }
 
-    // The header words of the segment whose data starts at @p data.
-    static uint8_t* headerOf(uint8_t* data) { return data - 8; }
+    // The header words of the segment whose data starts at @p data: the
+    // segment's start. Allocated: size and flags at +0, check and holder at
+    // +4, held-list links at +8 and +12. Free: size at +0, the previous link
+    // at +4, the next link at +8, the end tag in the last word.
+    static uint8_t* headerOf(uint8_t* data) { return data - kHeader; }
+    // The last word of the segment whose data starts at @p data: a free one's end tag.
+    static uint8_t* lastWordOf(uint8_t* data) { return headerOf(data) + kSegmentBytes - 4; }
+
+    static constexpr size_t kDataBytes = 24;
+    static constexpr size_t kSegmentBytes = HeapAgent::SegmentBytes(kDataBytes);
 
     Area area{1024};
     SegmentedHeap heap;
@@ -501,17 +548,17 @@ TEST(SegmentedHeapBoundsTest, TheFoldedBoundsKeepEveryReason)
     const size_t size = heap.heapBytes();
     uint8_t* const base = area.data(); // GuardedArea's data is 8-byte aligned.
     // Requests: 0 is a bad argument; above the heap, or too big for its
-    // last 8 bytes, NoMemory, counted; the whole heap less a header fits.
+    // last kHeader bytes, NoMemory, counted; the whole heap less a header fits.
     EXPECT_EQ(heap.allocate(0, kTaskA).status(), Status::InvalidArgument);
     EXPECT_EQ(heap.allocate(size + 1, kTaskA).status(), Status::NoMemory);
     EXPECT_EQ(heap.allocate(size, kTaskA).status(), Status::NoMemory);
-    EXPECT_EQ(heap.allocate(size - 7, kTaskA).status(), Status::NoMemory);
+    EXPECT_EQ(heap.allocate(size - kHeader + 1, kTaskA).status(), Status::NoMemory);
     EXPECT_EQ(heap.allocate(SIZE_MAX, kTaskA).status(), Status::NoMemory);
     EXPECT_EQ(statisticsOf(heap).failedAllocations, 4u);
-    void* whole = heap.allocate(size - 8, kTaskA).value();
-    EXPECT_EQ(whole, base + 8);
+    void* whole = heap.allocate(size - kHeader, kTaskA).value();
+    EXPECT_EQ(whole, base + kHeader);
     // Addresses: one past the end and the 8 bytes below it, the bytes below
-    // the heap, and the heap's first 8 bytes.
+    // the heap, and the heap's first kHeader bytes.
     EXPECT_EQ(heap.release(base + size, kTaskA), Status::InvalidArgument);
     EXPECT_EQ(heap.release(base - 8, kTaskA), Status::InvalidArgument);
     EXPECT_EQ(heap.release(base - 1, kTaskA), Status::InvalidArgument);
@@ -525,19 +572,27 @@ TEST(SegmentedHeapBoundsTest, TheFoldedBoundsKeepEveryReason)
     void* first = other.allocate(8, kTaskA).value();
     EXPECT_EQ(other.release(base + size - 8, kTaskA), Status::Corrupted); // The last 8 bytes: inside.
     EXPECT_EQ(other.release(first, kTaskA), Status::Corrupted);
+
+    // The last 8 bytes of the heap's first header (its held-list links).
+    SegmentedHeap third;
+    ASSERT_EQ(third.initialise(area.data(), area.size(), 0x5EED), Status::Ok);
+    void* firstOfThird = third.allocate(8, kTaskA).value();
+    EXPECT_EQ(third.release(base + kHeader - 8, kTaskA), Status::Corrupted);
+    EXPECT_EQ(third.release(firstOfThird, kTaskA), Status::Corrupted);
 }
 
 TEST_F(SegmentedHeapCorruptionTest, OverrunIntoTheNextHeaderIsDetectedByBothSegments)
 {
-    // segments[0] is lowest; writing past its end hits segments[1]'s header.
-    std::memset(segments[0], 0x11, 24 + 8);
+    // segments[0] is lowest; writing past its end hits segments[1]'s header
+    // (its size and its check and holder).
+    std::memset(segments[0], 0x11, kDataBytes + 8);
     EXPECT_EQ(heap.release(segments[0], kTaskA), Status::Corrupted); // Its successor's header fails.
     expectDisabled(heap, segments[1]);
 }
 
 TEST_F(SegmentedHeapCorruptionTest, OverwrittenHolderIsCorruptionNotAnotherOwner)
 {
-    headerOf(segments[0])[4] = static_cast<uint8_t>(kTaskB);
+    headerOf(segments[0])[4] = static_cast<uint8_t>(kTaskB); // The holder's low byte.
     EXPECT_EQ(heap.release(segments[0], kTaskB), Status::Corrupted);
     expectDisabled(heap, segments[1]);
 }
@@ -551,7 +606,7 @@ TEST_F(SegmentedHeapCorruptionTest, OverwrittenSizeIsDetected)
 
 TEST_F(SegmentedHeapCorruptionTest, WriteAfterReturnIntoTheLinksIsCaughtByAllocate)
 {
-    std::memset(segments[2], 0x00, 8); // The free segment's next link and more.
+    std::memset(headerOf(segments[2]) + 8, 0x00, 8); // The free segment's next link and more.
     std::memset(headerOf(segments[2]) + 4, 0x00, 4); // Its back link.
     EXPECT_EQ(heap.allocate(8, kTaskA).status(), Status::Corrupted);
     expectDisabled(heap, segments[0]);
@@ -559,14 +614,14 @@ TEST_F(SegmentedHeapCorruptionTest, WriteAfterReturnIntoTheLinksIsCaughtByAlloca
 
 TEST_F(SegmentedHeapCorruptionTest, OverwrittenBoundaryTagIsCaughtWhenTheSuccessorReturns)
 {
-    std::memset(segments[2] + 16 + 4, 0x33, 4); // Last word of the free 32-byte segment.
+    std::memset(lastWordOf(segments[2]), 0x33, 4); // Last word of the free segment.
     EXPECT_EQ(heap.release(segments[3], kTaskA), Status::Corrupted); // segments[3] follows it.
     expectDisabled(heap, segments[0]);
 }
 
 TEST_F(SegmentedHeapCorruptionTest, OverwrittenBoundaryTagIsCaughtByTheAudit)
 {
-    std::memset(segments[2] + 16 + 4, 0x33, 4);
+    std::memset(lastWordOf(segments[2]), 0x33, 4);
     EXPECT_EQ(heap.audit(), Status::Corrupted);
     expectDisabled(heap, segments[0]);
 }
@@ -584,7 +639,7 @@ TEST_F(SegmentedHeapCorruptionTest, FreeListLoopIsCaught)
     // Point the free segment's next link at itself: Allocate takes it first
     // from its class list, and its successor's back link does not point back.
     const uint32_t self = static_cast<uint32_t>(headerOf(segments[2]) - area.data());
-    std::memcpy(segments[2], &self, 4);
+    std::memcpy(headerOf(segments[2]) + 8, &self, 4);
     EXPECT_EQ(heap.allocate(16, kTaskA).status(), Status::Corrupted);
     expectDisabled(heap, segments[0]);
 }
@@ -592,7 +647,7 @@ TEST_F(SegmentedHeapCorruptionTest, FreeListLoopIsCaught)
 TEST_F(SegmentedHeapCorruptionTest, FreeListLoopIsCaughtByTheAudit)
 {
     const uint32_t self = static_cast<uint32_t>(headerOf(segments[2]) - area.data());
-    std::memcpy(segments[2], &self, 4);
+    std::memcpy(headerOf(segments[2]) + 8, &self, 4);
     EXPECT_EQ(heap.audit(), Status::Corrupted);
 }
 
@@ -611,7 +666,7 @@ TEST_F(SegmentedHeapCorruptionTest, ClearedPreviousFreeFlagIsCaughtByAudit)
 
 TEST_F(SegmentedHeapCorruptionTest, RecoveryStopsAtAnOverwrittenHeader)
 {
-    std::memset(headerOf(segments[3]), 0x44, 8);
+    std::memset(headerOf(segments[3]), 0x44, kHeader);
     heap.reclaimHeldBy(kTaskA);
     EXPECT_TRUE(heap.isCorrupted());
 }
@@ -627,7 +682,7 @@ TEST(SegmentedHeapSaltTest, HeadersAreBoundToTheirHeap)
     void* inA = a.allocate(40, kTaskA).value();
     void* inB = b.allocate(40, kTaskA).value();
     ASSERT_EQ(static_cast<uint8_t*>(inA) - first.data(), static_cast<uint8_t*>(inB) - second.data());
-    std::memcpy(static_cast<uint8_t*>(inB) - 8, static_cast<uint8_t*>(inA) - 8, 8);
+    std::memcpy(static_cast<uint8_t*>(inB) - kHeader, static_cast<uint8_t*>(inA) - kHeader, kHeader);
     EXPECT_EQ(b.release(inB, kTaskA), Status::Corrupted);
 }
 

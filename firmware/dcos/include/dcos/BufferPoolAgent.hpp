@@ -6,7 +6,7 @@
 //
 // Where the memory comes from: the application owns the area. It declares a
 // static array sized with AreaBytes and passes it to Create; the pool keeps
-// its bookkeeping (one 32-bit word per buffer) at the start of that area and
+// its bookkeeping (twelve bytes per buffer) at the start of that area and
 // the buffers after it. The kernel therefore has no memory of its own to run
 // out of, the size of every pool is fixed at build time, and Delete hands the
 // area back to the application unchanged in size.
@@ -90,12 +90,14 @@ public:
 
     /// Bytes an 8-byte aligned area needs to hold @p bufferCount buffers of @p bufferSize bytes.
     ///
-    /// The pool keeps one 32-bit state word per buffer at the start of the
-    /// area, padded to 8 bytes, and the buffers after it. Buffers start on a
+    /// The pool keeps twelve bytes per buffer at the start of the area (a
+    /// 32-bit state word, and two links of the holding task's list, so that
+    /// recovery finds what a task held without a search), padded to 8 bytes,
+    /// and the buffers after it. Buffers start on a
     /// 4-byte boundary, and on an 8-byte boundary when the size is a multiple of 8.
     static constexpr size_t AreaBytes(size_t bufferSize, size_t bufferCount)
     {
-        return ((bufferCount * 4 + 7) & ~size_t{7}) + bufferCount * Stride(bufferSize);
+        return ((bufferCount * 12 + 7) & ~size_t{7}) + bufferCount * Stride(bufferSize);
     }
 
     /// Creates a pool of as many @p bufferSize byte buffers as fit in the

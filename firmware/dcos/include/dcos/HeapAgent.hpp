@@ -1,7 +1,7 @@
 // The segmented heap memory agent's application interface (seed 7.8).
 //
 // A heap is a physically contiguous area from which segments of any size are
-// allocated. Every segment carries an 8-byte header, starts on an 8-byte
+// allocated. Every segment carries a 16-byte header, starts on an 8-byte
 // boundary and holds at least 8 bytes; a returned segment is merged with its
 // free neighbours on both sides, so two free segments are never adjacent.
 // Where the seed allocated first fit, walking the free list, DCOS keeps the
@@ -83,8 +83,13 @@ struct HeapStatistics {
 /// the configuration services cost O(N) in the number of pool and heap slots.
 class HeapAgent {
 public:
-    /// Bytes of the header in front of every segment (seed 7.8).
-    static constexpr size_t kHeaderBytes = 8;
+    /// Bytes of the header in front of every segment (seed 7.8): the size
+    /// and flags, the holder and its check, and the two links of the holding
+    /// task's list, so that recovery finds what a task held without a search.
+    static constexpr size_t kHeaderBytes = 16;
+    /// Largest heap, in bytes: a segment's place in it must fit the 20 bits
+    /// a held list's handle has for it (in units of 8 bytes).
+    static constexpr size_t kMaximumHeapBytes = (size_t{1} << 23) - 64;
     /// Alignment of every segment, and the granularity of segment sizes.
     static constexpr size_t kAlignment = 8;
     /// Smallest number of bytes a segment holds.
@@ -103,8 +108,9 @@ public:
     /// Create aligns the area's start up to 8 bytes and its length down to a
     /// multiple of 8; the area must stay valid and untouched by the
     /// application (except inside allocated segments) until the heap is
-    /// deleted. Fails with InvalidArgument for a null area, fewer than 16
-    /// bytes after alignment (one smallest segment), more than 1 GiB, a bad
+    /// deleted. Fails with InvalidArgument for a null area, fewer than 24
+    /// bytes after alignment (one smallest segment), more than
+    /// kMaximumHeapBytes (8 MiB less 64 bytes), a bad
     /// name or visibility; AlreadyExists when the area overlaps another
     /// pool's or heap's area; TableFull; InInterrupt.
     static Result<ObjectId> Create(void* area, size_t areaBytes, const char* name, Visibility visibility);
@@ -119,9 +125,9 @@ public:
     /// Allocates a segment of at least @p bytes, held by the calling task
     /// (by the system in an interrupt handler). O(1); never blocks.
     ///
-    /// The segment is 8-byte aligned and holds SegmentBytes(bytes) - 8 bytes
+    /// The segment is 8-byte aligned and holds SegmentBytes(bytes) - 16 bytes
     /// or, when the rest of the free segment would be too small to use, up
-    /// to 8 more. Fails with InvalidArgument for 0 bytes, NoMemory when
+    /// to 16 more. Fails with InvalidArgument for 0 bytes, NoMemory when
     /// @p bytes is more than GetStatistics' largestFreeSegment (counted in
     /// the statistics), Corrupted, and the id errors.
     static Result<void*> Allocate(ObjectId heap, size_t bytes);

@@ -42,9 +42,9 @@ Status BufferPool::initialise(void* area, size_t areaBytes, size_t bufferSize, u
     }
     const size_t usable = areaBytes - (aligned - begin);
     const size_t stride = BufferPoolAgent::Stride(bufferSize);
-    // AreaBytes(n) lies between n * (4 + stride) and that plus 4, so the
+    // AreaBytes(n) lies between n * (12 + stride) and that plus 4, so the
     // estimate below is at most one too high.
-    size_t count = usable / (4 + stride);
+    size_t count = usable / (4 + HeldLinks::kBytes + stride);
     if (count != 0 && BufferPoolAgent::AreaBytes(bufferSize, count) > usable) {
         --count;
     }
@@ -53,10 +53,11 @@ Status BufferPool::initialise(void* area, size_t areaBytes, size_t bufferSize, u
     }
 
     states_ = reinterpret_cast<uint8_t*>(aligned);
-    base_ = aligned + roundUp8(count * 4);
-    bufferSize_ = static_cast<uint32_t>(bufferSize);
+    base_ = aligned + roundUp8(count * (4 + HeldLinks::kBytes));
+    links_ = states_ + count * 4;
+    sizeSlack_ = static_cast<uint8_t>(stride - bufferSize);
     stride_ = static_cast<uint32_t>(stride);
-    shift_ = std::countr_zero(stride);
+    shift_ = static_cast<uint8_t>(std::countr_zero(stride));
     inverse_ = inverseOf(stride >> shift_);
     count_ = static_cast<uint32_t>(count);
     limit_ = count_;
@@ -104,7 +105,7 @@ Status BufferPool::releaseSlowly(void* buffer, uint16_t holder)
     return Status::Ok;
 }
 
-Status BufferPool::transfer(void* buffer, uint16_t from, uint16_t to)
+Status BufferPool::transferIndex(void* buffer, uint16_t from, uint16_t to, uint16_t& previous)
 {
     if (isCorrupted()) {
         return Status::Corrupted;
@@ -116,8 +117,21 @@ Status BufferPool::transfer(void* buffer, uint16_t from, uint16_t to)
     if (!index.ok()) {
         return index.status();
     }
+    uint32_t next;
+    (void)stateOf(index.value(), previous, next); // Checked by allocatedIndexOf: from or the system.
     storeState(index.value(), ((static_cast<uint32_t>(to) << 16) | index.value()) ^ allocatedKey_);
     return Status::Ok;
+}
+
+bool BufferPool::reclaim(uint32_t index, uint16_t holder)
+{
+    uint16_t current;
+    uint32_t next;
+    if (index >= limit_ || stateOf(index, current, next) != State::Allocated || current != holder) {
+        return false;
+    }
+    pushFree(index);
+    return true;
 }
 
 size_t BufferPool::reclaimHeldBy(uint16_t holder)
@@ -173,7 +187,7 @@ Status BufferPool::audit()
 BufferPoolStatistics BufferPool::statistics() const
 {
     BufferPoolStatistics statistics;
-    statistics.bufferSize = bufferSize_;
+    statistics.bufferSize = stride_ - sizeSlack_;
     statistics.totalBuffers = count_;
     statistics.freeBuffers = freeCount();
     statistics.lowWaterMark = lowWater_;

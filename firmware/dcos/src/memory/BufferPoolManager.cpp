@@ -78,6 +78,85 @@ constinit uint32_t poolOffsets[ObjectId::kMaxIndex + 1];
     return reinterpret_cast<PoolObject*>(reinterpret_cast<uintptr_t>(pools) + poolOffsets[id.index()]);
 }
 
+// A buffer's handle on its holder's list (HeldList.hpp): the pool's slot in
+// the high half, the buffer's index in the low one.
+static_assert(kPoolCapacity <= 0x1000, "a pool's slot takes 12 bits of a handle, below the list marks");
+[[gnu::always_inline]] inline uint32_t heldHandle(const PoolObject* object, uint32_t index)
+{
+    // The slot times 2^16, from the byte offset without a division where
+    // the object's size is a power of two (64 bytes on the board).
+    const uintptr_t offset = reinterpret_cast<uintptr_t>(object) - reinterpret_cast<uintptr_t>(pools);
+    if constexpr ((sizeof(PoolObject) & (sizeof(PoolObject) - 1)) == 0 && sizeof(PoolObject) <= 0x10000) {
+        return static_cast<uint32_t>(offset * (0x10000 / sizeof(PoolObject))) | index;
+    } else {
+        return static_cast<uint32_t>((offset / sizeof(PoolObject)) << 16) | index;
+    }
+}
+
+// HeldList's resolver: the links of the buffer a handle names, or null when
+// the slot's pool is not in service or the index is beyond its buffers. A
+// mark (kHeldEnd and the others) has a slot above every capacity.
+[[gnu::always_inline]] inline uint8_t* heldLinks(uint32_t handle)
+{
+    const uint32_t slot = handle >> 16;
+    if (slot >= kPoolCapacity) [[unlikely]] {
+        return nullptr;
+    }
+    return pools[slot].pool.linksIfInService(handle & 0xFFFF);
+}
+
+// The list operations with this agent's resolver, out of line for every
+// path but the two fast ones, which inline their own.
+[[gnu::noinline]] void takeHeld(HeldHead& head, uint32_t handle) { HeldList::take(head, handle, heldLinks); }
+
+[[gnu::noinline]] void giveHeld(HeldHead& head, uint32_t handle, uint8_t* links)
+{
+    HeldList::give(head, handle, links, heldLinks);
+}
+
+// Records a buffer just handed out (its index) as held by its holder,
+// given as callerHolderWord() gave it: the running task's id, or the
+// system's tag, whose buffers are on no list.
+[[gnu::always_inline]] inline void listTaken(const PoolObject* object, uint32_t index, uint32_t holderWord)
+{
+    if (holderWord != BufferPool::kSystemHolder) [[likely]] {
+        HeldList::take(Scheduler::current().heldBuffers, heldHandle(object, index), heldLinks);
+    }
+}
+
+// Takes a buffer its holder (as for listTaken()) is giving back off the
+// holder's list.
+[[gnu::always_inline]] inline void listGiven(const PoolObject* object, uint32_t index, uint8_t* links,
+                                             uint32_t holderWord)
+{
+    if (holderWord != BufferPool::kSystemHolder) [[likely]] {
+        HeldList::give(Scheduler::current().heldBuffers, heldHandle(object, index), links, heldLinks);
+    }
+}
+
+constinit uint32_t recoveryWalkCount = 0;
+
+// Gives back every buffer the dead task held, from its list; when the list
+// was lost, from a walk over every pool for its holder tag.
+size_t reclaimHeldBuffers(Task* task, uint16_t holder)
+{
+    return memory_area::reclaimHeld(
+        task, &Task::heldBuffers, heldLinks,
+        [holder](uint32_t handle) { return pools[handle >> 16].pool.reclaim(handle & 0xFFFF, holder); },
+        [holder] {
+            // Only active slots can hold an object: the walk is O(active slots), not O(capacity).
+            size_t reclaimed = 0;
+            const PoolObject* const activeEnd = pools + poolTable.activeCount();
+            for (PoolObject* object = pools; object != activeEnd; ++object) {
+                if (object->inUse() && object->pool.inService()) {
+                    reclaimed += object->pool.reclaimHeldBy(holder);
+                }
+            }
+            return reclaimed;
+        },
+        recoveryWalkCount);
+}
+
 // Activates the first slots on first use; call with interrupts disabled.
 void start()
 {
@@ -208,24 +287,42 @@ DCOS_CONFIGURATION_SERVICE Status BufferPoolManager::Delete(ObjectId id)
 
 Result<void*> BufferPoolManager::Allocate(ObjectId id)
 {
-    const uint16_t holder = memory_area::callerHolder(BufferPool::kSystemHolder);
+    Task* const task = memory_area::callerTask();
+    const uint16_t holder = task != nullptr ? memory_area::holderOfTask(task->id) : BufferPool::kSystemHolder;
     Lock lock;
     const Result<PoolObject*> object = lookup(id);
     if (!object.ok()) {
         return object.status();
     }
-    return object.value()->pool.allocate(holder);
+    BufferPool& pool = object.value()->pool;
+    const Result<void*> buffer = pool.allocate(holder);
+    if (buffer.ok()) {
+        const uint32_t index = pool.indexOfBuffer(buffer.value());
+        if (task != nullptr) {
+            takeHeld(task->heldBuffers, heldHandle(object.value(), index));
+        }
+    }
+    return buffer;
 }
 
 Status BufferPoolManager::Return(ObjectId id, void* buffer)
 {
-    const uint16_t holder = memory_area::callerHolder(BufferPool::kSystemHolder);
+    Task* const task = memory_area::callerTask();
+    const uint16_t holder = task != nullptr ? memory_area::holderOfTask(task->id) : BufferPool::kSystemHolder;
     Lock lock;
     const Result<PoolObject*> object = lookup(id);
     if (!object.ok()) {
         return object.status();
     }
-    return object.value()->pool.release(buffer, holder);
+    BufferPool& pool = object.value()->pool;
+    // Off the caller's list only if the caller holds it: release() then
+    // succeeds. A system buffer is on no list.
+    const uint32_t index = pool.indexOfBuffer(buffer);
+    uint16_t current = BufferPool::kFreeMark;
+    if (task != nullptr && pool.holderOf(index, current) && current == holder) {
+        giveHeld(task->heldBuffers, heldHandle(object.value(), index), pool.linksOf(index));
+    }
+    return pool.release(buffer, holder);
 }
 
 Result<BufferPoolStatistics> BufferPoolManager::GetStatistics(ObjectId id)
@@ -257,7 +354,9 @@ DCOS_CONFIGURATION_SERVICE Status BufferPoolManager::XferOwnership(ObjectId id, 
 {
     return memory_area::transferMemory(
         lookup, [](PoolObject* object) -> BufferPool& { return object->pool; }, id, buffer, newOwner,
-        BufferPool::kSystemHolder);
+        BufferPool::kSystemHolder, [](PoolObject* object, uint32_t index, uint8_t* links, Task* from, Task* to) {
+            memory_area::moveHeld(&Task::heldBuffers, from, to, heldHandle(object, index), links, takeHeld, giveHeld);
+        });
 }
 
 DCOS_CONFIGURATION_SERVICE unsigned BufferPoolManager::recoverResourcesOf(ObjectId deadTask)
@@ -265,21 +364,16 @@ DCOS_CONFIGURATION_SERVICE unsigned BufferPoolManager::recoverResourcesOf(Object
     if (deadTask.isNull() || deadTask.type() != ObjectType::Task) {
         return 0;
     }
-    // Called by the task agent with interrupts already disabled; the walk
-    // over every buffer is the O(N) cost of recovery.
+    // Called by the task agent with interrupts already disabled: the
+    // buffers the task held, from its list, then the pools it owns.
     Lock lock;
-    const uint16_t holder = memory_area::holderOfTask(deadTask);
-    size_t recovered = 0;
-    // Only active slots can hold an object: the walk is O(active slots), not O(capacity).
-    const PoolObject* const activeEnd = pools + poolTable.activeCount();
-    for (PoolObject* object = pools; object != activeEnd; ++object) {
-        if (object->inUse() && object->pool.inService()) {
-            recovered += object->pool.reclaimHeldBy(holder);
-        }
-    }
+    const Result<Task*> task = TaskManager::resolve(deadTask);
+    size_t recovered = reclaimHeldBuffers(task.ok() ? task.value() : nullptr, memory_area::holderOfTask(deadTask));
     recovered += poolTable.forEachOwnedBy(deadTask, [](ObjectId id, PoolObject*& object) { remove(id, *object); });
     return static_cast<unsigned>(recovered);
 }
+
+uint32_t BufferPoolManager::recoveryWalks() { return recoveryWalkCount; }
 
 bool BufferPoolManager::overlapsArea(uintptr_t begin, uintptr_t end)
 {
@@ -353,7 +447,11 @@ Result<void*> BufferPoolAgent::Allocate(ObjectId id)
         internal::PoolObject* const object = internal::fastObjectOf(id);
         if (object->id == id) [[likely]] {
             if (void* buffer = object->pool.tryAllocate(
-                    [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); })) [[likely]] {
+                    [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); },
+                    [object](uint32_t index, uint8_t*, uint32_t holder) {
+                        internal::listTaken(object, index, holder);
+                    }))
+                [[likely]] {
                 return buffer;
             }
         }
@@ -368,7 +466,11 @@ Status BufferPoolAgent::Return(ObjectId id, void* buffer)
         internal::PoolObject* const object = internal::fastObjectOf(id);
         if (object->id == id) [[likely]] {
             if (object->pool.tryRelease(
-                    buffer, [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); })) [[likely]] {
+                    buffer, [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); },
+                    [object](uint32_t index, uint8_t* links, uint32_t holder) {
+                        internal::listGiven(object, index, links, holder);
+                    }))
+                [[likely]] {
                 return Status::Ok;
             }
         }

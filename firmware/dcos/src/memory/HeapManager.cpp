@@ -91,6 +91,92 @@ void remove(ObjectId id, HeapObject& object)
 
 unsigned recoverHeaps(ObjectId deadTask) { return HeapManager::recoverResourcesOf(deadTask); }
 
+// A segment's handle on its holder's list (HeldList.hpp): the heap's slot in
+// the high 12 bits, the segment's offset in units of 8 bytes in the low 20.
+static_assert(kHeapCapacity <= 0x1000, "a heap's slot takes 12 bits of a handle");
+static_assert(((SegmentedHeap::kMaximumHeapBytes - SegmentedHeap::kSmallestSegment) >> 3) < 0x100000
+                  && ((0xFFFu << 20) | ((SegmentedHeap::kMaximumHeapBytes - SegmentedHeap::kSmallestSegment) >> 3))
+                         < kHeldHandleLimit,
+              "every segment's offset fits a handle, and no handle is a list mark");
+[[gnu::always_inline]] inline uint32_t heldHandle(const HeapObject* object, uint32_t offset)
+{
+    return (static_cast<uint32_t>(object - heaps) << 20) | (offset >> 3);
+}
+
+// HeldList's resolver: the links of the allocated segment a handle names, or
+// null. A mark has a slot above every capacity.
+[[gnu::always_inline]] inline uint8_t* heldLinks(uint32_t handle)
+{
+    const uint32_t slot = handle >> 20;
+    if (slot >= kHeapCapacity) [[unlikely]] {
+        return nullptr;
+    }
+    return heaps[slot].heap.linksIfAllocated((handle & 0xFFFFF) << 3);
+}
+
+// The list operations with this agent's resolver, out of line: the
+// allocator around them costs hundreds of instructions, a call a handful.
+[[gnu::noinline]] void takeHeld(HeldHead& head, uint32_t handle) { HeldList::take(head, handle, heldLinks); }
+
+[[gnu::noinline]] void giveHeld(HeldHead& head, uint32_t handle, uint8_t* links)
+{
+    HeldList::give(head, handle, links, heldLinks);
+}
+
+
+// Allocate for @p task (null: the system) and put the segment on its list.
+// Call with interrupts disabled.
+[[gnu::always_inline]] inline Result<void*> allocateFor(HeapObject& object, size_t bytes, Task* task)
+{
+    const uint16_t holder = task != nullptr ? memory_area::holderOfTask(task->id) : SegmentedHeap::kSystemHolder;
+    const Result<void*> segment = object.heap.allocate(bytes, holder);
+    if (segment.ok()) [[likely]] {
+        if (task != nullptr) [[likely]] {
+            HeldList::take(task->heldSegments, heldHandle(&object, object.heap.offsetOf(segment.value())), heldLinks);
+        }
+    }
+    return segment;
+}
+
+// Return for @p task (null: the system) and take the segment off its list.
+// Call with interrupts disabled.
+[[gnu::always_inline]] inline Status releaseFor(HeapObject& object, void* segment, Task* task)
+{
+    const uint16_t holder = task != nullptr ? memory_area::holderOfTask(task->id) : SegmentedHeap::kSystemHolder;
+    SegmentedHeap::Released released;
+    const Status status = object.heap.release(segment, holder, &released);
+    // The segment's own links may be gone in the merge, so it is taken off
+    // with the values release() read; a system segment is on no list.
+    if (status == Status::Ok && task != nullptr && released.holder == holder) [[likely]] {
+        HeldLinksCopy links(released.next, released.previous);
+        HeldList::give(task->heldSegments, heldHandle(&object, object.heap.offsetOf(segment)), links.bytes, heldLinks);
+    }
+    return status;
+}
+
+constinit uint32_t recoveryWalkCount = 0;
+
+// Gives back every segment the dead task held, from its list; when the list
+// was lost, from a walk over every heap for its holder tag.
+size_t reclaimHeldSegments(Task* task, uint16_t holder)
+{
+    return memory_area::reclaimHeld(
+        task, &Task::heldSegments, heldLinks,
+        [holder](uint32_t handle) { return heaps[handle >> 20].heap.reclaim((handle & 0xFFFFF) << 3, holder); },
+        [holder] {
+            // Only active slots can hold an object: the walk is O(active slots), not O(capacity).
+            size_t reclaimed = 0;
+            const HeapObject* const activeEnd = heaps + heapTable.activeCount();
+            for (HeapObject* object = heaps; object != activeEnd; ++object) {
+                if (object->inUse) {
+                    reclaimed += object->heap.reclaimHeldBy(holder);
+                }
+            }
+            return reclaimed;
+        },
+        recoveryWalkCount);
+}
+
 } // namespace
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> HeapManager::Create(void* area, size_t areaBytes, const char* name, Visibility visibility)
@@ -154,24 +240,24 @@ DCOS_CONFIGURATION_SERVICE Status HeapManager::Delete(ObjectId id)
 
 Result<void*> HeapManager::Allocate(ObjectId id, size_t bytes)
 {
-    const uint16_t holder = memory_area::callerHolder(SegmentedHeap::kSystemHolder);
+    Task* const task = memory_area::callerTask();
     Lock lock;
     const Result<HeapObject*> object = lookup(id);
     if (!object.ok()) {
         return object.status();
     }
-    return object.value()->heap.allocate(bytes, holder);
+    return allocateFor(*object.value(), bytes, task);
 }
 
 Status HeapManager::Return(ObjectId id, void* segment)
 {
-    const uint16_t holder = memory_area::callerHolder(SegmentedHeap::kSystemHolder);
+    Task* const task = memory_area::callerTask();
     Lock lock;
     const Result<HeapObject*> object = lookup(id);
     if (!object.ok()) {
         return object.status();
     }
-    return object.value()->heap.release(segment, holder);
+    return releaseFor(*object.value(), segment, task);
 }
 
 Result<HeapStatistics> HeapManager::GetStatistics(ObjectId id)
@@ -200,7 +286,9 @@ DCOS_CONFIGURATION_SERVICE Status HeapManager::XferOwnership(ObjectId id, void* 
 {
     return memory_area::transferMemory(
         lookup, [](HeapObject* object) -> SegmentedHeap& { return object->heap; }, id, segment, newOwner,
-        SegmentedHeap::kSystemHolder);
+        SegmentedHeap::kSystemHolder, [](HeapObject* object, uint32_t offset, uint8_t* links, Task* from, Task* to) {
+            memory_area::moveHeld(&Task::heldSegments, from, to, heldHandle(object, offset), links, takeHeld, giveHeld);
+        });
 }
 
 DCOS_CONFIGURATION_SERVICE unsigned HeapManager::recoverResourcesOf(ObjectId deadTask)
@@ -208,21 +296,17 @@ DCOS_CONFIGURATION_SERVICE unsigned HeapManager::recoverResourcesOf(ObjectId dea
     if (deadTask.isNull() || deadTask.type() != ObjectType::Task) {
         return 0;
     }
-    // Called by the task agent with interrupts already disabled; the walk
-    // over every segment is the O(N) cost of recovery.
+    // Called by the task agent with interrupts already disabled: the
+    // segments the task held, from its list, then the heaps it owns.
     Lock lock;
-    const uint16_t holder = memory_area::holderOfTask(deadTask);
-    size_t recovered = 0;
-    // Only active slots can hold an object: the walk is O(active slots), not O(capacity).
-    const HeapObject* const activeEnd = heaps + heapTable.activeCount();
-    for (HeapObject* object = heaps; object != activeEnd; ++object) {
-        if (object->inUse) {
-            recovered += object->heap.reclaimHeldBy(holder);
-        }
-    }
+    const Result<Task*> task = TaskManager::resolve(deadTask);
+    size_t recovered =
+        reclaimHeldSegments(task.ok() ? task.value() : nullptr, memory_area::holderOfTask(deadTask));
     recovered += heapTable.forEachOwnedBy(deadTask, [](ObjectId id, HeapObject*& object) { remove(id, *object); });
     return static_cast<unsigned>(recovered);
 }
+
+uint32_t HeapManager::recoveryWalks() { return recoveryWalkCount; }
 
 bool HeapManager::overlapsArea(uintptr_t begin, uintptr_t end)
 {
@@ -292,7 +376,7 @@ Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes)
     {
         const internal::FlagsRestoringGuard guard;
         if (internal::HeapObject* const* found = internal::heapTable.find(id)) [[likely]] {
-            return (*found)->heap.allocate(bytes, internal::memory_area::callerHolder(SegmentedHeap::kSystemHolder));
+            return internal::allocateFor(**found, bytes, internal::memory_area::callerTask());
         }
     }
     return HeapManager::Allocate(id, bytes);
@@ -303,7 +387,7 @@ Status HeapAgent::Return(ObjectId id, void* segment)
     {
         const internal::FlagsRestoringGuard guard;
         if (internal::HeapObject* const* found = internal::heapTable.find(id)) [[likely]] {
-            return (*found)->heap.release(segment, internal::memory_area::callerHolder(SegmentedHeap::kSystemHolder));
+            return internal::releaseFor(**found, segment, internal::memory_area::callerTask());
         }
     }
     return HeapManager::Return(id, segment);

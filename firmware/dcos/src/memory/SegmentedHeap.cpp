@@ -40,7 +40,7 @@ constexpr bool SegmentedHeap::roundedClassesAgree(uint32_t limit)
             return false;
         }
     }
-    for (uint32_t power = 17; power <= 30; ++power) { // Around every larger power of two.
+    for (uint32_t power = 17; power <= 23; ++power) { // Around every larger power of two.
         for (uint32_t needed = (1u << power) - 64; needed <= (1u << power) + 64; needed += kAlignment) {
             const uint32_t rounded = needed + (uint32_t{1} << (highestBit(needed) - kClassBits)) - 1;
             const SizeClass expected = classOf(rounded);
@@ -118,6 +118,7 @@ Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
     // Round the request up to a class boundary: every segment of the class
     // found then fits, and the first one is taken without a search.
     static_assert(roundedClassesAgree(1u << 17));
+    static_assert(classOf(kMaximumHeapBytes & ~uint32_t{7}).level < kLevels, "the largest segment has a class");
     SizeClass found = roundedClassOf(needed);
     if (!findFrom(found)) {
         // The request's own class may still hold a segment that fits: try its first.
@@ -185,25 +186,42 @@ Result<void*> SegmentedHeap::allocate(size_t bytes, uint16_t holder)
     return static_cast<void*>(base_ + current + kHeaderBytes);
 }
 
-Status SegmentedHeap::release(void* segment, uint16_t holder)
+Status SegmentedHeap::release(void* segment, uint16_t holder, Released* released)
 {
     Allocated header{};
     const Result<uint32_t> offset = allocatedOffsetOf(segment, holder, header);
     if (!offset.ok()) {
         return offset.status();
     }
+    if (released != nullptr) {
+        released->holder = header.holder;
+        released->next = HeldLinks::next(base_ + offset.value() + 8);
+        released->previous = HeldLinks::previous(base_ + offset.value() + 8);
+    }
     return releaseAt(offset.value(), header.size, header.previousFree) != 0 ? Status::Ok : Status::Corrupted;
 }
 
-Status SegmentedHeap::transfer(void* segment, uint16_t from, uint16_t to)
+Status SegmentedHeap::transferOffset(void* segment, uint16_t from, uint16_t to, uint32_t& offset,
+                                     uint16_t& previous)
 {
     Allocated header{};
-    const Result<uint32_t> offset = allocatedOffsetOf(segment, from, header);
-    if (!offset.ok()) {
-        return offset.status();
+    const Result<uint32_t> found = allocatedOffsetOf(segment, from, header);
+    if (!found.ok()) {
+        return found.status();
     }
-    writeAllocated(offset.value(), header.size, header.previousFree, to);
+    writeAllocated(found.value(), header.size, header.previousFree, to);
+    offset = found.value();
+    previous = header.holder;
     return Status::Ok;
+}
+
+bool SegmentedHeap::reclaim(uint32_t offset, uint16_t holder)
+{
+    Allocated header{};
+    if (offset >= limit_ || (offset & kFlagMask) != 0 || !checkAllocated(offset, header) || header.holder != holder) {
+        return false;
+    }
+    return releaseAt(offset, header.size, header.previousFree) != 0;
 }
 
 size_t SegmentedHeap::reclaimHeldBy(uint16_t holder)
@@ -410,16 +428,6 @@ inline void SegmentedHeap::unlink(uint32_t offset, SizeClass sizeClass)
     }
 }
 
-inline uint32_t SegmentedHeap::word(uint32_t offset) const
-{
-    // The area belongs to the application and may be declared with any
-    // type; memcpy is a single load whatever that type is.
-    uint32_t value;
-    __builtin_memcpy(&value, base_ + offset, sizeof value);
-    return value;
-}
-
-inline void SegmentedHeap::setWord(uint32_t offset, uint32_t value) { __builtin_memcpy(base_ + offset, &value, sizeof value); }
 
 inline uint16_t SegmentedHeap::seal(uint32_t offset, uint32_t first, uint16_t holder) const
 {
@@ -486,6 +494,15 @@ inline bool SegmentedHeap::checkAllocated(uint32_t offset, Allocated& header) co
            && header.size <= size_ - offset && (second >> 16) == seal(offset, first, header.holder);
 }
 
+uint8_t* SegmentedHeap::linksIfAllocated(uint32_t offset) const
+{
+    Allocated header{};
+    if (offset >= limit_ || (offset & kFlagMask) != 0 || !checkAllocated(offset, header)) {
+        return nullptr;
+    }
+    return base_ + offset + 8;
+}
+
 inline bool SegmentedHeap::checkListed(uint32_t offset, SizeClass sizeClass) const
 {
     // checkLinks() and the list neighbours' links back, each word read
@@ -515,7 +532,7 @@ inline Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t
 {
     const uintptr_t address = reinterpret_cast<uintptr_t>(segment);
     const uintptr_t base = reinterpret_cast<uintptr_t>(base_);
-    // A segment's data starts 8 bytes past a multiple of 8 inside the heap:
+    // A segment's data starts 16 bytes past a multiple of 8 inside the heap:
     // one compare (against limit_, the heap's size less a header, 0 when
     // corrupted; below the heap's start the offset wraps) and one mask
     // accept it; anything else is told apart only then.
@@ -527,7 +544,7 @@ inline Result<uint32_t> SegmentedHeap::allocatedOffsetOf(void* segment, uint16_t
         if (size_ == 0 || address < base || address - base >= size_) {
             return Status::InvalidArgument; // Not this heap's memory: the heap is unharmed.
         }
-        return fail(); // A wild pointer into the heap (its first 8 bytes included).
+        return fail(); // A wild pointer into the heap (its first 16 bytes included).
     }
     // A free or merged segment (a double return) or an overwritten header fails here.
     if (!checkAllocated(static_cast<uint32_t>(offset), header)) {

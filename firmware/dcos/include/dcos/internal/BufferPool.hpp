@@ -2,7 +2,7 @@
 //
 // A pool manages an area the caller supplies:
 //
-//     | state[0] ... state[n-1] | pad to 8 | buffer 0 | buffer 1 | ... | buffer n-1 |
+//     | state[0] ... state[n-1] | links[0] ... links[n-1] | pad to 8 | buffer 0 | ... | buffer n-1 |
 //
 // Each buffer has a 32-bit state word in the table at the start of the area.
 // Its low half is the buffer's own index and its high half the holder (a
@@ -39,10 +39,16 @@
 // give the precise status. The cost of a fast path is the same whatever the
 // pool holds.
 //
+// Each buffer also has two link words (HeldList.hpp), which the kernel uses
+// to keep every task's list of the buffers it holds; the pool only lays them
+// out and hands them over: tryAllocate() and tryRelease() give them to the
+// caller's functor with the buffer's index, and linksOf() finds them.
+//
 // The class does no locking; its owner serialises calls.
 #pragma once
 
 #include <dcos/BufferPoolAgent.hpp>
+#include <dcos/internal/HeldList.hpp>
 #include <dcos/Status.hpp>
 
 #include <bit>
@@ -62,6 +68,11 @@ public:
     static constexpr size_t kMinimumBufferSize = BufferPoolAgent::kMinimumBufferSize;
     /// Most buffers one pool can hold (16-bit indices, one value marks the list's end).
     static constexpr size_t kMaximumBuffers = BufferPoolAgent::kMaximumBuffers;
+
+    /// The functor of tryAllocate() and tryRelease() for callers that keep no lists.
+    struct IgnoreLinks {
+        void operator()(uint32_t, uint8_t*, uint32_t) const {}
+    };
 
     /// Creates an unused pool; initialise() puts it in service.
     constexpr BufferPool() = default;
@@ -84,8 +95,12 @@ public:
     ///
     /// The holder is asked for only once the head passed its checks: while
     /// they run, the kernel's fast path has no register to spare for it.
-    template <typename HolderWord>
-    [[gnu::always_inline]] void* tryAllocate(HolderWord holderWord)
+    ///
+    /// @p taken(index, links, holderWord) is called with the buffer's index,
+    /// its link words and what @p holderWord() gave, once it is the
+    /// holder's, before it is returned.
+    template <typename HolderWord, typename Taken = IgnoreLinks>
+    [[gnu::always_inline]] void* tryAllocate(HolderWord holderWord, Taken taken = {})
     {
         const uint32_t index = head_;
         if (index >= limit_) {
@@ -99,7 +114,9 @@ public:
             return nullptr;
         }
         head_ = word >> 16; // Checked when it is the head: below limit_, or the end.
-        storeState(index, ((static_cast<uint32_t>(holderWord()) << 16) | index) ^ allocatedKey_);
+        const uint32_t holder = static_cast<uint32_t>(holderWord());
+        storeState(index, ((holder << 16) | index) ^ allocatedKey_);
+        taken(index, linksOf(index), holder);
         // One subtraction in memory keeps both counts: the free buffers are
         // the low-water mark plus those above it, and only when none is
         // above it does the mark move (the borrow says so).
@@ -125,8 +142,12 @@ public:
     /// tryAllocate()); false in every other case (release() then decides).
     /// The holder is asked for once the address is known to be a buffer's,
     /// for the reason tryAllocate() gives. O(1).
-    template <typename HolderWord>
-    [[gnu::always_inline]] bool tryRelease(void* buffer, HolderWord holderWord)
+    ///
+    /// @p given(index, links, holderWord) is called with the buffer's index,
+    /// its link words and what @p holderWord() gave, once it is known to be
+    /// the holder's, before it is freed.
+    template <typename HolderWord, typename Given = IgnoreLinks>
+    [[gnu::always_inline]] bool tryRelease(void* buffer, HolderWord holderWord, Given given = {})
     {
         const uintptr_t index = indexOf(buffer);
         if (index >= limit_) {
@@ -134,16 +155,18 @@ public:
         }
         // The word it must hold, built before the load, so that no address
         // waits in a register while the holder is asked for.
-        const uint32_t expected =
-            ((static_cast<uint32_t>(holderWord()) << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_;
+        const uint32_t holder = static_cast<uint32_t>(holderWord());
+        const uint32_t expected = ((holder << 16) | static_cast<uint32_t>(index)) ^ allocatedKey_;
         if (loadState(static_cast<uint32_t>(index)) != expected) {
             return false; // Free already, another holder's, the system's, or overwritten.
         }
+        given(static_cast<uint32_t>(index), linksOf(static_cast<uint32_t>(index)), holder);
         pushFree(static_cast<uint32_t>(index));
         return true;
     }
 
     /// Takes the buffer at the head of the free list for @p holder. O(1).
+    /// Its link words are left for the caller (linksOf()).
     ///
     /// Fails with NoMemory when none is free, Corrupted when the pool is or
     /// turns out to be corrupted, and InvalidArgument for the reserved
@@ -175,7 +198,29 @@ public:
     /// Hands @p buffer, held by @p from or by the system, to the holder @p to. O(1).
     ///
     /// Fails as release() does; InvalidArgument for the holder kFreeMark.
-    Status transfer(void* buffer, uint16_t from, uint16_t to);
+    /// On success @p moved(index, links, previousHolder) is called, with
+    /// previousHolder @p from or kSystemHolder.
+    template <typename Moved>
+    Status transfer(void* buffer, uint16_t from, uint16_t to, Moved moved)
+    {
+        uint16_t previous = kSystemHolder;
+        const Status status = transferIndex(buffer, from, to, previous);
+        if (status == Status::Ok) {
+            const uint32_t index = indexOfBuffer(buffer);
+            moved(index, linksOf(index), previous);
+        }
+        return status;
+    }
+    /// transfer() for callers that keep no lists.
+    Status transfer(void* buffer, uint16_t from, uint16_t to)
+    {
+        return transfer(buffer, from, to, [](uint32_t, uint8_t*, uint16_t) {});
+    }
+
+    /// Frees the buffer with index @p index if @p holder holds it; false
+    /// (nothing changed) if not, or if the index is out of range. Recovery
+    /// uses it on the items of a dead task's list. O(1).
+    bool reclaim(uint32_t index, uint16_t holder);
 
     /// Returns every buffer @p holder holds; returns how many. O(buffers).
     ///
@@ -206,6 +251,18 @@ public:
     size_t bufferCount() const { return count_; }
     /// Address of the buffer with index @p index.
     void* bufferAt(size_t index) const { return reinterpret_cast<void*>(base_ + index * stride_); }
+    /// The index of the buffer starting at @p buffer; bufferCount() or more
+    /// for any other address. O(1).
+    uint32_t indexOfBuffer(const void* buffer) const
+    {
+        const uintptr_t index = indexOf(buffer);
+        return index < count_ ? static_cast<uint32_t>(index) : count_;
+    }
+    /// The link words of the buffer with index @p index (below bufferCount()).
+    uint8_t* linksOf(uint32_t index) const { return links_ + index * HeldLinks::kBytes; }
+    /// linksOf(), or null when the index is out of range or the pool is
+    /// corrupted or out of service: for resolving a held list's handles. O(1).
+    uint8_t* linksIfInService(uint32_t index) const { return index < limit_ ? linksOf(index) : nullptr; }
 
 private:
     static constexpr uint32_t kEndOfList = 0xFFFF;
@@ -232,7 +289,7 @@ private:
     // and Montgomery's divisibility test).
     uintptr_t indexOf(const void* buffer) const
     {
-        return std::rotr((reinterpret_cast<uintptr_t>(buffer) - base_) * inverse_, shift_);
+        return std::rotr((reinterpret_cast<uintptr_t>(buffer) - base_) * inverse_, int{shift_});
     }
 
     void pushFree(uint32_t index)
@@ -252,13 +309,15 @@ private:
     // Finds the index of an allocated buffer for release() and transfer();
     // fails (disabling the pool where the seed asks for it) otherwise.
     Result<uint32_t> allocatedIndexOf(void* buffer, uint16_t holder);
+    Status transferIndex(void* buffer, uint16_t from, uint16_t to, uint16_t& previous);
     Status fail();
 
-    uint8_t* states_ = nullptr; // The state table: one 32-bit word per buffer.
+    uint8_t* states_ = nullptr; // The state table: one 32-bit word per buffer, then the links.
     uintptr_t base_ = 0;        // The first buffer.
     uint32_t stride_ = 0;
     uintptr_t inverse_ = 0;     // Of the stride's odd part, modulo 2^32 (2^64 on a 64-bit host).
-    int shift_ = 0;             // The stride's trailing zero bits.
+    uint8_t shift_ = 0;         // The stride's trailing zero bits.
+    uint8_t sizeSlack_ = 0;     // The stride less the buffer size (0 to 3).
     // count_ while in service, 0 once corrupted (which is how isCorrupted()
     // tells): the fast paths' one test.
     uint32_t limit_ = 0;
@@ -270,7 +329,7 @@ private:
     uint32_t allocatedKey_ = 0; // every allocated buffer's with this one.
     uint32_t count_ = 0;
     uint32_t failedAllocations_ = 0;
-    uint32_t bufferSize_ = 0;
+    uint8_t* links_ = nullptr; // The held-list links, after the state words.
     // Sixty bytes on the board: with the kernel's id beside it, a pool slot
     // is 64 bytes (BufferPoolManager.cpp). The area's bounds are the
     // kernel's to keep.

@@ -67,10 +67,14 @@ public:
     /// Implements BufferPoolAgent::XferOwnership for one buffer.
     static Status XferOwnership(ObjectId pool, void* buffer, ObjectId newOwner);
 
-    /// Returns every buffer @p deadTask holds, in every pool, then deletes
-    /// every pool it owns, whatever other tasks still hold. Returns the
-    /// number of buffers and pools recovered. O(buffers of all pools).
+    /// Returns every buffer @p deadTask holds, found from its held list,
+    /// then deletes every pool it owns, whatever other tasks still hold.
+    /// Returns the number of buffers and pools recovered. O(buffers held +
+    /// pools owned); when the list was lost (HeldList.hpp), O(buffers of
+    /// all pools) instead.
     static unsigned recoverResourcesOf(ObjectId deadTask);
+    /// How many recoveries found a held list lost and walked every pool instead.
+    static uint32_t recoveryWalks();
 
     /// Whether [begin, end) overlaps the area of a pool. O(N). Call with interrupts disabled.
     static bool overlapsArea(uintptr_t begin, uintptr_t end);

@@ -59,10 +59,13 @@ public:
     /// Implements HeapAgent::XferOwnership for one segment.
     static Status XferOwnership(ObjectId heap, void* segment, ObjectId newOwner);
 
-    /// Returns every segment @p deadTask holds, in every heap, then deletes
-    /// every heap it owns. Returns the number of segments and heaps
-    /// recovered. O(segments of all heaps).
+    /// Returns every segment @p deadTask holds, found from its held list,
+    /// then deletes every heap it owns. Returns the number of segments and
+    /// heaps recovered. O(segments held + heaps owned); when the list was
+    /// lost (HeldList.hpp), O(segments of all heaps) instead.
     static unsigned recoverResourcesOf(ObjectId deadTask);
+    /// How many recoveries found a held list lost and walked every heap instead.
+    static uint32_t recoveryWalks();
 
     /// Whether [begin, end) overlaps the area of a heap. O(N). Call with interrupts disabled.
     static bool overlapsArea(uintptr_t begin, uintptr_t end);

@@ -11,6 +11,7 @@
 #include <dcos/ObjectId.hpp>
 #include <dcos/Status.hpp>
 #include <dcos/Visibility.hpp>
+#include <dcos/internal/HeldList.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
@@ -31,6 +32,17 @@ namespace dcos::internal::memory_area {
 
 static_assert(static_cast<uint16_t>(ObjectId(0xFFFF, ObjectType::Task, ObjectId::kMaxIndex).raw()) < 0xFFFE,
               "a task's holder tag must differ from the system's and from the free mark");
+
+/// The running task when memory the caller takes becomes a task's (what
+/// callerHolder() then gives is its tag); null when it becomes the system's:
+/// in an interrupt handler and before the scheduler starts.
+[[gnu::always_inline]] inline Task* callerTask()
+{
+    if (inInterruptContext() || !Scheduler::started()) [[unlikely]] {
+        return nullptr;
+    }
+    return &Scheduler::current();
+}
 
 /// callerHolder() in the low half of a word whose high half is left as it
 /// comes (the running task's node), for the pool's fast paths, which shift
@@ -116,11 +128,60 @@ Status transferObject(Table& table, Lookup lookup, ObjectId id, ObjectId newOwne
     return table.XferOwnership(id, table.ownerOf(id).value(), newOwner);
 }
 
+/// Moves a held item's links after its holder changed: off the list of
+/// @p from (null when the system held it) and onto the list of @p to (null
+/// for the system, whose items are on no list). @p list selects the task's
+/// list of buffers or of segments; @p take and @p give are the agent's
+/// HeldList::take and give with its resolver. O(1).
+inline void moveHeld(HeldHead Task::*list, Task* from, Task* to, uint32_t handle, uint8_t* links,
+                     void (*take)(HeldHead&, uint32_t), void (*give)(HeldHead&, uint32_t, uint8_t*))
+{
+    if (from != nullptr) {
+        give(from->*list, handle, links);
+    }
+    if (to != nullptr) {
+        take(to->*list, handle);
+    }
+}
+
+/// Gives back everything a dead task held of one kind (@p list: its buffers
+/// or its segments) and empties its head: each item from the list with
+/// @p reclaimOne(handle), which frees it if the task's holder tag holds it
+/// and says whether it did; when the list was lost or an item fails that
+/// check, with @p walkAll(), which frees every item of the kind the tag
+/// holds, counted in @p walks. Returns the number of items given back.
+/// @p task is null when the dead task no longer resolves: then the walk.
+template <typename Resolve, typename ReclaimOne, typename WalkAll>
+size_t reclaimHeld(Task* task, HeldHead Task::*list, Resolve resolve, ReclaimOne reclaimOne, WalkAll walkAll,
+                   uint32_t& walks)
+{
+    size_t reclaimed = 0;
+    const bool complete = task != nullptr
+        && HeldList::forEachHeld(task->*list, resolve, [&reclaimed, reclaimOne](uint32_t handle, uint8_t*) {
+               if (!reclaimOne(handle)) {
+                   return false; // Not the task's: a damaged link.
+               }
+               ++reclaimed;
+               return true;
+           });
+    if (task != nullptr) {
+        task->*list = HeldHead{kHeldEnd, kHeldEnd};
+    }
+    if (!complete) {
+        ++walks;
+        reclaimed += walkAll();
+    }
+    return reclaimed;
+}
+
 /// XferOwnership of one buffer or segment the caller holds; areaOf gives
-/// the object's BufferPool or SegmentedHeap.
-template <typename Lookup, typename AreaOf>
+/// the object's BufferPool or SegmentedHeap. On success @p relink(object,
+/// item, links, from, to) moves the item between the held lists of the
+/// task that held it (null: the system) and the new owner (null: the
+/// system), with moveHeld().
+template <typename Lookup, typename AreaOf, typename Relink>
 Status transferMemory(Lookup lookup, AreaOf areaOf, ObjectId id, void* memory, ObjectId newOwner,
-                      uint16_t systemHolder)
+                      uint16_t systemHolder, Relink relink)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt;
@@ -135,7 +196,13 @@ Status transferMemory(Lookup lookup, AreaOf areaOf, ObjectId id, void* memory, O
     if (!newHolder.ok()) {
         return newHolder.status();
     }
-    return areaOf(object.value()).transfer(memory, holder, newHolder.value());
+    Task* const from = callerTask();
+    Task* const to = newOwner.isNull() ? nullptr : TaskManager::resolve(newOwner).value(); // Checked by holderFor.
+    auto* const area = object.value();
+    return areaOf(area).transfer(
+        memory, holder, newHolder.value(), [&](uint32_t item, uint8_t* links, uint16_t previousHolder) {
+            relink(area, item, links, previousHolder == systemHolder ? nullptr : from, to);
+        });
 }
 
 } // namespace dcos::internal::memory_area

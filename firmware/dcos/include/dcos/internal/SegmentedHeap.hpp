@@ -1,10 +1,10 @@
 // The algorithm of a segmented heap (seed 7.8), free of kernel and hardware.
 //
 // The heap tiles a caller-supplied area with segments. Every segment starts
-// on an 8-byte boundary with an 8-byte header; its size (header included) is
-// a multiple of 8 and at least 16, so it holds at least 8 bytes:
+// on an 8-byte boundary with a 16-byte header; its size (header included) is
+// a multiple of 8 and at least 24, so it holds at least 8 bytes:
 //
-//     allocated:  | size | A=1 | P | check:16 holder:16 | data ...                          |
+//     allocated:  | size | A=1 | P | check:16 holder:16 | held next | held prev | data ...  |
 //     free:       | size | A=0 | P=0 | prev link        | next link | ...        | end tag  |
 //
 // The first header word holds the size with two flags in its low bits: A, the
@@ -30,7 +30,7 @@
 // when it is larger than that segment and than every segment of a higher
 // class: statistics() reports exactly that limit as the largest request that
 // can succeed. The allocation is cut from the start of the chosen segment and
-// the remainder, unless under 16 bytes (then given with the allocation),
+// the remainder, unless under 24 bytes (then given with the allocation),
 // goes to the list of its class. Return merges the segment with a free
 // successor and a free predecessor at once (boundary tags), so no two free
 // segments are ever adjacent.
@@ -42,10 +42,16 @@
 // A header made obsolete by a merge is cleared, so an old pointer to a merged
 // segment is recognised as a double return.
 //
+// An allocated segment's third and fourth words are the links of its
+// holder's list (HeldList.hpp), which the kernel keeps: the heap lays them
+// out, hands over their values on release() and transfer(), and finds them
+// with linksIfAllocated().
+//
 // The class does no locking; its owner serialises calls.
 #pragma once
 
 #include <dcos/HeapAgent.hpp>
+#include <dcos/internal/HeldList.hpp>
 #include <dcos/Status.hpp>
 
 #include <stddef.h>
@@ -62,10 +68,18 @@ public:
     static constexpr size_t kHeaderBytes = HeapAgent::kHeaderBytes;
     /// Alignment and size granularity of segments.
     static constexpr size_t kAlignment = HeapAgent::kAlignment;
-    /// Smallest segment, header included: an 8-byte header and 8 bytes of data.
+    /// Smallest segment, header included: a 16-byte header and 8 bytes of data.
     static constexpr size_t kSmallestSegment = kHeaderBytes + HeapAgent::kMinimumSegment;
     /// Largest heap, in bytes.
-    static constexpr size_t kMaximumHeapBytes = size_t{1} << 30;
+    static constexpr size_t kMaximumHeapBytes = HeapAgent::kMaximumHeapBytes;
+
+    /// What release() found in a segment before it freed it: its holder and
+    /// the values of its held-list links.
+    struct Released {
+        uint16_t holder = kSystemHolder;
+        uint32_t next = kHeldEnd;
+        uint32_t previous = kHeldUnlisted;
+    };
 
     /// Creates an unused heap; initialise() puts it in service.
     constexpr SegmentedHeap() = default;
@@ -74,7 +88,7 @@ public:
     ///
     /// The start is aligned up and the length down to 8 bytes. @p salt makes
     /// this heap's check values differ from any other's. Fails with
-    /// InvalidArgument for a null area, fewer than 16 usable bytes or more
+    /// InvalidArgument for a null area, fewer than 24 usable bytes or more
     /// than kMaximumHeapBytes; the heap is then unused.
     Status initialise(void* area, size_t areaBytes, uint32_t salt);
 
@@ -90,12 +104,49 @@ public:
     /// holder than @p holder or the system holds it; Corrupted (the heap is
     /// disabled) for a free segment, a pointer that is not a segment's start,
     /// or bookkeeping that fails its checks.
-    Status release(void* segment, uint16_t holder);
+    Status release(void* segment, uint16_t holder) { return release(segment, holder, nullptr); }
+    /// release(), which on success also says in @p released who held the
+    /// segment and what its links were (the merge may overwrite them).
+    Status release(void* segment, uint16_t holder, Released* released);
 
     /// Hands @p segment, held by @p from or by the system, to the holder @p to. O(1).
     ///
-    /// Fails as release() does.
-    Status transfer(void* segment, uint16_t from, uint16_t to);
+    /// Fails as release() does. On success @p moved(offset, links,
+    /// previousHolder) is called, with previousHolder @p from or kSystemHolder.
+    template <typename Moved>
+    Status transfer(void* segment, uint16_t from, uint16_t to, Moved moved)
+    {
+        uint32_t offset = 0;
+        uint16_t previous = kSystemHolder;
+        const Status status = transferOffset(segment, from, to, offset, previous);
+        if (status == Status::Ok) {
+            moved(offset, base_ + offset + 8, previous);
+        }
+        return status;
+    }
+    /// transfer() for callers that keep no lists.
+    Status transfer(void* segment, uint16_t from, uint16_t to)
+    {
+        return transfer(segment, from, to, [](uint32_t, uint8_t*, uint16_t) {});
+    }
+
+    /// Frees the segment at @p offset if @p holder holds it; false (nothing
+    /// changed) if not, or if the offset is not an allocated segment's.
+    /// Recovery uses it on the items of a dead task's list. O(1).
+    bool reclaim(uint32_t offset, uint16_t holder);
+
+    /// The offset of the segment whose data starts at @p data, which
+    /// allocate() just returned.
+    uint32_t offsetOf(const void* data) const
+    {
+        return static_cast<uint32_t>(static_cast<const uint8_t*>(data) - base_ - kHeaderBytes);
+    }
+    /// The held-list links of the segment at @p offset, or null when the heap
+    /// is corrupted or out of service, the offset lies beyond it or no
+    /// allocated segment's checked header is there (so that a handle left
+    /// from a heap deleted in the same slot never leads into a segment's
+    /// data): for resolving a held list's handles. O(1).
+    uint8_t* linksIfAllocated(uint32_t offset) const;
 
     /// Returns every segment @p holder holds; returns how many. O(segments).
     ///
@@ -137,12 +188,12 @@ private:
     static constexpr uint32_t kFlagMask = 7;
     // Eight classes per power of two: a request rounded up to a class
     // boundary is at most an eighth larger, and the heads of one heap take
-    // 832 bytes (sixteen classes would double that for every heap slot).
+    // 576 bytes (sixteen classes would double that for every heap slot).
     static constexpr uint32_t kClassBits = 3;
     static constexpr uint32_t kClasses = 1u << kClassBits;
     // Class 0 holds the linear classes below 64 bytes; class k >= 1 holds
-    // [2^(k+5), 2^(k+6)) bytes, up to the 1 GiB heap.
-    static constexpr uint32_t kLevels = 26;
+    // [2^(k+5), 2^(k+6)) bytes, up to the largest heap (8 MiB: level 17).
+    static constexpr uint32_t kLevels = 18;
 
     // A size class: the power of two (level) and the class within it.
     struct SizeClass {
@@ -164,8 +215,18 @@ private:
     // Whether roundedClassOf() agrees with classOf() of the rounded size
     // for every segment size up to @p limit (a compile-time check).
     static constexpr bool roundedClassesAgree(uint32_t limit);
-    [[gnu::always_inline]] uint32_t word(uint32_t offset) const;
-    [[gnu::always_inline]] void setWord(uint32_t offset, uint32_t value);
+    // The area belongs to the application and may be declared with any
+    // type; memcpy is a single load or store whatever that type is.
+    [[gnu::always_inline]] uint32_t word(uint32_t offset) const
+    {
+        uint32_t value;
+        __builtin_memcpy(&value, base_ + offset, sizeof value);
+        return value;
+    }
+    [[gnu::always_inline]] void setWord(uint32_t offset, uint32_t value)
+    {
+        __builtin_memcpy(base_ + offset, &value, sizeof value);
+    }
     [[gnu::always_inline]] uint16_t seal(uint32_t offset, uint32_t first, uint16_t holder) const;
     [[gnu::always_inline]] uint32_t endTag(uint32_t size, uint32_t end) const;
     [[gnu::always_inline]] bool isLink(uint32_t link) const;
@@ -191,6 +252,7 @@ private:
     // check failed (the heap is then disabled). The header comes as values,
     // not as an Allocated in memory, so that the caller need not store it.
     uint32_t releaseAt(uint32_t offset, uint32_t size, bool previousFree);
+    Status transferOffset(void* segment, uint16_t from, uint16_t to, uint32_t& offset, uint16_t& previous);
     Status fail();
 
     uint8_t* base_ = nullptr;

@@ -10,6 +10,7 @@
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/DeadlineKey.hpp>
 #include <dcos/internal/DeadlineQueue.hpp>
+#include <dcos/internal/HeldList.hpp>
 #include <dcos/internal/IntrusiveList.hpp>
 #include <dcos/internal/TimeoutEntry.hpp>
 #include <dcos/internal/WaitQueue.hpp>
@@ -219,6 +220,13 @@ private:
     bool deliveryPending = false;
 
     void refreshDeliveryPending() { deliveryPending = exceptionPending || (pendingSignals & ~signalMask) != 0; }
+
+public:
+    // The memory this task holds (HeldList.hpp): its buffers and its heap
+    // segments, so that recovery walks only these. Last, so that the offsets
+    // the assembly uses stay where they are.
+    HeldHead heldBuffers{kHeldEnd, kHeldEnd};
+    HeldHead heldSegments{kHeldEnd, kHeldEnd};
 };
 
 } // namespace dcos::internal
