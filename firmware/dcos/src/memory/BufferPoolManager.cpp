@@ -9,7 +9,6 @@
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
-#include <dcos/internal/FlagsRestoringGuard.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -443,7 +442,7 @@ using internal::BufferPoolManager;
 Result<void*> BufferPoolAgent::Allocate(ObjectId id)
 {
     {
-        const internal::FlagsRestoringGuard guard;
+        const arch_x86::InterruptGuard guard;
         internal::PoolObject* const object = internal::fastObjectOf(id);
         if (object->id == id) [[likely]] {
             if (void* buffer = object->pool.tryAllocate(
@@ -462,7 +461,7 @@ Result<void*> BufferPoolAgent::Allocate(ObjectId id)
 Status BufferPoolAgent::Return(ObjectId id, void* buffer)
 {
     {
-        const internal::FlagsRestoringGuard guard;
+        const arch_x86::InterruptGuard guard;
         internal::PoolObject* const object = internal::fastObjectOf(id);
         if (object->id == id) [[likely]] {
             if (object->pool.tryRelease(

@@ -11,7 +11,6 @@
 #include <dcos/internal/SegmentedHeap.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
-#include <dcos/internal/FlagsRestoringGuard.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -374,7 +373,7 @@ using internal::SegmentedHeap;
 Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes)
 {
     {
-        const internal::FlagsRestoringGuard guard;
+        const arch_x86::InterruptGuard guard;
         if (internal::HeapObject* const* found = internal::heapTable.find(id)) [[likely]] {
             return internal::allocateFor(**found, bytes, internal::memory_area::callerTask());
         }
@@ -385,7 +384,7 @@ Result<void*> HeapAgent::Allocate(ObjectId id, size_t bytes)
 Status HeapAgent::Return(ObjectId id, void* segment)
 {
     {
-        const internal::FlagsRestoringGuard guard;
+        const arch_x86::InterruptGuard guard;
         if (internal::HeapObject* const* found = internal::heapTable.find(id)) [[likely]] {
             return internal::releaseFor(**found, segment, internal::memory_area::callerTask());
         }

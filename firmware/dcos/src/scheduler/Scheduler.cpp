@@ -109,8 +109,7 @@ void Scheduler::dispatchToMoreUrgent(Task& running, Task& task)
         dispatchPending_ = true; // The switch happens at the outermost interrupt's exit.
         return;
     }
-    const uint32_t flags = arch_x86::readEflags();
-    arch_x86::disableInterrupts();
+    const uint32_t flags = arch_x86::saveFlagsAndDisableInterrupts();
     // With no hold, no interrupt nesting and no dispatch already pending,
     // the runner was the most urgent task, so the deadline heap is empty
     // (asked anyway: it costs two instructions) and a task more urgent than
@@ -123,7 +122,7 @@ void Scheduler::dispatchToMoreUrgent(Task& running, Task& task)
         return;
     }
     requestDispatch();
-    restoreInterrupts(flags);
+    arch_x86::restoreFlags(flags);
 }
 
 void Scheduler::makeReadyByDeadline(Task& task)
@@ -174,8 +173,7 @@ void Scheduler::requestDispatch()
 
 void Scheduler::switchFromTask()
 {
-    const uint32_t flags = arch_x86::readEflags();
-    arch_x86::disableInterrupts();
+    const uint32_t flags = arch_x86::saveFlagsAndDisableInterrupts();
     Task* const previous = current_;
     Task* const next = pickNext();
     if (previous->state == TaskState::Terminating || next->hasDeliveryPending()) {
@@ -189,7 +187,7 @@ void Scheduler::switchFromTask()
             return;
         }
     }
-    restoreInterrupts(flags);
+    arch_x86::restoreFlags(flags);
 }
 
 arch_x86::InterruptFrame* Scheduler::frameForDirectResume(Task& task)

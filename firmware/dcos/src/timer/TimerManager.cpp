@@ -260,21 +260,10 @@ uint64_t TimerManager::timeOfDayNs()
 
 namespace {
 
-// InterruptGuard as two calls, for GetSystemClock, whose fast path and slow
-// path leave the critical section at different points.
-[[gnu::always_inline]] inline uint32_t saveAndDisableInterrupts()
-{
-    const uint32_t flags = arch_x86::readEflags();
-    arch_x86::disableInterrupts();
-    return flags;
-}
-
-[[gnu::always_inline]] inline void restoreInterrupts(uint32_t savedFlags)
-{
-    if ((savedFlags & arch_x86::eflagsInterruptEnable) != 0) {
-        arch_x86::enableInterrupts();
-    }
-}
+// GetSystemClock's fast path and slow path leave the critical section at
+// different points, so it uses InterruptGuard's two halves,
+// arch_x86::saveFlagsAndDisableInterrupts() and restoreFlags().
+using arch_x86::restoreFlags;
 
 // GetSystemClock's slow path: a read that is not within the second of the
 // cached calendar. Interrupts are disabled on entry and restored from
@@ -286,12 +275,12 @@ namespace {
 {
     DateTime time;
     if (calendar.advance(uptime) && calendar.read(uptime, time)) {
-        restoreInterrupts(savedFlags);
+        restoreFlags(savedFlags);
         return time;
     }
     const uint64_t base = baseNs;
     const uint32_t generation = clockGeneration;
-    restoreInterrupts(savedFlags);
+    restoreFlags(savedFlags);
     time = GregorianCalendar::fromNanoseconds(base + uptime);
     arch_x86::InterruptGuard guard;
     if (generation == clockGeneration) {
@@ -306,13 +295,13 @@ namespace {
     // The common case, a read within the second of the previous one, only
     // subtracts and copies (CalendarCache), with interrupts held off for a
     // few instructions.
-    const uint32_t savedFlags = saveAndDisableInterrupts();
+    const uint32_t savedFlags = arch_x86::saveFlagsAndDisableInterrupts();
     const uint64_t uptime = preciseUptime();
     Result<DateTime> result = calendar.answer();
     uint32_t nanosecond;
     if (calendar.contains(uptime, nanosecond)) {
         CalendarCache::patchNanosecond(result, nanosecond);
-        restoreInterrupts(savedFlags);
+        restoreFlags(savedFlags);
         return result;
     }
     result = convertSlowly(uptime, savedFlags);

@@ -103,8 +103,7 @@ public:
     /// Inline, so that Yield's cost is this and the switch itself.
     [[gnu::always_inline]] static void yieldCurrent()
     {
-        const uint32_t flags = arch_x86::readEflags();
-        arch_x86::disableInterrupts();
+        const uint32_t flags = arch_x86::saveFlagsAndDisableInterrupts();
         Task* const task = current_;
         auto& queue = readyQueues_[task->priority];
         // The common case: a static-priority task at the head of its queue,
@@ -120,7 +119,7 @@ public:
             switchDirectly(*task, *next, flags);
             return;
         }
-        restoreInterrupts(flags);
+        arch_x86::restoreFlags(flags);
     }
 
     /// Counts a tick against the running task's time slice.
@@ -156,13 +155,6 @@ private:
     /// An interrupt frame on a directly switched task's stack that resumes it
     /// where dcosSwitchFromTask left it, for a switch made at an interrupt's exit.
     static arch_x86::InterruptFrame* frameForDirectResume(Task& task);
-
-    static void restoreInterrupts(uint32_t flags)
-    {
-        if ((flags & arch_x86::eflagsInterruptEnable) != 0) {
-            arch_x86::enableInterrupts();
-        }
-    }
 
     /// The direct switch itself, for its three callers (yieldCurrent,
     /// switchFromTask, dispatchToMoreUrgent): next becomes the runner, what
