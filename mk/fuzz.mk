@@ -1,5 +1,6 @@
-# Fuzzing the CAN link layer (fieldbus/can) and the Modbus stack
-# (fieldbus/modbus) with libFuzzer.
+# Fuzzing the CAN link layer (fieldbus/can), the Modbus stack
+# (fieldbus/modbus), the host Modbus tools and the kernel's network tables
+# (firmware/dcos/fuzz) with libFuzzer.
 #
 #   make fuzz        builds the fuzz targets, replays each seed corpus once,
 #                    then fuzzes each target for FUZZ_SECONDS; fails on any crash
@@ -12,7 +13,7 @@
 # caused it is kept in $(FUZZ_BUILD)/artifacts/<target>/.
 
 FUZZ_BUILD := $(BUILD)/fuzz
-# Fuzzing time per target; ten targets, so 'make test' spends about 150 s here.
+# Fuzzing time per target; eleven targets, so 'make test' spends about 165 s here.
 FUZZ_SECONDS ?= 15
 FUZZ_TARGETS := frame isotp slcan frametext
 FUZZ_CORPUS := fieldbus/can/fuzz/corpus
@@ -28,6 +29,11 @@ MODBUS_FUZZ_REPORT := $(BUILD)/reports/fuzz-modbus-tests.xml
 HOST_MODBUS_FUZZ_TARGETS := modbus_arguments modbus_sim_config modbus_frames
 HOST_MODBUS_FUZZ_CORPUS := host_tools/modbus/fuzz/corpus
 HOST_MODBUS_FUZZ_REPORT := $(BUILD)/reports/fuzz-host-modbus-tests.xml
+# The kernel's parsers of outside input (firmware/dcos/fuzz): the network
+# interfaces manager's address text and tables, which the console sets.
+DCOS_FUZZ_TARGETS := network_tables
+DCOS_FUZZ_CORPUS := firmware/dcos/fuzz/corpus
+DCOS_FUZZ_REPORT := $(BUILD)/reports/fuzz-dcos-tests.xml
 
 FUZZ_CXX := clang++
 # toml++ is compiled into the fuzz targets as Debian's shared library, which
@@ -56,17 +62,20 @@ MODBUS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(MODBUS_FUZZ_TARGETS)
 HOST_MODBUS_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(HOSTMODBUS_SRCS) fieldbus/modbus/src/Crc16.cpp)
 HOST_MODBUS_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/modbus/fuzz/fuzz_%.cpp.o,$(HOST_MODBUS_FUZZ_TARGETS))
 HOST_MODBUS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOST_MODBUS_FUZZ_TARGETS))
+DCOS_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/dcos/src/network/NetworkAddress.cpp.o
+DCOS_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/dcos/fuzz/fuzz_%.cpp.o,$(DCOS_FUZZ_TARGETS))
+DCOS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(DCOS_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as
 # intermediate files and be deleted after every build.
 .SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS) $(MODBUS_FUZZ_LIBRARY_OBJS) $(MODBUS_FUZZ_TARGET_OBJS) \
-	$(HOST_MODBUS_FUZZ_LIBRARY_OBJS) $(HOST_MODBUS_FUZZ_TARGET_OBJS)
+	$(HOST_MODBUS_FUZZ_LIBRARY_OBJS) $(HOST_MODBUS_FUZZ_TARGET_OBJS) $(DCOS_FUZZ_LIBRARY_OBJS) $(DCOS_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
 fuzz: deps
 	@$(MAKE) --no-print-directory test-fuzz
 
-fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARIES)
+fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARIES) $(DCOS_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite.
@@ -79,6 +88,8 @@ test-fuzz:
 		--seconds $(FUZZ_SECONDS) --report $(MODBUS_FUZZ_REPORT) $(MODBUS_FUZZ_TARGETS) || status=1; \
 	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(HOST_MODBUS_FUZZ_CORPUS) \
 		--seconds $(FUZZ_SECONDS) --report $(HOST_MODBUS_FUZZ_REPORT) $(HOST_MODBUS_FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(DCOS_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(DCOS_FUZZ_REPORT) $(DCOS_FUZZ_TARGETS) || status=1; \
 	exit $${status:-0}
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
@@ -97,6 +108,11 @@ $(HOST_MODBUS_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/mod
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lfmt -lmodbus
+
+$(DCOS_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/dcos/fuzz/fuzz_%.cpp.o $(DCOS_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^
 
 FUZZ_FLAGS_STAMP := $(FUZZ_BUILD)/flags.stamp
 $(FUZZ_FLAGS_STAMP): FORCE

@@ -2,8 +2,8 @@
 #
 # The core is what every configuration links: the system, scheduler, task
 # and timer agents and what boot needs. The full configuration adds the
-# memory, port, DSM and semaphore agents, the application loader and the
-# console commands, with its root task (kernel/ConsoleRoot.cpp); the minimal
+# memory, port, DSM and semaphore agents, the network interfaces manager,
+# the application loader and the console commands, with its root task (kernel/ConsoleRoot.cpp); the minimal
 # one adds only its own root task (kernel/MinimalRoot.cpp). Every source is
 # compiled once: an image's configuration is the set of objects it links.
 
@@ -19,7 +19,8 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/MessageQueue.cpp \
 	firmware/dcos/src/application/ConfigurationReport.cpp \
 	firmware/dcos/src/system/DeviceManager.cpp \
-	firmware/dcos/src/system/DeviceCommands.cpp
+	firmware/dcos/src/system/DeviceCommands.cpp \
+	firmware/dcos/src/network/NetworkAddress.cpp
 
 # Kernel sources that run only on the target: task switching, the tick, traps.
 DCOS_TARGET_SRCS := \
@@ -36,7 +37,9 @@ DCOS_TARGET_SRCS := \
 	$(wildcard firmware/dcos/src/dsm/*.cpp) \
 	$(wildcard firmware/dcos/src/semaphore/*.cpp) \
 	firmware/dcos/src/application/ApplicationLoader.cpp \
-	firmware/dcos/src/application/ApplicationCommands.cpp
+	firmware/dcos/src/application/ApplicationCommands.cpp \
+	firmware/dcos/src/network/NetworkInterfacesManager.cpp \
+	firmware/dcos/src/network/NetworkCommands.cpp
 
 # The full configuration's kernel, in link order (which is the order of the
 # console commands' and the agents' recovery tables).

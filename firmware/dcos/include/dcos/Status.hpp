@@ -38,6 +38,7 @@ enum class [[nodiscard]] Status : uint8_t {
     Remote = 19,          ///< The id names an object on another node and no network is up.
     NotOpen = 20,         ///< The device must be opened first (Read, Write, Control, Close).
     Abandoned = 21,       ///< The task holding the resource ended while the caller waited.
+    Unreachable = 22,     ///< No interface or route of the network interfaces manager leads to the node.
 };
 
 /// Returns a short, stable English name for a status, for logs and the shell.
@@ -66,6 +67,7 @@ constexpr const char* statusName(Status status)
     case Status::Remote: return "remote object unreachable";
     case Status::Abandoned: return "holder ended";
     case Status::NotOpen: return "device not open";
+    case Status::Unreachable: return "node unreachable";
     }
     return "unknown status";
 }

@@ -139,7 +139,27 @@ static_assert(kSubscriptionsActiveAtBoot <= kSubscriptionCapacity && kSubscripti
 #define DCOS_CONFIG_HEAPS_ACTIVE 8
 #endif
 
+// The network interfaces manager's tables (seed 7.13): local interfaces,
+// node-to-address mappings, neighbours' physical addresses and routes.
+#ifndef DCOS_CONFIG_NETWORK_INTERFACES
+#define DCOS_CONFIG_NETWORK_INTERFACES 4
+#endif
+#ifndef DCOS_CONFIG_NETWORK_NODE_ADDRESSES
+#define DCOS_CONFIG_NETWORK_NODE_ADDRESSES 64
+#endif
+#ifndef DCOS_CONFIG_NETWORK_NEIGHBOURS
+#define DCOS_CONFIG_NETWORK_NEIGHBOURS 64
+#endif
+#ifndef DCOS_CONFIG_NETWORK_ROUTES
+#define DCOS_CONFIG_NETWORK_ROUTES 16
+#endif
+
 namespace dcos::internal {
+
+constexpr size_t kNetworkInterfaces = DCOS_CONFIG_NETWORK_INTERFACES;
+constexpr size_t kNetworkNodeAddresses = DCOS_CONFIG_NETWORK_NODE_ADDRESSES;
+constexpr size_t kNetworkNeighbours = DCOS_CONFIG_NETWORK_NEIGHBOURS;
+constexpr size_t kNetworkRoutes = DCOS_CONFIG_NETWORK_ROUTES;
 
 constexpr size_t kPoolCapacity = DCOS_CONFIG_POOL_CAPACITY;
 constexpr size_t kPoolsActiveAtBoot = DCOS_CONFIG_POOLS_ACTIVE;

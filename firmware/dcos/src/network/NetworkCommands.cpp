@@ -1,0 +1,185 @@
+// The network interfaces manager's console command (seed 7.13): "net"
+// lists its tables, resolves a node and, for the super user the console
+// runs as, changes them. Output is one entry per line, so the lab's tests
+// and a control engineer's scripts can read it.
+#include <dcos/NetworkInterfacesManager.hpp>
+#include <dcos/internal/NetworkTables.hpp>
+
+#include <runtime/Text.hpp>
+#include <shell/Shell.hpp>
+#include <shell/ShellCommand.hpp>
+
+namespace dcos::internal {
+
+namespace {
+
+using runtime::textEquals;
+
+// A copy of the tables to print from: static, since the tables are larger
+// than a shell's stack should carry, and the console runs one command at a time.
+constinit NetworkTables listed;
+
+struct Text {
+    char text[NetworkAddress::kTextSize];
+};
+
+Text textOf(NetworkAddress address)
+{
+    Text out;
+    address.format(out.text);
+    return out;
+}
+
+void list(shell::Shell& shell)
+{
+    copyNetworkTables(listed);
+    shell.print("interfaces\r\n");
+    listed.forEachInterface([&shell](uint8_t number, const NetworkInterface& interface) {
+        shell.print("  %u  %-6s %u  %s/%u  physical %lu\r\n", unsigned(number), interfaceKindName(interface.kind),
+                    unsigned(interface.channel), textOf(interface.address).text, unsigned(interface.prefixLength),
+                    static_cast<unsigned long>(interface.physical));
+    });
+    shell.print("nodes\r\n");
+    listed.forEachNodeAddress([&shell](const NetworkTables::NodeAddress& entry) {
+        shell.print("  node %u  %s\r\n", unsigned(entry.node), textOf(entry.address).text);
+    });
+    shell.print("neighbours\r\n");
+    listed.forEachNeighbour([&shell](const NetworkTables::Neighbour& entry) {
+        shell.print("  %s  physical %lu\r\n", textOf(entry.address).text, static_cast<unsigned long>(entry.physical));
+    });
+    shell.print("routes\r\n");
+    listed.forEachRoute([&shell](const NetworkTables::Route& entry) {
+        shell.print("  %s/%u  via %s\r\n", textOf(entry.destination).text, unsigned(entry.prefixLength),
+                    textOf(entry.gateway).text);
+    });
+}
+
+// "a.b.c.d/len": the address and its prefix length.
+bool parseSubnet(char* text, NetworkAddress& address, uint8_t& prefixLength)
+{
+    char* slash = text;
+    while (*slash != '\0' && *slash != '/') {
+        ++slash;
+    }
+    if (*slash != '/') {
+        return false;
+    }
+    *slash = '\0';
+    unsigned long length = 0;
+    const bool ok = NetworkAddress::parse(text, address) && shell::Shell::parseUnsigned(slash + 1, length) && length <= 32;
+    *slash = '/';
+    prefixLength = static_cast<uint8_t>(length);
+    return ok;
+}
+
+bool parseKind(const char* text, InterfaceKind& kind)
+{
+    constexpr InterfaceKind kinds[] = {InterfaceKind::Can, InterfaceKind::ModbusRtu, InterfaceKind::SharedMemory};
+    for (InterfaceKind candidate : kinds) {
+        if (textEquals(text, interfaceKindName(candidate))) {
+            kind = candidate;
+            return true;
+        }
+    }
+    return false;
+}
+
+shell::CommandResult report(shell::Shell& shell, Status status)
+{
+    if (status != Status::Ok) {
+        shell.print("net: %s\r\n", statusName(status));
+        return shell::CommandResult::Failed;
+    }
+    return shell::CommandResult::Ok;
+}
+
+shell::CommandResult resolve(shell::Shell& shell, const char* nodeText)
+{
+    unsigned long node = 0;
+    if (!shell::Shell::parseUnsigned(nodeText, node) || node > 0xFFFF) {
+        return shell::CommandResult::UsageError;
+    }
+    const Result<NextHop> hop = NetworkInterfacesManager::Resolve(static_cast<uint16_t>(node));
+    if (!hop.ok()) {
+        return report(shell, hop.status());
+    }
+    shell.print("node %lu: %s via %s, interface %u, physical %lu\r\n", node, textOf(hop.value().destination).text,
+                textOf(hop.value().via).text, unsigned(hop.value().interface),
+                static_cast<unsigned long>(hop.value().physical));
+    return shell::CommandResult::Ok;
+}
+
+shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
+{
+    if (argc == 1) {
+        list(shell);
+        return shell::CommandResult::Ok;
+    }
+    const bool remove = argc >= 3 && textEquals(argv[2], "remove");
+    const char* const what = argv[1];
+    NetworkAddress address;
+    NetworkAddress other;
+    uint8_t prefixLength = 0;
+    unsigned long number = 0;
+    unsigned long physical = 0;
+    if (textEquals(what, "resolve") && argc == 3) {
+        return resolve(shell, argv[2]);
+    }
+    if (textEquals(what, "interface")) {
+        if (remove && argc == 4 && shell::Shell::parseUnsigned(argv[3], number) && number <= 0xFF) {
+            return report(shell, NetworkInterfacesManager::RemoveInterface(static_cast<uint8_t>(number)));
+        }
+        InterfaceKind kind{};
+        if (argc == 6 && parseKind(argv[2], kind) && shell::Shell::parseUnsigned(argv[3], number) && number <= 0xFF
+            && parseSubnet(argv[4], address, prefixLength) && shell::Shell::parseUnsigned(argv[5], physical)) {
+            const Result<uint8_t> added = NetworkInterfacesManager::AddInterface(
+                kind, static_cast<uint8_t>(number), address, prefixLength, static_cast<uint32_t>(physical));
+            if (added.ok()) {
+                shell.print("interface %u\r\n", unsigned(added.value()));
+            }
+            return report(shell, added.status());
+        }
+        return shell::CommandResult::UsageError;
+    }
+    if ((textEquals(what, "map") || textEquals(what, "unmap")) && argc == 4
+        && shell::Shell::parseUnsigned(argv[2], number) && number <= 0xFFFF && NetworkAddress::parse(argv[3], address)) {
+        const uint16_t node = static_cast<uint16_t>(number);
+        return report(shell, textEquals(what, "map") ? NetworkInterfacesManager::MapNode(node, address)
+                                                     : NetworkInterfacesManager::UnmapNode(node, address));
+    }
+    if (textEquals(what, "neighbour")) {
+        if (remove && argc == 4 && NetworkAddress::parse(argv[3], address)) {
+            return report(shell, NetworkInterfacesManager::ClearPhysicalAddress(address));
+        }
+        if (argc == 4 && NetworkAddress::parse(argv[2], address) && shell::Shell::parseUnsigned(argv[3], physical)) {
+            return report(shell, NetworkInterfacesManager::SetPhysicalAddress(address, static_cast<uint32_t>(physical)));
+        }
+        return shell::CommandResult::UsageError;
+    }
+    if (textEquals(what, "route")) {
+        if (remove && argc == 4 && parseSubnet(argv[3], address, prefixLength)) {
+            return report(shell, NetworkInterfacesManager::RemoveRoute(address, prefixLength));
+        }
+        if (argc == 4 && parseSubnet(argv[2], address, prefixLength) && NetworkAddress::parse(argv[3], other)) {
+            return report(shell, NetworkInterfacesManager::AddRoute(address, prefixLength, other));
+        }
+        return shell::CommandResult::UsageError;
+    }
+    return shell::CommandResult::UsageError;
+}
+
+} // namespace
+
+DCOS_SHELL_COMMAND_DETAILED(
+    netCommand, "net", "network interfaces manager: list, resolve or change the tables",
+    "net [resolve NODE | interface can|modbus|shm CHANNEL A.B.C.D/LEN PHYSICAL | interface remove N"
+    " | map|unmap NODE A.B.C.D | neighbour A.B.C.D PHYSICAL | neighbour remove A.B.C.D"
+    " | route A.B.C.D/LEN GATEWAY | route remove A.B.C.D/LEN]",
+    "  interfaces: number, kind, channel, own address/subnet prefix, own physical address\r\n"
+    "  nodes: a logical node and one of its network addresses, tried in this order\r\n"
+    "  neighbours: a network address on a local subnet and its physical address\r\n"
+    "  routes: a destination subnet and the gateway it goes through\r\n"
+    "  changing the tables needs a super user (the console is one)",
+    net);
+
+} // namespace dcos::internal
