@@ -32,13 +32,7 @@ constexpr NetworkAddress address(uint8_t a, uint8_t b, uint8_t c, uint8_t d)
 NetworkInterface interfaceOf(InterfaceKind kind, uint8_t channel, NetworkAddress own, uint8_t prefixLength,
                              uint32_t physical)
 {
-    NetworkInterface interface;
-    interface.kind = kind;
-    interface.channel = channel;
-    interface.address = own;
-    interface.prefixLength = prefixLength;
-    interface.physical = physical;
-    return interface;
+    return NetworkInterface{kind, channel, own, prefixLength, physical};
 }
 
 std::string text(NetworkAddress value)

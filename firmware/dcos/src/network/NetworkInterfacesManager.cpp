@@ -36,14 +36,8 @@ DCOS_CONFIGURATION_SERVICE Result<uint8_t> NetworkInterfacesManager::AddInterfac
     if (const Status status = checkChange(); status != Status::Ok) {
         return status;
     }
-    NetworkInterface interface;
-    interface.kind = kind;
-    interface.channel = channel;
-    interface.address = address;
-    interface.prefixLength = prefixLength;
-    interface.physical = physical;
     Lock lock;
-    return tables.addInterface(interface);
+    return tables.addInterface(NetworkInterface{kind, channel, address, prefixLength, physical});
 }
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::RemoveInterface(uint8_t interface)

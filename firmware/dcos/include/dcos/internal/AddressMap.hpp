@@ -62,21 +62,16 @@ public:
             || !isPhysicalAddressOf(interface.kind, interface.physical)) {
             return Status::InvalidArgument;
         }
-        size_t free = kInterfaces;
-        for (size_t i = 0; i < kInterfaces; ++i) {
-            if (!interfaceUsed_[i]) {
-                free = free == kInterfaces ? i : free;
-            } else if (interfaces_[i].address == interface.address
-                       || (interfaces_[i].kind == interface.kind && interfaces_[i].channel == interface.channel)) {
-                return Status::AlreadyExists;
-            }
+        const Result<size_t> free = freeEntry(interfaceUsed_, [this, &interface](size_t i) {
+            return interfaces_[i].address == interface.address
+                   || (interfaces_[i].kind == interface.kind && interfaces_[i].channel == interface.channel);
+        });
+        if (!free.ok()) {
+            return free.status();
         }
-        if (free == kInterfaces) {
-            return Status::TableFull;
-        }
-        interfaces_[free] = interface;
-        interfaceUsed_[free] = true;
-        return static_cast<uint8_t>(free);
+        interfaces_[free.value()] = interface;
+        interfaceUsed_[free.value()] = true;
+        return static_cast<uint8_t>(free.value());
     }
 
     Status removeInterface(uint8_t number)
@@ -102,34 +97,23 @@ public:
         if (!address.isUnicast()) {
             return Status::InvalidArgument;
         }
-        size_t free = kNodeAddresses;
-        for (size_t i = 0; i < kNodeAddresses; ++i) {
-            if (!nodeUsed_[i]) {
-                free = free == kNodeAddresses ? i : free;
-            } else if (nodes_[i].address == address) {
-                return Status::AlreadyExists;
-            }
-        }
-        if (free == kNodeAddresses) {
-            return Status::TableFull;
+        const Result<size_t> free =
+            freeEntry(nodeUsed_, [this, address](size_t i) { return nodes_[i].address == address; });
+        if (!free.ok()) {
+            return free.status();
         }
         // Entries are tried in the order they were mapped: a sequence number
         // keeps that order whichever free entry the mapping lands in.
-        nodes_[free] = NodeAddress{node, address};
-        nodeOrder_[free] = ++mappings_;
-        nodeUsed_[free] = true;
+        nodes_[free.value()] = NodeAddress{node, address};
+        nodeOrder_[free.value()] = ++mappings_;
+        nodeUsed_[free.value()] = true;
         return Status::Ok;
     }
 
     Status unmapNode(uint16_t node, NetworkAddress address)
     {
-        for (size_t i = 0; i < kNodeAddresses; ++i) {
-            if (nodeUsed_[i] && nodes_[i].node == node && nodes_[i].address == address) {
-                nodeUsed_[i] = false;
-                return Status::Ok;
-            }
-        }
-        return Status::NotFound;
+        return releaseEntry(nodeUsed_,
+                            [this, node, address](size_t i) { return nodes_[i].node == node && nodes_[i].address == address; });
     }
 
     Status setPhysicalAddress(NetworkAddress address, uint32_t physical)
@@ -141,32 +125,26 @@ public:
         if (local == kInterfaces || !isPhysicalAddressOf(interfaces_[local].kind, physical)) {
             return Status::InvalidArgument;
         }
-        size_t free = kNeighbours;
-        for (size_t i = 0; i < kNeighbours; ++i) {
-            if (!neighbourUsed_[i]) {
-                free = free == kNeighbours ? i : free;
-            } else if (neighbours_[i].address == address) {
-                neighbours_[i].physical = physical;
-                return Status::Ok;
-            }
+        size_t known = kNeighbours;
+        const Result<size_t> free = freeEntry(neighbourUsed_, [this, address, &known](size_t i) {
+            known = neighbours_[i].address == address ? i : known;
+            return known == i;
+        });
+        if (known != kNeighbours) {
+            neighbours_[known].physical = physical; // Replaced.
+            return Status::Ok;
         }
-        if (free == kNeighbours) {
-            return Status::TableFull;
+        if (!free.ok()) {
+            return free.status();
         }
-        neighbours_[free] = Neighbour{address, physical};
-        neighbourUsed_[free] = true;
+        neighbours_[free.value()] = Neighbour{address, physical};
+        neighbourUsed_[free.value()] = true;
         return Status::Ok;
     }
 
     Status clearPhysicalAddress(NetworkAddress address)
     {
-        for (size_t i = 0; i < kNeighbours; ++i) {
-            if (neighbourUsed_[i] && neighbours_[i].address == address) {
-                neighbourUsed_[i] = false;
-                return Status::Ok;
-            }
-        }
-        return Status::NotFound;
+        return releaseEntry(neighbourUsed_, [this, address](size_t i) { return neighbours_[i].address == address; });
     }
 
     Status addRoute(NetworkAddress destination, uint8_t prefixLength, NetworkAddress gateway)
@@ -175,31 +153,22 @@ public:
             || !gateway.isUnicast()) {
             return Status::InvalidArgument;
         }
-        size_t free = kRoutes;
-        for (size_t i = 0; i < kRoutes; ++i) {
-            if (!routeUsed_[i]) {
-                free = free == kRoutes ? i : free;
-            } else if (routes_[i].destination == destination && routes_[i].prefixLength == prefixLength) {
-                return Status::AlreadyExists;
-            }
+        const Result<size_t> free = freeEntry(routeUsed_, [this, destination, prefixLength](size_t i) {
+            return routes_[i].destination == destination && routes_[i].prefixLength == prefixLength;
+        });
+        if (!free.ok()) {
+            return free.status();
         }
-        if (free == kRoutes) {
-            return Status::TableFull;
-        }
-        routes_[free] = Route{destination, prefixLength, gateway};
-        routeUsed_[free] = true;
+        routes_[free.value()] = Route{destination, prefixLength, gateway};
+        routeUsed_[free.value()] = true;
         return Status::Ok;
     }
 
     Status removeRoute(NetworkAddress destination, uint8_t prefixLength)
     {
-        for (size_t i = 0; i < kRoutes; ++i) {
-            if (routeUsed_[i] && routes_[i].destination == destination && routes_[i].prefixLength == prefixLength) {
-                routeUsed_[i] = false;
-                return Status::Ok;
-            }
-        }
-        return Status::NotFound;
+        return releaseEntry(routeUsed_, [this, destination, prefixLength](size_t i) {
+            return routes_[i].destination == destination && routes_[i].prefixLength == prefixLength;
+        });
     }
 
     /// NetworkInterfacesManager::Resolve for a map whose own node is @p localNode.
@@ -272,6 +241,39 @@ public:
     }
 
 private:
+    // The first free entry of a table whose use flags are @p used, after a
+    // walk of the entries in use that stops at the first one @p clashes
+    // with: AlreadyExists then, TableFull when no entry is free.
+    template <size_t kEntries, typename Clashes>
+    static Result<size_t> freeEntry(const bool (&used)[kEntries], Clashes clashes)
+    {
+        size_t free = kEntries;
+        for (size_t i = 0; i < kEntries; ++i) {
+            if (!used[i]) {
+                free = free == kEntries ? i : free;
+            } else if (clashes(i)) {
+                return Status::AlreadyExists;
+            }
+        }
+        if (free == kEntries) {
+            return Status::TableFull;
+        }
+        return free;
+    }
+
+    // Frees the entry in use that @p matches; NotFound when none does.
+    template <size_t kEntries, typename Matches>
+    static Status releaseEntry(bool (&used)[kEntries], Matches matches)
+    {
+        for (size_t i = 0; i < kEntries; ++i) {
+            if (used[i] && matches(i)) {
+                used[i] = false;
+                return Status::Ok;
+            }
+        }
+        return Status::NotFound;
+    }
+
     static constexpr bool validPrefix(uint8_t prefixLength)
     {
         return prefixLength >= NetworkAddress::kMinimumPrefixLength
