@@ -287,7 +287,7 @@ DCOS_CONFIGURATION_SERVICE Status BufferPoolManager::Delete(ObjectId id)
 Result<void*> BufferPoolManager::Allocate(ObjectId id)
 {
     Task* const task = memory_area::callerTask();
-    const uint16_t holder = task != nullptr ? memory_area::holderOfTask(task->id) : BufferPool::kSystemHolder;
+    const uint16_t holder = memory_area::holderOf(task, BufferPool::kSystemHolder);
     Lock lock;
     const Result<PoolObject*> object = lookup(id);
     if (!object.ok()) {
@@ -307,7 +307,7 @@ Result<void*> BufferPoolManager::Allocate(ObjectId id)
 Status BufferPoolManager::Return(ObjectId id, void* buffer)
 {
     Task* const task = memory_area::callerTask();
-    const uint16_t holder = task != nullptr ? memory_area::holderOfTask(task->id) : BufferPool::kSystemHolder;
+    const uint16_t holder = memory_area::holderOf(task, BufferPool::kSystemHolder);
     Lock lock;
     const Result<PoolObject*> object = lookup(id);
     if (!object.ok()) {
@@ -437,7 +437,7 @@ using internal::BufferPoolManager;
 // (BufferPool::tryAllocate, tryRelease). Every other
 // case, errors included, goes to the manager's complete service, which
 // resolves the id again under its own guard and gives the precise status.
-// callerHolder() never gives kFreeMark, as tryAllocate requires.
+// callerHolderWord() never gives kFreeMark, as tryAllocate requires.
 
 Result<void*> BufferPoolAgent::Allocate(ObjectId id)
 {

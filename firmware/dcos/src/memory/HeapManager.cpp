@@ -127,7 +127,7 @@ static_assert(((SegmentedHeap::kMaximumHeapBytes - SegmentedHeap::kSmallestSegme
 // Call with interrupts disabled.
 [[gnu::always_inline]] inline Result<void*> allocateFor(HeapObject& object, size_t bytes, Task* task)
 {
-    const uint16_t holder = task != nullptr ? memory_area::holderOfTask(task->id) : SegmentedHeap::kSystemHolder;
+    const uint16_t holder = memory_area::holderOf(task, SegmentedHeap::kSystemHolder);
     const Result<void*> segment = object.heap.allocate(bytes, holder);
     if (segment.ok()) [[likely]] {
         if (task != nullptr) [[likely]] {
@@ -141,7 +141,7 @@ static_assert(((SegmentedHeap::kMaximumHeapBytes - SegmentedHeap::kSmallestSegme
 // Call with interrupts disabled.
 [[gnu::always_inline]] inline Status releaseFor(HeapObject& object, void* segment, Task* task)
 {
-    const uint16_t holder = task != nullptr ? memory_area::holderOfTask(task->id) : SegmentedHeap::kSystemHolder;
+    const uint16_t holder = memory_area::holderOf(task, SegmentedHeap::kSystemHolder);
     SegmentedHeap::Released released;
     const Status status = object.heap.release(segment, holder, &released);
     // The segment's own links may be gone in the merge, so it is taken off

@@ -18,14 +18,19 @@ using Lock = arch_x86::InterruptGuard;
 
 constinit internal::NetworkTables tables;
 
-// What the services that change the tables check first: task context and
-// a super-user caller.
-Status checkChange()
+// A service that changes the tables: in task context, for a super-user
+// caller, @p change(tables) under the guard; its status (or result) else.
+template <typename Change>
+auto changeTables(Change change) -> decltype(change(tables))
 {
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
     }
-    return internal::currentTaskIsSuperUser() ? Status::Ok : Status::NotPermitted;
+    if (!internal::currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    Lock lock;
+    return change(tables);
 }
 
 } // namespace
@@ -33,20 +38,14 @@ Status checkChange()
 DCOS_CONFIGURATION_SERVICE Result<uint8_t> NetworkInterfacesManager::AddInterface(
     InterfaceKind kind, uint8_t channel, NetworkAddress address, uint8_t prefixLength, uint32_t physical)
 {
-    if (const Status status = checkChange(); status != Status::Ok) {
-        return status;
-    }
-    Lock lock;
-    return tables.addInterface(NetworkInterface{kind, channel, address, prefixLength, physical});
+    return changeTables([&](internal::NetworkTables& t) {
+        return t.addInterface(NetworkInterface{kind, channel, address, prefixLength, physical});
+    });
 }
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::RemoveInterface(uint8_t interface)
 {
-    if (const Status status = checkChange(); status != Status::Ok) {
-        return status;
-    }
-    Lock lock;
-    return tables.removeInterface(interface);
+    return changeTables([&](internal::NetworkTables& t) { return t.removeInterface(interface); });
 }
 
 Result<NetworkInterface> NetworkInterfacesManager::GetInterface(uint8_t interface)
@@ -57,59 +56,35 @@ Result<NetworkInterface> NetworkInterfacesManager::GetInterface(uint8_t interfac
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::MapNode(uint16_t node, NetworkAddress address)
 {
-    if (const Status status = checkChange(); status != Status::Ok) {
-        return status;
-    }
-    Lock lock;
-    return tables.mapNode(node, address);
+    return changeTables([&](internal::NetworkTables& t) { return t.mapNode(node, address); });
 }
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::UnmapNode(uint16_t node, NetworkAddress address)
 {
-    if (const Status status = checkChange(); status != Status::Ok) {
-        return status;
-    }
-    Lock lock;
-    return tables.unmapNode(node, address);
+    return changeTables([&](internal::NetworkTables& t) { return t.unmapNode(node, address); });
 }
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::SetPhysicalAddress(NetworkAddress address,
                                                                               uint32_t physical)
 {
-    if (const Status status = checkChange(); status != Status::Ok) {
-        return status;
-    }
-    Lock lock;
-    return tables.setPhysicalAddress(address, physical);
+    return changeTables([&](internal::NetworkTables& t) { return t.setPhysicalAddress(address, physical); });
 }
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::ClearPhysicalAddress(NetworkAddress address)
 {
-    if (const Status status = checkChange(); status != Status::Ok) {
-        return status;
-    }
-    Lock lock;
-    return tables.clearPhysicalAddress(address);
+    return changeTables([&](internal::NetworkTables& t) { return t.clearPhysicalAddress(address); });
 }
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::AddRoute(NetworkAddress destination,
                                                                     uint8_t prefixLength, NetworkAddress gateway)
 {
-    if (const Status status = checkChange(); status != Status::Ok) {
-        return status;
-    }
-    Lock lock;
-    return tables.addRoute(destination, prefixLength, gateway);
+    return changeTables([&](internal::NetworkTables& t) { return t.addRoute(destination, prefixLength, gateway); });
 }
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::RemoveRoute(NetworkAddress destination,
                                                                        uint8_t prefixLength)
 {
-    if (const Status status = checkChange(); status != Status::Ok) {
-        return status;
-    }
-    Lock lock;
-    return tables.removeRoute(destination, prefixLength);
+    return changeTables([&](internal::NetworkTables& t) { return t.removeRoute(destination, prefixLength); });
 }
 
 Result<NextHop> NetworkInterfacesManager::Resolve(uint16_t node)

@@ -87,7 +87,9 @@ struct HeldHead {
 constexpr uint32_t kHeldEnd = 0xFFFFFFFFu;
 /// The previous link of the first item.
 constexpr uint32_t kHeldFirst = 0xFFFFFFFEu;
-/// The previous link of an item on no list: the system's.
+/// The previous link of an item pushFront() could not take because its list
+/// was lost: remove() leaves it alone. (The system's items, on no list
+/// either, are never given to remove().)
 constexpr uint32_t kHeldUnlisted = 0xFFFFFFFDu;
 /// The head of a list that failed a check: recovery walks everything for its holder.
 constexpr uint32_t kHeldLost = 0xFFFFFFFCu;
@@ -211,7 +213,7 @@ public:
         return forEach(head.first, resolve, visit);
     }
 
-    /// Marks an item as on no list (the system's). O(1).
+    /// Marks an item as on no list, as pushFront() does when the list is lost. O(1).
     static void setUnlisted(uint8_t* links) { HeldLinks::setPrevious(links, kHeldUnlisted); }
 
     /// Walks the list headed by @p head from the first item: @p visit(handle,

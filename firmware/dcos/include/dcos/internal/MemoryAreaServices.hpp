@@ -33,38 +33,34 @@ namespace dcos::internal::memory_area {
 static_assert(static_cast<uint16_t>(ObjectId(0xFFFF, ObjectType::Task, ObjectId::kMaxIndex).raw()) < 0xFFFE,
               "a task's holder tag must differ from the system's and from the free mark");
 
-/// The running task when memory the caller takes becomes a task's (what
-/// callerHolder() then gives is its tag); null when it becomes the system's:
-/// in an interrupt handler and before the scheduler starts.
+/// The task that holds memory the caller takes: the running task, or null
+/// for the system in an interrupt handler and before the scheduler starts.
+/// Inline, from the scheduler's running task (what currentTaskId() gives),
+/// because Allocate and Return ask on their fast paths.
 [[gnu::always_inline]] inline Task* callerTask()
 {
+    // Unlikely: the task's case then runs straight through, without the jump
+    // over the system's that GCC would otherwise place on it.
     if (inInterruptContext() || !Scheduler::started()) [[unlikely]] {
         return nullptr;
     }
     return &Scheduler::current();
 }
 
-/// callerHolder() in the low half of a word whose high half is left as it
-/// comes (the running task's node), for the pool's fast paths, which shift
-/// the holder into place: a 16-bit value would cost them a store and a
-/// reload, or a mask.
-[[gnu::always_inline]] inline uint32_t callerHolderWord(uint16_t systemHolder)
+/// The holder tag of memory held by @p task, or @p systemHolder for null (the system).
+[[gnu::always_inline]] inline uint16_t holderOf(const Task* task, uint16_t systemHolder)
 {
-    // Unlikely: the task's case then runs straight through, without the jump
-    // over the system's that GCC would otherwise place on it.
-    if (inInterruptContext() || !Scheduler::started()) [[unlikely]] {
-        return systemHolder;
-    }
-    return Scheduler::current().id.raw();
+    return task != nullptr ? holderOfTask(task->id) : systemHolder;
 }
 
-/// The holder recorded for memory the caller takes: its task, or the system
-/// (systemHolder) in an interrupt handler and before the scheduler starts.
-/// Inline, from the scheduler's running task (what currentTaskId() gives),
-/// because Allocate and Return ask on their fast paths.
-[[gnu::always_inline]] inline uint16_t callerHolder(uint16_t systemHolder)
+/// The caller's holder (callerTask()) in the low half of a word whose high
+/// half is left as it comes (the running task's node), for the pool's fast
+/// paths, which shift the holder into place: a 16-bit value would cost them
+/// a store and a reload, or a mask.
+[[gnu::always_inline]] inline uint32_t callerHolderWord(uint16_t systemHolder)
 {
-    return static_cast<uint16_t>(callerHolderWord(systemHolder));
+    const Task* const task = callerTask();
+    return task != nullptr ? task->id.raw() : systemHolder;
 }
 
 /// The holder for a new owner given as a task id; the null id is the system.
@@ -186,7 +182,8 @@ Status transferMemory(Lookup lookup, AreaOf areaOf, ObjectId id, void* memory, O
     if (inInterruptContext()) {
         return Status::InInterrupt;
     }
-    const uint16_t holder = callerHolder(systemHolder);
+    Task* const from = callerTask();
+    const uint16_t holder = holderOf(from, systemHolder);
     arch_x86::InterruptGuard guard;
     const auto object = lookup(id);
     if (!object.ok()) {
@@ -196,7 +193,6 @@ Status transferMemory(Lookup lookup, AreaOf areaOf, ObjectId id, void* memory, O
     if (!newHolder.ok()) {
         return newHolder.status();
     }
-    Task* const from = callerTask();
     Task* const to = newOwner.isNull() ? nullptr : TaskManager::resolve(newOwner).value(); // Checked by holderFor.
     auto* const area = object.value();
     return areaOf(area).transfer(
