@@ -22,7 +22,9 @@ HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM)
 
 host-tools: $(HOST_TOOLS)
 
-$(DCOS_CAN): $(BUILD)/host/host_tools/can/tools/dcos-can.cpp.o $(patsubst %,$(BUILD)/host/%.o,$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
+# dcos-can decodes remote transactions with the kernel's own codec.
+$(DCOS_CAN): $(BUILD)/host/host_tools/can/tools/dcos-can.cpp.o $(patsubst %,$(BUILD)/host/%.o,$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS) \
+	firmware/dcos/src/network/RemoteMessage.cpp)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS)

@@ -59,6 +59,42 @@ def test_dump_shows_another_nodes_frames_with_emulated_times(hub):
     assert frames[0]["dcos"] == {"priority": 3, "type": "DSM publication", "source": 5, "destination": 255}
 
 
+def test_dump_decodes_remote_transactions(hub):
+    # docs/protocols/remote-transactions.md: a request, its pending and final
+    # replies, and a request no node should send.
+    dump = tool(hub, "--json", "dump", "-n", "4", "-t", "30000", "--decode")
+    text = tool(hub, "dump", "-n", "4", "-t", "30000", "--decode")
+    wait_for_participants(hub, 2)
+    other = Client(hub.socket_path, "other")
+    try:
+        other.attach(0, "can0")
+        for frame in (Frame(0x14110201, extended=True, dlc=8, data=bytes([1, 0x13, 0xA0, 0x05, 0, 0, 0, 200])),
+                      Frame(0x14100102, extended=True, dlc=8, data=bytes([1, 0x13, 0, 1, 0, 0, 0, 0])),
+                      Frame(0x14100102, extended=True, dlc=8, data=bytes([1, 0x13, 7, 0, 0, 0, 0, 0])),
+                      Frame(0x14110201, extended=True, dlc=3, data=bytes([9, 0x13, 0]))):
+            other.transmit(0, frame)
+        output, errors = dump.communicate(timeout=TIMEOUT)
+        lines, text_errors = text.communicate(timeout=TIMEOUT)
+    finally:
+        other.close()
+    assert dump.returncode == 0, errors
+    assert text.returncode == 0, text_errors
+    remote = [json.loads(line)["dcos"]["remote"] for line in output.splitlines()]
+    assert remote == [
+        {"service": "acquire", "transaction": 0x13, "object": 0xA005, "argument": 200},
+        {"service": "acquire", "transaction": 0x13, "status": "ok", "pending": True, "value": 0},
+        {"service": "acquire", "transaction": 0x13, "status": "timed out", "pending": False, "value": 0},
+        {"malformed": "wrong length"},
+    ]
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations == [
+        "prio 20 remote request 1->2: acquire txn 0x13 object 0xa005 argument 200",
+        "prio 20 remote reply 2->1: acquire txn 0x13 ok pending value 0",
+        "prio 20 remote reply 2->1: acquire txn 0x13 timed out value 0",
+        "prio 20 remote request 1->2: malformed: wrong length",
+    ], lines
+
+
 def test_frames_dcos_can_sends_reach_another_node(hub):
     other = Client(hub.socket_path, "other")
     try:

@@ -10,4 +10,5 @@ CAN_DRIVER_PORTABLE_SRCS := \
 
 # Sources that run only on the target: the console command.
 CAN_DRIVER_TARGET_SRCS := \
+	drivers/can/src/CanNetworkLink.cpp \
 	drivers/can/src/CanCommands.cpp

@@ -20,7 +20,8 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/application/ConfigurationReport.cpp \
 	firmware/dcos/src/system/DeviceManager.cpp \
 	firmware/dcos/src/system/DeviceCommands.cpp \
-	firmware/dcos/src/network/NetworkAddress.cpp
+	firmware/dcos/src/network/NetworkAddress.cpp \
+	firmware/dcos/src/network/RemoteMessage.cpp
 
 # Kernel sources that run only on the target: task switching, the tick, traps.
 DCOS_TARGET_SRCS := \
@@ -39,6 +40,8 @@ DCOS_TARGET_SRCS := \
 	firmware/dcos/src/application/ApplicationLoader.cpp \
 	firmware/dcos/src/application/ApplicationCommands.cpp \
 	firmware/dcos/src/network/NetworkInterfacesManager.cpp \
+	firmware/dcos/src/network/RemoteForward.cpp \
+	firmware/dcos/src/network/RemoteAgent.cpp \
 	firmware/dcos/src/network/NetworkCommands.cpp
 
 # The full configuration's kernel, in link order (which is the order of the
@@ -57,7 +60,8 @@ DCOS_CORE_SRCS := \
 	firmware/dcos/src/system/InterruptManager.cpp \
 	$(wildcard firmware/dcos/src/task/*.cpp firmware/dcos/src/task/*.S) \
 	$(wildcard firmware/dcos/src/scheduler/*.cpp firmware/dcos/src/scheduler/*.S) \
-	$(wildcard firmware/dcos/src/timer/*.cpp)
+	$(wildcard firmware/dcos/src/timer/*.cpp) \
+	firmware/dcos/src/network/RemoteForward.cpp
 
 # The minimal configuration's kernel: the core, in the full one's order, and its root task.
 DCOS_MINIMAL_SRCS := $(filter $(DCOS_CORE_SRCS),$(DCOS_FULL_SRCS)) firmware/dcos/src/kernel/MinimalRoot.cpp

@@ -232,7 +232,8 @@ class CanLab:
         port is on (lines maps line names to a baud rate and format, see
         dcoslab/rs485.py). The hub holds the clock until every board has
         joined, so all boot in step from emulated time 0. append is the
-        kernel command line of every board."""
+        kernel command line of every board; the key "append" of a board's
+        wiring gives that board its own (e.g. "node=2")."""
         self._directory = tempfile.TemporaryDirectory(prefix="dcos-canlab-")
         self.socket_path = os.path.join(self._directory.name, "hub.sock")
         self.hub = Hub(self.socket_path, buses, expect=list(wiring), pace=pace, timeout=timeout, lines=lines)
@@ -242,14 +243,17 @@ class CanLab:
             for name, channels in wiring.items():
                 properties = {"hub": self.socket_path, "hub-name": name}
                 line_ports = {}
+                board_append = append
                 for key, value in channels.items():
-                    if key == "rs485":
+                    if key == "append":
+                        board_append = value
+                    elif key == "rs485":
                         line_ports["rs485"] = {"hub": self.socket_path, "hub-name": name, "line": value}
                     else:
                         properties[key] = value
                 # Only what is asked for goes to boot: a world's own boot (dcoslab/vmworld.py)
                 # knows no kernel command line or line ports.
-                options = {"append": append} if append else {}
+                options = {"append": board_append} if board_append else {}
                 if line_ports:
                     options["line_ports"] = line_ports
                 emulator = boot(board_definition, kind, icount=True, name=name,

@@ -11,12 +11,15 @@
 // driver's state log until `events` reads it. The
 // commands that wait (send, dump) wait for the driver's events, never by
 // polling, and always with a time-out.
+#include <sja1000/CanNetworkLink.hpp>
 #include <sja1000/IsaSja1000Channel.hpp>
 
 #include <can/FrameText.hpp>
 #include <can/IsoTpReceiver.hpp>
 #include <can/IsoTpSender.hpp>
+#include <dcos/NetworkInterfacesManager.hpp>
 #include <dcos/SystemAgent.hpp>
+#include <dcos/internal/KernelConfig.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
 #include <runtime/Text.hpp>
@@ -74,25 +77,37 @@ bool parseChannel(shell::Shell& shell, const char* text, unsigned& channel)
     return false;
 }
 
-// The channel's driver, up; prints why not.
-bool requireUp(shell::Shell& shell, unsigned channel)
+// The network links of the channels (can attach): while one is attached,
+// the channel's frames belong to the remote agent.
+CanNetworkLink networkLinks[kChannels];
+uint8_t attachedInterface[kChannels];
+
+// The channel's driver, up and, unless @p allowAttached, not attached to
+// the network; prints why not.
+bool requireUp(shell::Shell& shell, unsigned channel, bool allowAttached = false)
 {
-    if (consoleChannels[channel].installed()) {
-        return true;
+    if (!consoleChannels[channel].installed()) {
+        shell.print("error: %s is down; bring it up with 'can up %s'\r\n", kNames[channel], kNames[channel]);
+        return false;
     }
-    shell.print("error: %s is down; bring it up with 'can up %s'\r\n", kNames[channel], kNames[channel]);
-    return false;
+    if (!allowAttached && networkLinks[channel].started()) {
+        shell.print("error: %s carries network interface %u; 'can detach %s' first\r\n", kNames[channel],
+                    attachedInterface[channel], kNames[channel]);
+        return false;
+    }
+    return true;
 }
 
 // The channel of a subcommand whose one argument is a channel that is up
 // ("can down can0"); false, with the usage or the error printed, otherwise.
-bool soleUpChannel(shell::Shell& shell, int argc, char** argv, const char* usage, unsigned& channel)
+bool soleUpChannel(shell::Shell& shell, int argc, char** argv, const char* usage, unsigned& channel,
+                   bool allowAttached = false)
 {
     if (argc != 3) {
         shell.print("usage: %s\r\n", usage);
         return false;
     }
-    return parseChannel(shell, argv[2], channel) && requireUp(shell, channel);
+    return parseChannel(shell, argv[2], channel) && requireUp(shell, channel, allowAttached);
 }
 // Points the driver's events at the task running the command (the shell
 // may have been restarted since the channel came up).
@@ -135,6 +150,11 @@ CommandResult up(shell::Shell& shell, int argc, char** argv)
         shell.print("error: bit rate '%s' cannot be made exactly; the CiA rates are 10000, 20000, 50000, 125000, "
                     "250000, 500000, 800000 and 1000000\r\n",
                     argv[3]);
+        return CommandResult::Failed;
+    }
+    if (networkLinks[channel].started()) {
+        shell.print("error: %s carries network interface %u; 'can detach %s' first\r\n", kNames[channel],
+                    attachedInterface[channel], kNames[channel]);
         return CommandResult::Failed;
     }
     IsaSja1000Channel& driver = consoleChannels[channel];
@@ -718,7 +738,7 @@ CommandResult state(shell::Shell& shell, int argc, char** argv)
 CommandResult statistics(shell::Shell& shell, int argc, char** argv)
 {
     unsigned channel;
-    if (!soleUpChannel(shell, argc, argv, "can stats <channel>", channel)) {
+    if (!soleUpChannel(shell, argc, argv, "can stats <channel>", channel, true)) {
         return CommandResult::Failed;
     }
     ChannelStatistics s{};
@@ -741,10 +761,75 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
     return CommandResult::Ok;
 }
 
+// The network interface of kind CAN on controller @p channel; prints why none.
+bool interfaceOfChannel(shell::Shell& shell, unsigned channel, uint8_t& interface, dcos::NetworkInterface& entry)
+{
+    for (unsigned i = 0; i < dcos::internal::kNetworkInterfaces; ++i) {
+        const dcos::Result<dcos::NetworkInterface> found = dcos::NetworkInterfacesManager::GetInterface(
+            static_cast<uint8_t>(i));
+        if (found.ok() && found.value().kind == dcos::InterfaceKind::Can && found.value().channel == channel) {
+            interface = static_cast<uint8_t>(i);
+            entry = found.value();
+            return true;
+        }
+    }
+    shell.print("error: no network interface is on %s; add one with 'net interface can %u <address>/<length> "
+                "<node number>'\r\n",
+                kNames[channel], channel);
+    return false;
+}
+
+CommandResult attach(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    if (!soleUpChannel(shell, argc, argv, "can attach <channel>", channel)) {
+        return CommandResult::Failed;
+    }
+    uint8_t interface;
+    dcos::NetworkInterface entry;
+    if (!interfaceOfChannel(shell, channel, interface, entry)) {
+        return CommandResult::Failed;
+    }
+    networkLinks[channel].bind(consoleChannels[channel].id());
+    const Status attached = dcos::NetworkInterfacesManager::AttachLink(interface, networkLinks[channel]);
+    if (attached != Status::Ok) {
+        shell.print("error: cannot attach %s to interface %u: %s\r\n", kNames[channel], interface,
+                    dcos::statusName(attached));
+        return CommandResult::Failed;
+    }
+    attachedInterface[channel] = interface;
+    char address[dcos::NetworkAddress::kTextSize];
+    entry.address.format(address);
+    shell.print("%s carries interface %u: %s/%u, CAN node %lu\r\n", kNames[channel], interface, address,
+                entry.prefixLength, static_cast<unsigned long>(entry.physical));
+    return CommandResult::Ok;
+}
+
+CommandResult detach(shell::Shell& shell, int argc, char** argv)
+{
+    unsigned channel;
+    if (!soleUpChannel(shell, argc, argv, "can detach <channel>", channel, true)) {
+        return CommandResult::Failed;
+    }
+    if (!networkLinks[channel].started()) {
+        shell.print("error: %s carries no network interface\r\n", kNames[channel]);
+        return CommandResult::Failed;
+    }
+    const Status detached = dcos::NetworkInterfacesManager::DetachLink(attachedInterface[channel]);
+    if (detached != Status::Ok) {
+        shell.print("error: cannot detach %s: %s\r\n", kNames[channel], dcos::statusName(detached));
+        return CommandResult::Failed;
+    }
+    listenHere(channel);
+    shell.print("%s detached from interface %u\r\n", kNames[channel], attachedInterface[channel]);
+    return CommandResult::Ok;
+}
+
 constexpr shell::Subcommand kSubcommands[] = {
     {"up", up},       {"down", down},   {"send", send},           {"dump", dump},
     {"state", state}, {"stats", statistics}, {"isotp-send", isoTpSend}, {"isotp-recv", isoTpReceive},
     {"queue", queue}, {"events", events}, {"policy", policy}, {"restart", restart}, {"filter", filter},
+    {"attach", attach}, {"detach", detach},
 };
 
 CommandResult canCommand(shell::Shell& shell, int argc, char** argv)
@@ -759,7 +844,8 @@ DCOS_SHELL_COMMAND_DETAILED(canShellCommand, "can", "bring CAN channels up and d
                             "dump <channel> [count] [ms] | state [channel] | stats <channel> | "
                             "isotp-send <channel> <src> <dst> <hex> | isotp-recv <channel> <src> <dst> [ms] | "
                             "queue <channel> <id>#<data>... | events <channel> [count] [ms] | "
-                            "policy <channel> auto|manual | restart <channel> | filter <channel> all|ext|std [id mask]",
+                            "policy <channel> auto|manual | restart <channel> | filter <channel> all|ext|std [id mask] | "
+                            "attach <channel> | detach <channel>",
                             "  channels: can0 (0x280, irq 10) and can1 (0x2a0, irq 11) of the ISA SJA1000 card\r\n"
                             "  frames: <id>#<data> as can-utils' cansend writes them: 3 hex digits for a standard\r\n"
                             "  identifier, 8 for an extended one; <id>#R[n] is a remote frame\r\n"
@@ -768,7 +854,9 @@ DCOS_SHELL_COMMAND_DETAILED(canShellCommand, "can", "bring CAN channels up and d
                             "  and isotprecv do: src is the identifier this end sends on, dst the one it receives on\r\n"
                             "  queue puts frames in the transmit queue without waiting; events shows the error-state\r\n"
                             "  changes the driver reported to the console (and waits for count of them)\r\n"
-                            "  policy: after bus-off recover at once (auto, the default) or on 'can restart' (manual)",
+                            "  policy: after bus-off recover at once (auto, the default) or on 'can restart' (manual)\r\n"
+                            "  attach makes the channel carry the network interface on it ('net interface can'):\r\n"
+                            "  remote transactions then go over it, and its frames belong to the network",
                             canCommand);
 
 } // namespace sja1000

@@ -22,6 +22,7 @@
 #include <can/MessageIdentifier.hpp>
 
 #include <dcos/Version.hpp>
+#include <dcos/internal/RemoteMessage.hpp>
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -72,8 +73,57 @@ std::string hex(const can::CanFrame& frame)
     return text;
 }
 
+// What a remote transaction's data says (docs/protocols/remote-transactions.md),
+// for the frame types that carry one; the decoder's refusal for a frame
+// no node should send.
+struct RemoteDecoding {
+    bool present = false; // The frame is a remote request or reply.
+    std::string text;
+    nlohmann::json json;
+};
+
+RemoteDecoding decodedRemote(const can::MessageIdentifier& id, const can::CanFrame& frame)
+{
+    using namespace dcos::internal;
+    RemoteDecoding out;
+    if (id.type() == can::MessageType::RemoteRequest) {
+        out.present = true;
+        RemoteRequest request;
+        const RemoteMessageError error = decodeRequest(frame.data(), frame.length(), request);
+        if (error != RemoteMessageError::None) {
+            out.text = fmt::format("malformed: {}", remoteMessageErrorName(error));
+            out.json = {{"malformed", remoteMessageErrorName(error)}};
+            return out;
+        }
+        out.text = fmt::format("{} txn 0x{:02x} object 0x{:04x} argument {}", remoteServiceName(request.service),
+                               request.transaction, request.object, request.argument);
+        out.json = {{"service", remoteServiceName(request.service)},
+                    {"transaction", request.transaction},
+                    {"object", request.object},
+                    {"argument", request.argument}};
+    } else if (id.type() == can::MessageType::RemoteReply) {
+        out.present = true;
+        RemoteReply reply;
+        const RemoteMessageError error = decodeReply(frame.data(), frame.length(), reply);
+        if (error != RemoteMessageError::None) {
+            out.text = fmt::format("malformed: {}", remoteMessageErrorName(error));
+            out.json = {{"malformed", remoteMessageErrorName(error)}};
+            return out;
+        }
+        out.text = fmt::format("{} txn 0x{:02x} {}{} value {}", remoteServiceName(reply.service), reply.transaction,
+                               dcos::statusName(reply.status), reply.pending ? " pending" : "", reply.value);
+        out.json = {{"service", remoteServiceName(reply.service)},
+                    {"transaction", reply.transaction},
+                    {"status", dcos::statusName(reply.status)},
+                    {"pending", reply.pending},
+                    {"value", reply.value}};
+    }
+    return out;
+}
+
 // What the DCOS identifier layout says of a frame, or an empty string for a
-// frame that is not a DCOS frame (standard, remote, unassigned type).
+// frame that is not a DCOS frame (standard, remote, unassigned type); for a
+// remote transaction, what its data says too.
 std::string decoded(const can::CanFrame& frame)
 {
     const can::LinkResult<can::MessageIdentifier> id = can::MessageIdentifier::fromFrame(frame);
@@ -81,8 +131,13 @@ std::string decoded(const can::CanFrame& frame)
         return {};
     }
     const can::MessageIdentifier& m = id.value();
-    return fmt::format("prio {} {} {}->{}", m.priority(), can::messageTypeName(m.type()), m.source(),
-                       m.isBroadcast() ? std::string("all") : std::to_string(m.destination()));
+    std::string text = fmt::format("prio {} {} {}->{}", m.priority(), can::messageTypeName(m.type()), m.source(),
+                                   m.isBroadcast() ? std::string("all") : std::to_string(m.destination()));
+    const RemoteDecoding remote = decodedRemote(m, frame);
+    if (remote.present) {
+        text += ": " + remote.text;
+    }
+    return text;
 }
 
 nlohmann::json frameJson(const Received& r, const std::string& interface, bool decode)
@@ -107,6 +162,10 @@ nlohmann::json frameJson(const Received& r, const std::string& interface, bool d
                          {"type", can::messageTypeName(id.value().type())},
                          {"source", id.value().source()},
                          {"destination", id.value().destination()}};
+            const RemoteDecoding remote = decodedRemote(id.value(), r.frame);
+            if (remote.present) {
+                j["dcos"]["remote"] = remote.json;
+            }
         }
     }
     return j;

@@ -30,6 +30,7 @@
 #pragma once
 
 #include <dcos/NetworkAddress.hpp>
+#include <dcos/NetworkLink.hpp>
 #include <dcos/Status.hpp>
 
 #include <stdint.h>
@@ -101,8 +102,21 @@ public:
     /// channel; TableFull.
     static Result<uint8_t> AddInterface(InterfaceKind kind, uint8_t channel, NetworkAddress address,
                                         uint8_t prefixLength, uint32_t physical);
-    /// Removes a local interface. NotFound when there is none with that number.
+    /// Removes a local interface, detaching its link first. NotFound when
+    /// there is none with that number.
     static Status RemoveInterface(uint8_t interface);
+
+    /// Gives interface @p interface the driver that carries it, and starts
+    /// the remote agent (RemoteAgent.hpp) on first use: from then on remote
+    /// transactions to nodes reached over the interface go through @p link,
+    /// and requests arriving on it are served. @p link must outlive the
+    /// attachment. NotFound when there is no such interface; AlreadyExists
+    /// when it has a link; the link's Start status; NoMemory or TableFull
+    /// when the remote agent's tasks cannot be created.
+    static Status AttachLink(uint8_t interface, NetworkLink& link);
+    /// Stops and forgets the link of @p interface; transactions waiting on
+    /// it end by their watchdog. NotFound when it has none.
+    static Status DetachLink(uint8_t interface);
     /// The interface with that number; NotFound when there is none.
     static Result<NetworkInterface> GetInterface(uint8_t interface);
 

@@ -41,6 +41,10 @@ enum class [[nodiscard]] Status : uint8_t {
     Unreachable = 22,     ///< No interface or route of the network interfaces manager leads to the node.
 };
 
+/// The highest Status value assigned; a status received from another node
+/// above it is refused (the values are part of the wire protocols).
+constexpr uint8_t kLastStatusValue = static_cast<uint8_t>(Status::Unreachable);
+
 /// Returns a short, stable English name for a status, for logs and the shell.
 constexpr const char* statusName(Status status)
 {

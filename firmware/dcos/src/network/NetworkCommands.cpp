@@ -3,7 +3,10 @@
 // runs as, changes them. Output is one entry per line, so the lab's tests
 // and a control engineer's scripts can read it.
 #include <dcos/NetworkInterfacesManager.hpp>
+#include <dcos/internal/IdText.hpp>
+#include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/NetworkTables.hpp>
+#include <dcos/internal/RemoteAgent.hpp>
 
 #include <runtime/Text.hpp>
 #include <shell/Shell.hpp>
@@ -109,10 +112,44 @@ shell::CommandResult resolve(shell::Shell& shell, const char* nodeText)
     return shell::CommandResult::Ok;
 }
 
+// The remote agent's counters, one "name value" per line, then the
+// transactions under way.
+void listRemote(shell::Shell& shell)
+{
+    const RemoteStatistics s = remoteStatistics();
+    shell.print("remote agent %s\r\n", remoteAgentStarted() ? "running" : "not started (no link attached)");
+    const struct {
+        const char* name;
+        uint32_t value;
+    } counters[] = {
+        {"requests", s.requests},         {"retransmissions", s.retransmissions},
+        {"replies", s.replies},           {"pending-replies", s.pendingReplies},
+        {"stray-replies", s.strayReplies}, {"unreachable", s.unreachable},
+        {"no-call-slot", s.noCallSlot},   {"served", s.served},
+        {"duplicates", s.duplicates},     {"refused-busy", s.refusedBusy},
+        {"malformed", s.malformed},       {"send-failures", s.sendFailures},
+    };
+    for (const auto& counter : counters) {
+        shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));
+    }
+    for (size_t slot = 0; slot < kRemoteCalls; ++slot) {
+        const RemoteCallInfo call = remoteCall(slot);
+        if (call.inUse) {
+            shell.print("  call %u  task %s  %s  transaction 0x%02x  interface %u  physical %lu\r\n",
+                        unsigned(slot), IdText(call.caller).c_str(), remoteServiceName(call.service),
+                        unsigned(call.transaction), unsigned(call.interface), static_cast<unsigned long>(call.peer));
+        }
+    }
+}
+
 shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
 {
     if (argc == 1) {
         list(shell);
+        return shell::CommandResult::Ok;
+    }
+    if (argc == 2 && textEquals(argv[1], "remote")) {
+        listRemote(shell);
         return shell::CommandResult::Ok;
     }
     const bool remove = argc >= 3 && textEquals(argv[2], "remove");
@@ -172,13 +209,14 @@ shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
 
 DCOS_SHELL_COMMAND_DETAILED(
     netCommand, "net", "network interfaces manager: list, resolve or change the tables",
-    "net [resolve NODE | interface can|modbus|shm CHANNEL A.B.C.D/LEN PHYSICAL | interface remove N"
+    "net [remote | resolve NODE | interface can|modbus|shm CHANNEL A.B.C.D/LEN PHYSICAL | interface remove N"
     " | map|unmap NODE A.B.C.D | neighbour A.B.C.D PHYSICAL | neighbour remove A.B.C.D"
     " | route A.B.C.D/LEN GATEWAY | route remove A.B.C.D/LEN]",
     "  interfaces: number, kind, channel, own address/subnet prefix, own physical address\r\n"
     "  nodes: a logical node and one of its network addresses, tried in this order\r\n"
     "  neighbours: a network address on a local subnet and its physical address\r\n"
     "  routes: a destination subnet and the gateway it goes through\r\n"
+    "  remote: the remote agent's counters and the remote transactions under way\r\n"
     "  changing the tables needs a super user (the console is one)",
     net);
 

@@ -7,6 +7,7 @@
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/NetworkTables.hpp>
+#include <dcos/internal/RemoteAgent.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -45,6 +46,10 @@ DCOS_CONFIGURATION_SERVICE Result<uint8_t> NetworkInterfacesManager::AddInterfac
 
 DCOS_CONFIGURATION_SERVICE Status NetworkInterfacesManager::RemoveInterface(uint8_t interface)
 {
+    if (!internal::inInterruptContext() && internal::currentTaskIsSuperUser()) {
+        // No transaction may leave by an interface that is gone.
+        internal::detachRemoteLink(interface);
+    }
     return changeTables([&](internal::NetworkTables& t) { return t.removeInterface(interface); });
 }
 

@@ -14,6 +14,7 @@
 #include <dcos/internal/FastPath.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
@@ -151,9 +152,19 @@ size_t semaphoreCount()
     return table.usedCount();
 }
 
+Result<bool> isBinarySemaphore(ObjectId id)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> semaphore = resolve(id);
+    if (!semaphore.ok()) {
+        return semaphore.status();
+    }
+    return semaphore.value()->kind == SemaphoreKind::Binary;
+}
+
 // The complete Acquire and Release: every case, from a resolved id.
 // The agent's fast paths (below) come here for all they do not handle.
-[[gnu::noinline]] Status acquireFull(ObjectId id, const uint64_t* timeoutIn)
+[[gnu::always_inline]] inline Status acquireLocal(ObjectId id, const uint64_t* timeoutIn)
 {
     const uint64_t timeout = *timeoutIn;
     arch_x86::InterruptGuard guard;
@@ -195,7 +206,7 @@ size_t semaphoreCount()
     return TaskManager::blockCurrent(WaitReason::Object, timeout);
 }
 
-[[gnu::noinline]] Status releaseFull(ObjectId id)
+[[gnu::always_inline]] inline Status releaseLocal(ObjectId id)
 {
     arch_x86::InterruptGuard guard;
     const Result<Semaphore*> resolved = resolve(id);
@@ -241,6 +252,15 @@ size_t semaphoreCount()
     semaphore.count = semaphore.count + 1;
     return Status::Ok;
 }
+
+// The slow paths: the local cases, then, for another node's id, the remote
+// transaction, with interrupts enabled again (it blocks).
+[[gnu::noinline]] Status acquireFull(ObjectId id, const uint64_t* timeoutIn)
+{
+    return orRemote(acquireLocal(id, timeoutIn), RemoteService::SemaphoreAcquire, id, remoteTimeoutMs(*timeoutIn));
+}
+
+[[gnu::noinline]] Status releaseFull(ObjectId id) { return orRemote(releaseLocal(id), RemoteService::SemaphoreRelease, id, 0); }
 
 } // namespace internal
 
@@ -367,12 +387,20 @@ Status SemaphoreAgent::Release(ObjectId id)
 
 Result<uint32_t> SemaphoreAgent::GetCount(ObjectId id)
 {
-    arch_x86::InterruptGuard guard;
-    const Result<Semaphore*> semaphore = internal::resolve(id);
-    if (!semaphore.ok()) {
-        return semaphore.status();
+    Status status;
+    {
+        arch_x86::InterruptGuard guard;
+        const Result<Semaphore*> semaphore = internal::resolve(id);
+        if (semaphore.ok()) {
+            return semaphore.value()->count;
+        }
+        status = semaphore.status();
     }
-    return semaphore.value()->count;
+    // Forwarded with interrupts enabled again: the remote agent blocks.
+    if (status == Status::Remote) {
+        return internal::forwardRemote(internal::RemoteService::SemaphoreGetCount, id, 0);
+    }
+    return status;
 }
 
 Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id)

@@ -3,6 +3,7 @@
 #include <dcos/GregorianCalendar.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/TimerManager.hpp>
@@ -170,7 +171,7 @@ Status TaskAgent::SendSignal(ObjectId id, unsigned signal)
     }
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
-        return task.status();
+        return internal::orRemote(task.status(), internal::RemoteService::SendSignal, id, signal);
     }
     TaskManager::sendSignal(*task.value(), signal);
     return Status::Ok;

@@ -2,6 +2,7 @@
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/StackArena.hpp>
 #include <dcos/internal/TaskManager.hpp>
@@ -630,20 +631,32 @@ void TaskManager::postEvent(Task& task, uint32_t events)
     postEventLocked(task, events);
 }
 
+namespace {
+
+// PostEvent's miss path: the id's error, or for another node's task the
+// remote transaction, with interrupts enabled again (it blocks).
+[[gnu::noinline]] Status postEventMissed(ObjectId id, uint32_t events)
+{
+    const Status missed = [id] {
+        arch_x86::InterruptGuard guard;
+        return TaskManager::resolve(id).status();
+    }();
+    return orRemote(missed, RemoteService::PostEvent, id, events);
+}
+
+} // namespace
+
 Status TaskManager::postEvent(ObjectId id, uint32_t events)
 {
-    arch_x86::InterruptGuard guard;
-    Task* const* found = table.find(id);
-    if (found != nullptr) [[likely]] {
-        postEventLocked(**found, events);
-        return Status::Ok;
+    {
+        arch_x86::InterruptGuard guard;
+        Task* const* found = table.find(id);
+        if (found != nullptr) [[likely]] {
+            postEventLocked(**found, events);
+            return Status::Ok;
+        }
     }
-    const Result<Task*> task = resolve(id);
-    if (!task.ok()) {
-        return task.status();
-    }
-    postEventLocked(*task.value(), events);
-    return Status::Ok;
+    return postEventMissed(id, events);
 }
 
 void TaskManager::sendSignal(Task& task, unsigned signal)

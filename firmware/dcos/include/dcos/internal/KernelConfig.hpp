@@ -154,7 +154,40 @@ static_assert(kSubscriptionsActiveAtBoot <= kSubscriptionCapacity && kSubscripti
 #define DCOS_CONFIG_NETWORK_ROUTES 16
 #endif
 
+// The remote agent (seed 6.4): transactions a node's tasks may have under
+// way at once, requests it remembers as served (to answer a retransmission
+// without executing it again), the tasks that serve them, and the
+// watchdog: a silent peer is asked again every watchdog period, and given
+// up after that many silent periods in a row.
+#ifndef DCOS_CONFIG_REMOTE_CALLS
+#define DCOS_CONFIG_REMOTE_CALLS 16
+#endif
+#ifndef DCOS_CONFIG_REMOTE_SERVED
+#define DCOS_CONFIG_REMOTE_SERVED 32
+#endif
+#ifndef DCOS_CONFIG_REMOTE_WORKERS
+#define DCOS_CONFIG_REMOTE_WORKERS 2
+#endif
+#ifndef DCOS_CONFIG_REMOTE_WATCHDOG_MS
+#define DCOS_CONFIG_REMOTE_WATCHDOG_MS 50
+#endif
+#ifndef DCOS_CONFIG_REMOTE_SILENT_PERIODS
+#define DCOS_CONFIG_REMOTE_SILENT_PERIODS 4
+#endif
+
 namespace dcos::internal {
+
+constexpr size_t kRemoteCalls = DCOS_CONFIG_REMOTE_CALLS;
+constexpr size_t kRemoteServed = DCOS_CONFIG_REMOTE_SERVED;
+constexpr size_t kRemoteWorkers = DCOS_CONFIG_REMOTE_WORKERS;
+constexpr uint32_t kRemoteWatchdogMs = DCOS_CONFIG_REMOTE_WATCHDOG_MS;
+constexpr unsigned kRemoteSilentPeriods = DCOS_CONFIG_REMOTE_SILENT_PERIODS;
+// A transaction number is the call slot in its low four bits and a
+// generation in the high four (docs/protocols/remote-transactions.md).
+static_assert(kRemoteCalls >= 1 && kRemoteCalls <= 16, "DCOS_CONFIG_REMOTE_CALLS: 1 to 16");
+static_assert(kRemoteServed >= kRemoteWorkers && kRemoteServed <= 255, "DCOS_CONFIG_REMOTE_SERVED: workers to 255");
+static_assert(kRemoteWorkers >= 1 && kRemoteWorkers <= 8, "DCOS_CONFIG_REMOTE_WORKERS: 1 to 8");
+static_assert(kRemoteWatchdogMs >= 1 && kRemoteSilentPeriods >= 1);
 
 constexpr size_t kNetworkInterfaces = DCOS_CONFIG_NETWORK_INTERFACES;
 constexpr size_t kNetworkNodeAddresses = DCOS_CONFIG_NETWORK_NODE_ADDRESSES;

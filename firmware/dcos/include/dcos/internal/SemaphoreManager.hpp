@@ -1,6 +1,9 @@
 // The semaphore agent's kernel side, as other kernel parts and the benchmarks see it.
 #pragma once
 
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+
 #include <stddef.h>
 
 namespace dcos::internal {
@@ -8,5 +11,11 @@ namespace dcos::internal {
 /// Semaphores that exist on this node, the kernel's own included (the
 /// console's shell-life semaphore). Cost O(1).
 size_t semaphoreCount();
+
+/// Whether the local semaphore @p id is binary, or why the id names none.
+/// The remote agent asks before it serves an Acquire or Release: a binary
+/// semaphore is held by a task, and its holder cannot be a task of another
+/// node yet. O(1).
+Result<bool> isBinarySemaphore(ObjectId id);
 
 } // namespace dcos::internal

@@ -1,0 +1,123 @@
+// A CAN channel as a network link (CanNetworkLink.hpp).
+#include <sja1000/CanNetworkLink.hpp>
+#include <sja1000/Sja1000Controller.hpp>
+
+#include <can/CanFrame.hpp>
+#include <can/MessageIdentifier.hpp>
+#include <dcos/SystemAgent.hpp>
+
+namespace sja1000 {
+
+using dcos::Result;
+using dcos::Status;
+
+// The link passes the kernel's message types through as CAN message types.
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RemoteReply) ==
+              static_cast<uint8_t>(can::MessageType::RemoteReply));
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RemoteRequest) ==
+              static_cast<uint8_t>(can::MessageType::RemoteRequest));
+
+Status CanNetworkLink::Start(dcos::ObjectId receiver, uint32_t receiveEvent, uint32_t ownPhysical)
+{
+    if (device_.isNull()) {
+        return Status::InvalidId;
+    }
+    if (ownPhysical > can::MessageIdentifier::kMaxNodeNumber) {
+        return Status::InvalidArgument; // Not a CAN node number.
+    }
+    Notification notification;
+    notification.task = receiver;
+    notification.receiveEvent = receiveEvent;
+    const Status status =
+        dcos::systemAgent.Control(device_, Sja1000Controller::kSetNotification, &notification, sizeof notification);
+    if (status != Status::Ok) {
+        return status;
+    }
+    // Frames that waited in the driver while no link was attached are old:
+    // a request among them may have been given up by its sender long ago,
+    // and must not be served now.
+    can::CanFrame stale;
+    while (true) {
+        const Result<size_t> read = dcos::systemAgent.Read(device_, 0, &stale, sizeof stale);
+        if (!read.ok() || read.value() == 0) {
+            break;
+        }
+        ++statistics_.stale;
+    }
+    ownPhysical_ = ownPhysical;
+    started_ = true;
+    return Status::Ok;
+}
+
+void CanNetworkLink::Stop()
+{
+    if (!started_) {
+        return;
+    }
+    Notification nobody;
+    (void)dcos::systemAgent.Control(device_, Sja1000Controller::kSetNotification, &nobody, sizeof nobody);
+    started_ = false;
+}
+
+Status CanNetworkLink::Send(const dcos::SystemMessage& message)
+{
+    if (message.destination > can::MessageIdentifier::kBroadcast || message.length > can::CanFrame::kMaxDataLength) {
+        return Status::InvalidArgument;
+    }
+    const can::LinkResult<can::MessageIdentifier> identifier = can::MessageIdentifier::make(
+        message.priority, static_cast<can::MessageType>(message.type), static_cast<uint8_t>(message.destination),
+        static_cast<uint8_t>(ownPhysical_));
+    if (!identifier.ok()) {
+        return Status::InvalidArgument;
+    }
+    const can::LinkResult<can::CanFrame> frame = can::CanFrame::makeData(
+        identifier.value().encode(), can::IdFormat::Extended, message.data, message.length);
+    if (!frame.ok()) {
+        return Status::InvalidArgument;
+    }
+    const Result<size_t> written = dcos::systemAgent.Write(device_, 0, &frame.value(), sizeof(can::CanFrame));
+    if (!written.ok()) {
+        return written.status();
+    }
+    if (written.value() != sizeof(can::CanFrame)) {
+        ++statistics_.queueFull;
+        return Status::Busy;
+    }
+    ++statistics_.sent;
+    return Status::Ok;
+}
+
+Result<bool> CanNetworkLink::Receive(dcos::SystemMessage& message)
+{
+    for (;;) {
+        can::CanFrame frame;
+        const Result<size_t> read = dcos::systemAgent.Read(device_, 0, &frame, sizeof frame);
+        if (!read.ok()) {
+            return read.status();
+        }
+        if (read.value() == 0) {
+            return false;
+        }
+        const can::LinkResult<can::MessageIdentifier> identifier = can::MessageIdentifier::fromFrame(frame);
+        if (!identifier.ok() || (identifier.value().type() != can::MessageType::RemoteRequest &&
+                                 identifier.value().type() != can::MessageType::RemoteReply)) {
+            ++statistics_.foreign;
+            continue;
+        }
+        const uint8_t destination = identifier.value().destination();
+        if (destination != ownPhysical_ && destination != can::MessageIdentifier::kBroadcast) {
+            ++statistics_.otherNodes;
+            continue;
+        }
+        message.priority = identifier.value().priority();
+        message.type = static_cast<dcos::SystemMessageType>(identifier.value().type());
+        message.destination = destination;
+        message.source = identifier.value().source();
+        message.length = frame.length();
+        __builtin_memcpy(message.data, frame.data(), frame.length());
+        ++statistics_.received;
+        return true;
+    }
+}
+
+} // namespace sja1000

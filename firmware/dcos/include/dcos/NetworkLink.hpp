@@ -1,0 +1,66 @@
+// What the network interfaces manager needs of a network driver (seed 7.13):
+// send a system message to a physical address, and hand over the messages
+// that arrived for this node.
+//
+// A link is the glue between one local interface of the manager's tables
+// and the driver that carries it: sja1000::CanNetworkLink puts a message in
+// one extended CAN frame whose identifier is the message's priority, type,
+// destination and source (docs/protocols/can.md). A super-user task attaches
+// it to an interface with NetworkInterfacesManager::AttachLink, and from
+// then on every remote transaction for a node reached over that interface
+// goes through it.
+//
+// The kernel calls Send from the task that makes the request (or from the
+// remote agent, for a reply) and Receive from the remote agent's receiver
+// task only, after the link posted that task the event it was given in
+// Start; the link never blocks.
+#pragma once
+
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+
+#include <stddef.h>
+#include <stdint.h>
+
+namespace dcos {
+
+/// The kinds of system message, with the values of the CAN message types
+/// (docs/protocols/can.md) so that a CAN link passes them through.
+enum class SystemMessageType : uint8_t {
+    RemoteReply = 0x10,
+    RemoteRequest = 0x11,
+};
+
+/// One system message as a link carries it.
+struct SystemMessage {
+    /// The sending task's priority, 0 (most urgent) to 31: the bus priority.
+    uint8_t priority = 0;
+    SystemMessageType type = SystemMessageType::RemoteRequest;
+    /// Physical addresses on the link's network (the CAN node numbers).
+    uint32_t destination = 0;
+    uint32_t source = 0;
+    uint8_t length = 0;
+    uint8_t data[8]{};
+};
+
+class NetworkLink {
+public:
+    /// Begins delivery: post @p receiveEvent to task @p receiver whenever a
+    /// message may be waiting. @p ownPhysical is the interface's own
+    /// physical address: the link passes on only messages to it or to the
+    /// broadcast address.
+    virtual Status Start(ObjectId receiver, uint32_t receiveEvent, uint32_t ownPhysical) = 0;
+    /// Ends delivery; nothing is posted after it returns.
+    virtual void Stop() = 0;
+    /// Queues @p message for sending; Busy when the driver's queue is full.
+    virtual Status Send(const SystemMessage& message) = 0;
+    /// The next message that arrived for this node: true and @p message
+    /// filled in, or false when none is waiting. Frames that are not system
+    /// messages for this node are dropped and counted by the link.
+    virtual Result<bool> Receive(SystemMessage& message) = 0;
+
+protected:
+    ~NetworkLink() = default;
+};
+
+} // namespace dcos

@@ -1,0 +1,79 @@
+// The remote agent: remote transactions (seed 6.4, Fig. 6.3).
+//
+// The requesting side. A primitive whose id names another node's object
+// reaches forward() through forwardRemote (RemoteForward.hpp). It resolves
+// the node with the network interfaces manager, takes one of kRemoteCalls
+// call slots, sends the request at the calling task's priority (the bus
+// priority, docs/protocols/can.md) and blocks the caller on the slot. The
+// watchdog wakes it every kRemoteWatchdogMs: with no word from the peer in
+// that period the request is sent again, with the same transaction number;
+// after kRemoteSilentPeriods silent periods in a row the caller gets
+// Unreachable. A pending reply (the peer has the request and works on it,
+// e.g. an Acquire that waits) counts as a word, so a long wait is kept
+// alive while the peer lives and cut short when it dies.
+//
+// The serving side. A receiver task, the most urgent task of the node,
+// takes every message from the attached links. It only sorts them: a reply
+// wakes its caller, a request joins the queue of requests. It never runs
+// a primitive, so an incoming request preempts a local task only through
+// the worker that serves it: kRemoteWorkers worker tasks take the most
+// urgent queued request, run at the requester's priority (which they
+// inherit from the message, so a local task more urgent than the request
+// is not preempted by it), perform it on their own stack with the agents'
+// ordinary services, and reply. The served table remembers the last
+// kRemoteServed requests by (interface, source, transaction number), so a
+// retransmitted request is answered from it (pending, or the stored reply)
+// and never executed twice.
+#pragma once
+
+#include <dcos/NetworkLink.hpp>
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/internal/RemoteMessage.hpp>
+
+#include <stdint.h>
+
+namespace dcos::internal {
+
+/// What the remote agent has done since boot, for the console and the tests.
+struct RemoteStatistics {
+    // The requesting side.
+    uint32_t requests = 0;        ///< Transactions begun.
+    uint32_t retransmissions = 0; ///< Requests sent again after a silent watchdog period.
+    uint32_t replies = 0;         ///< Final replies that completed a transaction.
+    uint32_t pendingReplies = 0;  ///< Pending replies received (keep-alives).
+    uint32_t strayReplies = 0;    ///< Replies for no waiting transaction (late, duplicated or foreign).
+    uint32_t unreachable = 0;     ///< Transactions given up after the watchdog's silent periods.
+    uint32_t noCallSlot = 0;      ///< Requests refused because every call slot was in use.
+    // The serving side.
+    uint32_t served = 0;          ///< Requests executed.
+    uint32_t duplicates = 0;      ///< Retransmitted requests answered without executing them again.
+    uint32_t refusedBusy = 0;     ///< Requests refused because every served entry was in use.
+    uint32_t malformed = 0;       ///< Messages that did not decode (see RemoteMessageError).
+    uint32_t sendFailures = 0;    ///< Messages a link did not take (its queue full).
+};
+
+/// Counters since boot. O(1).
+RemoteStatistics remoteStatistics();
+
+/// Whether the remote agent's tasks are running.
+bool remoteAgentStarted();
+
+/// One call slot's transaction, for the console's listing.
+struct RemoteCallInfo {
+    bool inUse = false;
+    ObjectId caller;
+    RemoteService service = RemoteService::SemaphoreAcquire;
+    uint8_t transaction = 0;
+    uint8_t interface = 0;
+    uint32_t peer = 0;
+};
+
+/// The call slot @p slot (0 to kRemoteCalls - 1). O(1).
+RemoteCallInfo remoteCall(size_t slot);
+
+/// Detaches the link of @p interface if it has one; for RemoveInterface,
+/// under nothing (task context).
+void detachRemoteLink(uint8_t interface);
+
+} // namespace dcos::internal

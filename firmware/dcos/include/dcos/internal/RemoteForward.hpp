@@ -1,0 +1,41 @@
+// The one place where a primitive turns remote (seed 6.4).
+//
+// Whether an id is local is decided once, by the object tables' miss path
+// (ObjectTableCore::missReason): an id of another node misses every table
+// and comes back as Status::Remote, so the local fast paths pay nothing for
+// distribution. The agents hand such an id, the service and its argument to
+// forwardRemote, which gives it to the remote agent (RemoteAgent.hpp) when
+// the full kernel has one running, and answers Remote (no network is up)
+// otherwise: the minimal kernel links no remote agent.
+#pragma once
+
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/internal/RemoteMessage.hpp>
+
+#include <stdint.h>
+
+namespace dcos::internal {
+
+/// Performs @p service on the remote object @p id with @p argument: the
+/// reply's value, or its status, or the remote agent's error.
+using RemoteForwarder = Result<uint32_t> (*)(RemoteService service, ObjectId id, uint32_t argument);
+
+/// Set by the remote agent when it starts; null until then.
+void setRemoteForwarder(RemoteForwarder forwarder);
+
+/// Forwards a request for another node's object, or Status::Remote when no
+/// remote agent runs. Out of line: only an agent's miss path calls it.
+[[gnu::noinline]] Result<uint32_t> forwardRemote(RemoteService service, ObjectId id, uint32_t argument);
+
+/// A service's status after its local attempt: @p local unless it is
+/// Remote, in which case the request is forwarded and its status returned.
+[[gnu::always_inline]] inline Status orRemote(Status local, RemoteService service, ObjectId id, uint32_t argument)
+{
+    if (local != Status::Remote) [[likely]] {
+        return local;
+    }
+    return forwardRemote(service, id, argument).status();
+}
+
+} // namespace dcos::internal

@@ -1,0 +1,607 @@
+// The remote agent (RemoteAgent.hpp; seed 6.4, Fig. 6.3): remote
+// transactions over the links of the network interfaces manager.
+#include <dcos/NetworkInterfacesManager.hpp>
+#include <dcos/SemaphoreAgent.hpp>
+#include <dcos/TaskAgent.hpp>
+#include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/RemoteAgent.hpp>
+#include <dcos/internal/RemoteForward.hpp>
+#include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/SemaphoreManager.hpp>
+#include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/WaitQueue.hpp>
+
+#include <arch_x86/Cpu.hpp>
+
+namespace dcos {
+
+namespace internal {
+
+namespace {
+
+using Lock = arch_x86::InterruptGuard;
+
+constexpr uint64_t kWatchdogNs = uint64_t{kRemoteWatchdogMs} * 1'000'000;
+constexpr uint8_t kSlotBits = 4;
+constexpr uint8_t kSlotMask = (1u << kSlotBits) - 1;
+constexpr size_t kTaskStackBytes = 4096;
+
+// ---- the links ------------------------------------------------------------
+
+struct AttachedLink {
+    NetworkLink* link = nullptr;
+    uint32_t ownPhysical = 0;
+};
+
+AttachedLink links[kNetworkInterfaces];
+
+// The interface's event for the receiver task: bit n for interface n.
+constexpr uint32_t eventOf(uint8_t interface) { return 1u << interface; }
+static_assert(kNetworkInterfaces <= 32);
+
+// ---- the requesting side ----------------------------------------------------
+
+struct CallSlot {
+    WaitQueue waiter; // The caller, while it waits for a word from the peer.
+    ObjectId caller;  // Null while the slot is free.
+    uint8_t generation = 0;
+    uint8_t transaction = 0;
+    uint8_t interface = 0;
+    uint32_t peer = 0;
+    RemoteService service = RemoteService::SemaphoreAcquire;
+    bool done = false;    // The final reply came: status and value hold it.
+    bool heard = false;   // A pending reply came in this watchdog period.
+    Status status = Status::Ok;
+    uint32_t value = 0;
+};
+
+CallSlot calls[kRemoteCalls];
+
+// ---- the serving side -------------------------------------------------------
+
+enum class ServedState : uint8_t { Free, Queued, Running, Done };
+
+struct ServedEntry {
+    ServedState state = ServedState::Free;
+    uint8_t interface = 0;
+    uint8_t priority = 0;
+    uint32_t source = 0;
+    RemoteRequest request{};
+    uint32_t order = 0; // Arrival order while queued; completion order once done.
+    uint8_t reply[kRemoteMessageBytes]{};
+};
+
+ServedEntry served[kRemoteServed];
+uint32_t arrivals = 0;
+uint32_t completions = 0;
+WaitQueue idleWorkers;
+
+RemoteStatistics statistics;
+bool started = false;
+ObjectId receiverTask;
+
+// ---- sending ------------------------------------------------------------------
+
+// Sends @p data as a message of @p type over @p interface's link; false
+// when the interface has no link or its queue is full. Task context.
+bool sendMessage(uint8_t interface, SystemMessageType type, uint8_t priority, uint32_t destination,
+                 const uint8_t (&data)[kRemoteMessageBytes])
+{
+    NetworkLink* link;
+    SystemMessage message;
+    {
+        Lock lock;
+        link = links[interface].link;
+        message.source = links[interface].ownPhysical;
+    }
+    if (link == nullptr) {
+        return false;
+    }
+    message.priority = priority;
+    message.type = type;
+    message.destination = destination;
+    message.length = kRemoteMessageBytes;
+    __builtin_memcpy(message.data, data, kRemoteMessageBytes);
+    if (link->Send(message) != Status::Ok) {
+        Lock lock;
+        ++statistics.sendFailures;
+        return false;
+    }
+    return true;
+}
+
+void sendReply(uint8_t interface, uint8_t priority, uint32_t destination, const RemoteReply& reply)
+{
+    uint8_t data[kRemoteMessageBytes];
+    encodeReply(reply, data);
+    (void)sendMessage(interface, SystemMessageType::RemoteReply, priority, destination, data);
+}
+
+// ---- the requesting side: forward -------------------------------------------
+
+// A free call slot, or null. Slots whose caller has died (killed while it
+// waited) are taken back here: the search is O(kRemoteCalls) and only a
+// request pays it. Under the lock.
+CallSlot* takeCallSlot(Task& self)
+{
+    for (size_t i = 0; i < kRemoteCalls; ++i) {
+        CallSlot& slot = calls[i];
+        const bool free = slot.caller.isNull() ||
+                          (slot.waiter.isEmpty() && !TaskManager::resolve(slot.caller).ok());
+        if (free) {
+            slot.caller = self.id;
+            slot.generation = static_cast<uint8_t>((slot.generation + 1) & kSlotMask);
+            slot.transaction = static_cast<uint8_t>((slot.generation << kSlotBits) | i);
+            slot.done = false;
+            slot.heard = false;
+            return &slot;
+        }
+    }
+    return nullptr;
+}
+
+Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt; // A remote transaction blocks its caller.
+    }
+    const Result<NextHop> hop = NetworkInterfacesManager::Resolve(id.node());
+    if (!hop.ok()) {
+        // A node the tables do not know stays "remote object unreachable",
+        // as before there were tables; a known node with no way to it is
+        // Unreachable.
+        return hop.status() == Status::NotFound ? Status::Remote : Status::Unreachable;
+    }
+    if (hop.value().via.raw() != hop.value().destination.raw()) {
+        // The request carries no logical destination, so a gateway could
+        // not tell whom it is for: forwarding through gateways comes with
+        // the routed messages of a later part (docs/protocols/remote-transactions.md).
+        return Status::NotSupported;
+    }
+    const uint8_t interface = hop.value().interface;
+    const uint32_t peer = hop.value().physical;
+
+    Task& self = Scheduler::current();
+    CallSlot* slot;
+    {
+        Lock lock;
+        if (links[interface].link == nullptr) {
+            return Status::Unreachable;
+        }
+        slot = takeCallSlot(self);
+        if (slot == nullptr) {
+            ++statistics.noCallSlot;
+            return Status::Busy;
+        }
+        slot->interface = interface;
+        slot->peer = peer;
+        slot->service = service;
+        ++statistics.requests;
+    }
+
+    RemoteRequest request;
+    request.service = service;
+    request.transaction = slot->transaction;
+    request.object = static_cast<uint16_t>(id.raw() & 0xFFFF);
+    request.argument = argument;
+    uint8_t data[kRemoteMessageBytes];
+    encodeRequest(request, data);
+
+    unsigned silentPeriods = 0;
+    for (;;) {
+        // The running priority, so a task that inherited urgency asks with it.
+        (void)sendMessage(interface, SystemMessageType::RemoteRequest, self.priority, peer, data);
+        Lock lock;
+        if (!slot->done) {
+            (void)TaskManager::blockOn(slot->waiter, kWatchdogNs);
+        }
+        if (slot->done) {
+            const Status status = slot->status;
+            const uint32_t value = slot->value;
+            slot->caller = ObjectId::null();
+            if (status != Status::Ok) {
+                return status;
+            }
+            return value;
+        }
+        if (slot->heard) {
+            slot->heard = false;
+            silentPeriods = 0;
+        } else if (++silentPeriods >= kRemoteSilentPeriods) {
+            slot->caller = ObjectId::null();
+            ++statistics.unreachable;
+            return Status::Unreachable;
+        }
+        ++statistics.retransmissions;
+    }
+}
+
+// A reply arrived on @p interface from @p source.
+void onReply(uint8_t interface, const SystemMessage& message)
+{
+    RemoteReply reply;
+    Lock lock;
+    if (decodeReply(message.data, message.length, reply) != RemoteMessageError::None) {
+        ++statistics.malformed;
+        return;
+    }
+    const size_t index = reply.transaction & kSlotMask;
+    if (index >= kRemoteCalls) {
+        ++statistics.strayReplies;
+        return;
+    }
+    CallSlot& slot = calls[index];
+    if (slot.caller.isNull() || slot.done || slot.transaction != reply.transaction ||
+        slot.interface != interface || slot.peer != message.source || slot.service != reply.service) {
+        ++statistics.strayReplies;
+        return;
+    }
+    if (reply.pending) {
+        ++statistics.pendingReplies;
+        slot.heard = true;
+        return;
+    }
+    ++statistics.replies;
+    slot.done = true;
+    slot.status = reply.status;
+    slot.value = reply.value;
+    (void)TaskManager::wakeFirst(slot.waiter, Status::Ok);
+}
+
+// ---- the serving side ---------------------------------------------------------
+
+// Where a new request goes: a free entry, else the served request of the
+// same caller slot (the requester has moved on from it, so it will never
+// be asked for again), else the request completed longest ago. Null when
+// every entry is queued or running. O(kRemoteServed), under the lock.
+ServedEntry* entryForNewRequest(uint8_t interface, uint32_t source, uint8_t transaction)
+{
+    ServedEntry* oldestDone = nullptr;
+    for (ServedEntry& entry : served) {
+        if (entry.state == ServedState::Free) {
+            return &entry;
+        }
+        if (entry.state == ServedState::Done) {
+            if (entry.interface == interface && entry.source == source &&
+                (entry.request.transaction & kSlotMask) == (transaction & kSlotMask)) {
+                return &entry;
+            }
+            if (oldestDone == nullptr || static_cast<int32_t>(entry.order - oldestDone->order) < 0) {
+                oldestDone = &entry;
+            }
+        }
+    }
+    return oldestDone;
+}
+
+// A request arrived on @p interface.
+void onRequest(uint8_t interface, const SystemMessage& message)
+{
+    RemoteRequest request;
+    if (decodeRequest(message.data, message.length, request) != RemoteMessageError::None) {
+        Lock lock;
+        ++statistics.malformed;
+        return;
+    }
+    RemoteReply answer;
+    answer.service = request.service;
+    answer.transaction = request.transaction;
+    uint8_t stored[kRemoteMessageBytes];
+    enum class Action : uint8_t { None, Pending, Stored, Busy } action = Action::None;
+    {
+        Lock lock;
+        ServedEntry* known = nullptr;
+        for (ServedEntry& entry : served) {
+            if (entry.state != ServedState::Free && entry.interface == interface && entry.source == message.source &&
+                entry.request.transaction == request.transaction) {
+                known = &entry;
+                break;
+            }
+        }
+        if (known != nullptr) {
+            ++statistics.duplicates;
+            if (known->state == ServedState::Done) {
+                __builtin_memcpy(stored, known->reply, kRemoteMessageBytes);
+                action = Action::Stored;
+            } else {
+                action = Action::Pending;
+            }
+        } else {
+            ServedEntry* entry = entryForNewRequest(interface, message.source, request.transaction);
+            if (entry == nullptr) {
+                ++statistics.refusedBusy;
+                action = Action::Busy;
+            } else {
+                entry->state = ServedState::Queued;
+                entry->interface = interface;
+                entry->priority = message.priority;
+                entry->source = message.source;
+                entry->request = request;
+                entry->order = arrivals++;
+                // The worker takes the request's priority as it wakes, not
+                // when it first runs: woken at its idle priority, it would
+                // wait behind every local task, however urgent the request.
+                Task* const worker = TaskManager::wakeFirst(idleWorkers, Status::Ok);
+                if (worker != nullptr) {
+                    (void)TaskManager::changePriority(*worker, message.priority);
+                }
+            }
+        }
+    }
+    switch (action) {
+    case Action::None: break;
+    case Action::Pending:
+        answer.pending = true;
+        sendReply(interface, message.priority, message.source, answer);
+        break;
+    case Action::Busy:
+        answer.status = Status::Busy;
+        sendReply(interface, message.priority, message.source, answer);
+        break;
+    case Action::Stored:
+        (void)sendMessage(interface, SystemMessageType::RemoteReply, message.priority, message.source, stored);
+        break;
+    }
+}
+
+// Performs @p request on this node's object, as the worker that runs it.
+RemoteReply perform(const RemoteRequest& request)
+{
+    RemoteReply reply;
+    reply.service = request.service;
+    reply.transaction = request.transaction;
+    const ObjectId id = request.objectOn(localNode());
+    switch (request.service) {
+    case RemoteService::SemaphoreAcquire:
+    case RemoteService::SemaphoreRelease: {
+        // A binary semaphore is held by a task: a worker cannot hold it for
+        // a task of another node (see docs/protocols/remote-transactions.md).
+        const Result<bool> binary = isBinarySemaphore(id);
+        if (!binary.ok()) {
+            reply.status = binary.status();
+        } else if (binary.value()) {
+            reply.status = Status::NotSupported;
+        } else if (request.service == RemoteService::SemaphoreAcquire) {
+            reply.status = SemaphoreAgent::Acquire(id, remoteTimeoutNs(request.argument));
+        } else {
+            reply.status = SemaphoreAgent::Release(id);
+        }
+        break;
+    }
+    case RemoteService::SemaphoreGetCount: {
+        const Result<uint32_t> count = SemaphoreAgent::GetCount(id);
+        reply.status = count.status();
+        reply.value = count.ok() ? count.value() : 0;
+        break;
+    }
+    case RemoteService::PostEvent: reply.status = TaskAgent::PostEvent(id, request.argument); break;
+    case RemoteService::SendSignal: reply.status = TaskAgent::SendSignal(id, request.argument); break;
+    }
+    // The object is this node's, so a Remote status cannot come back; were
+    // it to, the requester must not take it for its own "no network".
+    if (reply.status == Status::Remote) {
+        reply.status = Status::InvalidId;
+    }
+    return reply;
+}
+
+// The most urgent queued request, first come first served among equals. Under the lock.
+ServedEntry* mostUrgentQueued()
+{
+    ServedEntry* best = nullptr;
+    for (ServedEntry& entry : served) {
+        if (entry.state == ServedState::Queued &&
+            (best == nullptr || entry.priority < best->priority ||
+             (entry.priority == best->priority && static_cast<int32_t>(entry.order - best->order) < 0))) {
+            best = &entry;
+        }
+    }
+    return best;
+}
+
+void workerEntry(uintptr_t)
+{
+    Task& self = Scheduler::current();
+    for (;;) {
+        ServedEntry* job;
+        RemoteRequest request;
+        uint8_t interface;
+        uint8_t priority;
+        uint32_t source;
+        {
+            Lock lock;
+            job = mostUrgentQueued();
+            if (job == nullptr) {
+                (void)TaskManager::blockOn(idleWorkers, kWaitForever);
+                continue;
+            }
+            job->state = ServedState::Running;
+            request = job->request;
+            interface = job->interface;
+            priority = job->priority;
+            source = job->source;
+            ++statistics.served;
+        }
+        // Inherit the request's priority (seed 6.4): local tasks more
+        // urgent than the requester keep the processor.
+        (void)TaskManager::changePriority(self, priority);
+        const RemoteReply reply = perform(request);
+        {
+            Lock lock;
+            encodeReply(reply, job->reply);
+            job->state = ServedState::Done;
+            job->order = completions++;
+        }
+        sendReply(interface, priority, source, reply);
+    }
+}
+
+void receiverEntry(uintptr_t)
+{
+    constexpr uint32_t kAllLinks = (kNetworkInterfaces >= 32) ? ~0u : ((1u << kNetworkInterfaces) - 1);
+    for (;;) {
+        const Result<uint32_t> events = TaskAgent::ReceiveEvent(kAllLinks, EventWait::Any, kWaitForever);
+        if (!events.ok()) {
+            continue;
+        }
+        for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
+            if ((events.value() & eventOf(interface)) == 0) {
+                continue;
+            }
+            NetworkLink* link;
+            {
+                Lock lock;
+                link = links[interface].link;
+            }
+            if (link == nullptr) {
+                continue;
+            }
+            // Every waiting message, in arrival order; the driver's queue
+            // is bounded, so is this loop.
+            SystemMessage message;
+            for (;;) {
+                const Result<bool> got = link->Receive(message);
+                if (!got.ok() || !got.value()) {
+                    break;
+                }
+                if (message.type == SystemMessageType::RemoteReply) {
+                    onReply(interface, message);
+                } else {
+                    onRequest(interface, message);
+                }
+            }
+        }
+    }
+}
+
+Status startAgent()
+{
+    if (started) {
+        return Status::Ok;
+    }
+    TaskAttributes receiver;
+    receiver.name = "net-receiver";
+    receiver.priority = 0;
+    receiver.stackSize = kTaskStackBytes;
+    receiver.newProcess = true;
+    const Result<ObjectId> receiverId = TaskManager::create(receiver, receiverEntry, 0);
+    if (!receiverId.ok()) {
+        return receiverId.status();
+    }
+    for (size_t i = 0; i < kRemoteWorkers; ++i) {
+        TaskAttributes worker;
+        worker.name = "net-worker";
+        worker.priority = kLowestPriority;
+        worker.stackSize = kTaskStackBytes;
+        worker.newProcess = true;
+        const Result<ObjectId> workerId = TaskManager::create(worker, workerEntry, i);
+        if (!workerId.ok()) {
+            return workerId.status(); // The tasks made so far wait idle; the next attach tries again.
+        }
+    }
+    receiverTask = receiverId.value();
+    setRemoteForwarder(forward);
+    started = true;
+    return Status::Ok;
+}
+
+} // namespace
+
+RemoteStatistics remoteStatistics()
+{
+    Lock lock;
+    return statistics;
+}
+
+bool remoteAgentStarted() { return started; }
+
+RemoteCallInfo remoteCall(size_t slot)
+{
+    RemoteCallInfo info;
+    if (slot >= kRemoteCalls) {
+        return info;
+    }
+    Lock lock;
+    const CallSlot& call = calls[slot];
+    info.inUse = !call.caller.isNull();
+    info.caller = call.caller;
+    info.service = call.service;
+    info.transaction = call.transaction;
+    info.interface = call.interface;
+    info.peer = call.peer;
+    return info;
+}
+
+void detachRemoteLink(uint8_t interface)
+{
+    if (interface >= kNetworkInterfaces) {
+        return;
+    }
+    NetworkLink* link;
+    {
+        Lock lock;
+        link = links[interface].link;
+        links[interface].link = nullptr;
+    }
+    if (link != nullptr) {
+        link->Stop();
+    }
+}
+
+} // namespace internal
+
+Status NetworkInterfacesManager::AttachLink(uint8_t interface, NetworkLink& link)
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    if (!internal::currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    const Result<NetworkInterface> entry = GetInterface(interface);
+    if (!entry.ok()) {
+        return entry.status();
+    }
+    const Status agent = internal::startAgent();
+    if (agent != Status::Ok) {
+        return agent;
+    }
+    {
+        // Listed before it starts, so the receiver finds the link for the
+        // first event it posts.
+        internal::Lock lock;
+        if (internal::links[interface].link != nullptr) {
+            return Status::AlreadyExists;
+        }
+        internal::links[interface].link = &link;
+        internal::links[interface].ownPhysical = entry.value().physical;
+    }
+    const Status start =
+        link.Start(internal::receiverTask, internal::eventOf(interface), entry.value().physical);
+    if (start != Status::Ok) {
+        internal::Lock lock;
+        internal::links[interface].link = nullptr;
+    }
+    return start;
+}
+
+Status NetworkInterfacesManager::DetachLink(uint8_t interface)
+{
+    if (internal::inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    if (!internal::currentTaskIsSuperUser()) {
+        return Status::NotPermitted;
+    }
+    {
+        internal::Lock lock;
+        if (interface >= internal::kNetworkInterfaces || internal::links[interface].link == nullptr) {
+            return Status::NotFound;
+        }
+    }
+    internal::detachRemoteLink(interface);
+    return Status::Ok;
+}
+
+} // namespace dcos

@@ -1,0 +1,25 @@
+// The hook between the agents' miss paths and the remote agent (RemoteForward.hpp).
+#include <dcos/internal/RemoteForward.hpp>
+
+namespace dcos::internal {
+
+namespace {
+
+// Written once, by the remote agent's start in task context, before any
+// link delivers a frame; an aligned pointer store is atomic on x86.
+RemoteForwarder remoteForwarder = nullptr;
+
+} // namespace
+
+void setRemoteForwarder(RemoteForwarder forwarder) { remoteForwarder = forwarder; }
+
+Result<uint32_t> forwardRemote(RemoteService service, ObjectId id, uint32_t argument)
+{
+    RemoteForwarder const forwarder = remoteForwarder;
+    if (forwarder == nullptr) {
+        return Status::Remote;
+    }
+    return forwarder(service, id, argument);
+}
+
+} // namespace dcos::internal

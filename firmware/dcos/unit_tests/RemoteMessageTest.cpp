@@ -1,0 +1,135 @@
+// Host tests of the remote transaction messages
+// (docs/protocols/remote-transactions.md): the byte layout of requests and
+// replies, written out by hand from the specification, every refusal of the
+// decoders, and the time-out conversion both ways.
+#include <dcos/TaskAgent.hpp>
+#include <dcos/internal/RemoteMessage.hpp>
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <random>
+#include <type_traits>
+
+namespace {
+
+using dcos::Status;
+using namespace dcos::internal;
+
+using Bytes = std::array<uint8_t, kRemoteMessageBytes>;
+
+// The bytes the encoder writes for a request or a reply.
+template <typename Message>
+Bytes encoded(const Message& message)
+{
+    uint8_t bytes[kRemoteMessageBytes];
+    if constexpr (std::is_same_v<Message, RemoteRequest>) {
+        encodeRequest(message, bytes);
+    } else {
+        encodeReply(message, bytes);
+    }
+    Bytes out;
+    std::copy(bytes, bytes + kRemoteMessageBytes, out.begin());
+    return out;
+}
+
+TEST(RemoteMessageTest, ARequestIsServiceTransactionObjectAndArgumentBigEndian)
+{
+    RemoteRequest request;
+    request.service = RemoteService::PostEvent;
+    request.transaction = 0xA3;
+    request.object = 0x1234;
+    request.argument = 0x89ABCDEF;
+    EXPECT_EQ(encoded(request), (Bytes{0x04, 0xA3, 0x12, 0x34, 0x89, 0xAB, 0xCD, 0xEF}));
+    RemoteRequest back;
+    const Bytes bytes = encoded(request);
+    ASSERT_EQ(decodeRequest(bytes.data(), bytes.size(), back), RemoteMessageError::None);
+    EXPECT_EQ(back.service, RemoteService::PostEvent);
+    EXPECT_EQ(back.transaction, 0xA3);
+    EXPECT_EQ(back.object, 0x1234);
+    EXPECT_EQ(back.argument, 0x89ABCDEFu);
+    EXPECT_EQ(back.objectOn(7).raw(), 0x00071234u);
+}
+
+TEST(RemoteMessageTest, AReplyIsServiceTransactionStatusFlagsAndValueBigEndian)
+{
+    RemoteReply reply;
+    reply.service = RemoteService::SemaphoreGetCount;
+    reply.transaction = 0x15;
+    reply.status = Status::WouldBlock;
+    reply.pending = true;
+    reply.value = 0x01020304;
+    EXPECT_EQ(encoded(reply), (Bytes{0x03, 0x15, 0x08, 0x01, 0x01, 0x02, 0x03, 0x04}));
+    RemoteReply back;
+    const Bytes bytes = encoded(reply);
+    ASSERT_EQ(decodeReply(bytes.data(), bytes.size(), back), RemoteMessageError::None);
+    EXPECT_EQ(back.service, RemoteService::SemaphoreGetCount);
+    EXPECT_EQ(back.transaction, 0x15);
+    EXPECT_EQ(back.status, Status::WouldBlock);
+    EXPECT_TRUE(back.pending);
+    EXPECT_EQ(back.value, 0x01020304u);
+}
+
+TEST(RemoteMessageTest, EveryServiceAndStatusSurvivesTheRoundTrip)
+{
+    std::mt19937 random(14);
+    for (uint8_t service = 1; service <= kLastRemoteService; ++service) {
+        for (uint8_t status = 0; status <= dcos::kLastStatusValue; ++status) {
+            RemoteReply reply;
+            reply.service = static_cast<RemoteService>(service);
+            reply.transaction = static_cast<uint8_t>(random());
+            reply.status = static_cast<Status>(status);
+            reply.pending = (random() & 1) != 0;
+            reply.value = static_cast<uint32_t>(random());
+            const Bytes bytes = encoded(reply);
+            RemoteReply back;
+            ASSERT_EQ(decodeReply(bytes.data(), bytes.size(), back), RemoteMessageError::None);
+            EXPECT_EQ(encoded(back), bytes);
+        }
+        EXPECT_STRNE(remoteServiceName(static_cast<RemoteService>(service)), "?");
+    }
+}
+
+TEST(RemoteMessageTest, TheDecodersRefuseWhatNoNodeSends)
+{
+    RemoteRequest request;
+    RemoteReply reply;
+    const Bytes good{0x02, 0x01, 0x30, 0x05, 0, 0, 0, 0};
+    for (size_t length : {0u, 1u, 7u, 9u}) {
+        EXPECT_EQ(decodeRequest(good.data(), length, request), RemoteMessageError::WrongLength) << length;
+        EXPECT_EQ(decodeReply(good.data(), length, reply), RemoteMessageError::WrongLength) << length;
+    }
+    for (uint8_t service : {uint8_t{0}, uint8_t{kLastRemoteService + 1}, uint8_t{0xFF}}) {
+        Bytes bad = good;
+        bad[0] = service;
+        EXPECT_EQ(decodeRequest(bad.data(), bad.size(), request), RemoteMessageError::UnknownService);
+        EXPECT_EQ(decodeReply(bad.data(), bad.size(), reply), RemoteMessageError::UnknownService);
+    }
+    Bytes nullObject = good;
+    nullObject[2] = nullObject[3] = 0;
+    EXPECT_EQ(decodeRequest(nullObject.data(), nullObject.size(), request), RemoteMessageError::NullObject);
+    const Bytes goodReply{0x02, 0x01, 0x00, 0x00, 0, 0, 0, 0};
+    ASSERT_EQ(decodeReply(goodReply.data(), goodReply.size(), reply), RemoteMessageError::None);
+    Bytes badStatus = goodReply;
+    badStatus[2] = dcos::kLastStatusValue + 1;
+    EXPECT_EQ(decodeReply(badStatus.data(), badStatus.size(), reply), RemoteMessageError::UnknownStatus);
+    Bytes badFlags = goodReply;
+    badFlags[3] = 0x02;
+    EXPECT_EQ(decodeReply(badFlags.data(), badFlags.size(), reply), RemoteMessageError::ReservedBits);
+    EXPECT_STREQ(remoteMessageErrorName(RemoteMessageError::ReservedBits), "reserved bits set");
+}
+
+TEST(RemoteMessageTest, TimeOutsTravelAsWholeMillisecondsNeverShorter)
+{
+    EXPECT_EQ(remoteTimeoutMs(dcos::kPoll), kRemotePoll);
+    EXPECT_EQ(remoteTimeoutMs(dcos::kWaitForever), kRemoteForever);
+    EXPECT_EQ(remoteTimeoutMs(1), 1u);
+    EXPECT_EQ(remoteTimeoutMs(1'000'000), 1u);
+    EXPECT_EQ(remoteTimeoutMs(1'000'001), 2u);
+    EXPECT_EQ(remoteTimeoutMs(uint64_t{kRemoteForever} * 1'000'000), kRemoteForever - 1);
+    EXPECT_EQ(remoteTimeoutNs(kRemoteForever), dcos::kWaitForever);
+    EXPECT_EQ(remoteTimeoutNs(250), 250'000'000u);
+    EXPECT_EQ(remoteTimeoutNs(kRemotePoll), dcos::kPoll);
+}
+
+} // namespace

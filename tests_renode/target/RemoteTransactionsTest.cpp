@@ -1,0 +1,225 @@
+// The `remote` console command of the test image: the primitives that
+// remote transactions carry, called from the console task by id, so that an
+// emulator test (tests_renode/test_remote_transactions.py) runs the same
+// calls on a local object and on another board's object and compares the
+// results. Each line it prints starts with a tag the test reads:
+//
+//     RSEM <id>                   a semaphore was created
+//     RTASK <id>                  the listener task was created
+//     RRES <status> <value> <ms>  a primitive's status, its value, and the
+//                                 milliseconds of uptime it took
+//     RGOT <events> <signals>     what the listener has received so far
+//     RHOG <ms>                   the busy task ran that long
+//
+// The listener is a task that collects every event posted and every signal
+// sent to it; the hog is a task that keeps the processor busy at a chosen
+// priority, to show that a request of lower priority waits for it.
+#include "KernelTestSupport.hpp"
+
+#include <dcos/SemaphoreAgent.hpp>
+#include <dcos/TaskAgent.hpp>
+#include <dcos/TimerAgent.hpp>
+#include <dcos/internal/IdText.hpp>
+
+#include <runtime/Text.hpp>
+#include <shell/ShellCommand.hpp>
+
+namespace target_test {
+
+namespace {
+
+using dcos::ObjectId;
+using dcos::Result;
+using dcos::Status;
+using dcos::semaphoreAgent;
+using dcos::taskAgent;
+using dcos::timerAgent;
+using runtime::textEquals;
+using shell::CommandResult;
+
+constexpr uint64_t kNsPerMs = 1'000'000;
+
+volatile uint32_t listenerEvents = 0;
+volatile uint32_t listenerSignals = 0;
+
+void listenerSignal(unsigned signal) { listenerSignals = listenerSignals | (1u << signal); }
+
+void listenerEntry(uintptr_t)
+{
+    (void)taskAgent.SetSignalHandler(listenerSignal);
+    for (;;) {
+        const Result<uint32_t> got = taskAgent.ReceiveEvent(0xFFFFFFFF, dcos::EventWait::Any, dcos::kWaitForever);
+        if (got.ok()) {
+            listenerEvents = listenerEvents | got.value();
+        }
+    }
+}
+
+volatile uint64_t hogUntilNs = 0;
+volatile uint64_t hogRanNs = 0;
+
+void hogEntry(uintptr_t)
+{
+    const uint64_t start = timerAgent.Uptime();
+    while (timerAgent.Uptime() < hogUntilNs) {
+    }
+    hogRanNs = timerAgent.Uptime() - start;
+}
+
+bool parseId(const char* text, ObjectId& id)
+{
+    unsigned long raw;
+    if (!shell::Shell::parseUnsigned(text, raw) || raw > 0xFFFFFFFFul) {
+        return false;
+    }
+    id = ObjectId::fromRaw(static_cast<uint32_t>(raw));
+    return true;
+}
+
+// Prints "<tag> <id>" for a created object, or the error; the command's result.
+CommandResult reportCreated(shell::Shell& shell, const char* tag, const Result<ObjectId>& created)
+{
+    if (!created.ok()) {
+        shell.print("error: %s\r\n", dcos::statusName(created.status()));
+        return CommandResult::Failed;
+    }
+    shell.print("%s %s\r\n", tag, dcos::internal::IdText(created.value()).c_str());
+    return CommandResult::Ok;
+}
+
+Result<ObjectId> createTask(const char* name, unsigned long priority, dcos::TaskEntry entry)
+{
+    dcos::TaskAttributes attributes;
+    attributes.name = name;
+    attributes.priority = static_cast<uint8_t>(priority);
+    return taskAgent.Create(attributes, entry, 0);
+}
+
+void printResult(shell::Shell& shell, Status status, uint32_t value, uint64_t startNs)
+{
+    const uint64_t ms = (timerAgent.Uptime() - startNs) / kNsPerMs;
+    shell.print("RRES %s %lu %lu\r\n", dcos::statusName(status), static_cast<unsigned long>(value),
+                static_cast<unsigned long>(ms));
+}
+
+CommandResult remote(shell::Shell& shell, int argc, char** argv)
+{
+    if (argc < 2) {
+        return CommandResult::UsageError;
+    }
+    const char* const verb = argv[1];
+    unsigned long number = 0;
+    ObjectId id;
+    if (textEquals(verb, "sem") && (argc == 3 || argc == 4)) {
+        dcos::SemaphoreAttributes attributes;
+        attributes.visibility = dcos::Visibility::Global;
+        if (textEquals(argv[2], "binary")) {
+            attributes.kind = dcos::SemaphoreKind::Binary;
+            attributes.initialCount = 1;
+        } else if (shell::Shell::parseUnsigned(argv[2], number)) {
+            attributes.kind = dcos::SemaphoreKind::Counting;
+            attributes.initialCount = static_cast<uint32_t>(number);
+            unsigned long maximum = 0xFFFFFFFF;
+            if (argc == 4 && !shell::Shell::parseUnsigned(argv[3], maximum)) {
+                return CommandResult::UsageError;
+            }
+            attributes.maximumCount = static_cast<uint32_t>(maximum);
+        } else {
+            return CommandResult::UsageError;
+        }
+        return reportCreated(shell, "RSEM", semaphoreAgent.Create(attributes));
+    }
+    if (textEquals(verb, "listener") && argc == 2) {
+        return reportCreated(shell, "RTASK", createTask("listener", 10, listenerEntry));
+    }
+    if (textEquals(verb, "got") && argc == 2) {
+        shell.print("RGOT 0x%lx 0x%lx\r\n", static_cast<unsigned long>(listenerEvents),
+                    static_cast<unsigned long>(listenerSignals));
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "hog") && argc == 4) {
+        unsigned long priority, ms;
+        if (!shell::Shell::parseUnsigned(argv[2], priority) || priority > dcos::kLowestPriority ||
+            !shell::Shell::parseUnsigned(argv[3], ms)) {
+            return CommandResult::UsageError;
+        }
+        hogUntilNs = timerAgent.Uptime() + ms * kNsPerMs;
+        hogRanNs = 0;
+        const Result<ObjectId> created = createTask("hog", priority, hogEntry);
+        if (!created.ok()) {
+            shell.print("error: %s\r\n", dcos::statusName(created.status()));
+            return CommandResult::Failed;
+        }
+        // The hog runs now if it is more urgent than the console; the line
+        // comes when the console runs again.
+        shell.print("RHOG %lu\r\n", static_cast<unsigned long>(hogRanNs / kNsPerMs));
+        return CommandResult::Ok;
+    }
+    // The primitives, at the console's priority or at "at=P" (the request's
+    // priority, which the serving node inherits).
+    int first = 2;
+    unsigned long priority = 0xFF;
+    if (argc >= 3 && argv[2][0] == 'a' && argv[2][1] == 't' && argv[2][2] == '=') {
+        if (!shell::Shell::parseUnsigned(argv[2] + 3, priority) || priority > dcos::kLowestPriority) {
+            return CommandResult::UsageError;
+        }
+        first = 3;
+    }
+    if (argc < first + 1 || !parseId(argv[first], id)) {
+        return CommandResult::UsageError;
+    }
+    const int extra = argc - first - 1;
+    unsigned long argument = 0;
+    if (extra == 1 && !shell::Shell::parseUnsigned(argv[first + 1], argument)) {
+        return CommandResult::UsageError;
+    }
+    const ObjectId self = taskAgent.IdOfSelf();
+    uint8_t oldPriority = 0;
+    if (priority != 0xFF) {
+        const Result<uint8_t> current = taskAgent.GetPriority(self);
+        oldPriority = current.ok() ? current.value() : 0;
+        (void)taskAgent.ChangePriority(self, static_cast<uint8_t>(priority));
+    }
+    const uint64_t start = timerAgent.Uptime();
+    Status status = Status::InvalidArgument;
+    uint32_t value = 0;
+    bool known = true;
+    if (textEquals(verb, "acquire") && extra == 1) {
+        status = semaphoreAgent.Acquire(id, argument == 0xFFFFFFFF ? dcos::kWaitForever : argument * kNsPerMs);
+    } else if (textEquals(verb, "release") && extra == 0) {
+        status = semaphoreAgent.Release(id);
+    } else if (textEquals(verb, "count") && extra == 0) {
+        const Result<uint32_t> count = semaphoreAgent.GetCount(id);
+        status = count.status();
+        value = count.ok() ? count.value() : 0;
+    } else if (textEquals(verb, "post") && extra == 1) {
+        status = taskAgent.PostEvent(id, static_cast<uint32_t>(argument));
+    } else if (textEquals(verb, "signal") && extra == 1) {
+        status = taskAgent.SendSignal(id, static_cast<unsigned>(argument));
+    } else {
+        known = false;
+    }
+    if (priority != 0xFF) {
+        (void)taskAgent.ChangePriority(self, oldPriority);
+    }
+    if (!known) {
+        return CommandResult::UsageError;
+    }
+    printResult(shell, status, value, start);
+    return CommandResult::Ok;
+}
+
+} // namespace
+
+DCOS_SHELL_COMMAND_DETAILED(
+    remoteCommand, "remote", "call primitives by id, local or remote, for the lab's tests (test image only)",
+    "remote sem <count> [max] | sem binary | listener | got | hog <priority> <ms> | "
+    "acquire [at=P] <id> <ms> | release [at=P] <id> | count [at=P] <id> | post [at=P] <id> <events> | "
+    "signal [at=P] <id> <n>",
+    "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
+    "  hog: a task that keeps the processor busy at a priority for a time\r\n"
+    "  acquire ms: 0 polls, 4294967295 waits for ever; at=P calls at priority P\r\n"
+    "  prints RRES <status> <value> <ms taken>",
+    remote);
+
+} // namespace target_test

@@ -1,0 +1,232 @@
+"""Remote transactions (dissertation 6.4, Fig. 6.3) between emulated 486 boards on the lab's CAN bus.
+
+Two boards, node 1 and node 2, each with its CAN channel 0 on the lab bus
+can0 and attached to the network interfaces manager as interface 0. The
+test image's `remote` console command (tests_renode/target/
+RemoteTransactionsTest.cpp) calls a primitive by id; given the id of an
+object on the other board, the primitive goes over the bus as a remote
+transaction (docs/protocols/remote-transactions.md). Each test compares
+what the remote call answers with what the same call answers locally, and
+reads the bus log for the frames it cost.
+
+Times are emulated (-icount, the hub's timing model); every wait has a
+generous time-out that bounds a hung board, not a speed.
+"""
+
+import re
+
+import pytest
+
+from dcoslab.canbus import Frame
+
+BIT_RATE = 500_000
+WATCHDOG_MS = 50       # DCOS_CONFIG_REMOTE_WATCHDOG_MS
+SILENT_PERIODS = 4     # DCOS_CONFIG_REMOTE_SILENT_PERIODS
+REQUEST, REPLY = 0x11, 0x10
+RESULT = re.compile(r"RRES (.+) (\d+) (\d+)\r?$", re.M)
+
+
+def attach(board, node, peers):
+    """Brings channel 0 up as interface 0 (130.1.0.<node>, CAN node <node>) and maps the peers."""
+    for line in [f"can up can0 {BIT_RATE}", f"net interface can 0 130.1.0.{node}/16 {node}"] + [
+            command for peer in peers
+            for command in (f"net map {peer} 130.1.0.{peer}", f"net neighbour 130.1.0.{peer} {peer}")]:
+        output = board.command(line)
+        assert "error:" not in output, (line, output)
+    output = board.command("can attach can0")
+    assert f"can0 carries interface 0: 130.1.0.{node}/16, CAN node {node}" in output, output
+
+
+@pytest.fixture
+def pair(canlab):
+    lab = canlab({"can0": BIT_RATE}, {"board1": {"bus0": "can0", "append": "node=1"},
+                                      "board2": {"bus0": "can0", "append": "node=2"}})
+    one, two = lab.board("board1"), lab.board("board2")
+    attach(one, 1, [2])
+    attach(two, 2, [1])
+    return lab, one, two
+
+
+def created(board, line, tag):
+    output = board.command(line)
+    match = re.search(tag + r" (0x[0-9a-f]{8})", output)
+    assert match, output
+    return match.group(1)
+
+
+def call(board, line):
+    """Runs a `remote` primitive; (status, value, milliseconds)."""
+    output = board.command("remote " + line)
+    match = RESULT.search(output)
+    assert match, output
+    return match.group(1), int(match.group(2)), int(match.group(3))
+
+
+def counters(board):
+    output = board.command("net remote")
+    return {name: int(value) for name, value in re.findall(r"^  ([a-z-]+) (\d+)\r?$", output, re.M)}
+
+
+def dcos_frames(lab, kind, records=None):
+    """The bus log's DCOS frames of a message type, as (priority, destination, source, data).
+
+    records: the hub's records as a wait_for_records predicate is given them
+    (it holds the hub's lock, so lab.hub.frames() cannot be called there)."""
+    frames = []
+    for frame in (lab.hub.frames() if records is None else records):
+        if frame.outcome != "ok" or not frame.frame.extended:
+            continue
+        raw = frame.frame.id
+        if (raw >> 16) & 0xFF == kind:
+            frames.append((raw >> 24, (raw >> 8) & 0xFF, raw & 0xFF, bytes(frame.frame.data)))
+    return frames
+
+
+SEMAPHORE_SEQUENCE = ["count {}", "acquire {} 0", "count {}", "acquire {} 0", "acquire {} 200", "release {}",
+                      "release {}", "release {}", "count {}"]
+
+
+def run_sequence(board, semaphore):
+    return [call(board, step.format(semaphore)) for step in SEMAPHORE_SEQUENCE]
+
+
+def test_a_remote_counting_semaphore_answers_as_a_local_one(pair):
+    lab, one, two = pair
+    # One semaphore on node 2 used from node 1, its twin used on node 2 itself.
+    remote_semaphore = created(two, "remote sem 1 2", "RSEM")
+    local_semaphore = created(two, "remote sem 1 2", "RSEM")
+    assert remote_semaphore.startswith("0x0002")
+    remote = run_sequence(one, remote_semaphore)
+    local = run_sequence(two, local_semaphore)
+    assert [(status, value) for status, value, _ in remote] == [(status, value) for status, value, _ in local]
+    assert [status for status, _, _ in remote] == [
+        "ok", "ok", "ok", "would block", "timed out", "ok", "ok", "invalid argument", "ok"]
+    assert [value for _, value, _ in remote][::8] == [1, 2]
+    # The 200 ms wait was the serving node's, and the answer came after it.
+    assert 200 <= remote[4][2] < 200 + SILENT_PERIODS * WATCHDOG_MS
+    # Fixed-size primitives: one request frame and one final reply per call,
+    # plus the keep-alives of the 200 ms wait (a retransmission, a pending reply).
+    requests, replies = dcos_frames(lab, REQUEST), dcos_frames(lab, REPLY)
+    statistics = counters(one)
+    assert statistics["requests"] == len(SEMAPHORE_SEQUENCE)
+    assert statistics["replies"] == len(SEMAPHORE_SEQUENCE)
+    assert len(requests) == len(SEMAPHORE_SEQUENCE) + statistics["retransmissions"]
+    assert len(replies) == len(SEMAPHORE_SEQUENCE) + statistics["pending-replies"]
+    assert statistics["pending-replies"] >= 1 and statistics["unreachable"] == 0
+    # Every request went from CAN node 1 to 2, every reply back, 8 bytes each.
+    assert {(destination, source, len(data)) for _, destination, source, data in requests} == {(2, 1, 8)}
+    assert {(destination, source, len(data)) for _, destination, source, data in replies} == {(1, 2, 8)}
+    assert counters(two)["duplicates"] == statistics["retransmissions"]
+    assert counters(two)["served"] == len(SEMAPHORE_SEQUENCE)
+
+
+def test_a_remote_acquire_waits_for_a_release_on_the_serving_node(pair):
+    lab, one, two = pair
+    semaphore = created(two, "remote sem 0", "RSEM")
+    sleeper = created(two, "remote sem 0", "RSEM")
+    one.emulator.send(f"remote acquire {semaphore} 5000\r")
+    # Once the request is on the bus, node 2 waits 300 ms of its own time, then releases.
+    lab.hub.wait_for_records(lambda records: dcos_frames(lab, REQUEST, records), 120, "node 1's request")
+    assert call(two, f"acquire {sleeper} 300")[0] == "timed out"
+    assert call(two, f"release {semaphore}")[0] == "ok"
+    match = one.emulator.expect(r"RRES (.+) (\d+) (\d+)\r\n", timeout=120)
+    one.emulator.expect(r"dcos> ")
+    assert match.group(1) == b"ok"
+    assert 300 <= int(match.group(3)) < 5000
+    assert call(two, f"count {semaphore}")[:2] == ("ok", 0)
+    statistics = counters(one)
+    # The wait was kept alive: at least one retransmission answered as pending.
+    assert statistics["pending-replies"] >= 300 // WATCHDOG_MS - 2
+    assert statistics["unreachable"] == 0
+
+
+def test_events_and_signals_reach_a_task_on_another_node(pair):
+    lab, one, two = pair
+    listener = created(two, "remote listener", "RTASK")
+    assert call(one, f"post {listener} 0x5")[:2] == ("ok", 0)
+    assert call(one, f"signal {listener} 3")[:2] == ("ok", 0)
+    assert call(one, f"post {listener} 0")[0] == "invalid argument"  # refused before it leaves node 1
+    assert call(one, f"signal {listener} 40")[0] == "invalid argument"  # refused by node 2
+    # A signal is delivered when its task next runs (dissertation 7.6.1): the
+    # next event wakes the listener, and its handler runs first.
+    assert call(one, f"post {listener} 0x10")[:2] == ("ok", 0)
+    got = two.command("remote got")
+    assert "RGOT 0x15 0x8" in got, got
+
+
+def test_errors_come_back_as_the_local_call_gives_them(pair):
+    lab, one, two = pair
+    semaphore = created(two, "remote sem 1", "RSEM")
+    never_issued = "0x%08x" % (int(semaphore, 16) + 0x100)
+    assert call(one, f"count {never_issued}")[0] == call(two, f"count {never_issued}")[0] == "invalid id"
+    wrong_type = "0x0002" + "1" + semaphore[7:]  # a task id of node 2 that was never handed out
+    assert call(one, f"release {wrong_type}")[0] == call(two, f"release {wrong_type}")[0]
+    # A binary semaphore is held by a task: no task of node 1 can hold one of node 2 yet.
+    binary = created(two, "remote sem binary", "RSEM")
+    assert call(one, f"acquire {binary} 0")[0] == "not supported"
+    # A node the tables do not know.
+    assert call(one, "count 0x0007" + semaphore[6:])[0] == "remote object unreachable"
+
+
+def test_a_dead_node_gives_unreachable_within_the_watchdog_and_node_1_carries_on(pair):
+    lab, one, two = pair
+    semaphore = created(two, "remote sem 1", "RSEM")
+    assert call(one, f"count {semaphore}")[:2] == ("ok", 1)
+    output = two.command("can down can0")
+    assert "error:" in output  # an attached channel is not taken down under the network
+    assert "error:" not in two.command("can detach can0")
+    status, _, ms = call(one, f"acquire {semaphore} 10000")
+    assert status == "node unreachable"
+    assert SILENT_PERIODS * WATCHDOG_MS <= ms < (SILENT_PERIODS + 2) * WATCHDOG_MS
+    assert counters(one)["unreachable"] == 1
+    # Node 1 is unharmed: its own objects work, and node 2 serves again once attached.
+    local = created(one, "remote sem 1", "RSEM")
+    assert call(one, f"acquire {local} 0")[0] == "ok"
+    assert "carries interface 0" in two.command("can attach can0")
+    assert call(one, f"count {semaphore}")[:2] == ("ok", 1)
+
+
+def test_a_duplicated_request_is_answered_but_not_executed_again(pair):
+    lab, one, two = pair
+    semaphore = created(two, "remote sem 0", "RSEM")
+    index = int(semaphore, 16) & 0xFFFF
+    # A release request "from CAN node 1" with a transaction node 1 has not
+    # begun, put on the bus twice by a hub node, as a retransmission would be.
+    identifier = (8 << 24) | (REQUEST << 16) | (2 << 8) | 1
+    request = bytes([2, 0xF7, index >> 8, index & 0xFF, 0, 0, 0, 0])
+    for sent in (1, 2):
+        lab.hub.inject("can0", "injector", Frame.data_frame(identifier, request, extended=True))
+        lab.hub.wait_for_records(lambda records: len(dcos_frames(lab, REPLY, records)) >= sent, 60, "the reply")
+    # And a request of 3 bytes, which no node sends.
+    lab.hub.inject("can0", "injector", Frame.data_frame(identifier, request[:3], extended=True))
+    lab.hub.wait_for_records(lambda records: any(len(data) == 3 for _, _, _, data in dcos_frames(lab, REQUEST, records)),
+                             60, "the short request")
+    # The hub logs a frame when it ends; the boards may not have reached that
+    # time yet. 2 ms later node 2's receiver has surely taken it.
+    lab.hub.wait_until(lab.hub.frames()[-1].end + 2_000_000, 60)
+    assert call(two, f"count {semaphore}")[:2] == ("ok", 1)  # released once
+    served = counters(two)
+    assert served["served"] == 1 and served["duplicates"] == 1 and served["malformed"] == 1
+    replies = dcos_frames(lab, REPLY)
+    assert len(replies) == 2 and replies[0][3] == replies[1][3] == bytes([2, 0xF7, 0, 0, 0, 0, 0, 0])
+    # Node 1 had no such transaction: both replies are stray, and nothing else changed.
+    assert counters(one)["stray-replies"] == 2
+
+
+def test_a_request_runs_at_the_requesters_priority_on_the_serving_node(pair):
+    lab, one, two = pair
+    semaphore = created(two, "remote sem 1", "RSEM")
+    results = {}
+    for priority in (20, 2):
+        # A local task of priority 5 keeps node 2 busy for 1 s.
+        two.emulator.send("remote hog 5 1000\r")
+        two.emulator.expect(r"remote hog 5 1000\r\n")
+        results[priority] = call(one, f"count at={priority} {semaphore}")
+        two.emulator.expect(r"RHOG (\d+)\r\n", timeout=120)
+        two.emulator.expect(r"dcos> ")
+    # Less urgent than the busy task: served only when it is done.
+    assert results[20][:2] == ("ok", 1) and results[20][2] >= 500
+    # More urgent: served at once, the busy task preempted.
+    assert results[2][:2] == ("ok", 1) and results[2][2] < WATCHDOG_MS
+    priorities = [priority for priority, _, _, _ in dcos_frames(lab, REQUEST)]
+    assert 20 in priorities and 2 in priorities
