@@ -43,7 +43,7 @@ from dcoslab.canlab import CanLab
 from dcoslab import vmworld
 from dcoslab.labvm import LabVM, SlcanSetup
 from dcoslab.slcan_bridge import SlcanBridge, parse_lawicel, to_lawicel
-from dcoslab.vmworld import Report, World, attach_reports
+from dcoslab.vmworld import BridgedWorld, attach_reports, hold_world
 
 # The module's tests share a module-scoped lab VM: xdist (--dist loadgroup in
 # pytest.ini) keeps them on one worker, in order: the VM runs one script in phases
@@ -173,26 +173,6 @@ echo "@@QDISC $(tc -s qdisc show dev can0 | tr '\n' ' ')@@"
 """.replace("__MESSAGE__", " ".join(f"{byte:02X}" for byte in MESSAGE)).replace("__LAST_FRAME__", LAST_FRAME)
 
 
-class BridgedWorld(World):
-    """The board, the hub and the lab VM, joined by the slcan bridge."""
-
-    def __init__(self):
-        super().__init__()
-        self.bridge = None
-
-    def reports(self):
-        reports = super().reports()
-        if self.bridge is not None:
-            reports.append(Report("slcan bridge", lambda: f"counts {dict(self.bridge.counts)}, error "
-                                  f"{self.bridge.error}\n{self.bridge.log_text()}"))
-        return reports
-
-    def close(self):
-        if self.bridge is not None:
-            self.bridge.stop()
-        super().close()
-
-
 def _dcos_can_binary():
     """The host tool, carried into the VM as a file (the host's /tmp, where a CI clone may live, is not visible)."""
     path = os.path.join(REPOSITORY, "build", "host_tools", "bin", "dcos-can")
@@ -204,8 +184,7 @@ def _dcos_can_binary():
 
 @pytest.fixture(scope="module")
 def world():
-    world = BridgedWorld()
-    try:
+    def build(world):
         # canlab({"can0": 500_000}, {"board1": {"bus0": "can0"}}, pace=1.0, kind="production"), for the module.
         world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BITRATE}, {"board1": {"bus0": "can0"}},
                            pace=PACE, kind="production")
@@ -221,11 +200,8 @@ def world():
         assert re.search(rf"can0 up at 0x280 irq 10: {BITRATE} bit/s", output), output
         world.bridge.wait_for(lambda b: b.is_open, BOOT_TIMEOUT, "slcand to open the channel")
         world.mark("VM's slcan open")
-    except BaseException:
-        world.close()
-        raise
-    yield world
-    world.close()
+
+    yield from hold_world(BridgedWorld(), build)
 
 
 @pytest.fixture(autouse=True)

@@ -32,7 +32,7 @@ from dcoslab.board import load_board
 from dcoslab.canlab import CanLab
 from dcoslab import vmworld
 from dcoslab.labvm import LabVM, Sja1000Setup
-from dcoslab.vmworld import World, attach_reports, candump_form
+from dcoslab.vmworld import World, attach_reports, candump_form, hold_world
 
 # The module's tests share a module-scoped lab VM: xdist (--dist loadgroup in
 # pytest.ini) keeps them on one worker, in order: the VM runs one script in phases
@@ -153,8 +153,7 @@ UNACKED = 16  # one-shot frames nobody acknowledges: TEC 16 x 8 = 128, error pas
 
 @pytest.fixture(scope="module")
 def world():
-    world = World()
-    try:
+    def build(world):
         world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BITRATE}, {"board1": {"bus0": "can0"}},
                            pace=PACE, kind="production")
         world.board = world.lab.board("board1")
@@ -165,11 +164,8 @@ def world():
                                                          bitrate=BITRATE),
                          boot_timeout=BOOT_TIMEOUT, timeout=600)
         world.vm.start()
-    except BaseException:
-        world.close()
-        raise
-    yield world
-    world.close()
+
+    yield from hold_world(World(), build)
 
 
 @pytest.fixture(autouse=True)

@@ -39,10 +39,10 @@ class World:
         self.timings = {}
         self._emulators = []
 
-    def boot(self, board, kind, icount=False, name=None, device_properties=None, extra_args=()):
+    def boot(self, board, kind, icount=False, name=None, device_properties=None, extra_args=(), append=""):
         """The lab plugin's boot fixture, for a module-scoped CanLab; the emulators close with the world."""
-        emulator = Emulator(board, board.image(kind), icount=icount, device_properties=device_properties,
-                            extra_args=extra_args, name=name)
+        emulator = Emulator(board, board.image(kind), append=append, icount=icount,
+                            device_properties=device_properties, extra_args=extra_args, name=name)
         self._emulators.append(emulator)
         return emulator.start()
 
@@ -65,6 +65,41 @@ class World:
             emulator.close()
         if self.lab is not None:
             self.lab.close()
+
+
+class BridgedWorld(World):
+    """The boards, the hub and the lab VM, joined by the slcan bridge (dcoslab/slcan_bridge.py)."""
+
+    def __init__(self):
+        super().__init__()
+        self.bridge = None
+
+    def reports(self):
+        reports = super().reports()
+        if self.bridge is not None:
+            reports.append(Report("slcan bridge", lambda: f"counts {dict(self.bridge.counts)}, error "
+                                  f"{self.bridge.error}\n{self.bridge.log_text()}"))
+        return reports
+
+    def close(self):
+        if self.bridge is not None:
+            self.bridge.stop()
+        super().close()
+
+
+def hold_world(world, build):
+    """A module fixture's body: build(world) boots its pieces; the world is
+    yielded to the module's tests and closed afterwards, or at once if
+    building it failed. Use as `yield from hold_world(World(), build)`."""
+    try:
+        build(world)
+    except BaseException:
+        world.close()
+        raise
+    try:
+        yield world
+    finally:
+        world.close()
 
 
 def attach_reports(request, name="world"):
