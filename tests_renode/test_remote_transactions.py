@@ -13,28 +13,22 @@ Times are emulated (-icount, the hub's timing model); every wait has a
 generous time-out that bounds a hung board, not a speed.
 """
 
+import json
+import os
 import re
+import subprocess
+import sys
 
 import pytest
 
+from dcoslab import remote
 from dcoslab.canbus import Frame
+from dcoslab.remote import attach_node, created
 
 BIT_RATE = 500_000
 WATCHDOG_MS = 50       # DCOS_CONFIG_REMOTE_WATCHDOG_MS
 SILENT_PERIODS = 4     # DCOS_CONFIG_REMOTE_SILENT_PERIODS
 REQUEST, REPLY = 0x11, 0x10
-RESULT = re.compile(r"RRES (.+) (\d+) (\d+)\r?$", re.M)
-
-
-def attach(board, node, peers):
-    """Brings channel 0 up as interface 0 (130.1.0.<node>, CAN node <node>) and maps the peers."""
-    for line in [f"can up can0 {BIT_RATE}", f"net interface can 0 130.1.0.{node}/16 {node}"] + [
-            command for peer in peers
-            for command in (f"net map {peer} 130.1.0.{peer}", f"net neighbour 130.1.0.{peer} {peer}")]:
-        output = board.command(line)
-        assert "error:" not in output, (line, output)
-    output = board.command("can attach can0")
-    assert f"can0 carries interface 0: 130.1.0.{node}/16, CAN node {node}" in output, output
 
 
 @pytest.fixture
@@ -42,24 +36,15 @@ def pair(canlab):
     lab = canlab({"can0": BIT_RATE}, {"board1": {"bus0": "can0", "append": "node=1"},
                                       "board2": {"bus0": "can0", "append": "node=2"}})
     one, two = lab.board("board1"), lab.board("board2")
-    attach(one, 1, [2])
-    attach(two, 2, [1])
+    attach_node(one, 1, [2], BIT_RATE)
+    attach_node(two, 2, [1], BIT_RATE)
     return lab, one, two
 
 
-def created(board, line, tag):
-    output = board.command(line)
-    match = re.search(tag + r" (0x[0-9a-f]{8})", output)
-    assert match, output
-    return match.group(1)
-
-
 def call(board, line):
-    """Runs a `remote` primitive; (status, value, milliseconds)."""
-    output = board.command("remote " + line)
-    match = RESULT.search(output)
-    assert match, output
-    return match.group(1), int(match.group(2)), int(match.group(3))
+    """A `remote` primitive's (status, value, milliseconds)."""
+    status, value, us = remote.call(board, line)
+    return status, value, us / 1000
 
 
 def counters(board):
@@ -96,14 +81,14 @@ def test_a_remote_counting_semaphore_answers_as_a_local_one(pair):
     remote_semaphore = created(two, "remote sem 1 2", "RSEM")
     local_semaphore = created(two, "remote sem 1 2", "RSEM")
     assert remote_semaphore.startswith("0x0002")
-    remote = run_sequence(one, remote_semaphore)
+    far = run_sequence(one, remote_semaphore)
     local = run_sequence(two, local_semaphore)
-    assert [(status, value) for status, value, _ in remote] == [(status, value) for status, value, _ in local]
-    assert [status for status, _, _ in remote] == [
+    assert [(status, value) for status, value, _ in far] == [(status, value) for status, value, _ in local]
+    assert [status for status, _, _ in far] == [
         "ok", "ok", "ok", "would block", "timed out", "ok", "ok", "invalid argument", "ok"]
-    assert [value for _, value, _ in remote][::8] == [1, 2]
+    assert [value for _, value, _ in far][::8] == [1, 2]
     # The 200 ms wait was the serving node's, and the answer came after it.
-    assert 200 <= remote[4][2] < 200 + SILENT_PERIODS * WATCHDOG_MS
+    assert 200 <= far[4][2] < 200 + SILENT_PERIODS * WATCHDOG_MS
     # Fixed-size primitives: one request frame and one final reply per call,
     # plus the keep-alives of the 200 ms wait (a retransmission, a pending reply).
     requests, replies = dcos_frames(lab, REQUEST), dcos_frames(lab, REPLY)
@@ -132,7 +117,7 @@ def test_a_remote_acquire_waits_for_a_release_on_the_serving_node(pair):
     match = one.emulator.expect(r"RRES (.+) (\d+) (\d+)\r\n", timeout=120)
     one.emulator.expect(r"dcos> ")
     assert match.group(1) == b"ok"
-    assert 300 <= int(match.group(3)) < 5000
+    assert 300_000 <= int(match.group(3)) < 5_000_000
     assert call(two, f"count {semaphore}")[:2] == ("ok", 0)
     statistics = counters(one)
     # The wait was kept alive: at least one retransmission answered as pending.
@@ -230,3 +215,20 @@ def test_a_request_runs_at_the_requesters_priority_on_the_serving_node(pair):
     assert results[2][:2] == ("ok", 1) and results[2][2] < WATCHDOG_MS
     priorities = [priority for priority, _, _, _ in dcos_frames(lab, REQUEST)]
     assert 20 in priorities and 2 in priorities
+
+
+def test_the_benchs_remote_figures_are_two_frames_and_at_least_their_bus_time(tmp_path):
+    """make bench's remote figures (bench/remote_bench.py), checked against the physics of the bus."""
+    output = tmp_path / "remote.json"
+    run = subprocess.run([sys.executable, os.path.join(os.path.dirname(__file__), "bench", "remote_bench.py"),
+                          "--calls", "3", "--output", str(output)], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stdout + run.stderr
+    report = json.loads(output.read_text())
+    # A request and its reply: two extended 8-byte frames one after the
+    # other, each at least its length with no stuff bit at all (54 + 8n + 13
+    # bits, docs/protocols/labbus.md), at 1 Mbit/s.
+    frame_us = (54 + 64 + 13) * 1_000_000 / report["bit_rate"]
+    for name, entry in report["primitives"].items():
+        assert entry["status"] == ["ok"], name
+        assert entry["request_frames_per_call"] == entry["reply_frames_per_call"] == 1, name
+        assert entry["round_trip_us"]["min"] >= 2 * frame_us, (name, entry, frame_us)

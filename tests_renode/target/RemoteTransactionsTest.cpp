@@ -6,8 +6,8 @@
 //
 //     RSEM <id>                   a semaphore was created
 //     RTASK <id>                  the listener task was created
-//     RRES <status> <value> <ms>  a primitive's status, its value, and the
-//                                 milliseconds of uptime it took
+//     RRES <status> <value> <us>  a primitive's status, its value, and the
+//                                 microseconds of uptime it took
 //     RGOT <events> <signals>     what the listener has received so far
 //     RHOG <ms>                   the busy task ran that long
 //
@@ -97,9 +97,9 @@ Result<ObjectId> createTask(const char* name, unsigned long priority, dcos::Task
 
 void printResult(shell::Shell& shell, Status status, uint32_t value, uint64_t startNs)
 {
-    const uint64_t ms = (timerAgent.Uptime() - startNs) / kNsPerMs;
+    const uint64_t us = (timerAgent.Uptime() - startNs) / 1000;
     shell.print("RRES %s %lu %lu\r\n", dcos::statusName(status), static_cast<unsigned long>(value),
-                static_cast<unsigned long>(ms));
+                static_cast<unsigned long>(us));
 }
 
 CommandResult remote(shell::Shell& shell, int argc, char** argv)
@@ -219,7 +219,7 @@ DCOS_SHELL_COMMAND_DETAILED(
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
     "  hog: a task that keeps the processor busy at a priority for a time\r\n"
     "  acquire ms: 0 polls, 4294967295 waits for ever; at=P calls at priority P\r\n"
-    "  prints RRES <status> <value> <ms taken>",
+    "  prints RRES <status> <value> <microseconds taken>",
     remote);
 
 } // namespace target_test

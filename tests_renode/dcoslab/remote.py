@@ -1,0 +1,45 @@
+"""Boards that use each other's objects: the lab side of remote transactions.
+
+The words the emulator tests (test_remote_transactions*.py) and the bench's
+remote figures (bench/remote_bench.py) share: bringing a board's CAN
+channel up as a network interface of the network interfaces manager, and
+calling a primitive through the test image's `remote` console command
+(tests_renode/target/RemoteTransactionsTest.cpp). docs/guide/remote-objects.md
+walks through the same commands.
+"""
+
+import re
+
+_RESULT = re.compile(r"RRES (.+) (\d+) (\d+)\r?$", re.M)
+
+
+def attach_node(board, node, peers, bitrate, timeout=120):
+    """Channel 0 up as interface 0: network address 130.1.0.<node>, CAN node <node>; each peer mapped alike."""
+    lines = [f"can up can0 {bitrate}", f"net interface can 0 130.1.0.{node}/16 {node}"]
+    for peer in peers:
+        lines += [f"net map {peer} 130.1.0.{peer}", f"net neighbour 130.1.0.{peer} {peer}"]
+    for line in lines:
+        output = board.command(line, timeout=timeout)
+        assert "error:" not in output, (line, output)
+    output = board.command("can attach can0", timeout=timeout)
+    assert f"can0 carries interface 0: 130.1.0.{node}/16, CAN node {node}" in output, output
+
+
+def created(board, line, tag):
+    """Runs a `remote` command that creates an object ("remote sem 1", tag RSEM); its id."""
+    output = board.command(line)
+    match = re.search(tag + r" (0x[0-9a-f]{8})", output)
+    assert match, output
+    return match.group(1)
+
+
+def parse_result(text):
+    """(status, value, microseconds) from a `remote` primitive's RRES line."""
+    match = _RESULT.search(text)
+    assert match, text
+    return match.group(1), int(match.group(2)), int(match.group(3))
+
+
+def call(board, line, timeout=120):
+    """Runs a `remote` primitive ("count 0x0002a001"); (status, value, microseconds)."""
+    return parse_result(board.command("remote " + line, timeout=timeout))
