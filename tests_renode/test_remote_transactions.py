@@ -232,3 +232,25 @@ def test_the_benchs_remote_figures_are_two_frames_and_at_least_their_bus_time(tm
         assert entry["status"] == ["ok"], name
         assert entry["request_frames_per_call"] == entry["reply_frames_per_call"] == 1, name
         assert entry["round_trip_us"]["min"] >= 2 * frame_us, (name, entry, frame_us)
+
+
+def test_a_requester_that_dies_while_it_waits_frees_the_serving_nodes_workers(pair):
+    lab, one, two = pair
+    semaphore = created(two, "remote sem 0", "RSEM")
+    # Two tasks of node 1 wait for node 2's semaphore for ever: both of node
+    # 2's workers wait for them.
+    waiters = [created(one, f"remote waiter {semaphore}", "RTASK") for _ in range(2)]
+    lab.hub.wait_for_records(lambda records: len(dcos_frames(lab, REQUEST, records)) >= 2, 120, "both requests")
+    for waiter in waiters:
+        assert "RKILL ok" in one.command(f"remote kill {waiter}")
+    # The killed tasks retransmit no more; within 4 watchdog periods node 2
+    # stops waiting for them, and its workers serve the next request.
+    status, value, ms = call(one, f"count {semaphore}")
+    assert (status, value) == ("ok", 0)
+    assert ms < 3 * SILENT_PERIODS * WATCHDOG_MS
+    assert counters(two)["abandoned"] == 2
+    # Nobody waits any more: a unit released on node 2 stays there.
+    assert call(two, f"release {semaphore}")[0] == "ok"
+    assert call(one, f"count {semaphore}")[:2] == ("ok", 1)
+    # Node 1 lists no transaction of the dead tasks.
+    assert "  call " not in one.command("net remote")

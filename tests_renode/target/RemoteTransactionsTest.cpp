@@ -10,6 +10,7 @@
 //                                 microseconds of uptime it took
 //     RGOT <events> <signals>     what the listener has received so far
 //     RHOG <ms>                   the busy task ran that long
+//     RKILL <status>              KillTask's status
 //
 // The listener is a task that collects every event posted and every signal
 // sent to it; the hog is a task that keeps the processor busy at a chosen
@@ -53,6 +54,16 @@ void listenerEntry(uintptr_t)
             listenerEvents = listenerEvents | got.value();
         }
     }
+}
+
+// The waiters: tasks that acquire a semaphore (remote or not) for ever.
+volatile uint32_t waiterStatuses = 0; // Bit n: a waiter ended with status n.
+
+void waiterEntry(uintptr_t semaphore)
+{
+    const Status status = semaphoreAgent.Acquire(ObjectId::fromRaw(static_cast<uint32_t>(semaphore)),
+                                                 dcos::kWaitForever);
+    waiterStatuses = waiterStatuses | (1u << static_cast<unsigned>(status));
 }
 
 volatile uint64_t hogUntilNs = 0;
@@ -131,6 +142,16 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
     }
     if (textEquals(verb, "listener") && argc == 2) {
         return reportCreated(shell, "RTASK", createTask("listener", 10, listenerEntry));
+    }
+    if (textEquals(verb, "waiter") && argc == 3 && parseId(argv[2], id)) {
+        dcos::TaskAttributes attributes;
+        attributes.name = "waiter";
+        attributes.priority = 12;
+        return reportCreated(shell, "RTASK", taskAgent.Create(attributes, waiterEntry, id.raw()));
+    }
+    if (textEquals(verb, "kill") && argc == 3 && parseId(argv[2], id)) {
+        shell.print("RKILL %s\r\n", dcos::statusName(taskAgent.KillTask(id)));
+        return CommandResult::Ok;
     }
     if (textEquals(verb, "got") && argc == 2) {
         shell.print("RGOT 0x%lx 0x%lx\r\n", static_cast<unsigned long>(listenerEvents),
@@ -213,11 +234,12 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
 
 DCOS_SHELL_COMMAND_DETAILED(
     remoteCommand, "remote", "call primitives by id, local or remote, for the lab's tests (test image only)",
-    "remote sem <count> [max] | sem binary | listener | got | hog <priority> <ms> | "
+    "remote sem <count> [max] | sem binary | listener | got | hog <priority> <ms> | waiter <id> | kill <task> | "
     "acquire [at=P] <id> <ms> | release [at=P] <id> | count [at=P] <id> | post [at=P] <id> <events> | "
     "signal [at=P] <id> <n>",
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
     "  hog: a task that keeps the processor busy at a priority for a time\r\n"
+    "  waiter: a task that acquires the semaphore for ever; kill: KillTask\r\n"
     "  acquire ms: 0 polls, 4294967295 waits for ever; at=P calls at priority P\r\n"
     "  prints RRES <status> <value> <microseconds taken>",
     remote);

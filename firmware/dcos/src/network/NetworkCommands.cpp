@@ -127,6 +127,7 @@ void listRemote(shell::Shell& shell)
         {"stray-replies", s.strayReplies}, {"unreachable", s.unreachable},
         {"no-call-slot", s.noCallSlot},   {"served", s.served},
         {"duplicates", s.duplicates},     {"refused-busy", s.refusedBusy},
+        {"abandoned", s.abandoned},
         {"malformed", s.malformed},       {"send-failures", s.sendFailures},
     };
     for (const auto& counter : counters) {

@@ -3,6 +3,7 @@
 #include <dcos/NetworkInterfacesManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
+#include <dcos/TimerAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/RemoteAgent.hpp>
@@ -69,8 +70,14 @@ struct ServedEntry {
     uint32_t source = 0;
     RemoteRequest request{};
     uint32_t order = 0; // Arrival order while queued; completion order once done.
+    uint64_t heardNs = 0; // Uptime when the request last arrived, retransmissions included.
     uint8_t reply[kRemoteMessageBytes]{};
 };
+
+// A requester that waits retransmits its request every watchdog period, so
+// one not heard for as long as it would itself wait before giving up has
+// given up, or died: the serving node stops waiting for it.
+constexpr uint64_t kRequesterSilenceNs = kWatchdogNs * kRemoteSilentPeriods;
 
 ServedEntry served[kRemoteServed];
 uint32_t arrivals = 0;
@@ -301,6 +308,7 @@ void onRequest(uint8_t interface, const SystemMessage& message)
         }
         if (known != nullptr) {
             ++statistics.duplicates;
+            known->heardNs = TimerAgent::Uptime();
             if (known->state == ServedState::Done) {
                 __builtin_memcpy(stored, known->reply, kRemoteMessageBytes);
                 action = Action::Stored;
@@ -319,6 +327,7 @@ void onRequest(uint8_t interface, const SystemMessage& message)
                 entry->source = message.source;
                 entry->request = request;
                 entry->order = arrivals++;
+                entry->heardNs = TimerAgent::Uptime();
                 // The worker takes the request's priority as it wakes, not
                 // when it first runs: woken at its idle priority, it would
                 // wait behind every local task, however urgent the request.
@@ -345,8 +354,37 @@ void onRequest(uint8_t interface, const SystemMessage& message)
     }
 }
 
+// A remote Acquire that may wait: in slices of kRequesterSilenceNs, so
+// that a wait whose requester has gone silent ends (Timeout) within one
+// slice rather than holding a worker for ever. Between two slices the
+// worker joins the semaphore's waiters again, behind those of its priority.
+Status acquireForRequester(ObjectId id, uint32_t timeoutMs, const ServedEntry& entry)
+{
+    const bool forever = timeoutMs == kRemoteForever;
+    const uint64_t end = forever ? 0 : TimerAgent::Uptime() + remoteTimeoutNs(timeoutMs);
+    for (;;) {
+        uint64_t slice = kRequesterSilenceNs;
+        if (!forever) {
+            const uint64_t now = TimerAgent::Uptime();
+            if (now >= end) {
+                return Status::Timeout;
+            }
+            slice = end - now < slice ? end - now : slice;
+        }
+        const Status status = SemaphoreAgent::Acquire(id, slice);
+        if (status != Status::Timeout) {
+            return status;
+        }
+        Lock lock;
+        if (TimerAgent::Uptime() - entry.heardNs > kRequesterSilenceNs) {
+            ++statistics.abandoned;
+            return Status::Timeout;
+        }
+    }
+}
+
 // Performs @p request on this node's object, as the worker that runs it.
-RemoteReply perform(const RemoteRequest& request)
+RemoteReply perform(const RemoteRequest& request, const ServedEntry& entry)
 {
     RemoteReply reply;
     reply.service = request.service;
@@ -363,7 +401,8 @@ RemoteReply perform(const RemoteRequest& request)
         } else if (binary.value()) {
             reply.status = Status::NotSupported;
         } else if (request.service == RemoteService::SemaphoreAcquire) {
-            reply.status = SemaphoreAgent::Acquire(id, remoteTimeoutNs(request.argument));
+            reply.status = request.argument == kRemotePoll ? SemaphoreAgent::Acquire(id, kPoll)
+                                                           : acquireForRequester(id, request.argument, entry);
         } else {
             reply.status = SemaphoreAgent::Release(id);
         }
@@ -426,7 +465,7 @@ void workerEntry(uintptr_t)
         // Inherit the request's priority (seed 6.4): local tasks more
         // urgent than the requester keep the processor.
         (void)TaskManager::changePriority(self, priority);
-        const RemoteReply reply = perform(request);
+        const RemoteReply reply = perform(request, *job);
         {
             Lock lock;
             encodeReply(reply, job->reply);
@@ -524,7 +563,8 @@ RemoteCallInfo remoteCall(size_t slot)
     }
     Lock lock;
     const CallSlot& call = calls[slot];
-    info.inUse = !call.caller.isNull();
+    // A caller killed while it waited leaves its slot until a call takes it back.
+    info.inUse = !call.caller.isNull() && TaskManager::resolve(call.caller).ok();
     info.caller = call.caller;
     info.service = call.service;
     info.transaction = call.transaction;

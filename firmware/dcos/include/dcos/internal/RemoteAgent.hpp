@@ -23,7 +23,11 @@
 // ordinary services, and reply. The served table remembers the last
 // kRemoteServed requests by (interface, source, transaction number), so a
 // retransmitted request is answered from it (pending, or the stored reply)
-// and never executed twice.
+// and never executed twice. A request that waits (an Acquire with a
+// time-out) is watched from this side too: its requester retransmits every
+// watchdog period, and when it has not been heard for kRemoteSilentPeriods
+// periods the worker stops waiting for it, so a requester that dies cannot
+// hold a worker for ever.
 #pragma once
 
 #include <dcos/NetworkLink.hpp>
@@ -49,6 +53,7 @@ struct RemoteStatistics {
     uint32_t served = 0;          ///< Requests executed.
     uint32_t duplicates = 0;      ///< Retransmitted requests answered without executing them again.
     uint32_t refusedBusy = 0;     ///< Requests refused because every served entry was in use.
+    uint32_t abandoned = 0;       ///< Waits ended because their requester went silent (gave up or died).
     uint32_t malformed = 0;       ///< Messages that did not decode (see RemoteMessageError).
     uint32_t sendFailures = 0;    ///< Messages a link did not take (its queue full).
 };
