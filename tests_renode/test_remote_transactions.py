@@ -254,3 +254,46 @@ def test_a_requester_that_dies_while_it_waits_frees_the_serving_nodes_workers(pa
     assert call(one, f"count {semaphore}")[:2] == ("ok", 1)
     # Node 1 lists no transaction of the dead tasks.
     assert "  call " not in one.command("net remote")
+
+
+def test_a_remote_request_overtakes_a_bulk_transfer_of_lower_priority(pair):
+    lab, one, two = pair
+    semaphore = created(two, "remote sem 3", "RSEM")
+    # A hub node floods the bus with priority-31 segmented frames, back to
+    # back, as a bulk transfer would.
+    bulk = Frame.data_frame((31 << 24) | (0x30 << 16) | (2 << 8) | 9, bytes(8), extended=True)
+    lab.hub.babble("can0", "bulk", bulk)
+    try:
+        lab.hub.wait_for_records(lambda records: sum(r.frame == bulk for r in records) >= 3, 120, "the bulk transfer")
+        status, value, ms = call(one, f"count at=2 {semaphore}")
+        lab.hub.wait_for_records(lambda records: records[-1].frame == bulk and dcos_frames(lab, REPLY, records),
+                                 120, "the bulk transfer after the reply")
+    finally:
+        lab.hub.stop_babble("bulk")
+    assert (status, value) == ("ok", 3)
+    assert ms < WATCHDOG_MS  # answered at once: no retransmission needed
+    # In the bus log the request and then the reply each won arbitration
+    # against a bulk frame at its first bit, in the midst of the bulk frames.
+    records = lab.hub.frames()
+    request = next(i for i, r in enumerate(records) if (r.frame.id >> 16) & 0xFF == REQUEST)
+    assert records[request - 1].frame == bulk, lab.hub.log_text()
+    assert (records[request + 1].frame.id >> 16) & 0xFF == REPLY, lab.hub.log_text()
+    assert records[request + 2].frame == bulk, lab.hub.log_text()
+    for record in records[request:request + 2]:
+        assert record.frame.id >> 24 == 2
+        assert record.lost == (("hub.bulk", 0),), lab.hub.log_text()
+
+
+def test_a_corrupted_request_and_reply_change_no_result(pair):
+    lab, one, two = pair
+    semaphore = created(two, "remote sem 0", "RSEM")
+    # The next frame each board sends is destroyed at its CRC delimiter; the
+    # controllers repeat them, as CAN does, and the transaction's result is
+    # that of an undisturbed one.
+    lab.hub.corrupt("board1.0", 1)
+    lab.hub.corrupt("board2.0", 1)
+    assert call(one, f"release {semaphore}")[:2] == ("ok", 0)
+    assert call(one, f"count {semaphore}")[:2] == ("ok", 1)
+    outcomes = [r.outcome for r in lab.hub.frames() if r.frame.extended]
+    assert outcomes.count("form-error") == 2, lab.hub.log_text()
+    assert counters(two)["served"] == 2 and counters(two)["duplicates"] == 0
