@@ -248,6 +248,10 @@ def test_a_requester_that_dies_while_it_waits_frees_the_serving_nodes_workers(pa
     status, value, ms = call(one, f"count {semaphore}")
     assert (status, value) == ("ok", 0)
     assert ms < 3 * SILENT_PERIODS * WATCHDOG_MS
+    # The other worker's wait ends within two more slices of 200 ms: node 2
+    # lets 500 ms of its own time pass.
+    sleeper = created(two, "remote sem 0", "RSEM")
+    assert call(two, f"acquire {sleeper} 500")[0] == "timed out"
     assert counters(two)["abandoned"] == 2
     # Nobody waits any more: a unit released on node 2 stays there.
     assert call(two, f"release {semaphore}")[0] == "ok"
@@ -297,3 +301,18 @@ def test_a_corrupted_request_and_reply_change_no_result(pair):
     outcomes = [r.outcome for r in lab.hub.frames() if r.frame.extended]
     assert outcomes.count("form-error") == 2, lab.hub.log_text()
     assert counters(two)["served"] == 2 and counters(two)["duplicates"] == 0
+
+
+def test_every_one_of_many_calls_runs_exactly_once(pair):
+    lab, one, two = pair
+    # More calls from one call slot than its transaction numbers' 16
+    # generations, and than the serving node's 32 remembered requests.
+    semaphore = created(two, "remote sem 0", "RSEM")
+    calls = 40
+    for _ in range(calls):
+        assert call(one, f"release {semaphore}")[0] == "ok"
+    assert call(two, f"count {semaphore}")[:2] == ("ok", calls)
+    served = counters(two)
+    assert served["served"] == calls and served["duplicates"] == 0
+    transactions = [data[1] for _, _, _, data in dcos_frames(lab, REQUEST)]
+    assert len(transactions) == calls and len(set(transactions)) == 16  # the numbers did wrap

@@ -71,6 +71,7 @@ struct ServedEntry {
     RemoteRequest request{};
     uint32_t order = 0; // Arrival order while queued; completion order once done.
     uint64_t heardNs = 0; // Uptime when the request last arrived, retransmissions included.
+    bool superseded = false; // Its requester has begun another transaction on the same call slot.
     uint8_t reply[kRemoteMessageBytes]{};
 };
 
@@ -258,25 +259,41 @@ void onReply(uint8_t interface, const SystemMessage& message)
 
 // ---- the serving side ---------------------------------------------------------
 
-// Where a new request goes: a free entry, else the served request of the
-// same caller slot (the requester has moved on from it, so it will never
-// be asked for again), else the request completed longest ago. Null when
-// every entry is queued or running. O(kRemoteServed), under the lock.
-ServedEntry* entryForNewRequest(uint8_t interface, uint32_t source, uint8_t transaction)
+// The served table keeps at most one current entry per caller slot of a
+// requester: (interface, source, the transaction's slot bits). A request
+// with that entry's transaction number is a retransmission; one with
+// another number is the requester's next transaction on that slot (it
+// begins one only when it is done with, or gave up, the one before), so
+// the entry is never asked for again. Matching by the whole transaction
+// number alone would not do: the generation wraps after 16 transactions,
+// and an old entry of the same number would answer a new request.
+bool sameCallSlot(const ServedEntry& entry, uint8_t interface, uint32_t source, uint8_t transaction)
 {
+    return entry.state != ServedState::Free && !entry.superseded && entry.interface == interface &&
+           entry.source == source && (entry.request.transaction & kSlotMask) == (transaction & kSlotMask);
+}
+
+// Where a new request goes: the finished entry of the same caller slot,
+// else a free entry, else the request completed longest ago. Null when
+// every entry is queued or running. O(kRemoteServed), under the lock.
+ServedEntry* entryForNewRequest(ServedEntry* sameSlot)
+{
+    if (sameSlot != nullptr) {
+        if (sameSlot->state == ServedState::Done) {
+            return sameSlot;
+        }
+        // Still queued or running for a requester that gave it up: it
+        // finishes, but no longer answers for the slot.
+        sameSlot->superseded = true;
+    }
     ServedEntry* oldestDone = nullptr;
     for (ServedEntry& entry : served) {
         if (entry.state == ServedState::Free) {
             return &entry;
         }
-        if (entry.state == ServedState::Done) {
-            if (entry.interface == interface && entry.source == source &&
-                (entry.request.transaction & kSlotMask) == (transaction & kSlotMask)) {
-                return &entry;
-            }
-            if (oldestDone == nullptr || static_cast<int32_t>(entry.order - oldestDone->order) < 0) {
-                oldestDone = &entry;
-            }
+        if (entry.state == ServedState::Done &&
+            (oldestDone == nullptr || static_cast<int32_t>(entry.order - oldestDone->order) < 0)) {
+            oldestDone = &entry;
         }
     }
     return oldestDone;
@@ -298,14 +315,15 @@ void onRequest(uint8_t interface, const SystemMessage& message)
     enum class Action : uint8_t { None, Pending, Stored, Busy } action = Action::None;
     {
         Lock lock;
-        ServedEntry* known = nullptr;
+        ServedEntry* sameSlot = nullptr;
         for (ServedEntry& entry : served) {
-            if (entry.state != ServedState::Free && entry.interface == interface && entry.source == message.source &&
-                entry.request.transaction == request.transaction) {
-                known = &entry;
+            if (sameCallSlot(entry, interface, message.source, request.transaction)) {
+                sameSlot = &entry;
                 break;
             }
         }
+        ServedEntry* const known =
+            sameSlot != nullptr && sameSlot->request.transaction == request.transaction ? sameSlot : nullptr;
         if (known != nullptr) {
             ++statistics.duplicates;
             known->heardNs = TimerAgent::Uptime();
@@ -316,12 +334,13 @@ void onRequest(uint8_t interface, const SystemMessage& message)
                 action = Action::Pending;
             }
         } else {
-            ServedEntry* entry = entryForNewRequest(interface, message.source, request.transaction);
+            ServedEntry* entry = entryForNewRequest(sameSlot);
             if (entry == nullptr) {
                 ++statistics.refusedBusy;
                 action = Action::Busy;
             } else {
                 entry->state = ServedState::Queued;
+                entry->superseded = false;
                 entry->interface = interface;
                 entry->priority = message.priority;
                 entry->source = message.source;
