@@ -139,6 +139,20 @@ def test_events_and_signals_reach_a_task_on_another_node(pair):
     assert "RGOT 0x15 0x8" in got, got
 
 
+def test_a_task_and_a_semaphore_of_another_node_can_be_read(pair):
+    lab, one, two = pair
+    listener = created(two, "remote listener", "RTASK")
+    binary = created(two, "remote sem binary", "RSEM")
+    assert call(two, f"acquire {binary} 0")[0] == "ok"  # held by node 2's console task
+    holder = call(two, f"holder {binary}")[:2]
+    assert holder[0] == "ok" and holder[1] >> 16 == 2
+    # Each read gives the value the same call gives on node 2 itself.
+    for line in (f"state {listener}", f"priority {listener}", f"holder {binary}"):
+        assert call(one, line)[:2] == call(two, line)[:2], line
+    assert call(one, f"priority {listener}")[:2] == ("ok", 10)
+    assert call(one, f"state {listener}")[:2] == ("ok", 4)  # TaskState::Blocked, in its ReceiveEvent
+
+
 def test_errors_come_back_as_the_local_call_gives_them(pair):
     lab, one, two = pair
     semaphore = created(two, "remote sem 1", "RSEM")

@@ -217,6 +217,18 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         status = taskAgent.PostEvent(id, static_cast<uint32_t>(argument));
     } else if (textEquals(verb, "signal") && extra == 1) {
         status = taskAgent.SendSignal(id, static_cast<unsigned>(argument));
+    } else if (textEquals(verb, "state") && extra == 0) {
+        const Result<dcos::TaskState> state = taskAgent.GetState(id);
+        status = state.status();
+        value = state.ok() ? static_cast<uint32_t>(state.value()) : 0;
+    } else if (textEquals(verb, "priority") && extra == 0) {
+        const Result<uint8_t> taskPriority = taskAgent.GetPriority(id);
+        status = taskPriority.status();
+        value = taskPriority.ok() ? taskPriority.value() : 0;
+    } else if (textEquals(verb, "holder") && extra == 0) {
+        const Result<ObjectId> holder = semaphoreAgent.GetHolder(id);
+        status = holder.status();
+        value = holder.ok() ? holder.value().raw() : 0;
     } else {
         known = false;
     }
@@ -236,7 +248,7 @@ DCOS_SHELL_COMMAND_DETAILED(
     remoteCommand, "remote", "call primitives by id, local or remote, for the lab's tests (test image only)",
     "remote sem <count> [max] | sem binary | listener | got | hog <priority> <ms> | waiter <id> | kill <task> | "
     "acquire [at=P] <id> <ms> | release [at=P] <id> | count [at=P] <id> | post [at=P] <id> <events> | "
-    "signal [at=P] <id> <n>",
+    "signal [at=P] <id> <n> | state [at=P] <task> | priority [at=P] <task> | holder [at=P] <semaphore>",
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
     "  hog: a task that keeps the processor busy at a priority for a time\r\n"
     "  waiter: a task that acquires the semaphore for ever; kill: KillTask\r\n"

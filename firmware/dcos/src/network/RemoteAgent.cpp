@@ -402,6 +402,19 @@ Status acquireForRequester(ObjectId id, uint32_t timeoutMs, const ServedEntry& e
     }
 }
 
+// A read service's result as the reply's status and value.
+uint32_t replyValueOf(uint32_t value) { return value; }
+uint32_t replyValueOf(uint8_t value) { return value; }
+uint32_t replyValueOf(TaskState state) { return static_cast<uint32_t>(state); }
+uint32_t replyValueOf(ObjectId id) { return id.raw(); }
+
+template <typename T>
+void replyWith(RemoteReply& reply, const Result<T>& result)
+{
+    reply.status = result.status();
+    reply.value = result.ok() ? replyValueOf(result.value()) : 0;
+}
+
 // Performs @p request on this node's object, as the worker that runs it.
 RemoteReply perform(const RemoteRequest& request, const ServedEntry& entry)
 {
@@ -427,14 +440,12 @@ RemoteReply perform(const RemoteRequest& request, const ServedEntry& entry)
         }
         break;
     }
-    case RemoteService::SemaphoreGetCount: {
-        const Result<uint32_t> count = SemaphoreAgent::GetCount(id);
-        reply.status = count.status();
-        reply.value = count.ok() ? count.value() : 0;
-        break;
-    }
+    case RemoteService::SemaphoreGetCount: replyWith(reply, SemaphoreAgent::GetCount(id)); break;
     case RemoteService::PostEvent: reply.status = TaskAgent::PostEvent(id, request.argument); break;
     case RemoteService::SendSignal: reply.status = TaskAgent::SendSignal(id, request.argument); break;
+    case RemoteService::TaskGetState: replyWith(reply, TaskAgent::GetState(id)); break;
+    case RemoteService::TaskGetPriority: replyWith(reply, TaskAgent::GetPriority(id)); break;
+    case RemoteService::SemaphoreGetHolder: replyWith(reply, SemaphoreAgent::GetHolder(id)); break;
     }
     // The object is this node's, so a Remote status cannot come back; were
     // it to, the requester must not take it for its own "no network".

@@ -42,6 +42,9 @@ const char* remoteServiceName(RemoteService service)
     case RemoteService::SemaphoreGetCount: return "count";
     case RemoteService::PostEvent: return "post";
     case RemoteService::SendSignal: return "signal";
+    case RemoteService::TaskGetState: return "state";
+    case RemoteService::TaskGetPriority: return "priority";
+    case RemoteService::SemaphoreGetHolder: return "holder";
     }
     return "?";
 }

@@ -397,20 +397,21 @@ Result<uint32_t> SemaphoreAgent::GetCount(ObjectId id)
         status = semaphore.status();
     }
     // Forwarded with interrupts enabled again: the remote agent blocks.
-    if (status == Status::Remote) {
-        return internal::forwardRemote(internal::RemoteService::SemaphoreGetCount, id, 0);
-    }
-    return status;
+    return internal::remoteValueOr<uint32_t>(status, internal::RemoteService::SemaphoreGetCount, id);
 }
 
 Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id)
 {
-    arch_x86::InterruptGuard guard;
-    const Result<Semaphore*> semaphore = internal::resolve(id);
-    if (!semaphore.ok()) {
-        return semaphore.status();
+    Status status;
+    {
+        arch_x86::InterruptGuard guard;
+        const Result<Semaphore*> semaphore = internal::resolve(id);
+        if (semaphore.ok()) {
+            return semaphore.value()->holder != nullptr ? semaphore.value()->holder->id : ObjectId::null();
+        }
+        status = semaphore.status();
     }
-    return semaphore.value()->holder != nullptr ? semaphore.value()->holder->id : ObjectId::null();
+    return internal::remoteValueOr<ObjectId>(status, internal::RemoteService::SemaphoreGetHolder, id);
 }
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::NameToObject(const char* name)

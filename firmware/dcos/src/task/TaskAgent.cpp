@@ -244,7 +244,13 @@ Result<TaskState> TaskAgent::GetState(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
-        return task.status();
+        const Result<TaskState> remote =
+            internal::remoteValueOr<TaskState>(task.status(), internal::RemoteService::TaskGetState, id);
+        // Another node's answer is outside input: a state no node has is refused.
+        if (remote.ok() && static_cast<uint8_t>(remote.value()) > static_cast<uint8_t>(TaskState::Terminating)) {
+            return Status::Corrupted;
+        }
+        return remote;
     }
     arch_x86::InterruptGuard guard;
     const Task& t = *task.value();
@@ -258,7 +264,14 @@ Result<uint8_t> TaskAgent::GetPriority(ObjectId id)
 {
     const Result<Task*> task = TaskManager::resolve(id);
     if (!task.ok()) {
-        return task.status();
+        const Result<uint32_t> remote =
+            internal::remoteValueOr<uint32_t>(task.status(), internal::RemoteService::TaskGetPriority, id);
+        if (!remote.ok()) {
+            return remote.status();
+        }
+        // Another node's answer is outside input: a priority no task has is refused.
+        return remote.value() > kLowestPriority ? Result<uint8_t>(Status::Corrupted)
+                                                : Result<uint8_t>(static_cast<uint8_t>(remote.value()));
     }
     return task.value()->basePriority;
 }

@@ -38,4 +38,23 @@ void setRemoteForwarder(RemoteForwarder forwarder);
     return forwardRemote(service, id, argument).status();
 }
 
+/// A read service's result after its local attempt failed with @p local:
+/// that status unless it is Remote, else the remote reply's value as T.
+template <typename T>
+Result<T> remoteValueOr(Status local, RemoteService service, ObjectId id)
+{
+    if (local != Status::Remote) {
+        return local;
+    }
+    const Result<uint32_t> reply = forwardRemote(service, id, 0);
+    if (!reply.ok()) {
+        return reply.status();
+    }
+    if constexpr (__is_same(T, ObjectId)) { // The compiler's trait: the firmware has no <type_traits>.
+        return ObjectId::fromRaw(reply.value());
+    } else {
+        return static_cast<T>(reply.value());
+    }
+}
+
 } // namespace dcos::internal

@@ -38,10 +38,13 @@ enum class RemoteService : uint8_t {
     SemaphoreGetCount = 3, ///< argument: 0; value: the count.
     PostEvent = 4,         ///< argument: the events.
     SendSignal = 5,        ///< argument: the signal number.
+    TaskGetState = 6,      ///< argument: 0; value: the TaskState.
+    TaskGetPriority = 7,   ///< argument: 0; value: the static priority.
+    SemaphoreGetHolder = 8, ///< argument: 0; value: the holding task's id (0: free).
 };
 
 /// The last service value assigned.
-constexpr uint8_t kLastRemoteService = 5;
+constexpr uint8_t kLastRemoteService = 8;
 
 /// A short name of a service, for the console and logs.
 const char* remoteServiceName(RemoteService service);
