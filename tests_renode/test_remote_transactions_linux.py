@@ -65,9 +65,12 @@ def receive(seconds=120):
     return message
 
 # Phase 1: serve node 1 until the go frame, whose data is the object of a
-# semaphore of node 1.
-count = 5
+# semaphore of node 1. Semaphore 0xA003 has no unit: an Acquire that waits
+# for it is kept alive with pending replies, one per retransmission, until
+# the third retransmission, when a unit "arrives" and the final reply goes.
+counts = {0xA001: 5, 0xA003: 0}
 served = {}
+waiting = {}
 while True:
     message = receive()
     if not message.is_extended_id:
@@ -80,19 +83,33 @@ while True:
         continue
     data = bytes(message.data)
     key = (source, data[1])
+    service, transaction, obj, argument = struct.unpack(">BBHI", data)
+    if key in waiting:
+        waiting[key] += 1
+        final = waiting[key] >= 3
+        print(f"@@PEER RETRANSMISSION {waiting[key]}@@", flush=True)
+        if final:
+            del waiting[key]
+            served[key] = struct.pack(">BBBBI", service, transaction, OK, 0, 0)
+        else:
+            bus.send(can.Message(arbitration_id=identifier(priority, REPLY, source, ME), is_extended_id=True,
+                                 data=struct.pack(">BBBBI", service, transaction, OK, 1, 0)))
+            continue
     if key not in served:
-        service, transaction, obj, argument = struct.unpack(">BBHI", data)
         print(f"@@PEER REQUEST priority={priority} service={service} transaction={transaction:02X} "
               f"object={obj:04X} argument={argument}@@", flush=True)
         status, value = OK, 0
-        if obj != 0xA001:
+        if obj not in counts:
             status = INVALID_ID
         elif service == COUNT:
-            value = count
+            value = counts[obj]
         elif service == RELEASE:
-            count += 1
-        elif service == ACQUIRE and count > 0:
-            count -= 1
+            counts[obj] += 1
+        elif service == ACQUIRE and counts[obj] > 0:
+            counts[obj] -= 1
+        elif service == ACQUIRE and argument > 0:
+            waiting[key] = 0
+            continue
         elif service == ACQUIRE:
             status = WOULD_BLOCK
         else:
@@ -176,6 +193,21 @@ def test_the_board_uses_a_semaphore_of_a_python_can_node(world):
     ]
     transactions = [re.search(r"transaction=(\w+)", line).group(1) for line in requests]
     assert len(set(transactions)) == len(transactions), transactions
+
+
+def test_the_board_waits_on_a_python_can_node_kept_alive_by_its_pending_replies(world):
+    # The peer answers the first two retransmissions "pending" and the third
+    # with the unit: the board waited through three watchdog periods, the
+    # last two of them not silent, and did not give up.
+    status, value, us = remote.call(world.board, "acquire 0x0003a003 5000", timeout=STEP)
+    assert (status, value) == ("ok", 0)
+    assert us >= 3 * 50_000
+    request = peer_line(world, "REQUEST")
+    assert request.startswith("priority=24 service=1 ") and request.endswith("object=A003 argument=5000"), request
+    assert [peer_line(world, "RETRANSMISSION") for _ in range(3)] == ["1", "2", "3"]
+    counters = world.board.command("net remote")
+    assert re.search(r"pending-replies [1-9]", counters), counters
+    assert re.search(r"unreachable 0\r?$", counters, re.M), counters
 
 
 def test_a_python_can_node_uses_a_semaphore_of_the_board(world):
