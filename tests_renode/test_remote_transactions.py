@@ -300,6 +300,10 @@ def test_a_remote_request_overtakes_a_bulk_transfer_of_lower_priority(pair):
     for record in records[request:request + 2]:
         assert record.frame.id >> 24 == 2
         assert record.lost == (("hub.bulk", 0),), lab.hub.log_text()
+    # Node 1's link passed its one reply to the remote agent and dropped the
+    # bulk frames, which are no remote transaction.
+    link = re.search(r"can0 link interface=0 sent=(\d+) received=(\d+) foreign=(\d+)", one.command("can stats can0"))
+    assert link and (int(link.group(1)), int(link.group(2))) == (1, 1) and int(link.group(3)) >= 3, link
 
 
 def test_a_corrupted_request_and_reply_change_no_result(pair):

@@ -61,6 +61,11 @@ void CanNetworkLink::Stop()
 
 Status CanNetworkLink::Send(const dcos::SystemMessage& message)
 {
+    if (!started_) {
+        // Attached but not started yet (or stopped): its own node number is
+        // not known, and a frame sent now would carry a wrong source.
+        return Status::Busy;
+    }
     if (message.destination > can::MessageIdentifier::kBroadcast || message.length > can::CanFrame::kMaxDataLength) {
         return Status::InvalidArgument;
     }
