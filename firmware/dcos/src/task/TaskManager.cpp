@@ -634,12 +634,18 @@ void TaskManager::postEvent(Task& task, uint32_t events)
 namespace {
 
 // PostEvent's miss path: the id's error, or for another node's task the
-// remote transaction, with interrupts enabled again (it blocks).
+// remote transaction, with interrupts enabled again (it blocks). The id is
+// resolved again under a guard of its own, so a task that came to be
+// between the two guards still gets its events, as before this path split.
 [[gnu::noinline]] Status postEventMissed(ObjectId id, uint32_t events)
 {
-    const Status missed = [id] {
+    const Status missed = [id, events] {
         arch_x86::InterruptGuard guard;
-        return TaskManager::resolve(id).status();
+        const Result<Task*> task = TaskManager::resolve(id);
+        if (task.ok()) {
+            TaskManager::postEvent(*task.value(), events);
+        }
+        return task.status();
     }();
     return orRemote(missed, RemoteService::PostEvent, id, events);
 }
