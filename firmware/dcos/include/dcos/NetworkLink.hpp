@@ -36,7 +36,8 @@ struct SystemMessage {
     /// The sending task's priority, 0 (most urgent) to 31: the bus priority.
     uint8_t priority = 0;
     SystemMessageType type = SystemMessageType::RemoteRequest;
-    /// Physical addresses on the link's network (the CAN node numbers).
+    /// Physical addresses on the link's network (the CAN node numbers). The
+    /// source is filled in by Receive; Send puts the link's own address.
     uint32_t destination = 0;
     uint32_t source = 0;
     uint8_t length = 0;
@@ -52,7 +53,9 @@ public:
     virtual Status Start(ObjectId receiver, uint32_t receiveEvent, uint32_t ownPhysical) = 0;
     /// Ends delivery; nothing is posted after it returns.
     virtual void Stop() = 0;
-    /// Queues @p message for sending; Busy when the driver's queue is full.
+    /// Queues @p message for sending, from the link's own physical address
+    /// (given to Start); Busy when the driver's queue is full or the link
+    /// has not started.
     virtual Status Send(const SystemMessage& message) = 0;
     /// The next message that arrived for this node: true and @p message
     /// filled in, or false when none is waiting. Frames that are not system

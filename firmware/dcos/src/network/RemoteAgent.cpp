@@ -30,12 +30,9 @@ constexpr size_t kTaskStackBytes = 4096;
 
 // ---- the links ------------------------------------------------------------
 
-struct AttachedLink {
-    NetworkLink* link = nullptr;
-    uint32_t ownPhysical = 0;
-};
-
-AttachedLink links[kNetworkInterfaces];
+// The link of each interface, null while it has none. A link knows its own
+// physical address (Start), and puts it in every frame it sends.
+NetworkLink* links[kNetworkInterfaces];
 
 // The interface's event for the receiver task: bit n for interface n.
 constexpr uint32_t eventOf(uint8_t interface) { return 1u << interface; }
@@ -97,15 +94,14 @@ bool sendMessage(uint8_t interface, SystemMessageType type, uint8_t priority, ui
                  const uint8_t (&data)[kRemoteMessageBytes])
 {
     NetworkLink* link;
-    SystemMessage message;
     {
         Lock lock;
-        link = links[interface].link;
-        message.source = links[interface].ownPhysical;
+        link = links[interface];
     }
     if (link == nullptr) {
         return false;
     }
+    SystemMessage message;
     message.priority = priority;
     message.type = type;
     message.destination = destination;
@@ -174,7 +170,7 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
     CallSlot* slot;
     {
         Lock lock;
-        if (links[interface].link == nullptr) {
+        if (links[interface] == nullptr) {
             return Status::Unreachable;
         }
         slot = takeCallSlot(self);
@@ -521,7 +517,7 @@ void receiverEntry(uintptr_t)
             NetworkLink* link;
             {
                 Lock lock;
-                link = links[interface].link;
+                link = links[interface];
             }
             if (link == nullptr) {
                 continue;
@@ -544,32 +540,38 @@ void receiverEntry(uintptr_t)
     }
 }
 
+// Creates the receiver and the workers on first use. A start that failed
+// part way (no task slot, no stack) resumes where it stopped on the next
+// attach, so no task is made twice.
 Status startAgent()
 {
+    static size_t workersCreated = 0;
     if (started) {
         return Status::Ok;
     }
-    TaskAttributes receiver;
-    receiver.name = "net-receiver";
-    receiver.priority = 0;
-    receiver.stackSize = kTaskStackBytes;
-    receiver.newProcess = true;
-    const Result<ObjectId> receiverId = TaskManager::create(receiver, receiverEntry, 0);
-    if (!receiverId.ok()) {
-        return receiverId.status();
+    if (receiverTask.isNull()) {
+        TaskAttributes receiver;
+        receiver.name = "net-receiver";
+        receiver.priority = 0;
+        receiver.stackSize = kTaskStackBytes;
+        receiver.newProcess = true;
+        const Result<ObjectId> receiverId = TaskManager::create(receiver, receiverEntry, 0);
+        if (!receiverId.ok()) {
+            return receiverId.status();
+        }
+        receiverTask = receiverId.value();
     }
-    for (size_t i = 0; i < kRemoteWorkers; ++i) {
+    for (; workersCreated < kRemoteWorkers; ++workersCreated) {
         TaskAttributes worker;
         worker.name = "net-worker";
         worker.priority = kLowestPriority;
         worker.stackSize = kTaskStackBytes;
         worker.newProcess = true;
-        const Result<ObjectId> workerId = TaskManager::create(worker, workerEntry, i);
+        const Result<ObjectId> workerId = TaskManager::create(worker, workerEntry, workersCreated);
         if (!workerId.ok()) {
-            return workerId.status(); // The tasks made so far wait idle; the next attach tries again.
+            return workerId.status();
         }
     }
-    receiverTask = receiverId.value();
     setRemoteForwarder(forward);
     started = true;
     return Status::Ok;
@@ -611,8 +613,8 @@ void detachRemoteLink(uint8_t interface)
     NetworkLink* link;
     {
         Lock lock;
-        link = links[interface].link;
-        links[interface].link = nullptr;
+        link = links[interface];
+        links[interface] = nullptr;
     }
     if (link != nullptr) {
         link->Stop();
@@ -639,19 +641,18 @@ Status NetworkInterfacesManager::AttachLink(uint8_t interface, NetworkLink& link
     }
     {
         // Listed before it starts, so the receiver finds the link for the
-        // first event it posts.
+        // first event it posts; it sends nothing until started.
         internal::Lock lock;
-        if (internal::links[interface].link != nullptr) {
+        if (internal::links[interface] != nullptr) {
             return Status::AlreadyExists;
         }
-        internal::links[interface].link = &link;
-        internal::links[interface].ownPhysical = entry.value().physical;
+        internal::links[interface] = &link;
     }
     const Status start =
         link.Start(internal::receiverTask, internal::eventOf(interface), entry.value().physical);
     if (start != Status::Ok) {
         internal::Lock lock;
-        internal::links[interface].link = nullptr;
+        internal::links[interface] = nullptr;
     }
     return start;
 }
@@ -666,7 +667,7 @@ Status NetworkInterfacesManager::DetachLink(uint8_t interface)
     }
     {
         internal::Lock lock;
-        if (interface >= internal::kNetworkInterfaces || internal::links[interface].link == nullptr) {
+        if (interface >= internal::kNetworkInterfaces || internal::links[interface] == nullptr) {
             return Status::NotFound;
         }
     }
