@@ -23,12 +23,11 @@ import pytest
 
 from dcoslab import remote
 from dcoslab.canbus import Frame
-from dcoslab.remote import attach_node, created
+from dcoslab.remote import REPLY, REQUEST, attach_node, created, dcos_frames
 
 BIT_RATE = 500_000
 WATCHDOG_MS = 50       # DCOS_CONFIG_REMOTE_WATCHDOG_MS
 SILENT_PERIODS = 4     # DCOS_CONFIG_REMOTE_SILENT_PERIODS
-REQUEST, REPLY = 0x11, 0x10
 
 
 @pytest.fixture
@@ -50,21 +49,6 @@ def call(board, line):
 def counters(board):
     output = board.command("net remote")
     return {name: int(value) for name, value in re.findall(r"^  ([a-z-]+) (\d+)\r?$", output, re.M)}
-
-
-def dcos_frames(lab, kind, records=None):
-    """The bus log's DCOS frames of a message type, as (priority, destination, source, data).
-
-    records: the hub's records as a wait_for_records predicate is given them
-    (it holds the hub's lock, so lab.hub.frames() cannot be called there)."""
-    frames = []
-    for frame in (lab.hub.frames() if records is None else records):
-        if frame.outcome != "ok" or not frame.frame.extended:
-            continue
-        raw = frame.frame.id
-        if (raw >> 16) & 0xFF == kind:
-            frames.append((raw >> 24, (raw >> 8) & 0xFF, raw & 0xFF, bytes(frame.frame.data)))
-    return frames
 
 
 SEMAPHORE_SEQUENCE = ["count {}", "acquire {} 0", "count {}", "acquire {} 0", "acquire {} 200", "release {}",

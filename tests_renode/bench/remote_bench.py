@@ -28,34 +28,29 @@ sys.path.insert(0, os.path.dirname(HERE))  # tests_renode, for dcoslab
 from dcoslab.board import REPOSITORY, load_board  # noqa: E402
 from dcoslab.canlab import CanLab  # noqa: E402
 from dcoslab.emulator import EmulatorError  # noqa: E402
-from dcoslab.remote import attach_node, call, created  # noqa: E402
+from dcoslab.remote import REPLY, REQUEST, attach_node, call, created, dcos_frames  # noqa: E402
 from dcoslab.vmworld import World  # noqa: E402
 
 BIT_RATE = 1_000_000
 SEED_LATENCY_US = 80  # network latency, one way: dissertation 9.3.4, Table 9.11
-REQUEST, REPLY = 0x11, 0x10
 
 
-def remote_frames(lab):
+def frame_counts(lab):
     """How many remote requests and replies the hub's log holds so far."""
-    counts = {REQUEST: 0, REPLY: 0}
-    for record in lab.hub.frames():
-        if record.outcome == "ok" and record.frame.extended and (record.frame.id >> 16) & 0xFF in counts:
-            counts[(record.frame.id >> 16) & 0xFF] += 1
-    return counts[REQUEST], counts[REPLY]
+    return len(dcos_frames(lab, REQUEST)), len(dcos_frames(lab, REPLY))
 
 
 def measure(lab, caller, calls, calls_per_primitive):
     """Each (name, command) run calls_per_primitive times: its status, round trips and frames per call."""
     results = {}
     for name, command in calls:
-        before = remote_frames(lab)
+        before = frame_counts(lab)
         trips, statuses = [], set()
         for _ in range(calls_per_primitive):
             status, _, microseconds = call(caller, command)
             statuses.add(status)
             trips.append(microseconds)
-        after = remote_frames(lab)
+        after = frame_counts(lab)
         results[name] = {
             "status": sorted(statuses),
             "round_trip_us": {"min": min(trips), "median": statistics.median(trips), "max": max(trips)},

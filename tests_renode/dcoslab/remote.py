@@ -12,6 +12,9 @@ import re
 
 _RESULT = re.compile(r"RRES (.+) (\d+) (\d+)\r?$", re.M)
 
+# The CAN message types of remote transactions (docs/protocols/can.md).
+REQUEST, REPLY = 0x11, 0x10
+
 
 def attach_node(board, node, peers, bitrate, timeout=120):
     """Channel 0 up as interface 0: network address 130.1.0.<node>, CAN node <node>; each peer mapped alike."""
@@ -43,3 +46,18 @@ def parse_result(text):
 def call(board, line, timeout=120):
     """Runs a `remote` primitive ("count 0x0002a001"); (status, value, microseconds)."""
     return parse_result(board.command("remote " + line, timeout=timeout))
+
+
+def dcos_frames(lab, kind, records=None):
+    """The bus log's DCOS frames of a message type, as (priority, destination, source, data).
+
+    records: the hub's records as a wait_for_records predicate is given them
+    (it holds the hub's lock, so lab.hub.frames() cannot be called there)."""
+    frames = []
+    for frame in (lab.hub.frames() if records is None else records):
+        if frame.outcome != "ok" or not frame.frame.extended:
+            continue
+        raw = frame.frame.id
+        if (raw >> 16) & 0xFF == kind:
+            frames.append((raw >> 24, (raw >> 8) & 0xFF, raw & 0xFF, bytes(frame.frame.data)))
+    return frames

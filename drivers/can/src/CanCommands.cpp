@@ -82,6 +82,18 @@ bool parseChannel(shell::Shell& shell, const char* text, unsigned& channel)
 CanNetworkLink networkLinks[kChannels];
 uint8_t attachedInterface[kChannels];
 
+// Whether the channel carries a network interface, which the commands that
+// take its frames or change its set-up must leave alone; prints so.
+bool attachedToNetwork(shell::Shell& shell, unsigned channel)
+{
+    if (!networkLinks[channel].started()) {
+        return false;
+    }
+    shell.print("error: %s carries network interface %u; 'can detach %s' first\r\n", kNames[channel],
+                attachedInterface[channel], kNames[channel]);
+    return true;
+}
+
 // The channel's driver, up and, unless @p allowAttached, not attached to
 // the network; prints why not.
 bool requireUp(shell::Shell& shell, unsigned channel, bool allowAttached = false)
@@ -90,12 +102,7 @@ bool requireUp(shell::Shell& shell, unsigned channel, bool allowAttached = false
         shell.print("error: %s is down; bring it up with 'can up %s'\r\n", kNames[channel], kNames[channel]);
         return false;
     }
-    if (!allowAttached && networkLinks[channel].started()) {
-        shell.print("error: %s carries network interface %u; 'can detach %s' first\r\n", kNames[channel],
-                    attachedInterface[channel], kNames[channel]);
-        return false;
-    }
-    return true;
+    return allowAttached || !attachedToNetwork(shell, channel);
 }
 
 // The channel of a subcommand whose one argument is a channel that is up
@@ -152,9 +159,7 @@ CommandResult up(shell::Shell& shell, int argc, char** argv)
                     argv[3]);
         return CommandResult::Failed;
     }
-    if (networkLinks[channel].started()) {
-        shell.print("error: %s carries network interface %u; 'can detach %s' first\r\n", kNames[channel],
-                    attachedInterface[channel], kNames[channel]);
+    if (attachedToNetwork(shell, channel)) {
         return CommandResult::Failed;
     }
     IsaSja1000Channel& driver = consoleChannels[channel];
