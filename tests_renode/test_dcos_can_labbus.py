@@ -56,7 +56,47 @@ def test_dump_shows_another_nodes_frames_with_emulated_times(hub):
     assert all(f["emulated_time"] for f in frames)
     # The second frame starts after the first (extended, 2 bytes: 93 bits with intermission, 2 us each).
     assert frames[1]["timestamp_ns"] - frames[0]["timestamp_ns"] >= 52 * 2000, frames
-    assert frames[0]["dcos"] == {"priority": 3, "type": "DSM publication", "source": 5, "destination": 255}
+    assert frames[0]["dcos"] == {"priority": 3, "type": "DSM publication", "source": 5, "destination": 255,
+                                 "publication": {"malformed": "wrong length"}}
+
+
+def test_dump_puts_publications_back_together(hub):
+    # docs/protocols/publications.md's worked example: publisher index 0xA53,
+    # sequence 0x5677, page 10..1F; a part out of turn; a withdrawal.
+    example = [bytes.fromhex("3A53567710111213"), bytes.fromhex("7A53141516171819"),
+               bytes.fromhex("BA531A1B1C1D1E1F")]
+    frames = [Frame(0x0A20FF02, extended=True, dlc=len(data), data=data)
+              for data in example + [example[2], bytes.fromhex("CA53")]]
+    dump = tool(hub, "--json", "dump", "-n", "5", "-t", "30000", "--decode")
+    text = tool(hub, "dump", "-n", "5", "-t", "30000", "--decode")
+    wait_for_participants(hub, 2)
+    other = Client(hub.socket_path, "other")
+    try:
+        other.attach(0, "can0")
+        for frame in frames:
+            other.transmit(0, frame)
+        output, errors = dump.communicate(timeout=TIMEOUT)
+        lines, text_errors = text.communicate(timeout=TIMEOUT)
+    finally:
+        other.close()
+    assert dump.returncode == 0, errors
+    assert text.returncode == 0, text_errors
+    publications = [json.loads(line)["dcos"]["publication"] for line in output.splitlines()]
+    assert publications == [
+        {"index": 0xA53, "part": 0, "sequence": 0x5677},
+        {"index": 0xA53, "part": 1},
+        {"index": 0xA53, "part": 2, "page": "101112131415161718191A1B1C1D1E1F", "page_sequence": 0x5677},
+        {"index": 0xA53, "part": 2, "out_of_turn": True},
+        {"index": 0xA53, "withdrawn": True},
+    ]
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations == [
+        "prio 10 DSM publication 2->all: publisher 0xa53 part 1/3 seq 22135",
+        "prio 10 DSM publication 2->all: publisher 0xa53 part 2/3",
+        "prio 10 DSM publication 2->all: publisher 0xa53 part 3/3 page 101112131415161718191A1B1C1D1E1F (seq 22135)",
+        "prio 10 DSM publication 2->all: publisher 0xa53 part 3/3 out of turn",
+        "prio 10 DSM publication 2->all: publisher 0xa53 withdrawn",
+    ], lines
 
 
 def test_dump_decodes_remote_transactions(hub):

@@ -21,7 +21,8 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/system/DeviceManager.cpp \
 	firmware/dcos/src/system/DeviceCommands.cpp \
 	firmware/dcos/src/network/NetworkAddress.cpp \
-	firmware/dcos/src/network/RemoteMessage.cpp
+	firmware/dcos/src/network/RemoteMessage.cpp \
+	firmware/dcos/src/network/PublicationMessage.cpp
 
 # Kernel sources that run only on the target: task switching, the tick, traps.
 DCOS_TARGET_SRCS := \

@@ -12,8 +12,8 @@ import re
 
 _RESULT = re.compile(r"RRES (.+) (\d+) (\d+)\r?$", re.M)
 
-# The CAN message types of remote transactions (docs/protocols/can.md).
-REQUEST, REPLY = 0x11, 0x10
+# The CAN message types of remote transactions and publications (docs/protocols/can.md).
+REQUEST, REPLY, PUBLICATION = 0x11, 0x10, 0x20
 
 
 def attach_node(board, node, peers, bitrate, timeout=120):
@@ -26,6 +26,28 @@ def attach_node(board, node, peers, bitrate, timeout=120):
         assert "error:" not in output, (line, output)
     output = board.command("can attach can0", timeout=timeout)
     assert f"can0 carries interface 0: 130.1.0.{node}/16, CAN node {node}" in output, output
+
+
+def attach_redundant(board, node, peers, bitrate, timeout=120, policy="auto"):
+    """Both channels up as interfaces 0 and 1, on subnets 130.1 and 130.2: CAN node <node> on each.
+
+    Each peer is mapped onto both subnets (multi-homed), 130.1 first, so a
+    remote transaction goes over channel 0 and a publication over both.
+    policy: what a channel does after bus-off ("manual": it stays off)."""
+    lines = []
+    for channel in (0, 1):
+        lines += [f"can up can{channel} {bitrate}", f"can policy can{channel} {policy}",
+                  f"net interface can {channel} 130.{channel + 1}.0.{node}/16 {node}"]
+    for peer in peers:
+        for channel in (0, 1):
+            lines += [f"net map {peer} 130.{channel + 1}.0.{peer}", f"net neighbour 130.{channel + 1}.0.{peer} {peer}"]
+    for line in lines:
+        output = board.command(line, timeout=timeout)
+        assert "error:" not in output, (line, output)
+    for channel in (0, 1):
+        output = board.command(f"can attach can{channel}", timeout=timeout)
+        assert f"can{channel} carries interface {channel}: 130.{channel + 1}.0.{node}/16, CAN node {node}" in output, \
+            output
 
 
 def created(board, line, tag):

@@ -16,6 +16,19 @@ static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RemoteReply) ==
               static_cast<uint8_t>(can::MessageType::RemoteReply));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RemoteRequest) ==
               static_cast<uint8_t>(can::MessageType::RemoteRequest));
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::DsmPublication) ==
+              static_cast<uint8_t>(can::MessageType::DsmPublication));
+
+namespace {
+
+// The message types the kernel takes from a link.
+bool isSystemMessage(can::MessageType type)
+{
+    return type == can::MessageType::RemoteRequest || type == can::MessageType::RemoteReply ||
+           type == can::MessageType::DsmPublication;
+}
+
+} // namespace
 
 Status CanNetworkLink::Start(dcos::ObjectId receiver, uint32_t receiveEvent, uint32_t ownPhysical)
 {
@@ -66,11 +79,13 @@ Status CanNetworkLink::Send(const dcos::SystemMessage& message)
         // not known, and a frame sent now would carry a wrong source.
         return Status::Busy;
     }
-    if (message.destination > can::MessageIdentifier::kBroadcast || message.length > can::CanFrame::kMaxDataLength) {
+    const uint32_t destination =
+        message.destination == dcos::NetworkLink::kBroadcast ? can::MessageIdentifier::kBroadcast : message.destination;
+    if (destination > can::MessageIdentifier::kBroadcast || message.length > can::CanFrame::kMaxDataLength) {
         return Status::InvalidArgument;
     }
     const can::LinkResult<can::MessageIdentifier> identifier = can::MessageIdentifier::make(
-        message.priority, static_cast<can::MessageType>(message.type), static_cast<uint8_t>(message.destination),
+        message.priority, static_cast<can::MessageType>(message.type), static_cast<uint8_t>(destination),
         static_cast<uint8_t>(ownPhysical_));
     if (!identifier.ok()) {
         return Status::InvalidArgument;
@@ -104,8 +119,7 @@ Result<bool> CanNetworkLink::Receive(dcos::SystemMessage& message)
             return false;
         }
         const can::LinkResult<can::MessageIdentifier> identifier = can::MessageIdentifier::fromFrame(frame);
-        if (!identifier.ok() || (identifier.value().type() != can::MessageType::RemoteRequest &&
-                                 identifier.value().type() != can::MessageType::RemoteReply)) {
+        if (!identifier.ok() || !isSystemMessage(identifier.value().type())) {
             ++statistics_.foreign;
             continue;
         }
@@ -116,7 +130,8 @@ Result<bool> CanNetworkLink::Receive(dcos::SystemMessage& message)
         }
         message.priority = identifier.value().priority();
         message.type = static_cast<dcos::SystemMessageType>(identifier.value().type());
-        message.destination = destination;
+        message.destination = destination == can::MessageIdentifier::kBroadcast ? dcos::NetworkLink::kBroadcast
+                                                                                : destination;
         message.source = identifier.value().source();
         message.length = frame.length();
         __builtin_memcpy(message.data, frame.data(), frame.length());

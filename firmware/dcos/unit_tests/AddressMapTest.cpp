@@ -179,6 +179,31 @@ TEST(AddressMapTest, AMultiHomedNodeIsReachedByItsFirstWorkingAddress)
     EXPECT_EQ(map.resolve(5, 9).value().interface, 1);
 }
 
+TEST(AddressMapTest, TheReverseMappingFindsASenderOnEachOfItsInterfaces)
+{
+    Map map;
+    ASSERT_TRUE(map.addInterface(interfaceOf(InterfaceKind::Can, 0, address(130, 1, 0, 9), 16, 9)).ok());
+    ASSERT_TRUE(map.addInterface(interfaceOf(InterfaceKind::Can, 1, address(130, 2, 0, 9), 16, 9)).ok());
+    ASSERT_EQ(map.mapNode(5, address(130, 1, 0, 5)), Status::Ok);
+    ASSERT_EQ(map.mapNode(5, address(130, 2, 0, 5)), Status::Ok);
+    ASSERT_EQ(map.mapNode(6, address(130, 2, 0, 6)), Status::Ok);
+    EXPECT_EQ(map.nodeAt(0, 5).status(), Status::NotFound) << "no neighbour has CAN node 5 yet";
+    ASSERT_EQ(map.setPhysicalAddress(address(130, 1, 0, 5), 5), Status::Ok);
+    ASSERT_EQ(map.setPhysicalAddress(address(130, 2, 0, 5), 7), Status::Ok);
+    ASSERT_EQ(map.setPhysicalAddress(address(130, 2, 0, 6), 5), Status::Ok);
+    EXPECT_EQ(map.nodeAt(0, 5).value(), 5);
+    EXPECT_EQ(map.nodeAt(1, 7).value(), 5) << "the same node on its second bus, under another CAN node number";
+    EXPECT_EQ(map.nodeAt(1, 5).value(), 6) << "CAN node 5 of the second bus is another node";
+    EXPECT_EQ(map.nodeAt(0, 7).status(), Status::NotFound) << "CAN node 7 is on the second bus only";
+    EXPECT_EQ(map.nodeAt(2, 5).status(), Status::NotFound) << "no interface 2";
+    EXPECT_EQ(map.nodeAt(200, 5).status(), Status::NotFound);
+    ASSERT_EQ(map.setPhysicalAddress(address(130, 1, 0, 4), 4), Status::Ok);
+    EXPECT_EQ(map.nodeAt(0, 4).status(), Status::NotFound) << "a neighbour no node is mapped onto";
+    ASSERT_EQ(map.unmapNode(5, address(130, 1, 0, 5)), Status::Ok);
+    EXPECT_EQ(map.nodeAt(0, 5).status(), Status::NotFound);
+    EXPECT_EQ(map.nodeAt(1, 7).value(), 5);
+}
+
 TEST(AddressMapTest, TheLongestRouteWins)
 {
     Map map;

@@ -22,6 +22,7 @@
 #include <can/MessageIdentifier.hpp>
 
 #include <dcos/Version.hpp>
+#include <dcos/internal/PublicationMessage.hpp>
 #include <dcos/internal/RemoteMessage.hpp>
 
 #include <CLI/CLI.hpp>
@@ -73,21 +74,75 @@ std::string hex(const can::CanFrame& frame)
     return text;
 }
 
-// What a remote transaction's data says (docs/protocols/remote-transactions.md),
-// for the frame types that carry one; the decoder's refusal for a frame
-// no node should send.
-struct RemoteDecoding {
-    bool present = false; // The frame is a remote request or reply.
+// What a DCOS frame's data says, for the frame types that carry a system
+// message: a remote transaction (docs/protocols/remote-transactions.md) or
+// a publication (docs/protocols/publications.md); the decoder's refusal for
+// a frame no node should send.
+struct DataDecoding {
+    const char* key = nullptr; // "remote" or "publication"; null for other frames.
     std::string text;
     nlohmann::json json;
 };
 
-RemoteDecoding decodedRemote(const can::MessageIdentifier& id, const can::CanFrame& frame)
+// Puts each sender's publications back together, as a receiving node
+// does, so that the third part of one shows the whole page.
+class PublicationPages {
+public:
+    DataDecoding decode(const can::MessageIdentifier& id, const can::CanFrame& frame)
+    {
+        using namespace dcos::internal;
+        DataDecoding out;
+        out.key = "publication";
+        PublicationPart part;
+        const PublicationMessageError error = decodePublicationPart(frame.data(), frame.length(), part);
+        if (error != PublicationMessageError::None) {
+            out.text = fmt::format("malformed: {}", publicationMessageErrorName(error));
+            out.json = {{"malformed", publicationMessageErrorName(error)}};
+            return out;
+        }
+        out.json = {{"index", part.index}};
+        if (part.kind == PublicationPartKind::Withdrawal) {
+            out.text = fmt::format("publisher 0x{:03x} withdrawn", part.index);
+            out.json["withdrawn"] = true;
+            return out;
+        }
+        const int number = static_cast<int>(part.kind);
+        out.text = fmt::format("publisher 0x{:03x} part {}/3", part.index, number + 1);
+        out.json["part"] = number;
+        if (part.kind == PublicationPartKind::First) {
+            out.text += fmt::format(" seq {}", part.sequence);
+            out.json["sequence"] = part.sequence;
+        }
+        PublicationAssembler& assembler = pages_[(uint32_t{id.source()} << 12) | part.index];
+        const PublicationAssembler::Outcome outcome = assembler.take(part);
+        if (outcome == PublicationAssembler::Outcome::Complete) {
+            std::string page;
+            for (uint8_t byte : assembler.page().bytes) {
+                page += fmt::format("{:02X}", byte);
+            }
+            out.text += fmt::format(" page {} (seq {})", page, assembler.sequence());
+            out.json["page"] = page;
+            out.json["page_sequence"] = assembler.sequence();
+        } else if (outcome == PublicationAssembler::Outcome::Dropped) {
+            out.text += " out of turn";
+            out.json["out_of_turn"] = true;
+        }
+        return out;
+    }
+
+private:
+    std::map<uint32_t, dcos::internal::PublicationAssembler> pages_;
+};
+
+DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& frame, PublicationPages& pages)
 {
     using namespace dcos::internal;
-    RemoteDecoding out;
+    if (id.type() == can::MessageType::DsmPublication) {
+        return pages.decode(id, frame);
+    }
+    DataDecoding out;
     if (id.type() == can::MessageType::RemoteRequest) {
-        out.present = true;
+        out.key = "remote";
         RemoteRequest request;
         const RemoteMessageError error = decodeRequest(frame.data(), frame.length(), request);
         if (error != RemoteMessageError::None) {
@@ -102,7 +157,7 @@ RemoteDecoding decodedRemote(const can::MessageIdentifier& id, const can::CanFra
                     {"object", request.object},
                     {"argument", request.argument}};
     } else if (id.type() == can::MessageType::RemoteReply) {
-        out.present = true;
+        out.key = "remote";
         RemoteReply reply;
         const RemoteMessageError error = decodeReply(frame.data(), frame.length(), reply);
         if (error != RemoteMessageError::None) {
@@ -123,8 +178,8 @@ RemoteDecoding decodedRemote(const can::MessageIdentifier& id, const can::CanFra
 
 // What the DCOS identifier layout says of a frame, or an empty string for a
 // frame that is not a DCOS frame (standard, remote, unassigned type); for a
-// remote transaction, what its data says too.
-std::string decoded(const can::CanFrame& frame)
+// remote transaction or a publication, what its data says too.
+std::string decoded(const can::CanFrame& frame, PublicationPages& pages)
 {
     const can::LinkResult<can::MessageIdentifier> id = can::MessageIdentifier::fromFrame(frame);
     if (!id.ok()) {
@@ -133,14 +188,14 @@ std::string decoded(const can::CanFrame& frame)
     const can::MessageIdentifier& m = id.value();
     std::string text = fmt::format("prio {} {} {}->{}", m.priority(), can::messageTypeName(m.type()), m.source(),
                                    m.isBroadcast() ? std::string("all") : std::to_string(m.destination()));
-    const RemoteDecoding remote = decodedRemote(m, frame);
-    if (remote.present) {
-        text += ": " + remote.text;
+    const DataDecoding data = decodedData(m, frame, pages);
+    if (data.key != nullptr) {
+        text += ": " + data.text;
     }
     return text;
 }
 
-nlohmann::json frameJson(const Received& r, const std::string& interface, bool decode)
+nlohmann::json frameJson(const Received& r, const std::string& interface, bool decode, PublicationPages& pages)
 {
     nlohmann::json j{{"interface", interface},
                      {"timestamp_ns", r.timestamp.count()},
@@ -162,9 +217,9 @@ nlohmann::json frameJson(const Received& r, const std::string& interface, bool d
                          {"type", can::messageTypeName(id.value().type())},
                          {"source", id.value().source()},
                          {"destination", id.value().destination()}};
-            const RemoteDecoding remote = decodedRemote(id.value(), r.frame);
-            if (remote.present) {
-                j["dcos"]["remote"] = remote.json;
+            const DataDecoding data = decodedData(id.value(), r.frame, pages);
+            if (data.key != nullptr) {
+                j["dcos"][data.key] = data.json;
             }
         }
     }
@@ -182,6 +237,7 @@ int dump(hostcan::Transport& transport, const DumpOptions& options, bool json)
 {
     const auto deadline = Clock::now() + std::chrono::milliseconds(options.timeoutMs);
     long shown = 0;
+    PublicationPages pages;
     while (options.count == 0 || shown < options.count) {
         auto wait = std::chrono::milliseconds(200);
         if (options.timeoutMs > 0) {
@@ -201,14 +257,14 @@ int dump(hostcan::Transport& transport, const DumpOptions& options, bool json)
         }
         const double seconds = std::chrono::duration<double>(r.timestamp).count();
         if (json) {
-            fmt::print("{}\n", frameJson(r, transport.name(), options.decode).dump());
+            fmt::print("{}\n", frameJson(r, transport.name(), options.decode, pages).dump());
         } else if (r.kind == Received::Kind::Event) {
             fmt::print(" ({:.6f})  {}  ERROR  {}  {}\n", seconds, transport.name(), hostcan::busEventName(r.event),
                        r.detail);
         } else {
             char text[can::FrameText::kMaxFormattedLength + 1];
             (void)can::FrameText::format(r.frame, text, sizeof text);
-            const std::string annotation = options.decode ? decoded(r.frame) : std::string();
+            const std::string annotation = options.decode ? decoded(r.frame, pages) : std::string();
             fmt::print(" ({:.6f})  {}  {}{}{}\n", seconds, transport.name(), text, annotation.empty() ? "" : "  ; ",
                        annotation);
         }

@@ -153,6 +153,12 @@ public:
     /// mapped to no address; Unreachable when none of its addresses leads
     /// anywhere. Open to every task and to interrupt handlers.
     static Result<NextHop> Resolve(uint16_t node);
+    /// The reverse mapping (seed 7.13): the logical node that sent from
+    /// physical address @p physical on interface @p interface, the node
+    /// mapped onto the neighbour's network address there. A multi-homed
+    /// node is found on each of its interfaces. NotFound when the tables
+    /// do not know the sender. Open to every task and to interrupt handlers.
+    static Result<uint16_t> NodeAt(uint8_t interface, uint32_t physical);
 };
 
 } // namespace dcos

@@ -29,6 +29,7 @@ namespace dcos {
 enum class SystemMessageType : uint8_t {
     RemoteReply = 0x10,
     RemoteRequest = 0x11,
+    DsmPublication = 0x20, ///< A part of a publication, to the broadcast address (docs/protocols/publications.md).
 };
 
 /// One system message as a link carries it.
@@ -46,6 +47,9 @@ struct SystemMessage {
 
 class NetworkLink {
 public:
+    /// The destination of a message for every node on the link's network.
+    static constexpr uint32_t kBroadcast = 0xFFFFFFFF;
+
     /// Begins delivery: post @p receiveEvent to task @p receiver whenever a
     /// message may be waiting. @p ownPhysical is the interface's own
     /// physical address: the link passes on only messages to it or to the

@@ -27,6 +27,17 @@
 // mix of two. The copy is a fixed 16 bytes, so holding interrupts off for it
 // costs O(1). The dual-processor board will need a spinlock around the same
 // critical sections.
+//
+// Publications over the network (seed 7.10, Fig. 7.12;
+// docs/protocols/publications.md). A publisher of Global visibility is
+// published on every attached link at each Write, at the writer's
+// priority, after the local hand-over and with interrupts enabled (an
+// interrupt handler's Write is published by the network receiver task, as
+// it cannot use a driver). The other side keeps remote publishers: a
+// subscription to another node's publisher points at one of them, a
+// PublisherObject like a local one, so Read is the same code, fast path
+// included. The network receiver task fills it from the frames it
+// reassembles, once per publication whichever bus brought it first.
 #include <dcos/DsmAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/DsmManager.hpp>
@@ -39,6 +50,10 @@
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/WaitQueue.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
+#include <dcos/internal/PublicationMessage.hpp>
+#include <dcos/internal/RemoteAgent.hpp>
+#include <dcos/internal/RemoteForward.hpp>
+#include <dcos/TimerAgent.hpp>
 
 #include <arch_x86/Cpu.hpp>
 
@@ -46,9 +61,17 @@ namespace dcos::internal {
 
 namespace {
 
+// Why a Write cannot take the fast path: the publisher is being deleted,
+// or its Writes go out on the network too.
+constexpr uint8_t kDying = 0x01;     ///< Being deleted: refused as stale while its readers are woken.
+constexpr uint8_t kNetworked = 0x02; ///< Global visibility: every Write is published on the links.
+
 struct PublisherObject {
     ObjectId id;
-    bool dying = false;       ///< Being deleted: refused as stale while its readers are woken.
+    uint8_t slowWrite = 0;    ///< kDying, kNetworked.
+    bool publishPending = false; ///< An interrupt handler wrote it; the network receiver publishes it.
+    uint8_t priority = 0;     ///< The last writing task's priority: the bus priority of its publications.
+    Visibility visibility = Visibility::Local;
     uint32_t incarnation = 0; ///< Advanced by every Delete of this slot; never reset.
     uint32_t dataId = kNoDsmData;
     DsmPage page{};
@@ -76,6 +99,18 @@ PublisherObject publishers[kPublisherCapacity];
 ObjectTable<SubscriptionObject, kSubscriptionCapacity, TaskOwnerKeys> subscriptionTable(ObjectType::DsmSubscription, 0);
 bool started = false;
 
+// Another node's publisher that subscriptions of this node's tasks read.
+struct RemotePublisher {
+    PublisherObject publisher;  // Its id is the remote publisher's; it is in no table.
+    uint16_t subscriptions = 0; // Open through it; the slot is free at 0.
+    bool withdrawn = false;     // Its node deleted it: its subscriptions read Deleted.
+    PublicationFilter filter;
+    PublicationAssembler assemblers[kNetworkInterfaces];
+};
+
+RemotePublisher remotePublishers[kRemotePublishers];
+DsmNetworkStatistics networkCounters;
+
 size_t publisherSlotOf(ObjectId id) { return publisherTable.slotNumber(id); }
 
 // Activates the boot-time slots and takes the board's node id on the first
@@ -100,7 +135,7 @@ Result<PublisherObject*> resolvePublisher(ObjectId id)
     if (!entry.ok()) {
         return entry.status();
     }
-    if ((*entry.value())->dying) {
+    if (((*entry.value())->slowWrite & kDying) != 0) {
         return Status::StaleId;
     }
     return *entry.value();
@@ -135,16 +170,66 @@ Result<SubscriptionObject*> resolveOwnSubscription(ObjectId id)
 // therefore invalid and the publisher marked dying before the first wake,
 // so it cannot wait again or open a new subscription, and the slot is
 // freed last, so no new publisher can take it while waking is under way.
+//
+// A networked publisher's subscribers on other nodes are told with a
+// withdrawal, sent here with interrupts still disabled (recovery walks the
+// table under its guard); the link only queues it.
 void destroy(PublisherObject& publisher, ObjectId id)
 {
-    publisher.dying = true;
+    const bool networked = (publisher.slowWrite & kNetworked) != 0;
+    publisher.slowWrite = kDying;
     publisher.incarnation = publisher.incarnation + 1;
     TaskManager::wakeAll(publisher.readers, Status::Deleted);
     publisher.dataId = kNoDsmData;
     publisher.page = DsmPage{};
     publisher.id = ObjectId::null();
-    publisher.dying = false;
+    publisher.publishPending = false;
+    publisher.slowWrite = 0;
     (void)publisherTable.Delete(id);
+    if (networked) {
+        sendWithdrawal(id, publisher.visibility, publisher.priority);
+    }
+}
+
+// The remote publisher @p subscription reads, or null for a local one.
+RemotePublisher* remoteOf(const SubscriptionObject& subscription)
+{
+    const auto* first = &remotePublishers[0].publisher;
+    const auto* last = &remotePublishers[kRemotePublishers - 1].publisher;
+    if (subscription.publisher < first || subscription.publisher > last) {
+        return nullptr;
+    }
+    for (RemotePublisher& remote : remotePublishers) {
+        if (&remote.publisher == subscription.publisher) {
+            return &remote;
+        }
+    }
+    return nullptr;
+}
+
+// A subscription is going: the remote publisher it read loses one, and is
+// free again when it has none left. Under the guard.
+void releaseRemote(const SubscriptionObject& subscription)
+{
+    RemotePublisher* const remote = remoteOf(subscription);
+    if (remote == nullptr || remote->subscriptions == 0) {
+        return;
+    }
+    if (--remote->subscriptions == 0) {
+        remote->publisher.id = ObjectId::null();
+        remote->publisher.incarnation = remote->publisher.incarnation + 1;
+    }
+}
+
+// The live remote publisher for @p id, or null. O(kRemotePublishers), under the guard.
+RemotePublisher* findRemote(ObjectId id)
+{
+    for (RemotePublisher& remote : remotePublishers) {
+        if (remote.subscriptions != 0 && !remote.withdrawn && remote.publisher.id == id) {
+            return &remote;
+        }
+    }
+    return nullptr;
 }
 
 unsigned recoverDsm(ObjectId deadTask)
@@ -153,12 +238,102 @@ unsigned recoverDsm(ObjectId deadTask)
     start();
     const size_t publishersRecovered = publisherTable.forEachOwnedBy(
         deadTask, [](ObjectId id, PublisherObject*& publisher) { destroy(*publisher, id); });
-    const size_t subscriptionsRecovered = subscriptionTable.forEachOwnedBy(
-        deadTask, [](ObjectId id, SubscriptionObject&) { (void)subscriptionTable.Delete(id); });
+    const size_t subscriptionsRecovered =
+        subscriptionTable.forEachOwnedBy(deadTask, [](ObjectId id, SubscriptionObject& subscription) {
+            releaseRemote(subscription);
+            (void)subscriptionTable.Delete(id);
+        });
     return static_cast<unsigned>(publishersRecovered + subscriptionsRecovered);
 }
 
+// Takes @p page into @p publisher with the next data identifier, which it
+// returns, and hands it to the waiting readers. Under the guard.
+uint32_t publishLocally(PublisherObject& publisher, const DsmPage& page)
+{
+    copySixteenBytes(publisher.page.bytes, page.bytes);
+    publisher.dataId = nextDataId(publisher.dataId);
+    // Every reader that began to wait before this Write gets the page. A
+    // woken reader more urgent than the writer runs at once, inside this
+    // loop, and may Read again and wait again, or an interrupt handler may
+    // Write again. Such a reader joins the queue behind those still to be
+    // served (first come first served), having waited at the latest
+    // identifier, and the loop stops at it: nobody is served twice with the
+    // same page, and every reader gets the latest page at its hand-over.
+    while (!publisher.readers.isEmpty()) {
+        Task& reader = publisher.readers.first();
+        ReadRequest& request = *reinterpret_cast<ReadRequest*>(reader.waitData);
+        if (request.blockedAt == publisher.dataId) {
+            break;
+        }
+        *request.page = publisher.page;
+        request.dataId = publisher.dataId;
+        TaskManager::wakeFirst(publisher.readers, Status::Ok);
+    }
+    return publisher.dataId;
+}
+
+// DsmAgent::Open for another node's publisher: a subscription to a remote
+// publisher of this node, once the publisher's node has said it exists
+// and may be read from here.
+Result<ObjectId> openRemote(ObjectId publisherId)
+{
+    if (publisherId.type() != ObjectType::DsmPublisher) {
+        return Status::WrongType;
+    }
+    // The subscription is made first, owned by the caller, so that a caller
+    // killed while it waits for the publisher's node leaves nothing behind:
+    // recovery closes it like any other. The remote publisher is taken
+    // first too, so that the page the publisher's node sends again on
+    // receiving the request finds it.
+    ObjectId subscriptionId;
+    {
+        arch_x86::InterruptGuard guard;
+        start();
+        RemotePublisher* remote = findRemote(publisherId);
+        if (remote == nullptr) {
+            for (RemotePublisher& candidate : remotePublishers) {
+                if (candidate.subscriptions == 0) {
+                    remote = &candidate;
+                    break;
+                }
+            }
+            if (remote == nullptr) {
+                ++networkCounters.noRemotePublisher;
+                return Status::TableFull;
+            }
+            remote->publisher.id = publisherId;
+            remote->publisher.dataId = kNoDsmData;
+            remote->publisher.page = DsmPage{};
+            remote->withdrawn = false;
+            remote->filter.reset();
+            for (PublicationAssembler& assembler : remote->assemblers) {
+                assembler.reset();
+            }
+        }
+        const Result<ObjectId> id = subscriptionTable.Create(currentTaskId(), nullptr, Visibility::Local);
+        if (!id.ok()) {
+            return id.status();
+        }
+        subscriptionId = id.value();
+        ++remote->subscriptions;
+        *subscriptionTable.resolve(subscriptionId).value() =
+            SubscriptionObject{&remote->publisher, remote->publisher.incarnation};
+    }
+    const Result<uint32_t> opened = forwardRemote(RemoteService::DsmOpen, publisherId, 0);
+    if (opened.ok()) {
+        return subscriptionId;
+    }
+    arch_x86::InterruptGuard guard;
+    const Result<SubscriptionObject*> subscription = resolveSubscription(subscriptionId);
+    if (subscription.ok()) {
+        releaseRemote(*subscription.value());
+        (void)subscriptionTable.Delete(subscriptionId);
+    }
+    return opened.status();
+}
+
 } // namespace
+
 
 size_t DsmManager::publisherCount()
 {
@@ -172,6 +347,112 @@ size_t DsmManager::subscriptionCount()
     arch_x86::InterruptGuard guard;
     start();
     return subscriptionTable.usedCount();
+}
+
+void DsmManager::deliverPublication(uint8_t interface, uint16_t node, const PublicationPart& part, uint64_t nowNs)
+{
+    arch_x86::InterruptGuard guard;
+    start();
+    RemotePublisher* const remote = findRemote(publisherOn(node, part.index));
+    if (remote == nullptr || interface >= kNetworkInterfaces) {
+        ++networkCounters.unsubscribed; // Nobody here reads it: the common case of a broadcast.
+        return;
+    }
+    if (part.kind == PublicationPartKind::Withdrawal) {
+        ++networkCounters.withdrawals;
+        remote->withdrawn = true;
+        remote->publisher.incarnation = remote->publisher.incarnation + 1;
+        TaskManager::wakeAll(remote->publisher.readers, Status::Deleted);
+        return;
+    }
+    PublicationAssembler& assembler = remote->assemblers[interface];
+    switch (assembler.take(part)) {
+    case PublicationAssembler::Outcome::Gathering: return;
+    case PublicationAssembler::Outcome::Dropped: ++networkCounters.torn; return;
+    case PublicationAssembler::Outcome::Complete: break;
+    }
+    if (!remote->filter.take(assembler.sequence(), nowNs)) {
+        ++networkCounters.duplicates;
+        return;
+    }
+    ++networkCounters.received;
+    (void)publishLocally(remote->publisher, assembler.page());
+}
+
+Result<uint32_t> DsmManager::serveRemoteOpen(ObjectId publisherId, bool withinController)
+{
+    DsmPage page;
+    uint32_t dataId;
+    Visibility visibility;
+    {
+        arch_x86::InterruptGuard guard;
+        start();
+        const Result<PublisherObject*> publisher = resolvePublisher(publisherId);
+        if (!publisher.ok()) {
+            return publisher.status();
+        }
+        // Visibility (seed 6.4): a local publisher is this node's alone, a
+        // regional one the controller's.
+        visibility = publisher.value()->visibility;
+        if (visibility == Visibility::Local || (visibility == Visibility::Regional && !withinController)) {
+            return Status::NotPermitted;
+        }
+        dataId = publisher.value()->dataId;
+        copySixteenBytes(page.bytes, publisher.value()->page.bytes);
+    }
+    if (dataId != kNoDsmData) {
+        // The new subscriber's node has the latest page at once, not at the
+        // next Write; the others drop it as a duplicate.
+        sendPublication(publisherId, visibility, dataId, page, Scheduler::current().priority);
+    }
+    return dataId;
+}
+
+void DsmManager::publishDeferred()
+{
+    // O(publishers): only an interrupt handler's Write asks for this.
+    for (PublisherObject& publisher : publishers) {
+        DsmPage page;
+        uint32_t dataId;
+        ObjectId id;
+        Visibility visibility;
+        uint8_t priority;
+        {
+            arch_x86::InterruptGuard guard;
+            if (!publisher.publishPending) {
+                continue;
+            }
+            publisher.publishPending = false;
+            id = publisher.id;
+            dataId = publisher.dataId;
+            visibility = publisher.visibility;
+            priority = publisher.priority;
+            copySixteenBytes(page.bytes, publisher.page.bytes);
+        }
+        sendPublication(id, visibility, dataId, page, priority);
+    }
+}
+
+DsmNetworkStatistics DsmManager::networkStatistics()
+{
+    arch_x86::InterruptGuard guard;
+    return internal::networkCounters;
+}
+
+RemotePublisherInfo DsmManager::remotePublisher(size_t slot)
+{
+    RemotePublisherInfo info;
+    if (slot >= kRemotePublishers) {
+        return info;
+    }
+    arch_x86::InterruptGuard guard;
+    const RemotePublisher& remote = remotePublishers[slot];
+    info.inUse = remote.subscriptions != 0;
+    info.publisher = remote.publisher.id;
+    info.subscriptions = remote.subscriptions;
+    info.withdrawn = remote.withdrawn;
+    info.dataId = remote.publisher.dataId;
+    return info;
 }
 
 DCOS_RESOURCE_RECOVERY(dsmRecovery, "distributed shared memory", recoverDsm);
@@ -205,6 +486,10 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Create(const char* name, V
     publisher.id = id.value();
     publisher.dataId = kNoDsmData;
     publisher.page = DsmPage{};
+    publisher.visibility = visibility;
+    publisher.slowWrite = visibility == Visibility::Global ? internal::kNetworked : 0;
+    publisher.publishPending = false;
+    publisher.priority = internal::Scheduler::started() ? internal::Scheduler::current().priority : 0;
     *publisherTable.resolve(id.value()).value() = &publisher;
     return id.value();
 }
@@ -228,46 +513,49 @@ DCOS_CONFIGURATION_SERVICE Status DsmAgent::Delete(ObjectId id)
 
 namespace {
 
-// The next data identifier after @p dataId; kNoDsmData is skipped.
-uint32_t nextDataId(uint32_t dataId) { return dataId + 1 == kNoDsmData ? dataId + 2 : dataId + 1; }
 
 // The complete Write: every case, from the id. DsmAgent::Write's fast path
-// comes here for all it does not handle.
+// comes here for all it does not handle. A networked publisher's page goes
+// out on the links after the local hand-over, with interrupts enabled.
 [[gnu::noinline]] Result<uint32_t> writeFull(ObjectId id, const DsmPage* newPage)
 {
-    arch_x86::InterruptGuard guard;
-    start();
-    const Result<PublisherObject*> resolved = resolvePublisher(id);
-    if (!resolved.ok()) {
-        return resolved.status();
-    }
-    if (!internal::inInterruptContext()) {
-        const Status ownerCheck = publisherTable.checkOwner(id, internal::currentTaskId());
-        if (ownerCheck != Status::Ok) {
-            return ownerCheck; // Single writer: the owner, super user or not.
+    DsmPage published;
+    uint32_t written;
+    Visibility visibility;
+    uint8_t priority;
+    {
+        arch_x86::InterruptGuard guard;
+        start();
+        const Result<PublisherObject*> resolved = resolvePublisher(id);
+        if (!resolved.ok()) {
+            return resolved.status();
         }
-    }
-    PublisherObject& publisher = *resolved.value();
-    internal::copySixteenBytes(publisher.page.bytes, newPage->bytes);
-    publisher.dataId = nextDataId(publisher.dataId);
-    const uint32_t written = publisher.dataId;
-    // Every reader that began to wait before this Write gets the page. A
-    // woken reader more urgent than the writer runs at once, inside this
-    // loop, and may Read again and wait again, or an interrupt handler may
-    // Write again. Such a reader joins the queue behind those still to be
-    // served (first come first served), having waited at the latest
-    // identifier, and the loop stops at it: nobody is served twice with the
-    // same page, and every reader gets the latest page at its hand-over.
-    while (!publisher.readers.isEmpty()) {
-        internal::Task& reader = publisher.readers.first();
-        ReadRequest& request = *reinterpret_cast<ReadRequest*>(reader.waitData);
-        if (request.blockedAt == publisher.dataId) {
-            break;
+        const bool interrupt = internal::inInterruptContext();
+        if (!interrupt) {
+            const Status ownerCheck = publisherTable.checkOwner(id, internal::currentTaskId());
+            if (ownerCheck != Status::Ok) {
+                return ownerCheck; // Single writer: the owner, super user or not.
+            }
         }
-        *request.page = publisher.page;
-        request.dataId = publisher.dataId;
-        TaskManager::wakeFirst(publisher.readers, Status::Ok);
+        PublisherObject& publisher = *resolved.value();
+        written = internal::publishLocally(publisher, *newPage);
+        if ((publisher.slowWrite & internal::kNetworked) == 0) {
+            return written;
+        }
+        if (interrupt) {
+            // A handler cannot use a driver: the network receiver task
+            // publishes the page, the latest one when it comes to it.
+            publisher.publishPending = true;
+            ++internal::networkCounters.deferred;
+            internal::requestDeferredPublications();
+            return written;
+        }
+        publisher.priority = internal::Scheduler::current().priority;
+        internal::copySixteenBytes(published.bytes, publisher.page.bytes);
+        visibility = publisher.visibility;
+        priority = publisher.priority;
     }
+    internal::sendPublication(id, visibility, written, published, priority);
     return written;
 }
 
@@ -285,11 +573,11 @@ Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page)
         PublisherObject* const* found = publisherTable.find(id, owner);
         if (found != nullptr) [[likely]] {
             PublisherObject& publisher = **found;
-            if (!publisher.dying && publisher.readers.isEmpty()
+            if (publisher.slowWrite == 0 && publisher.readers.isEmpty()
                 && (internal::inInterruptContext()
                     || (internal::Scheduler::started() && owner == internal::Scheduler::current().id))) [[likely]] {
                 internal::copySixteenBytes(publisher.page.bytes, page.bytes);
-                const uint32_t written = nextDataId(publisher.dataId);
+                const uint32_t written = internal::nextDataId(publisher.dataId);
                 publisher.dataId = written;
                 return written;
             }
@@ -303,19 +591,27 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::Open(ObjectId publisherId)
     if (internal::inInterruptContext()) {
         return Status::InInterrupt;
     }
-    arch_x86::InterruptGuard guard;
-    start();
-    const Result<PublisherObject*> publisher = resolvePublisher(publisherId);
-    if (!publisher.ok()) {
-        return publisher.status();
+    {
+        arch_x86::InterruptGuard guard;
+        start();
+        const Result<PublisherObject*> publisher = resolvePublisher(publisherId);
+        if (publisher.status() != Status::Remote) {
+            if (!publisher.ok()) {
+                return publisher.status();
+            }
+            const Result<ObjectId> id =
+                subscriptionTable.Create(internal::currentTaskId(), nullptr, Visibility::Local);
+            if (!id.ok()) {
+                return id.status();
+            }
+            *subscriptionTable.resolve(id.value()).value() =
+                SubscriptionObject{publisher.value(), publisher.value()->incarnation};
+            return id.value();
+        }
     }
-    const Result<ObjectId> id = subscriptionTable.Create(internal::currentTaskId(), nullptr, Visibility::Local);
-    if (!id.ok()) {
-        return id.status();
-    }
-    *subscriptionTable.resolve(id.value()).value() =
-        SubscriptionObject{publisher.value(), publisher.value()->incarnation};
-    return id.value();
+    // Another node's publisher: asked for over the network, so with
+    // interrupts enabled.
+    return internal::openRemote(publisherId);
 }
 
 DCOS_CONFIGURATION_SERVICE Status DsmAgent::Close(ObjectId id)
@@ -325,6 +621,7 @@ DCOS_CONFIGURATION_SERVICE Status DsmAgent::Close(ObjectId id)
     if (!subscription.ok()) {
         return subscription.status();
     }
+    internal::releaseRemote(*subscription.value());
     return subscriptionTable.Delete(id);
 }
 

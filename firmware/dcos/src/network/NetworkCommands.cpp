@@ -3,6 +3,7 @@
 // runs as, changes them. Output is one entry per line, so the lab's tests
 // and a control engineer's scripts can read it.
 #include <dcos/NetworkInterfacesManager.hpp>
+#include <dcos/internal/DsmManager.hpp>
 #include <dcos/internal/IdText.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/NetworkTables.hpp>
@@ -129,6 +130,8 @@ void listRemote(shell::Shell& shell)
         {"duplicates", s.duplicates},     {"refused-busy", s.refusedBusy},
         {"abandoned", s.abandoned},
         {"malformed", s.malformed},       {"send-failures", s.sendFailures},
+        {"publications-sent", s.publicationsSent}, {"publication-parts", s.publicationParts},
+        {"unknown-senders", s.unknownSenders},
     };
     for (const auto& counter : counters) {
         shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));
@@ -143,6 +146,33 @@ void listRemote(shell::Shell& shell)
     }
 }
 
+// Publications over the network: the receiving side's counters, then the
+// other nodes' publishers this node's tasks read.
+void listPublications(shell::Shell& shell)
+{
+    const DsmNetworkStatistics s = DsmManager::networkStatistics();
+    const struct {
+        const char* name;
+        uint32_t value;
+    } counters[] = {
+        {"received", s.received},         {"duplicates", s.duplicates},
+        {"torn", s.torn},                 {"unsubscribed", s.unsubscribed},
+        {"withdrawals", s.withdrawals},   {"deferred", s.deferred},
+        {"no-remote-publisher", s.noRemotePublisher},
+    };
+    for (const auto& counter : counters) {
+        shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));
+    }
+    for (size_t slot = 0; slot < kRemotePublishers; ++slot) {
+        const RemotePublisherInfo remote = DsmManager::remotePublisher(slot);
+        if (remote.inUse) {
+            shell.print("  publisher %s  subscriptions %u  data %lu%s\r\n", IdText(remote.publisher).c_str(),
+                        unsigned(remote.subscriptions), static_cast<unsigned long>(remote.dataId),
+                        remote.withdrawn ? "  withdrawn" : "");
+        }
+    }
+}
+
 shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
 {
     if (argc == 1) {
@@ -151,6 +181,10 @@ shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
     }
     if (argc == 2 && textEquals(argv[1], "remote")) {
         listRemote(shell);
+        return shell::CommandResult::Ok;
+    }
+    if (argc == 2 && textEquals(argv[1], "publications")) {
+        listPublications(shell);
         return shell::CommandResult::Ok;
     }
     const bool remove = argc >= 3 && textEquals(argv[2], "remove");
@@ -210,7 +244,7 @@ shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
 
 DCOS_SHELL_COMMAND_DETAILED(
     netCommand, "net", "network interfaces manager: list, resolve or change the tables",
-    "net [remote | resolve NODE | interface can|modbus|shm CHANNEL A.B.C.D/LEN PHYSICAL | interface remove N"
+    "net [remote | publications | resolve NODE | interface can|modbus|shm CHANNEL A.B.C.D/LEN PHYSICAL | interface remove N"
     " | map|unmap NODE A.B.C.D | neighbour A.B.C.D PHYSICAL | neighbour remove A.B.C.D"
     " | route A.B.C.D/LEN GATEWAY | route remove A.B.C.D/LEN]",
     "  interfaces: number, kind, channel, own address/subnet prefix, own physical address\r\n"
@@ -218,6 +252,7 @@ DCOS_SHELL_COMMAND_DETAILED(
     "  neighbours: a network address on a local subnet and its physical address\r\n"
     "  routes: a destination subnet and the gateway it goes through\r\n"
     "  remote: the remote agent's counters and the remote transactions under way\r\n"
+    "  publications: publications received from other nodes, and their publishers read here\r\n"
     "  changing the tables needs a super user (the console is one)",
     net);
 

@@ -98,6 +98,12 @@ Result<NextHop> NetworkInterfacesManager::Resolve(uint16_t node)
     return tables.resolve(node, internal::localNode());
 }
 
+Result<uint16_t> NetworkInterfacesManager::NodeAt(uint8_t interface, uint32_t physical)
+{
+    Lock lock;
+    return tables.nodeAt(interface, physical);
+}
+
 namespace internal {
 
 void copyNetworkTables(NetworkTables& copy)

@@ -5,7 +5,9 @@
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/DsmManager.hpp>
 #include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/PublicationMessage.hpp>
 #include <dcos/internal/RemoteAgent.hpp>
 #include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/Scheduler.hpp>
@@ -36,7 +38,9 @@ NetworkLink* links[kNetworkInterfaces];
 
 // The interface's event for the receiver task: bit n for interface n.
 constexpr uint32_t eventOf(uint8_t interface) { return 1u << interface; }
-static_assert(kNetworkInterfaces <= 32);
+// The receiver's event for publications written by interrupt handlers.
+constexpr uint32_t kDeferredPublicationsEvent = 1u << 31;
+static_assert(kNetworkInterfaces <= 31);
 
 // ---- the requesting side ----------------------------------------------------
 
@@ -90,8 +94,8 @@ ObjectId receiverTask;
 
 // Sends @p data as a message of @p type over @p interface's link; false
 // when the interface has no link or its queue is full. Task context.
-bool sendMessage(uint8_t interface, SystemMessageType type, uint8_t priority, uint32_t destination,
-                 const uint8_t (&data)[kRemoteMessageBytes])
+bool sendBytes(uint8_t interface, SystemMessageType type, uint8_t priority, uint32_t destination,
+               const uint8_t* data, uint8_t length)
 {
     NetworkLink* link;
     {
@@ -105,14 +109,33 @@ bool sendMessage(uint8_t interface, SystemMessageType type, uint8_t priority, ui
     message.priority = priority;
     message.type = type;
     message.destination = destination;
-    message.length = kRemoteMessageBytes;
-    __builtin_memcpy(message.data, data, kRemoteMessageBytes);
+    message.length = length;
+    __builtin_memcpy(message.data, data, length);
     if (link->Send(message) != Status::Ok) {
         Lock lock;
         ++statistics.sendFailures;
         return false;
     }
     return true;
+}
+
+bool sendMessage(uint8_t interface, SystemMessageType type, uint8_t priority, uint32_t destination,
+                 const uint8_t (&data)[kRemoteMessageBytes])
+{
+    return sendBytes(interface, type, priority, destination, data, kRemoteMessageBytes);
+}
+
+// Whether a publisher of @p visibility is published over @p interface.
+bool reaches(Visibility visibility, uint8_t interface)
+{
+    if (visibility == Visibility::Global) {
+        return true;
+    }
+    if (visibility == Visibility::Local) {
+        return false;
+    }
+    const Result<NetworkInterface> entry = NetworkInterfacesManager::GetInterface(interface);
+    return entry.ok() && entry.value().kind == InterfaceKind::SharedMemory;
 }
 
 void sendReply(uint8_t interface, uint8_t priority, uint32_t destination, const RemoteReply& reply)
@@ -251,6 +274,27 @@ void onReply(uint8_t interface, const SystemMessage& message)
     slot.status = reply.status;
     slot.value = reply.value;
     (void)TaskManager::wakeFirst(slot.waiter, Status::Ok);
+}
+
+// A publication frame arrived on @p interface.
+void onPublication(uint8_t interface, const SystemMessage& message)
+{
+    PublicationPart part;
+    if (decodePublicationPart(message.data, message.length, part) != PublicationMessageError::None) {
+        Lock lock;
+        ++statistics.malformed;
+        return;
+    }
+    const Result<uint16_t> node = NetworkInterfacesManager::NodeAt(interface, message.source);
+    {
+        Lock lock;
+        ++statistics.publicationParts;
+        if (!node.ok()) {
+            ++statistics.unknownSenders;
+            return;
+        }
+    }
+    DsmManager::deliverPublication(interface, node.value(), part, TimerAgent::Uptime());
 }
 
 // ---- the serving side ---------------------------------------------------------
@@ -442,6 +486,12 @@ RemoteReply perform(const RemoteRequest& request, const ServedEntry& entry)
     case RemoteService::TaskGetState: replyWith(reply, TaskAgent::GetState(id)); break;
     case RemoteService::TaskGetPriority: replyWith(reply, TaskAgent::GetPriority(id)); break;
     case RemoteService::SemaphoreGetHolder: replyWith(reply, SemaphoreAgent::GetHolder(id)); break;
+    case RemoteService::DsmOpen: {
+        const Result<NetworkInterface> arrived = NetworkInterfacesManager::GetInterface(entry.interface);
+        const bool withinController = arrived.ok() && arrived.value().kind == InterfaceKind::SharedMemory;
+        replyWith(reply, DsmManager::serveRemoteOpen(id, withinController));
+        break;
+    }
     }
     // The object is this node's, so a Remote status cannot come back; were
     // it to, the requester must not take it for its own "no network".
@@ -506,9 +556,13 @@ void receiverEntry(uintptr_t)
 {
     constexpr uint32_t kAllLinks = (kNetworkInterfaces >= 32) ? ~0u : ((1u << kNetworkInterfaces) - 1);
     for (;;) {
-        const Result<uint32_t> events = TaskAgent::ReceiveEvent(kAllLinks, EventWait::Any, kWaitForever);
+        const Result<uint32_t> events =
+            TaskAgent::ReceiveEvent(kAllLinks | kDeferredPublicationsEvent, EventWait::Any, kWaitForever);
         if (!events.ok()) {
             continue;
+        }
+        if ((events.value() & kDeferredPublicationsEvent) != 0) {
+            DsmManager::publishDeferred();
         }
         for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
             if ((events.value() & eventOf(interface)) == 0) {
@@ -530,10 +584,10 @@ void receiverEntry(uintptr_t)
                 if (!got.ok() || !got.value()) {
                     break;
                 }
-                if (message.type == SystemMessageType::RemoteReply) {
-                    onReply(interface, message);
-                } else {
-                    onRequest(interface, message);
+                switch (message.type) {
+                case SystemMessageType::RemoteReply: onReply(interface, message); break;
+                case SystemMessageType::RemoteRequest: onRequest(interface, message); break;
+                case SystemMessageType::DsmPublication: onPublication(interface, message); break;
                 }
             }
         }
@@ -603,6 +657,50 @@ RemoteCallInfo remoteCall(size_t slot)
     info.interface = call.interface;
     info.peer = call.peer;
     return info;
+}
+
+void sendPublication(ObjectId publisher, Visibility visibility, uint32_t dataId, const DsmPage& page,
+                     uint8_t priority)
+{
+    uint8_t frames[kPublicationFrames][kPublicationFrameBytes];
+    encodePublication(publicationIndexOf(publisher), dataId, page, frames);
+    for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
+        if (!reaches(visibility, interface)) {
+            continue;
+        }
+        // The three parts in a row: a part the link did not take leaves a
+        // publication the receivers drop, so the rest is not sent.
+        bool whole = true;
+        for (size_t part = 0; part < kPublicationFrames && whole; ++part) {
+            whole = sendBytes(interface, SystemMessageType::DsmPublication, priority, NetworkLink::kBroadcast,
+                              frames[part], kPublicationFrameBytes);
+        }
+        if (whole) {
+            Lock lock;
+            ++statistics.publicationsSent;
+        }
+    }
+}
+
+void sendWithdrawal(ObjectId publisher, Visibility visibility, uint8_t priority)
+{
+    uint8_t frame[kWithdrawalBytes];
+    encodeWithdrawal(publicationIndexOf(publisher), frame);
+    for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
+        if (reaches(visibility, interface) &&
+            sendBytes(interface, SystemMessageType::DsmPublication, priority, NetworkLink::kBroadcast, frame,
+                      kWithdrawalBytes)) {
+            Lock lock;
+            ++statistics.publicationsSent;
+        }
+    }
+}
+
+void requestDeferredPublications()
+{
+    if (started) {
+        (void)TaskAgent::PostEvent(receiverTask, kDeferredPublicationsEvent);
+    }
 }
 
 void detachRemoteLink(uint8_t interface)

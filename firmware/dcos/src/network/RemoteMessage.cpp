@@ -45,6 +45,7 @@ const char* remoteServiceName(RemoteService service)
     case RemoteService::TaskGetState: return "state";
     case RemoteService::TaskGetPriority: return "priority";
     case RemoteService::SemaphoreGetHolder: return "holder";
+    case RemoteService::DsmOpen: return "dsm-open";
     }
     return "?";
 }

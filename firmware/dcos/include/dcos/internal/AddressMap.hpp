@@ -201,6 +201,30 @@ public:
         }
     }
 
+    /// NetworkInterfacesManager::NodeAt: the logical node whose network
+    /// address, in interface @p interface's subnet, has physical address
+    /// @p physical. NotFound when no neighbour there has it or no node is
+    /// mapped onto its address. O(neighbours + node addresses).
+    Result<uint16_t> nodeAt(uint8_t interface, uint32_t physical) const
+    {
+        if (interface >= kInterfaces || !interfaceUsed_[interface]) {
+            return Status::NotFound;
+        }
+        const NetworkInterface& local = interfaces_[interface];
+        for (size_t n = 0; n < kNeighbours; ++n) {
+            if (!neighbourUsed_[n] || neighbours_[n].physical != physical ||
+                !neighbours_[n].address.isIn(local.address, local.prefixLength)) {
+                continue;
+            }
+            for (size_t i = 0; i < kNodeAddresses; ++i) {
+                if (nodeUsed_[i] && nodes_[i].address == neighbours_[n].address) {
+                    return nodes_[i].node;
+                }
+            }
+        }
+        return Status::NotFound;
+    }
+
     /// Visits every entry of each table, for listings: @p visit(entry) with
     /// the interface's number first for interfaces.
     template <typename Visit>

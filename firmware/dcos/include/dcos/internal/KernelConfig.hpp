@@ -175,7 +175,17 @@ static_assert(kSubscriptionsActiveAtBoot <= kSubscriptionCapacity && kSubscripti
 #define DCOS_CONFIG_REMOTE_SILENT_PERIODS 4
 #endif
 
+// Publications over the network (seed 7.10): the other nodes' publishers
+// this node's tasks may hold subscriptions to at once. Each keeps the
+// latest page received, with one reassembly per interface.
+#ifndef DCOS_CONFIG_REMOTE_PUBLISHERS
+#define DCOS_CONFIG_REMOTE_PUBLISHERS 16
+#endif
+
 namespace dcos::internal {
+
+constexpr size_t kRemotePublishers = DCOS_CONFIG_REMOTE_PUBLISHERS;
+static_assert(kRemotePublishers >= 1 && kRemotePublishers <= 255, "DCOS_CONFIG_REMOTE_PUBLISHERS: 1 to 255");
 
 constexpr size_t kRemoteCalls = DCOS_CONFIG_REMOTE_CALLS;
 constexpr size_t kRemoteServed = DCOS_CONFIG_REMOTE_SERVED;

@@ -30,9 +30,11 @@
 // hold a worker for ever.
 #pragma once
 
+#include <dcos/DsmAgent.hpp>
 #include <dcos/NetworkLink.hpp>
 #include <dcos/ObjectId.hpp>
 #include <dcos/Status.hpp>
+#include <dcos/Visibility.hpp>
 #include <dcos/internal/RemoteMessage.hpp>
 
 #include <stdint.h>
@@ -56,6 +58,10 @@ struct RemoteStatistics {
     uint32_t abandoned = 0;       ///< Waits ended because their requester went silent (gave up or died).
     uint32_t malformed = 0;       ///< Messages that did not decode (see RemoteMessageError).
     uint32_t sendFailures = 0;    ///< Messages a link did not take (its queue full).
+    // Publications (docs/protocols/publications.md).
+    uint32_t publicationsSent = 0; ///< Publications and withdrawals queued whole, counted once per link.
+    uint32_t publicationParts = 0; ///< Publication frames received and decoded.
+    uint32_t unknownSenders = 0;   ///< Publication frames from a physical address the tables map to no node.
 };
 
 /// Counters since boot. O(1).
@@ -76,6 +82,19 @@ struct RemoteCallInfo {
 
 /// The call slot @p slot (0 to kRemoteCalls - 1). O(1).
 RemoteCallInfo remoteCall(size_t slot);
+
+/// Publishes @p page, the Write of @p publisher with data identifier
+/// @p dataId, on every attached link its visibility reaches (Global: all;
+/// Regional: the controller's own, the shared-memory links), at bus
+/// priority @p priority. Nothing when the remote agent has not started.
+/// Task context; the link only queues the frames.
+void sendPublication(ObjectId publisher, Visibility visibility, uint32_t dataId, const DsmPage& page,
+                     uint8_t priority);
+/// Tells the same links that @p publisher is deleted.
+void sendWithdrawal(ObjectId publisher, Visibility visibility, uint8_t priority);
+/// Asks the receiver task to publish what interrupt handlers wrote
+/// (DsmManager::publishDeferred). Interrupt context.
+void requestDeferredPublications();
 
 /// Detaches the link of @p interface if it has one; for RemoveInterface,
 /// under nothing (task context).

@@ -41,10 +41,13 @@ enum class RemoteService : uint8_t {
     TaskGetState = 6,      ///< argument: 0; value: the TaskState.
     TaskGetPriority = 7,   ///< argument: 0; value: the static priority.
     SemaphoreGetHolder = 8, ///< argument: 0; value: the holding task's id (0: free).
+    /// argument: 0; value: the publisher's data identifier. The publisher
+    /// sends its latest page again (docs/protocols/publications.md).
+    DsmOpen = 9,
 };
 
 /// The last service value assigned.
-constexpr uint8_t kLastRemoteService = 8;
+constexpr uint8_t kLastRemoteService = 9;
 
 /// A short name of a service, for the console and logs.
 const char* remoteServiceName(RemoteService service);

@@ -1,0 +1,189 @@
+"""Publications over the network (dissertation 7.10, Fig. 7.12) between emulated 486 boards on two CAN buses.
+
+Two boards, node 1 and node 2, each with CAN channel 0 on the lab bus can0
+and channel 1 on can1, attached to the network interfaces manager as
+interfaces 0 and 1 (each node multi-homed, one subnet per bus). A global
+publisher on one board is published on both buses at each Write
+(docs/protocols/publications.md); a task on the other board opens a
+subscription to it by id and reads every page. The test image's `pubsub`
+command (tests_renode/target/PublicationsTest.cpp) writes pages whose
+four words derive from one counter, so the reading task tells a whole page
+from a torn one, and counts repeats (a duplicate or old page, which a
+subscriber must never see) and gaps (writes it missed).
+
+Times are emulated (-icount, the hub's timing model); every wait has a
+generous time-out that bounds a hung board, not a speed.
+"""
+
+import re
+
+import pytest
+
+from dcoslab.remote import PUBLICATION, attach_redundant, created, parse_result
+
+BIT_RATE = 500_000
+STEP = 120
+
+
+@pytest.fixture
+def pair(canlab):
+    lab = canlab({"can0": BIT_RATE, "can1": BIT_RATE},
+                 {"board1": {"bus0": "can0", "bus1": "can1", "append": "node=1"},
+                  "board2": {"bus0": "can0", "bus1": "can1", "append": "node=2"}})
+    one, two = lab.board("board1"), lab.board("board2")
+    attach_redundant(one, 1, [2], BIT_RATE)
+    # After a bus-off a channel of node 2 stays off, as a cut cable would leave it.
+    attach_redundant(two, 2, [1], BIT_RATE, policy="manual")
+    return lab, one, two
+
+
+def publish(board, name, visibility="global", priority=10, period_ms=20, count=40):
+    output = board.command(f"pubsub publish {name} {visibility} {priority} {period_ms} {count}")
+    match = re.search(r"PPUB (0x[0-9a-f]{8})", output)
+    assert match, output
+    return match.group(1)
+
+
+def subscribe(board, publisher, priority=5, timeout_ms=None):
+    line = f"pubsub subscribe {publisher} {priority}" + ("" if timeout_ms is None else f" {timeout_ms}")
+    output = board.command(line)
+    assert "PTASK" in output, output
+
+
+def tally(board):
+    output = board.command("pubsub tally")
+    match = re.search(r"PSUB (.+?) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+)\r?$", output, re.M)
+    assert match, output
+    names = ("received", "last", "repeats", "torn", "gaps", "deleted", "timeouts")
+    return match.group(1), dict(zip(names, map(int, match.groups()[1:])))
+
+
+def wait_tally(lab, board, predicate, what, timeout=STEP):
+    """Polls the subscriber's tally (every 20 ms of emulated time) until predicate holds."""
+    end = lab.hub.now_ns + timeout * 1_000_000_000  # emulated: bounds a board that stopped publishing
+    while True:
+        status, counts = tally(board)
+        if predicate(status, counts):
+            return status, counts
+        assert lab.hub.now_ns < end, f"{what}: {status} {counts}"
+        lab.hub.wait_until(lab.hub.now_ns + 20_000_000, STEP)
+
+
+def published(board):
+    output = board.command("pubsub published")
+    return int(re.search(r"PCOUNT (\d+)", output).group(1))
+
+
+def counters(board, verb):
+    output = board.command(f"net {verb}")
+    return {name: int(value) for name, value in re.findall(r"^  ([a-z-]+) (\d+)\r?$", output, re.M)}
+
+
+def publication_frames(lab, bus=None):
+    """The publication frames on the bus log: (bus, priority, destination, source, data)."""
+    frames = []
+    for record in lab.hub.frames():
+        raw = record.frame.id
+        if record.outcome == "ok" and record.frame.extended and (raw >> 16) & 0xFF == PUBLICATION:
+            if bus is None or record.bus == bus:
+                frames.append((record.bus, raw >> 24, (raw >> 8) & 0xFF, raw & 0xFF, bytes(record.frame.data)))
+    return frames
+
+
+def open_result(board, publisher):
+    return parse_result(board.command(f"pubsub open {publisher}", timeout=STEP))
+
+
+def test_every_write_reaches_a_remote_subscriber_once_over_two_buses(pair):
+    lab, one, two = pair
+    publisher = publish(two, "level", count=40)
+    assert publisher.startswith("0x00028")
+    subscribe(one, publisher)
+    wait_tally(lab, one, lambda status, _: status != "busy", "the subscriber to open")
+    two.command("pubsub go")
+    status, counts = wait_tally(lab, one, lambda _, c: c["last"] == 40, "the 40th page")
+    assert status == "ok"
+    assert counts == {"received": 40, "last": 40, "repeats": 0, "torn": 0, "gaps": 0, "deleted": 0,
+                      "timeouts": 0}
+    # Three frames per publication on each bus, at the writer's priority,
+    # to the broadcast address, from CAN node 2, eight bytes each.
+    lab.hub.wait_until(lab.hub.now_ns + 5_000_000, STEP)
+    for bus in ("can0", "can1"):
+        frames = publication_frames(lab, bus)
+        assert len(frames) == 3 * 40, bus
+        assert {(priority, destination, source, len(data)) for _, priority, destination, source, data in frames} \
+            == {(10, 255, 2, 8)}
+        # The parts in order, and the sequence numbers 1 to 40.
+        assert [data[0] >> 6 for *_, data in frames] == [0, 1, 2] * 40
+        assert [int.from_bytes(data[2:4], "big") for *_, data in frames[::3]] == list(range(1, 41))
+    statistics = counters(one, "publications")
+    assert statistics["received"] == 40 and statistics["duplicates"] == 40, statistics
+    assert statistics["torn"] == 0 and statistics["withdrawals"] == 0
+    assert counters(two, "remote")["publications-sent"] == 80
+
+
+def test_a_bus_lost_during_publication_loses_no_sample(pair):
+    lab, one, two = pair
+    publisher = publish(two, "flow", count=60, period_ms=20)
+    subscribe(one, publisher)
+    wait_tally(lab, one, lambda status, _: status != "busy", "the subscriber to open")
+    two.command("pubsub go")
+    wait_tally(lab, one, lambda _, c: c["last"] >= 20, "the 20th page")
+    # Node 2's channel 0 goes bus-off and stays off: can0 carries nothing
+    # more from it, and its transmit queue fills.
+    lab.hub.force_bus_off("board2.0")
+    status, counts = wait_tally(lab, one, lambda _, c: c["last"] == 60, "the 60th page")
+    assert status == "ok"
+    assert counts["received"] == 60 and counts["gaps"] == 0, counts
+    assert counts["repeats"] == 0 and counts["torn"] == 0, counts
+    can0, can1 = publication_frames(lab, "can0"), publication_frames(lab, "can1")
+    assert len(can1) == 3 * 60
+    assert len(can0) < 3 * 45, "can0 went quiet after the bus-off"
+    statistics = counters(one, "publications")
+    assert statistics["received"] == 60
+    assert statistics["duplicates"] < 45
+    # A publication cut off on can0 half-way is dropped there, never mixed.
+    assert counters(two, "remote")["send-failures"] > 0
+
+
+def test_a_new_subscriber_gets_the_latest_page_at_once_and_the_deletion(pair):
+    lab, one, two = pair
+    publisher = publish(two, "setpoint", count=5, period_ms=5)
+    two.command("pubsub go")
+    lab.hub.wait_until(lab.hub.now_ns + 100_000_000, STEP)
+    assert published(two) == 5
+    # The publisher writes no more; a subscriber opened now has page 5 at
+    # once, sent again by node 2 on receiving the Open.
+    subscribe(one, publisher)
+    status, counts = wait_tally(lab, one, lambda _, c: c["received"] == 1, "the latest page")
+    assert status == "ok" and counts["last"] == 5 and counts["repeats"] == 0
+    assert counters(one, "publications")["received"] == 1
+    # Deleting the publisher withdraws it: the waiting reader gets Deleted.
+    two.command("pubsub delete")
+    status, counts = wait_tally(lab, one, lambda _, c: c["deleted"] == 1, "the withdrawal")
+    assert counts["received"] == 1
+    statistics = counters(one, "publications")
+    assert statistics["withdrawals"] == 1
+    # The remote publisher is free again once its subscription is closed.
+    assert "publisher 0x" not in one.command("net publications")
+
+
+def test_opening_a_remote_publisher_is_refused_as_a_local_open_would_be(pair):
+    lab, one, two = pair
+    local_only = publish(two, "private", visibility="local", count=0)
+    regional = publish(two, "cabinet", visibility="regional", count=0)
+    semaphore = created(two, "remote sem 1", "RSEM")
+    assert open_result(one, local_only)[0] == "not permitted"
+    assert open_result(one, regional)[0] == "not permitted", "regional: the nodes of one controller, not the bus"
+    assert open_result(one, semaphore)[0] == "wrong object type"
+    # A publisher index no publisher has, on node 2: node 2's own refusal.
+    assert open_result(one, "0x00028fff")[0] == open_result(two, "0x00028fff")[0]
+    # A node the tables do not know.
+    assert open_result(one, "0x00098001")[0] == "remote object unreachable"
+    # Refusals leave nothing behind: no remote publisher is held.
+    assert "publisher 0x" not in one.command("net publications")
+    global_one = publish(two, "shared", count=0)
+    status, subscription, _ = open_result(one, global_one)
+    assert status == "ok" and subscription != 0
+    # Open and Close: its remote publisher is free again.
+    assert "publisher 0x" not in one.command("net publications")
