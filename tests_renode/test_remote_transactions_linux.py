@@ -1,4 +1,4 @@
-"""Remote transactions against a node we did not write: python-can on the Linux kernel's SocketCAN.
+"""Remote transactions and publications against a node we did not write: python-can on the Linux kernel's SocketCAN.
 
 docs/protocols/remote-transactions.md specifies the request and the reply
 byte by byte. Here a peer written from that page alone, in Python with
@@ -7,7 +7,11 @@ the kernel's can0 (slcan, bridged to the lab hub) as DCOS node 3 with CAN
 node number 3. It holds one counting semaphore, object 0xA001, of count 5.
 An emulated 486 board, node 1, uses that semaphore by its id through the
 ordinary semaphore primitives; then the peer uses one of the board's
-semaphores by sending the board requests of its own.
+semaphores by sending the board requests of its own. Last, publications
+(docs/protocols/publications.md): the board subscribes to the peer's
+publisher, which publishes pages with a duplicate, a malformed frame and a
+torn page among them, then withdraws it; and the peer reads the board's
+publisher from its frames.
 
 Emulated time is paced at a fiftieth of wall time, so that the VM's
 answers, slow under an emulated CPU on a busy host, come well within the
@@ -132,6 +136,75 @@ for transaction, service in ((0x21, RELEASE), (0x22, COUNT)):
     got_service, got_transaction, status, flags, value = struct.unpack(">BBBBI", bytes(message.data))
     print(f"@@PEER REPLY priority={priority} service={got_service} transaction={got_transaction:02X} "
           f"status={status} flags={flags} value={value}@@", flush=True)
+
+# Phase 3: publications (docs/protocols/publications.md). The board opens a
+# subscription to this node's publisher 0x00038005: answer its DsmOpen
+# request, then publish pages 1 to 4 with what a bus can do to them: page 1
+# twice (as a second bus would bring it), a frame of the wrong length, page
+# 2 with its second part lost, pages 3 and 4 whole. The withdrawal waits
+# for the go frame WITHDRAW.
+PUBLICATION, DSM_OPEN, WITHDRAW = 0x20, 9, 0x7F6
+
+def page_of(counter):
+    words = (counter, ~counter & 0xFFFFFFFF, (counter * 2654435761) & 0xFFFFFFFF, counter ^ 0x5A5A5A5A)
+    return b"".join(word.to_bytes(4, "big") for word in words)
+
+def parts(index, sequence, page):
+    tag = sequence & 3
+    def head(part):
+        return bytes([part << 6 | tag << 4 | index >> 8, index & 0xFF])
+    return [head(0) + sequence.to_bytes(2, "big") + page[0:4], head(1) + page[4:10], head(2) + page[10:16]]
+
+def publish(data):
+    bus.send(can.Message(arbitration_id=identifier(12, PUBLICATION, 0xFF, ME), is_extended_id=True, data=data))
+
+while True:
+    message = receive()
+    if not message.is_extended_id:
+        continue
+    priority, kind, destination, source = fields(message)
+    if kind == REQUEST and destination == ME and bytes(message.data)[0] == DSM_OPEN:
+        break
+service, transaction, obj, argument = struct.unpack(">BBHI", bytes(message.data))
+print(f"@@PEER OPEN priority={priority} object={obj:04X} argument={argument}@@", flush=True)
+bus.send(can.Message(arbitration_id=identifier(priority, REPLY, source, ME), is_extended_id=True,
+                     data=struct.pack(">BBBBI", service, transaction, OK, 0, 0)))
+one, two, three, four = (parts(0x005, n, page_of(n)) for n in (1, 2, 3, 4))
+for data in one + one + [one[0][:7]] + [two[0], two[2]] + three + four:
+    publish(data)
+print("@@PEER PUBLISHED@@", flush=True)
+while True:
+    message = receive()
+    if not message.is_extended_id and message.arbitration_id == WITHDRAW:
+        break
+publish(bytes([0xC0, 0x05]))
+print("@@PEER WITHDRAWN@@", flush=True)
+
+# Then read the board's own publications, three pages, and put them back
+# together from the frames as the page above specifies.
+pages = 0
+gathering = None
+while pages < 3:
+    message = receive()
+    if not message.is_extended_id:
+        continue
+    priority, kind, destination, source = fields(message)
+    if kind != PUBLICATION or source != BOARD:
+        continue
+    data = bytes(message.data)
+    part, tag, index = data[0] >> 6, (data[0] >> 4) & 3, (data[0] & 0x0F) << 8 | data[1]
+    if part == 0 and len(data) == 8:
+        gathering = [int.from_bytes(data[2:4], "big"), data[4:8], 1]
+    elif gathering and part == gathering[2] and tag == gathering[0] & 3 and len(data) == 8:
+        gathering[1] += data[2:8]
+        gathering[2] += 1
+        if part == 2:
+            print(f"@@PEER PAGE priority={priority} destination={destination} index={index:03X} "
+                  f"sequence={gathering[0]} page={gathering[1].hex()}@@", flush=True)
+            pages += 1
+            gathering = None
+    else:
+        gathering = None
 bus.shutdown()
 """
 
@@ -218,5 +291,57 @@ def test_a_python_can_node_uses_a_semaphore_of_the_board(world):
     replies = [peer_line(world, "REPLY") for _ in range(2)]
     assert replies == ["priority=9 service=2 transaction=21 status=0 flags=0 value=0",
                        "priority=9 service=3 transaction=22 status=0 flags=0 value=1"], replies
-    world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
     assert call(world, f"count {semaphore}") == ("ok", 1)
+
+
+def page_of(counter):
+    """The test image's page for write number counter (tests_renode/target/PublicationsTest.cpp)."""
+    words = (counter, ~counter & 0xFFFFFFFF, (counter * 2654435761) & 0xFFFFFFFF, counter ^ 0x5A5A5A5A)
+    return b"".join(word.to_bytes(4, "big") for word in words)
+
+
+def board_tally(world):
+    output = world.board.command("pubsub tally", timeout=STEP)
+    match = re.search(r"PSUB (.+?) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+)\r?$", output, re.M)
+    assert match, output
+    return match.group(1), [int(value) for value in match.groups()[1:]]
+
+
+def wait_board_tally(world, predicate, what):
+    end = world.lab.hub.now_ns + STEP * 1_000_000_000  # emulated: bounds a board that stopped reading
+    while True:
+        status, counts = board_tally(world)
+        if predicate(status, counts):
+            return status, counts
+        assert world.lab.hub.now_ns < end, f"{what}: {status} {counts}"
+        world.lab.hub.wait_until(world.lab.hub.now_ns + 20_000_000, STEP)
+
+
+def test_publications_between_the_board_and_a_python_can_node(world):
+    # The board reads the peer's publisher 0x00038005 through a subscription.
+    output = world.board.command("pubsub subscribe 0x00038005 5", timeout=STEP)
+    assert "PTASK" in output, output
+    assert peer_line(world, "OPEN") == "priority=5 object=8005 argument=0"
+    world.vm.expect(r"@@PEER PUBLISHED@@", timeout=STEP)
+    # Pages 1, 3 and 4, each once; page 2 lost its second part and was
+    # dropped, never mixed with another (received, last, repeats, torn, gaps).
+    status, counts = wait_board_tally(world, lambda _, c: c[1] == 4, "page 4")
+    assert status == "ok" and counts[:5] == [3, 4, 0, 0, 1], counts
+    statistics = world.board.command("net publications", timeout=STEP)
+    assert re.search(r"^  duplicates 1\r?$", statistics, re.M), statistics
+    assert re.search(r"^  torn 1\r?$", statistics, re.M), statistics
+    assert "publisher 0x00038005  subscriptions 1  data 3" in statistics, statistics
+    assert re.search(r"malformed [1-9]", world.board.command("net remote", timeout=STEP))
+    # The withdrawal: the board's reader is told the publisher is gone.
+    world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7F6, b""))
+    world.vm.expect(r"@@PEER WITHDRAWN@@", timeout=STEP)
+    status, counts = wait_board_tally(world, lambda _, c: c[5] == 1, "the withdrawal")
+    assert counts[0] == 3
+    # The peer reads the board's publisher, written three times at priority 7.
+    output = world.board.command("pubsub publish out global 7 10 3", timeout=STEP)
+    index = int(re.search(r"PPUB (0x[0-9a-f]{8})", output).group(1), 16) & 0x0FFF
+    world.board.command("pubsub go", timeout=STEP)
+    pages = [peer_line(world, "PAGE") for _ in range(3)]
+    assert pages == [f"priority=7 destination=255 index={index:03X} sequence={n} page={page_of(n).hex()}"
+                     for n in (1, 2, 3)], pages
+    world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
