@@ -19,7 +19,7 @@ import re
 
 import pytest
 
-from dcoslab.remote import PUBLICATION, attach_redundant, created, parse_result
+from dcoslab.remote import attach_redundant, created, parse_result, publication_records, publish, subscribe, wait_tally
 
 BIT_RATE = 500_000
 STEP = 120
@@ -37,38 +37,6 @@ def pair(canlab):
     return lab, one, two
 
 
-def publish(board, name, visibility="global", priority=10, period_ms=20, count=40):
-    output = board.command(f"pubsub publish {name} {visibility} {priority} {period_ms} {count}")
-    match = re.search(r"PPUB (0x[0-9a-f]{8})", output)
-    assert match, output
-    return match.group(1)
-
-
-def subscribe(board, publisher, priority=5, timeout_ms=None):
-    line = f"pubsub subscribe {publisher} {priority}" + ("" if timeout_ms is None else f" {timeout_ms}")
-    output = board.command(line)
-    assert "PTASK" in output, output
-
-
-def tally(board):
-    output = board.command("pubsub tally")
-    match = re.search(r"PSUB (.+?) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+)\r?$", output, re.M)
-    assert match, output
-    names = ("received", "last", "repeats", "torn", "gaps", "deleted", "timeouts")
-    return match.group(1), dict(zip(names, map(int, match.groups()[1:])))
-
-
-def wait_tally(lab, board, predicate, what, timeout=STEP):
-    """Polls the subscriber's tally (every 20 ms of emulated time) until predicate holds."""
-    end = lab.hub.now_ns + timeout * 1_000_000_000  # emulated: bounds a board that stopped publishing
-    while True:
-        status, counts = tally(board)
-        if predicate(status, counts):
-            return status, counts
-        assert lab.hub.now_ns < end, f"{what}: {status} {counts}"
-        lab.hub.wait_until(lab.hub.now_ns + 20_000_000, STEP)
-
-
 def published(board):
     output = board.command("pubsub published")
     return int(re.search(r"PCOUNT (\d+)", output).group(1))
@@ -81,13 +49,8 @@ def counters(board, verb):
 
 def publication_frames(lab, bus=None):
     """The publication frames on the bus log: (bus, priority, destination, source, data)."""
-    frames = []
-    for record in lab.hub.frames():
-        raw = record.frame.id
-        if record.outcome == "ok" and record.frame.extended and (raw >> 16) & 0xFF == PUBLICATION:
-            if bus is None or record.bus == bus:
-                frames.append((record.bus, raw >> 24, (raw >> 8) & 0xFF, raw & 0xFF, bytes(record.frame.data)))
-    return frames
+    return [(record.bus, record.frame.id >> 24, (record.frame.id >> 8) & 0xFF, record.frame.id & 0xFF,
+             bytes(record.frame.data)) for record in publication_records(lab, bus)]
 
 
 def open_result(board, publisher):

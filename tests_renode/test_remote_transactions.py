@@ -219,7 +219,8 @@ def test_the_benchs_remote_figures_are_two_frames_and_at_least_their_bus_time(tm
     """make bench's remote figures (bench/remote_bench.py), checked against the physics of the bus."""
     output = tmp_path / "remote.json"
     run = subprocess.run([sys.executable, os.path.join(os.path.dirname(__file__), "bench", "remote_bench.py"),
-                          "--calls", "3", "--output", str(output)], capture_output=True, text=True, timeout=600)
+                          "--calls", "3", "--writes", "10", "--output", str(output)], capture_output=True, text=True,
+                         timeout=600)
     assert run.returncode == 0, run.stdout + run.stderr
     report = json.loads(output.read_text())
     # A request and its reply: two extended 8-byte frames one after the
@@ -230,6 +231,12 @@ def test_the_benchs_remote_figures_are_two_frames_and_at_least_their_bus_time(tm
         assert entry["status"] == ["ok"], name
         assert entry["request_frames_per_call"] == entry["reply_frames_per_call"] == 1, name
         assert entry["round_trip_us"]["min"] >= 2 * frame_us, (name, entry, frame_us)
+    # A publication: three such frames on each bus, one after the other.
+    publications = report["publications"]
+    assert publications["subscriber"]["received"] == publications["writes"] == 10
+    for bus, entry in publications["buses"].items():
+        assert entry["frames_per_publication"] == 3, bus
+        assert entry["bus_time_us"]["min"] >= 3 * frame_us, (bus, entry, frame_us)
 
 
 def test_a_requester_that_dies_while_it_waits_frees_the_serving_nodes_workers(pair):

@@ -29,7 +29,7 @@ from dcoslab.canbus import Frame
 from dcoslab.canlab import CanLab
 from dcoslab import remote
 from dcoslab.labvm import LabVM, SlcanSetup
-from dcoslab.remote import attach_node, created
+from dcoslab.remote import attach_node, created, page_of, wait_tally
 from dcoslab.slcan_bridge import SlcanBridge
 from dcoslab.vmworld import BridgedWorld, attach_reports, hold_world
 
@@ -294,29 +294,6 @@ def test_a_python_can_node_uses_a_semaphore_of_the_board(world):
     assert call(world, f"count {semaphore}") == ("ok", 1)
 
 
-def page_of(counter):
-    """The test image's page for write number counter (tests_renode/target/PublicationsTest.cpp)."""
-    words = (counter, ~counter & 0xFFFFFFFF, (counter * 2654435761) & 0xFFFFFFFF, counter ^ 0x5A5A5A5A)
-    return b"".join(word.to_bytes(4, "big") for word in words)
-
-
-def board_tally(world):
-    output = world.board.command("pubsub tally", timeout=STEP)
-    match = re.search(r"PSUB (.+?) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+)\r?$", output, re.M)
-    assert match, output
-    return match.group(1), [int(value) for value in match.groups()[1:]]
-
-
-def wait_board_tally(world, predicate, what):
-    end = world.lab.hub.now_ns + STEP * 1_000_000_000  # emulated: bounds a board that stopped reading
-    while True:
-        status, counts = board_tally(world)
-        if predicate(status, counts):
-            return status, counts
-        assert world.lab.hub.now_ns < end, f"{what}: {status} {counts}"
-        world.lab.hub.wait_until(world.lab.hub.now_ns + 20_000_000, STEP)
-
-
 def test_publications_between_the_board_and_a_python_can_node(world):
     # The board reads the peer's publisher 0x00038005 through a subscription.
     output = world.board.command("pubsub subscribe 0x00038005 5", timeout=STEP)
@@ -325,8 +302,9 @@ def test_publications_between_the_board_and_a_python_can_node(world):
     world.vm.expect(r"@@PEER PUBLISHED@@", timeout=STEP)
     # Pages 1, 3 and 4, each once; page 2 lost its second part and was
     # dropped, never mixed with another (received, last, repeats, torn, gaps).
-    status, counts = wait_board_tally(world, lambda _, c: c[1] == 4, "page 4")
-    assert status == "ok" and counts[:5] == [3, 4, 0, 0, 1], counts
+    status, counts = wait_tally(world.lab, world.board, lambda _, c: c["last"] == 4, "page 4", STEP)
+    assert status == "ok", status
+    assert (counts["received"], counts["repeats"], counts["torn"], counts["gaps"]) == (3, 0, 0, 1), counts
     statistics = world.board.command("net publications", timeout=STEP)
     assert re.search(r"^  duplicates 1\r?$", statistics, re.M), statistics
     assert re.search(r"^  torn 1\r?$", statistics, re.M), statistics
@@ -335,8 +313,8 @@ def test_publications_between_the_board_and_a_python_can_node(world):
     # The withdrawal: the board's reader is told the publisher is gone.
     world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7F6, b""))
     world.vm.expect(r"@@PEER WITHDRAWN@@", timeout=STEP)
-    status, counts = wait_board_tally(world, lambda _, c: c[5] == 1, "the withdrawal")
-    assert counts[0] == 3
+    status, counts = wait_tally(world.lab, world.board, lambda _, c: c["deleted"] == 1, "the withdrawal", STEP)
+    assert counts["received"] == 3
     # The peer reads the board's publisher, written three times at priority 7.
     output = world.board.command("pubsub publish out global 7 10 3", timeout=STEP)
     index = int(re.search(r"PPUB (0x[0-9a-f]{8})", output).group(1), 16) & 0x0FFF

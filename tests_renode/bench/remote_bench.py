@@ -10,7 +10,11 @@ and reports:
 - the round trip, from the call to its return on node 1, in microseconds of
   emulated time (the board's uptime), beside the seed's network latency of
   80 us, one way (dissertation, 9.3.4 and Table 9.11), so 160 us a round trip;
-- the frames each call put on the bus, from the hub's log.
+- the frames each call put on the bus, from the hub's log;
+- for publications (docs/protocols/publications.md), on two buses: the
+  frames per publication on each bus, the bus time one publication takes
+  (its first frame's start to its third frame's end), and the pages a
+  remote subscriber took, missed, saw twice or torn.
 
 The figures are measurements, not budgets: the round trip is mostly the two
 frames' bit times at 1 Mbit/s, which no code change shortens.
@@ -28,7 +32,8 @@ sys.path.insert(0, os.path.dirname(HERE))  # tests_renode, for dcoslab
 from dcoslab.board import REPOSITORY, load_board  # noqa: E402
 from dcoslab.canlab import CanLab  # noqa: E402
 from dcoslab.emulator import EmulatorError  # noqa: E402
-from dcoslab.remote import REPLY, REQUEST, attach_node, call, created, dcos_frames  # noqa: E402
+from dcoslab.remote import (REPLY, REQUEST, attach_redundant, call, created, dcos_frames,  # noqa: E402
+                            publication_records, publish, subscribe, wait_tally)
 from dcoslab.vmworld import World  # noqa: E402
 
 BIT_RATE = 1_000_000
@@ -60,22 +65,43 @@ def measure(lab, caller, calls, calls_per_primitive):
     return results
 
 
+def measure_publications(lab, writer, reader, writes, timeout):
+    """writes Writes of a global publisher on writer, read on reader: frames, bus time, what the reader saw."""
+    publisher = publish(writer, "bench", priority=10, period_ms=5, count=writes, timeout=timeout)
+    subscribe(reader, publisher, priority=5, timeout=timeout)
+    wait_tally(lab, reader, lambda status, _: status != "busy", "the subscription", timeout)
+    writer.command("pubsub go", timeout=timeout)
+    status, counts = wait_tally(lab, reader, lambda _, c: c["last"] == writes, f"page {writes}", timeout)
+    lab.hub.wait_until(lab.hub.now_ns + 5_000_000, timeout)
+    buses = {}
+    for bus in ("can0", "can1"):
+        records = publication_records(lab, bus)
+        spans = [records[i + 2].end - records[i].start for i in range(0, len(records) - 2, 3)]
+        buses[bus] = {"frames_per_publication": len(records) / writes,
+                      "bus_time_us": {"min": min(spans) / 1000, "median": statistics.median(spans) / 1000,
+                                      "max": max(spans) / 1000}}
+    return {"status": status, "writes": writes, "subscriber": counts, "buses": buses}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--output", default=os.path.join(REPOSITORY, "build", "bench", "remote.json"))
     parser.add_argument("--calls", type=int, default=20, help="calls per primitive")
+    parser.add_argument("--writes", type=int, default=50, help="Writes of the published page")
     parser.add_argument("--timeout", type=float, default=120.0, help="seconds for each wait on the emulators")
     arguments = parser.parse_args()
     calls_per_primitive = arguments.calls
 
     world = World()
     try:
-        world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BIT_RATE},
-                           {"node1": {"bus0": "can0", "append": "node=1"},
-                            "node2": {"bus0": "can0", "append": "node=2"}}, kind="test", timeout=arguments.timeout)
+        world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BIT_RATE, "can1": BIT_RATE},
+                           {"node1": {"bus0": "can0", "bus1": "can1", "append": "node=1"},
+                            "node2": {"bus0": "can0", "bus1": "can1", "append": "node=2"}}, kind="test",
+                           timeout=arguments.timeout)
         caller, server = world.lab.board("node1"), world.lab.board("node2")
-        attach_node(caller, 1, [2], BIT_RATE, arguments.timeout)
-        attach_node(server, 2, [1], BIT_RATE, arguments.timeout)
+        # Both channels attached; remote transactions go over can0 (mapped first).
+        attach_redundant(caller, 1, [2], BIT_RATE, arguments.timeout)
+        attach_redundant(server, 2, [1], BIT_RATE, arguments.timeout)
         semaphore = created(server, "remote sem 1000000", "RSEM")
         listener = created(server, "remote listener", "RTASK")
         results = measure(world.lab, caller, [
@@ -84,6 +110,7 @@ def main():
             ("SemaphoreRelease", f"release {semaphore}"),
             ("PostEvent", f"post {listener} 0x1"),
         ], calls_per_primitive)
+        publications = measure_publications(world.lab, server, caller, arguments.writes, arguments.timeout)
     except (EmulatorError, AssertionError) as error:
         print(f"remote_bench.py: the run failed.\n{error}", file=sys.stderr)
         return 1
@@ -100,14 +127,25 @@ def main():
               f"{trip['min']:>12} / {trip['median']:>7} / {trip['max']:>7} {frames:>12.1f}")
     print(f"  the seed's network latency (9.3.4, Table 9.11): {SEED_LATENCY_US} us one way, "
           f"{2 * SEED_LATENCY_US} us a round trip")
+    counts = publications["subscriber"]
+    print(f"Publications of one global publisher, {publications['writes']} Writes, on can0 and can1: the remote "
+          f"subscriber took {counts['received']}, missed {counts['gaps']}, saw {counts['repeats']} twice, "
+          f"{counts['torn']} torn")
+    for bus, entry in publications["buses"].items():
+        span = entry["bus_time_us"]
+        print(f"  {bus}: {entry['frames_per_publication']:.1f} frames per publication, "
+              f"{span['min']:.0f} / {span['median']:.0f} / {span['max']:.0f} us on the bus (min/median/max)")
     report = {"bit_rate": BIT_RATE, "calls_per_primitive": calls_per_primitive,
-              "seed_latency_us": SEED_LATENCY_US, "primitives": results}
+              "seed_latency_us": SEED_LATENCY_US, "primitives": results, "publications": publications}
     os.makedirs(os.path.dirname(os.path.abspath(arguments.output)), exist_ok=True)
     with open(arguments.output, "w", encoding="utf-8") as handle:
         json.dump(report, handle, indent=2)
         handle.write("\n")
     print(f"wrote {arguments.output}")
     bad = [name for name, entry in results.items() if entry["status"] != ["ok"]]
+    if publications["status"] != "ok" or counts["received"] != publications["writes"] or counts["repeats"] \
+            or counts["torn"]:
+        bad.append("publications")
     if bad:
         print(f"remote_bench.py: calls that did not succeed: {', '.join(bad)}", file=sys.stderr)
         return 1

@@ -1,11 +1,13 @@
-"""Boards that use each other's objects: the lab side of remote transactions.
+"""Boards that use each other's objects: the lab side of remote transactions and publications.
 
 The words the emulator tests (test_remote_transactions*.py) and the bench's
 remote figures (bench/remote_bench.py) share: bringing a board's CAN
 channel up as a network interface of the network interfaces manager, and
 calling a primitive through the test image's `remote` console command
-(tests_renode/target/RemoteTransactionsTest.cpp). docs/guide/remote-objects.md
-walks through the same commands.
+(tests_renode/target/RemoteTransactionsTest.cpp), publishing and
+subscribing through its `pubsub` command (tests_renode/target/
+PublicationsTest.cpp). docs/guide/remote-objects.md walks through the same
+commands.
 """
 
 import re
@@ -83,3 +85,59 @@ def dcos_frames(lab, kind, records=None):
         if (raw >> 16) & 0xFF == kind:
             frames.append((raw >> 24, (raw >> 8) & 0xFF, raw & 0xFF, bytes(frame.frame.data)))
     return frames
+
+
+def publish(board, name, visibility="global", priority=10, period_ms=20, count=40, timeout=120):
+    """A publishing task on board (`pubsub publish`): the publisher's id. It writes after `pubsub go`."""
+    output = board.command(f"pubsub publish {name} {visibility} {priority} {period_ms} {count}", timeout=timeout)
+    match = re.search(r"PPUB (0x[0-9a-f]{8})", output)
+    assert match, output
+    return match.group(1)
+
+
+def subscribe(board, publisher, priority=5, timeout_ms=None, timeout=120):
+    """A subscribing task on board that reads every new page of publisher (`pubsub subscribe`)."""
+    line = f"pubsub subscribe {publisher} {priority}" + ("" if timeout_ms is None else f" {timeout_ms}")
+    output = board.command(line, timeout=timeout)
+    assert "PTASK" in output, output
+
+
+def page_of(counter):
+    """The page the test image's publishing task writes for write number counter (PublicationsTest.cpp)."""
+    words = (counter, ~counter & 0xFFFFFFFF, (counter * 2654435761) & 0xFFFFFFFF, counter ^ 0x5A5A5A5A)
+    return b"".join(word.to_bytes(4, "big") for word in words)
+
+
+TALLY_NAMES = ("received", "last", "repeats", "torn", "gaps", "deleted", "timeouts")
+
+
+def tally(board, timeout=120):
+    """The subscribing task's open status and its counts (`pubsub tally`), by TALLY_NAMES."""
+    output = board.command("pubsub tally", timeout=timeout)
+    match = re.search(r"PSUB (.+?) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+) (\d+)\r?$", output, re.M)
+    assert match, output
+    return match.group(1), dict(zip(TALLY_NAMES, map(int, match.groups()[1:])))
+
+
+def wait_tally(lab, board, predicate, what, timeout=120):
+    """Polls the tally every 20 ms of emulated time until predicate(status, counts) holds.
+
+    timeout is in seconds of emulated time: it bounds a board that stopped publishing."""
+    end = lab.hub.now_ns + timeout * 1_000_000_000
+    while True:
+        status, counts = tally(board)
+        if predicate(status, counts):
+            return status, counts
+        assert lab.hub.now_ns < end, f"{what}: {status} {counts}"
+        lab.hub.wait_until(lab.hub.now_ns + 20_000_000, timeout)
+
+
+def publication_records(lab, bus=None):
+    """The bus log's publication frames (of any bus, or of bus), as the hub's records."""
+    records = []
+    for record in lab.hub.frames():
+        raw = record.frame.id
+        if record.outcome == "ok" and record.frame.extended and (raw >> 16) & 0xFF == PUBLICATION:
+            if bus is None or record.bus == bus:
+                records.append(record)
+    return records
