@@ -131,6 +131,22 @@ def test_a_new_subscriber_gets_the_latest_page_at_once_and_the_deletion(pair):
     assert "publisher 0x" not in one.command("net publications")
 
 
+def test_an_interrupt_handlers_write_is_published_by_the_network_task(pair):
+    lab, one, two = pair
+    publisher = publish(two, "sampled", count=0)
+    subscribe(one, publisher)
+    wait_tally(lab, one, lambda status, _: status != "busy", "the subscriber to open")
+    # The spare line's routine writes pages 1 and 2 of the publisher; the
+    # handler cannot use a driver, node 2's network receiver publishes them.
+    for counter in (1, 2):
+        assert parse_result(two.command(f"pubsub isr {counter}"))[0] == "ok"
+        status, counts = wait_tally(lab, one, lambda _, c, n=counter: c["last"] == n, f"page {counter}")
+    assert counts["received"] == 2 and counts["repeats"] == 0 and counts["torn"] == 0, counts
+    assert counters(two, "publications")["deferred"] == 2
+    # At the priority of the task that last wrote it, or created it: 10.
+    assert {priority for _, priority, _, _, _ in publication_frames(lab)} == {10}
+
+
 def test_opening_a_remote_publisher_is_refused_as_a_local_open_would_be(pair):
     lab, one, two = pair
     local_only = publish(two, "private", visibility="local", count=0)

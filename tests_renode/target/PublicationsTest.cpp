@@ -22,6 +22,7 @@
 #include "KernelTestSupport.hpp"
 
 #include <dcos/DsmAgent.hpp>
+#include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
 #include <dcos/internal/IdText.hpp>
@@ -106,6 +107,17 @@ void publisherEntry(uintptr_t)
         (void)taskAgent.SleepFor(10 * kNsPerMs);
     }
     (void)dsmAgent.Delete(created.value());
+}
+
+// An interrupt handler's Write: the routine on the spare line (5, vector
+// 0x25) writes the page of isrCounter to the publishing task's publisher.
+constexpr unsigned kSpareLine = 5;
+volatile uint32_t isrCounter = 0;
+volatile Status isrWrite = Status::Ok;
+
+void writingIsr(void*)
+{
+    isrWrite = dsmAgent.Write(ObjectId::fromRaw(publisherRaw), pageOf(isrCounter)).status();
 }
 
 // The subscriber's tally.
@@ -232,6 +244,23 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
         shell.print("PCOUNT %lu\r\n", static_cast<unsigned long>(published));
         return CommandResult::Ok;
     }
+    if (textEquals(verb, "isr") && argc == 3) {
+        // isr <counter>: the page of <counter> written by an interrupt handler.
+        unsigned long counter = 0;
+        if (!shell::Shell::parseUnsigned(argv[2], counter) || counter == 0) {
+            return CommandResult::UsageError;
+        }
+        const Status installed = dcos::systemAgent.InstallISR(kSpareLine, writingIsr, nullptr);
+        if (installed != Status::Ok) {
+            shell.print("error: InstallISR: %s\r\n", dcos::statusName(installed));
+            return CommandResult::Failed;
+        }
+        isrCounter = static_cast<uint32_t>(counter);
+        asm volatile("int $0x25" ::: "memory");
+        (void)dcos::systemAgent.RemoveISR(kSpareLine);
+        shell.print("RRES %s 0 0\r\n", dcos::statusName(isrWrite));
+        return CommandResult::Ok;
+    }
     if (textEquals(verb, "go") && argc == 2) {
         publishGo = true;
         return CommandResult::Ok;
@@ -293,10 +322,10 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
 
 DCOS_SHELL_COMMAND_DETAILED(
     pubsubCommand, "pubsub", "publishers and subscribers across boards, for the lab's tests (test image only)",
-    "pubsub publish <name> local|regional|global <priority> <period ms> <count> | go | published | delete | "
+    "pubsub publish <name> local|regional|global <priority> <period ms> <count> | go | isr <counter> | published | delete | "
     "subscribe <publisher> <priority> [read time-out ms] | tally | open <publisher>",
     "  publish: a task creates the publisher; after go it writes <count> pages, one per period,\r\n"
-    "  then keeps the publisher until delete\r\n"
+    "  then keeps the publisher until delete; isr: an interrupt handler writes page <counter>\r\n"
     "  subscribe: a task opens the publisher (local or remote) and reads every new page\r\n"
     "  tally: PSUB <open status> <received> <last> <repeats> <torn> <gaps> <deleted> <time-outs>\r\n"
     "  open: Open and Close at once; prints RRES <status> <subscription> <microseconds>",
