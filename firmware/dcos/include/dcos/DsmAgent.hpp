@@ -1,5 +1,4 @@
-// The distributed shared memory agent's application interface, local part
-// (seed 7.10).
+// The distributed shared memory agent's application interface (seed 7.10).
 //
 // Despite its name, distributed shared memory is a publisher-subscriber
 // mechanism: a task creates a publisher, a 16-byte page it alone writes,
@@ -10,10 +9,11 @@
 // single writer, strictly consistent: a Read returns exactly the page of
 // one Write, never parts of two, and always the latest one.
 //
-// Every primitive takes logical ids. The publisher keeps its page, data
-// identifier and waiting readers itself, so the network issue can drive the
-// same object from a remote request; ids of other nodes give Status::Remote
-// until then.
+// Every primitive takes logical ids. A publisher of Global visibility is
+// also published over the network at every Write, and a task of another
+// node opens a subscription to it by its id and reads it with the same
+// calls (docs/protocols/publications.md); the other primitives given
+// another node's id answer Status::Remote.
 #pragma once
 
 #include <dcos/ObjectId.hpp>
@@ -71,6 +71,13 @@ public:
     ///
     /// Any task may subscribe to any publisher it has the id of. Fails with
     /// TableFull (see AddSubscribers), InInterrupt and the id errors. Cost O(1).
+    ///
+    /// Another node's publisher is asked for over the network first: it must
+    /// be Global (NotPermitted otherwise), and its node sends its latest page
+    /// at once. TableFull also when DCOS_CONFIG_REMOTE_PUBLISHERS other
+    /// nodes' publishers are read already; the remote transaction's own
+    /// errors (Unreachable, Busy, Remote without a network). Cost: one
+    /// remote transaction and O(DCOS_CONFIG_REMOTE_PUBLISHERS).
     static Result<ObjectId> Open(ObjectId publisher);
 
     /// Closes a subscription the caller owns; only its owner may, so no
