@@ -23,7 +23,7 @@ PYTHON     := /usr/bin/python3
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 
 .DEFAULT_GOAL := all
-.PHONY: all deps run test test-host test-emulator test-fuzz fuzz bench clean firmware host-tests host-tools emulator FORCE
+.PHONY: all deps run plant test test-host test-emulator test-fuzz fuzz bench clean firmware host-tests host-tools emulator FORCE
 .DELETE_ON_ERROR:
 
 include mk/firmware.mk
@@ -47,6 +47,14 @@ else
 	@$(MAKE) --no-print-directory sdk
 	@$(call app_make,$(APP),run)
 endif
+
+# The distributed plant of docs/guide/distributed-plant.md: two controllers on
+# two CAN buses hold a simulated process; ARGS="--seconds 20" and the like go
+# to tests_renode/plant.py (--help lists them).
+plant: deps
+	@$(MAKE) --no-print-directory firmware host-tools sdk
+	@$(call app_make,docs/examples/plant,app)
+	@$(PYTHON) tests_renode/plant.py $(ARGS)
 
 # Every suite runs even when an earlier one fails; the summary line counts
 # them all and the exit status says whether anything failed.

@@ -15,7 +15,7 @@
 #   share/dcos/application.mk    the application build (see its header)
 #   share/dcos/board-486.mk      the compiler and linker flags of the 486 board
 #   share/dcos/boards/           the emulated boards
-#   share/dcos/python/           the emulator lab (dcoslab) and its launcher
+#   share/dcos/python/           the emulator lab (dcoslab), its launcher and the distributed plant (plant.py)
 #   share/dcos/pytest.ini        pytest settings for applications' tests
 #   share/dcos/tools/            the i486 instruction check, the configuration error summary,
 #                                the plant simulator, bringup/ (the I/O board bring-up tool)
@@ -100,6 +100,7 @@ for example in host_tools/modbus/examples/*.toml; do
     put "$example" "$prefix/share/dcos/modbus/$(basename "$example")"
 done
 put tests_renode/launch.py "$prefix/share/dcos/python/launch.py"
+put tests_renode/plant.py "$prefix/share/dcos/python/plant.py"
 for module in tests_renode/dcoslab/*.py; do
     put "$module" "$prefix/share/dcos/python/dcoslab/$(basename "$module")"
 done

@@ -48,7 +48,7 @@ $(QEMU_BINARY):
 	@$(QEMU_BUILD_SCRIPT)
 
 SDK_INPUTS := $(LIBRARY_486) $(LIBRARY_486_MINIMAL) $(IMAGE_486) $(BOARD_FLAGS_486) $(QEMU_BINARY) mk/install-sdk.sh mk/application.mk \
-	firmware/boot/link.ld host_tools/isa_check/check_i486.py host_tools/app_build/explain_configuration_error.py tests_renode/launch.py tests_renode/pytest.ini \
+	firmware/boot/link.ld host_tools/isa_check/check_i486.py host_tools/app_build/explain_configuration_error.py tests_renode/launch.py tests_renode/plant.py tests_renode/pytest.ini \
 	$(wildcard tests_renode/dcoslab/*.py tests_renode/boards/*.json) \
 	host_tools/bringup/mfio_bringup.py host_tools/bringup/bringup_report.py host_tools/plant_simulator/plant_simulator.py \
 	$(wildcard host_tools/modbus/examples/*.toml) \

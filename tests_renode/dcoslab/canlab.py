@@ -233,7 +233,9 @@ class CanLab:
         dcoslab/rs485.py). The hub holds the clock until every board has
         joined, so all boot in step from emulated time 0. append is the
         kernel command line of every board; the key "append" of a board's
-        wiring gives that board its own (e.g. "node=2")."""
+        wiring gives that board its own (e.g. "node=2"), the key "devices"
+        more device properties ({"isa-mfio": {"wiring": "plant", ...}}) and
+        the key "args" more emulator arguments (a -chardev for them)."""
         self._directory = tempfile.TemporaryDirectory(prefix="dcos-canlab-")
         self.socket_path = os.path.join(self._directory.name, "hub.sock")
         self.hub = Hub(self.socket_path, buses, expect=list(wiring), pace=pace, timeout=timeout, lines=lines)
@@ -244,9 +246,15 @@ class CanLab:
                 properties = {"hub": self.socket_path, "hub-name": name}
                 line_ports = {}
                 board_append = append
+                devices = {}
+                board_args = []
                 for key, value in channels.items():
                     if key == "append":
                         board_append = value
+                    elif key == "devices":
+                        devices = value
+                    elif key == "args":
+                        board_args = list(value)
                     elif key == "rs485":
                         line_ports["rs485"] = {"hub": self.socket_path, "hub-name": name, "line": value}
                     else:
@@ -257,8 +265,8 @@ class CanLab:
                 if line_ports:
                     options["line_ports"] = line_ports
                 emulator = boot(board_definition, kind, icount=True, name=name,
-                                device_properties={"isa-sja1000": properties},
-                                extra_args=["-rtc", f"base={RTC_BASE}"], **options)
+                                device_properties={"isa-sja1000": properties, **devices},
+                                extra_args=["-rtc", f"base={RTC_BASE}", *board_args], **options)
                 self.boards[name] = LabBoard(name, emulator, self.hub)
             for board in self.boards.values():
                 board.emulator.expect(r"dcos> ", timeout=timeout)

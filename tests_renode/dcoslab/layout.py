@@ -21,9 +21,15 @@ if os.path.exists(_MARKER):
     BOARDS_DIRECTORY = os.path.join(ROOT, _layout["boards"])
     # The emulator with the DCOS board models, copied by make install.
     EMULATOR_DIRECTORY = os.path.join(ROOT, _layout["emulator_dir"])
+    # The plant simulator for the I/O board (host_tools/plant_simulator).
+    PLANT_SIMULATOR = os.path.join(ROOT, "share", "dcos", "tools", "plant_simulator.py")
+    # The host CAN tool (host_tools/can).
+    DCOS_CAN = os.path.join(ROOT, "bin", "dcos-can")
 else:
     INSTALLED = False
     # The repository; board image paths are relative to it.
     ROOT = os.path.dirname(os.path.dirname(HERE))
     BOARDS_DIRECTORY = os.path.join(ROOT, "tests_renode", "boards")
     EMULATOR_DIRECTORY = None
+    PLANT_SIMULATOR = os.path.join(ROOT, "host_tools", "plant_simulator", "plant_simulator.py")
+    DCOS_CAN = os.path.join(ROOT, "build", "host_tools", "bin", "dcos-can")

@@ -9,6 +9,7 @@ The helpers below are the phases' common words: the frames as candump -L
 writes them, the hub's "go" frames, and the VM's marked output sections.
 """
 
+import os
 import time
 
 from .canbus import Frame
@@ -40,8 +41,11 @@ class World:
         self._emulators = []
 
     def boot(self, board, kind, icount=False, name=None, device_properties=None, extra_args=(), append=""):
-        """The lab plugin's boot fixture, for a module-scoped CanLab; the emulators close with the world."""
-        emulator = Emulator(board, board.image(kind), append=append, icount=icount,
+        """The lab plugin's boot fixture, for a module-scoped CanLab; the emulators close with the world.
+
+        kind is an image kind of the board or the path of an image file."""
+        image = kind if os.path.sep in kind else board.image(kind)
+        emulator = Emulator(board, image, append=append, icount=icount,
                             device_properties=device_properties, extra_args=extra_args, name=name)
         self._emulators.append(emulator)
         return emulator.start()

@@ -1,0 +1,85 @@
+// The seed's Test Case 2 (9.4.2, Fig. 9.6) with plain tasks: a regulatory
+// control loop of three components, each a task, joined by distributed
+// shared memory publishers, so that one copy of the application runs with
+// all three components on one node or split over nodes unchanged.
+//
+//     sampler --"pv"--> controller --"mv"--> actuator
+//     AI0 every period    set point, P + feed-forward    AO0
+//
+// A component is given the ids of the publishers it reads; whether such an
+// id names a local publisher or another node's is the DSM agent's business
+// (docs/protocols/publications.md), not the component's.
+#pragma once
+
+#include <dcos/DsmAgent.hpp>
+#include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+
+#include <stdint.h>
+
+namespace plant {
+
+/// The sampler's period: one conversion and one publication.
+constexpr uint64_t kPeriodNs = 10'000'000;
+/// A reader that waits this long for a page counts a time-out and waits again.
+constexpr uint64_t kReadTimeoutNs = 100'000'000;
+
+/// A value on its way from the plant to the actuator: microvolts, and the
+/// uptime of the sample it derives from, so the actuator, on the sampler's
+/// node, sees the loop's delay through every component.
+struct Signal {
+    int32_t microvolts = 0;
+    uint64_t sampledNs = 0;
+};
+
+/// The page layout, byte by byte so that any node reads it alike: bytes
+/// 0-3 the microvolts, 4-11 the sample's uptime, both little-endian.
+dcos::DsmPage encode(const Signal& signal);
+Signal decode(const dcos::DsmPage& page);
+
+/// What each component has done.
+struct SamplerStatistics {
+    uint32_t samples = 0;
+    int32_t lastMicrovolts = 0;
+    uint32_t errors = 0; ///< Conversions or Writes that failed.
+};
+
+struct ControllerStatistics {
+    uint32_t cycles = 0;
+    int32_t lastPv = 0;
+    int32_t lastMv = 0;
+    uint32_t timeouts = 0;
+    uint32_t errors = 0;
+};
+
+struct ActuatorStatistics {
+    uint32_t writes = 0;
+    int32_t lastMv = 0;
+    uint64_t lastDelayNs = 0; ///< From the sample to the DAC write (sampler on the same node).
+    uint64_t maxDelayNs = 0;
+    uint32_t timeouts = 0;
+    uint32_t errors = 0;
+};
+
+/// Installs the I/O board (0x300, interrupt line 5) for the sampler and
+/// the actuator; Ok when it is installed already.
+dcos::Status installBoard();
+
+/// Starts component 1: creates the global publisher "pv" and the sampler
+/// task, which writes AI0 to it every kPeriodNs. Returns the publisher.
+dcos::Result<dcos::ObjectId> startSampler();
+/// Starts component 2: creates the global publisher "mv" and the controller
+/// task, which reads @p pv and writes the controller output. Returns "mv".
+dcos::Result<dcos::ObjectId> startController(dcos::ObjectId pv);
+/// Starts component 3: the actuator task, which reads @p mv and writes AO0.
+dcos::Status startActuator(dcos::ObjectId mv);
+
+/// The controller's set point; it applies from its next cycle.
+void setSetPoint(int32_t microvolts);
+int32_t setPoint();
+
+SamplerStatistics samplerStatistics();
+ControllerStatistics controllerStatistics();
+ActuatorStatistics actuatorStatistics();
+
+} // namespace plant

@@ -1,0 +1,151 @@
+"""The distributed plant: the control loop of docs/examples/plant on one or two boards.
+
+A PlantLab starts the host plant simulator (host_tools/plant_simulator, a
+first-order-plus-dead-time process written to CSV) and boots the plant
+application's image on the lab's CAN buses: node 1, whose I/O board is
+wired to the simulator, and, for the two-node configuration, node 2. It
+brings both channels of each board up as network interfaces (two buses,
+dcoslab/remote.py's attach_redundant) and starts the loop's components
+with the application's `plant` console command:
+
+    configuration "one": node 1 runs the sampler, the controller and the actuator;
+    configuration "two": node 1 the sampler and the actuator, node 2 the controller.
+
+The seed's Test Case 2 (9.4.2, Fig. 9.7, instances 1 and 2); `make plant`
+(tests_renode/plant.py) and docs/examples/plant/tests use it.
+"""
+
+import csv
+import os
+import re
+import subprocess
+import sys
+import time
+
+from .canlab import CanLab
+from .layout import PLANT_SIMULATOR
+from .remote import attach_redundant
+# The plant: gain 1, time constant 200 ms, dead time 20 ms, as the single-board closed loop test's.
+PLANT_OPTIONS = ["--gain", "1", "--tau", "0.2", "--dead-time", "0.02", "--input-channel", "0",
+                 "--output-channel", "0"]
+BIT_RATE = 500_000
+
+_STARTED = re.compile(r"plant: \w+ started, publisher (0x[0-9a-f]{8})")
+
+
+class PlantError(RuntimeError):
+    pass
+
+
+def start_plant_simulator(socket_path, csv_path, options=(), timeout=60):
+    """The simulator listening on socket_path, writing its trajectory to csv_path; its process."""
+    process = subprocess.Popen([sys.executable, PLANT_SIMULATOR, "--socket", socket_path, "--csv", csv_path,
+                                "--accept-timeout", "300", *PLANT_OPTIONS, *options],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + timeout
+    while not os.path.exists(socket_path):
+        if process.poll() is not None or time.monotonic() > deadline:
+            process.kill()
+            raise PlantError(f"the plant simulator did not listen on {socket_path}: {process.stderr.read()}")
+        time.sleep(0.05)
+    return process
+
+
+def read_trajectory(csv_path):
+    """(seconds, AO0 in volts, plant output in volts) for each conversion in the simulator's CSV."""
+    rows = []
+    with open(csv_path, newline="", encoding="utf-8") as handle:
+        for row in csv.DictReader(handle):
+            rows.append((int(row["time_ns"]) / 1e9, float(row["dac0"]), float(row["process_output"])))
+    return rows
+
+
+def statistics(board, timeout=120):
+    """The `plant` command's three lines, as {component: {field: number}}."""
+    output = board.command("plant", timeout=timeout)
+    result = {}
+    for component, fields in re.findall(r"^(sampler|controller|actuator): (.*?)\r?$", output, re.M):
+        result[component] = {name.strip().replace(" ", "_"): int(value)
+                             for name, value in re.findall(r"([a-z ]+?) (-?\d+)(?: uV| us)?(?:,|$)", fields)}
+    if len(result) != 3:
+        raise PlantError(f"unexpected `plant` output: {output!r}")
+    return result
+
+
+class PlantLab:
+    def __init__(self, boot, board_definition, image, directory, configuration="two", bit_rate=BIT_RATE,
+                 timeout=120, pace=None):
+        if configuration not in ("one", "two"):
+            raise ValueError(f"configuration {configuration!r}: one or two")
+        self.configuration = configuration
+        self.timeout = timeout
+        self.csv_path = os.path.join(directory, "plant.csv")
+        socket_path = os.path.join(directory, "plant.sock")
+        self.simulator = start_plant_simulator(socket_path, self.csv_path)
+        nodes = {"node1": {"bus0": "can0", "bus1": "can1", "append": "node=1",
+                           "devices": {"isa-mfio": {"wiring": "plant", "plant": "plant"}},
+                           "args": ["-chardev", f"socket,id=plant,path={socket_path}"]}}
+        if configuration == "two":
+            nodes["node2"] = {"bus0": "can0", "bus1": "can1", "append": "node=2"}
+        try:
+            self.lab = CanLab(boot, board_definition, {"can0": bit_rate, "can1": bit_rate}, nodes, pace=pace,
+                              kind=image, timeout=timeout)
+            self.io = self.lab.board("node1")
+            self.control = self.lab.board("node2") if configuration == "two" else self.io
+            if configuration == "two":
+                attach_redundant(self.io, 1, [2], bit_rate, timeout)
+                attach_redundant(self.control, 2, [1], bit_rate, timeout)
+        except BaseException:
+            self.close()
+            raise
+
+    def start(self):
+        """Starts the components where the configuration puts them; (pv, mv) publisher ids."""
+        if self.configuration == "one":
+            output = self.io.command("plant all", timeout=self.timeout)
+            ids = _STARTED.findall(output)
+            if len(ids) != 2 or "actuator started" not in output:
+                raise PlantError(f"plant all: {output!r}")
+            return ids[0], ids[1]
+        pv = self._started(self.io, "plant io")
+        mv = self._started(self.control, f"plant control {pv}")
+        output = self.io.command(f"plant actuate {mv}", timeout=self.timeout)
+        if "actuator started" not in output:
+            raise PlantError(f"plant actuate: {output!r}")
+        return pv, mv
+
+    def _started(self, board, line):
+        output = board.command(line, timeout=self.timeout)
+        match = _STARTED.search(output)
+        if not match:
+            raise PlantError(f"{line}: {output!r}")
+        return match.group(1)
+
+    def run_until(self, seconds):
+        """Lets emulated time run until `seconds` after the boards' start."""
+        self.lab.hub.wait_until(int(seconds * 1e9), self.timeout)
+
+    def set_point(self, millivolts):
+        output = self.control.command(f"plant setpoint {millivolts}", timeout=self.timeout)
+        if "set point" not in output:
+            raise PlantError(f"plant setpoint: {output!r}")
+
+    def statistics(self):
+        """Every component's statistics, from the nodes that run them."""
+        io = statistics(self.io, self.timeout)
+        control = statistics(self.control, self.timeout)
+        return {"sampler": io["sampler"], "controller": control["controller"], "actuator": io["actuator"]}
+
+    def trajectory(self):
+        return read_trajectory(self.csv_path)
+
+    def close(self):
+        lab = getattr(self, "lab", None)
+        if lab is not None:
+            lab.close()
+        if self.simulator.poll() is None:
+            self.simulator.terminate()
+        try:
+            self.simulator.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.simulator.kill()
