@@ -35,8 +35,31 @@ def tool(hub, *arguments, bus="can0"):
                             stderr=subprocess.PIPE, text=True)
 
 
-def wait_for_participants(hub, count):
-    hub.wait_for(lambda: len(hub.participants) >= count, TIMEOUT, f"{count} participants")
+def wait_for_participants(hub, count, bus="can0"):
+    """Until count tools have joined and attached a port to bus: a frame sent before a tool's
+    port is on the bus is not one the tool can see."""
+    hub.wait_for(lambda: len(hub.participants) >= count and len(hub.buses[bus].ports) >= count, TIMEOUT,
+                 f"{count} participants on {bus}")
+
+
+def decoded_dumps(hub, frames):
+    """Another node sends frames; what `dcos-can dump --decode` prints of them, in JSON and in text."""
+    count = str(len(frames))
+    dump = tool(hub, "--json", "dump", "-n", count, "-t", "30000", "--decode")
+    text = tool(hub, "dump", "-n", count, "-t", "30000", "--decode")
+    wait_for_participants(hub, 2)
+    other = Client(hub.socket_path, "other")
+    try:
+        other.attach(0, "can0")
+        for frame in frames:
+            other.transmit(0, frame)
+        output, errors = dump.communicate(timeout=TIMEOUT)
+        lines, text_errors = text.communicate(timeout=TIMEOUT)
+    finally:
+        other.close()
+    assert dump.returncode == 0, errors
+    assert text.returncode == 0, text_errors
+    return output, lines
 
 
 def test_dump_shows_another_nodes_frames_with_emulated_times(hub):
@@ -67,20 +90,7 @@ def test_dump_puts_publications_back_together(hub):
                bytes.fromhex("BA531A1B1C1D1E1F")]
     frames = [Frame(0x0A20FF02, extended=True, dlc=len(data), data=data)
               for data in example + [example[2], bytes.fromhex("CA53")]]
-    dump = tool(hub, "--json", "dump", "-n", "5", "-t", "30000", "--decode")
-    text = tool(hub, "dump", "-n", "5", "-t", "30000", "--decode")
-    wait_for_participants(hub, 2)
-    other = Client(hub.socket_path, "other")
-    try:
-        other.attach(0, "can0")
-        for frame in frames:
-            other.transmit(0, frame)
-        output, errors = dump.communicate(timeout=TIMEOUT)
-        lines, text_errors = text.communicate(timeout=TIMEOUT)
-    finally:
-        other.close()
-    assert dump.returncode == 0, errors
-    assert text.returncode == 0, text_errors
+    output, lines = decoded_dumps(hub, frames)
     publications = [json.loads(line)["dcos"]["publication"] for line in output.splitlines()]
     assert publications == [
         {"index": 0xA53, "part": 0, "sequence": 0x5677},
@@ -102,23 +112,11 @@ def test_dump_puts_publications_back_together(hub):
 def test_dump_decodes_remote_transactions(hub):
     # docs/protocols/remote-transactions.md: a request, its pending and final
     # replies, and a request no node should send.
-    dump = tool(hub, "--json", "dump", "-n", "4", "-t", "30000", "--decode")
-    text = tool(hub, "dump", "-n", "4", "-t", "30000", "--decode")
-    wait_for_participants(hub, 2)
-    other = Client(hub.socket_path, "other")
-    try:
-        other.attach(0, "can0")
-        for frame in (Frame(0x14110201, extended=True, dlc=8, data=bytes([1, 0x13, 0xA0, 0x05, 0, 0, 0, 200])),
-                      Frame(0x14100102, extended=True, dlc=8, data=bytes([1, 0x13, 0, 1, 0, 0, 0, 0])),
-                      Frame(0x14100102, extended=True, dlc=8, data=bytes([1, 0x13, 7, 0, 0, 0, 0, 0])),
-                      Frame(0x14110201, extended=True, dlc=3, data=bytes([9, 0x13, 0]))):
-            other.transmit(0, frame)
-        output, errors = dump.communicate(timeout=TIMEOUT)
-        lines, text_errors = text.communicate(timeout=TIMEOUT)
-    finally:
-        other.close()
-    assert dump.returncode == 0, errors
-    assert text.returncode == 0, text_errors
+    output, lines = decoded_dumps(hub, [
+        Frame(0x14110201, extended=True, dlc=8, data=bytes([1, 0x13, 0xA0, 0x05, 0, 0, 0, 200])),
+        Frame(0x14100102, extended=True, dlc=8, data=bytes([1, 0x13, 0, 1, 0, 0, 0, 0])),
+        Frame(0x14100102, extended=True, dlc=8, data=bytes([1, 0x13, 7, 0, 0, 0, 0, 0])),
+        Frame(0x14110201, extended=True, dlc=3, data=bytes([9, 0x13, 0]))])
     remote = [json.loads(line)["dcos"]["remote"] for line in output.splitlines()]
     assert remote == [
         {"service": "acquire", "transaction": 0x13, "object": 0xA005, "argument": 200},
@@ -151,7 +149,7 @@ def test_frames_dcos_can_sends_reach_another_node(hub):
 
 def test_stats_take_the_bit_rate_from_the_hub(hub):
     stats = tool(hub, "--json", "stats", "-s", "3", bus="can1")
-    wait_for_participants(hub, 1)
+    wait_for_participants(hub, 1, bus="can1")
     other = Client(hub.socket_path, "other")
     try:
         other.attach(0, "can1")

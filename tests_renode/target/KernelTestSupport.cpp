@@ -135,4 +135,14 @@ bool checkStatus(shell::Shell& shell, dcos::Status actual, dcos::Status expected
     return true;
 }
 
+bool parseObjectId(const char* text, dcos::ObjectId& id)
+{
+    unsigned long raw;
+    if (!shell::Shell::parseUnsigned(text, raw) || raw > 0xFFFFFFFFul) {
+        return false;
+    }
+    id = dcos::ObjectId::fromRaw(static_cast<uint32_t>(raw));
+    return true;
+}
+
 } // namespace target_test

@@ -64,4 +64,8 @@ bool check(shell::Shell& shell, bool condition, const char* what);
 /// Compares a status and prints both on mismatch.
 bool checkStatus(shell::Shell& shell, dcos::Status actual, dcos::Status expected, const char* what);
 
+/// An object id typed on the console (a number, 0x for hexadecimal); false
+/// for text that is not one or does not fit 32 bits.
+bool parseObjectId(const char* text, dcos::ObjectId& id);
+
 } // namespace target_test

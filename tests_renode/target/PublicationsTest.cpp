@@ -171,16 +171,6 @@ void subscriberEntry(uintptr_t)
     }
 }
 
-bool parseId(const char* text, ObjectId& id)
-{
-    unsigned long raw;
-    if (!shell::Shell::parseUnsigned(text, raw) || raw > 0xFFFFFFFFul) {
-        return false;
-    }
-    id = ObjectId::fromRaw(static_cast<uint32_t>(raw));
-    return true;
-}
-
 bool parseVisibility(const char* text, dcos::Visibility& visibility)
 {
     if (textEquals(text, "local")) {
@@ -269,7 +259,7 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
         publishDelete = true;
         return CommandResult::Ok;
     }
-    if (textEquals(verb, "subscribe") && (argc == 4 || argc == 5) && parseId(argv[2], id) &&
+    if (textEquals(verb, "subscribe") && (argc == 4 || argc == 5) && parseObjectId(argv[2], id) &&
         shell::Shell::parseUnsigned(argv[3], priority) && priority <= dcos::kLowestPriority) {
         // subscribe <publisher> <priority> [read time-out ms]
         unsigned long timeoutMs = 0;
@@ -302,7 +292,7 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
                     static_cast<unsigned long>(waits));
         return CommandResult::Ok;
     }
-    if (textEquals(verb, "open") && argc == 3 && parseId(argv[2], id)) {
+    if (textEquals(verb, "open") && argc == 3 && parseObjectId(argv[2], id)) {
         // Open and Close at once from the console: the refusals.
         const uint64_t start = timerAgent.Uptime();
         const Result<ObjectId> opened = dsmAgent.Open(id);

@@ -77,16 +77,6 @@ void hogEntry(uintptr_t)
     hogRanNs = timerAgent.Uptime() - start;
 }
 
-bool parseId(const char* text, ObjectId& id)
-{
-    unsigned long raw;
-    if (!shell::Shell::parseUnsigned(text, raw) || raw > 0xFFFFFFFFul) {
-        return false;
-    }
-    id = ObjectId::fromRaw(static_cast<uint32_t>(raw));
-    return true;
-}
-
 // Prints "<tag> <id>" for a created object, or the error; the command's result.
 CommandResult reportCreated(shell::Shell& shell, const char* tag, const Result<ObjectId>& created)
 {
@@ -143,13 +133,13 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
     if (textEquals(verb, "listener") && argc == 2) {
         return reportCreated(shell, "RTASK", createTask("listener", 10, listenerEntry));
     }
-    if (textEquals(verb, "waiter") && argc == 3 && parseId(argv[2], id)) {
+    if (textEquals(verb, "waiter") && argc == 3 && parseObjectId(argv[2], id)) {
         dcos::TaskAttributes attributes;
         attributes.name = "waiter";
         attributes.priority = 12;
         return reportCreated(shell, "RTASK", taskAgent.Create(attributes, waiterEntry, id.raw()));
     }
-    if (textEquals(verb, "kill") && argc == 3 && parseId(argv[2], id)) {
+    if (textEquals(verb, "kill") && argc == 3 && parseObjectId(argv[2], id)) {
         shell.print("RKILL %s\r\n", dcos::statusName(taskAgent.KillTask(id)));
         return CommandResult::Ok;
     }
@@ -186,7 +176,7 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         }
         first = 3;
     }
-    if (argc < first + 1 || !parseId(argv[first], id)) {
+    if (argc < first + 1 || !parseObjectId(argv[first], id)) {
         return CommandResult::UsageError;
     }
     const int extra = argc - first - 1;
