@@ -166,3 +166,52 @@ def test_opening_a_remote_publisher_is_refused_as_a_local_open_would_be(pair):
     assert status == "ok" and subscription != 0
     # Open and Close: its remote publisher is free again.
     assert "publisher 0x" not in one.command("net publications")
+
+
+def remote_publishers(board):
+    return re.findall(r"^  publisher (0x[0-9a-f]{8})", board.command("net publications"), re.M)
+
+
+def test_a_dead_node_gives_unreachable_and_leaves_nothing_held(pair):
+    lab, one, two = pair
+    # Node 3 is mapped, with a CAN node number, but no board answers.
+    for line in ("net map 3 130.1.0.3", "net neighbour 130.1.0.3 3"):
+        assert "error:" not in one.command(line)
+    status, _, microseconds = open_result(one, "0x00038000")
+    assert status == "node unreachable"
+    assert microseconds < 1_000_000, "given up by the watchdog, not a time-out of its own"
+    assert remote_publishers(one) == []
+    # A task killed while it waits for the dead node leaves nothing either.
+    subscriber = re.search(r"PTASK (0x[0-9a-f]{8})", one.command("pubsub subscribe 0x00038000 5")).group(1)
+    lab.hub.wait_until(lab.hub.now_ns + 60_000_000, STEP)
+    assert remote_publishers(one) == ["0x00038000"], "held while the Open waits"
+    assert "RKILL ok" in one.command(f"remote kill {subscriber}")
+    assert remote_publishers(one) == []
+
+
+def test_a_subscriber_killed_while_it_reads_gives_its_remote_publisher_back(pair):
+    lab, one, two = pair
+    publisher = publish(two, "quiet", count=0)
+    subscriber = re.search(r"PTASK (0x[0-9a-f]{8})", one.command(f"pubsub subscribe {publisher} 5")).group(1)
+    wait_tally(lab, one, lambda status, _: status == "ok", "the subscriber to open")
+    assert remote_publishers(one) == [publisher]
+    assert "RKILL ok" in one.command(f"remote kill {subscriber}")
+    assert remote_publishers(one) == []
+    # Node 2 does not know or care: its publisher carries on.
+    assert open_result(one, publisher)[0] == "ok"
+
+
+def test_the_remote_publisher_table_full_is_refused_and_recovers(pair):
+    lab, one, two = pair
+    capacity = 16  # DCOS_CONFIG_REMOTE_PUBLISHERS
+    publishers = [publish(two, f"p{index}", count=0) for index in range(capacity + 1)]
+    for publisher in publishers[:capacity]:
+        assert parse_result(one.command(f"pubsub hold {publisher}"))[0] == "ok"
+    # Another subscription to one already read shares its slot.
+    assert parse_result(one.command(f"pubsub hold {publishers[0]}"))[0] == "ok"
+    assert parse_result(one.command(f"pubsub hold {publishers[capacity]}"))[0] == "object table full"
+    assert counters(one, "publications")["no-remote-publisher"] == 1
+    assert len(remote_publishers(one)) == capacity
+    assert parse_result(one.command("pubsub release"))[1] == capacity + 1
+    assert remote_publishers(one) == []
+    assert parse_result(one.command(f"pubsub hold {publishers[capacity]}"))[0] == "ok"

@@ -171,6 +171,11 @@ void subscriberEntry(uintptr_t)
     }
 }
 
+// Subscriptions the console holds (pubsub hold), to fill the remote publisher table.
+constexpr size_t kMostHeld = 32;
+ObjectId held[kMostHeld];
+size_t heldCount = 0;
+
 bool parseVisibility(const char* text, dcos::Visibility& visibility)
 {
     if (textEquals(text, "local")) {
@@ -292,6 +297,28 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
                     static_cast<unsigned long>(waits));
         return CommandResult::Ok;
     }
+    if (textEquals(verb, "hold") && argc == 3 && parseObjectId(argv[2], id)) {
+        // Open a subscription and keep it (the console task owns it) until release.
+        if (heldCount == kMostHeld) {
+            shell.print("error: %u subscriptions held already\r\n", unsigned(kMostHeld));
+            return CommandResult::Failed;
+        }
+        const Result<ObjectId> opened = dsmAgent.Open(id);
+        if (opened.ok()) {
+            held[heldCount++] = opened.value();
+        }
+        shell.print("RRES %s %lu 0\r\n", dcos::statusName(opened.status()),
+                    static_cast<unsigned long>(opened.ok() ? opened.value().raw() : 0));
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "release") && argc == 2) {
+        unsigned closed = 0;
+        for (; heldCount > 0; --heldCount) {
+            closed += dsmAgent.Close(held[heldCount - 1]) == Status::Ok ? 1 : 0;
+        }
+        shell.print("RRES ok %u 0\r\n", closed);
+        return CommandResult::Ok;
+    }
     if (textEquals(verb, "open") && argc == 3 && parseObjectId(argv[2], id)) {
         // Open and Close at once from the console: the refusals.
         const uint64_t start = timerAgent.Uptime();
@@ -313,12 +340,13 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
 DCOS_SHELL_COMMAND_DETAILED(
     pubsubCommand, "pubsub", "publishers and subscribers across boards, for the lab's tests (test image only)",
     "pubsub publish <name> local|regional|global <priority> <period ms> <count> | go | isr <counter> | published | delete | "
-    "subscribe <publisher> <priority> [read time-out ms] | tally | open <publisher>",
+    "subscribe <publisher> <priority> [read time-out ms] | tally | open <publisher> | hold <publisher> | release",
     "  publish: a task creates the publisher; after go it writes <count> pages, one per period,\r\n"
     "  then keeps the publisher until delete; isr: an interrupt handler writes page <counter>\r\n"
     "  subscribe: a task opens the publisher (local or remote) and reads every new page\r\n"
     "  tally: PSUB <open status> <received> <last> <repeats> <torn> <gaps> <deleted> <time-outs>\r\n"
-    "  open: Open and Close at once; prints RRES <status> <subscription> <microseconds>",
+    "  open: Open and Close at once; prints RRES <status> <subscription> <microseconds>\r\n"
+    "  hold: Open and keep the subscription; release: Close every one held",
     pubsub);
 
 } // namespace target_test
