@@ -203,3 +203,23 @@ def test_stats_count_bus_errors_and_frames_with_a_bad_length(hub):
     assert result["frames"] == 3, result
     assert result["events"] == {"bus-error": 3}, result
     assert result["state"] == "error-active", result
+
+
+def test_dump_decodes_name_queries(hub):
+    # docs/protocols/remote-transactions.md, "Names": node 1 asks every node
+    # for the semaphore "pump"; node 2 answers with its id; a query part
+    # for a type without names.
+    output, lines = decoded_dumps(hub, [
+        Frame(0x1812FF01, extended=True, dlc=8, data=bytes([0x0A, 0x10]) + b"pump\0\0"),
+        Frame(0x1812FF01, extended=True, dlc=8, data=bytes([0x4A, 0x10, 0, 0, 0, 0, 0, 0])),
+        Frame(0x1812FF01, extended=True, dlc=8, data=bytes([0x8A, 0x10, 0, 0, 0, 0, 0, 0])),
+        Frame(0x18100102, extended=True, dlc=8, data=bytes([10, 0x10, 0, 0, 0x00, 0x02, 0xA0, 0x01])),
+        Frame(0x1812FF01, extended=True, dlc=8, data=bytes([0x09, 0x11]) + b"abcdef")])
+    decoded = [json.loads(line)["dcos"] for line in output.splitlines()]
+    assert decoded[0]["name_query"] == {"type": "semaphore", "part": 0, "transaction": 0x10, "name_bytes": "pump"}
+    assert decoded[3]["remote"] == {"service": "name", "transaction": 0x10, "status": "ok", "pending": False,
+                                    "value": 0x0002A001}
+    assert decoded[4]["name_query"] == {"malformed": "no such object type"}
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations[:2] == ['prio 24 name query 1->all: semaphore part 1/3 txn 0x10 "pump"',
+                               'prio 24 name query 1->all: semaphore part 2/3 txn 0x10 ""'], lines

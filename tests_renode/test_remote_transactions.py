@@ -325,3 +325,59 @@ def test_every_one_of_many_calls_runs_exactly_once(pair):
     assert served["served"] == calls and served["duplicates"] == 0
     transactions = [data[1] for _, _, _, data in dcos_frames(lab, REQUEST)]
     assert len(transactions) == calls and len(set(transactions)) == 16  # the numbers did wrap
+
+
+NAME_QUERY = 0x12
+
+
+def test_names_are_found_on_the_other_node_as_their_visibility_allows(pair):
+    lab, one, two = pair
+    pump = created(two, "remote named pump global", "RSEM")
+    created(two, "remote named valve local", "RSEM")
+    created(two, "remote named door regional", "RSEM")
+    publisher = re.search(r"PPUB (0x[0-9a-f]{8})", two.command("pubsub publish level global 10 10 0")).group(1)
+    # Global: found from node 1, with node 2's id, in one query and one reply.
+    queries_before = len(dcos_frames(lab, NAME_QUERY))
+    status, value, us = remote.call(one, "name semaphore pump")
+    assert (status, f"0x{value:08x}") == ("ok", pump)
+    assert us < WATCHDOG_MS * 1000, "answered at once, not after a retransmission"
+    lab.hub.wait_until(lab.hub.now_ns + 2_000_000, 60)
+    queries = dcos_frames(lab, NAME_QUERY)[queries_before:]
+    assert len(queries) == 3 and {(destination, source, len(data)) for _, destination, source, data in queries} \
+        == {(255, 1, 8)}
+    assert bytes(queries[0][3][2:6]) == b"pump"
+    status, value, _ = remote.call(one, "name publisher level")
+    assert (status, f"0x{value:08x}") == ("ok", publisher)
+    # Local and regional objects are not seen from another node over the
+    # fieldbus, nor is a task of local visibility: every node stays silent,
+    # and after the watchdog's silent periods the answer is "not found".
+    created(two, "remote listener", "RTASK")
+    for kind, name in (("semaphore", "valve"), ("semaphore", "door"), ("task", "listener"), ("timer", "nothing")):
+        status, _, us = remote.call(one, f"name {kind} {name}")
+        assert status == "not found", (kind, name)
+        assert (SILENT_PERIODS - 1) * WATCHDOG_MS * 1000 <= us < 2 * SILENT_PERIODS * WATCHDOG_MS * 1000, (name, us)
+    # A node's own object comes first, without asking the bus.
+    own = created(one, "remote named pump local", "RSEM")
+    queries_before = len(dcos_frames(lab, NAME_QUERY))
+    status, value, _ = remote.call(one, "name semaphore pump")
+    assert (status, f"0x{value:08x}") == ("ok", own)
+    assert len(dcos_frames(lab, NAME_QUERY)) == queries_before
+    # Names follow deletion: node 2's pump deleted, node 1 finds only its own.
+    assert "RRES ok" in two.command(f"remote delete {pump}")
+    assert "RRES ok" in one.command(f"remote delete {own}")
+    assert remote.call(one, "name semaphore pump")[0] == "not found"
+    statistics = counters(two)
+    assert statistics["malformed"] == 0 and statistics["refused-busy"] == 0
+
+
+def test_a_name_query_nobody_can_answer_is_refused_not_served(pair):
+    lab, one, two = pair
+    # A name query for a type without names, and a torn one, from node 1's
+    # CAN node number: node 2 counts them as malformed and answers nothing.
+    before = counters(two)["malformed"]
+    lab.hub.inject("can0", "lab", Frame(0x00120201, extended=True, dlc=8,
+                                         data=bytes([0x09, 0x01]) + b"abcdef"))
+    lab.hub.inject("can0", "lab", Frame(0x00120201, extended=True, dlc=3, data=bytes([0x08, 0x01, 0x00])))
+    lab.hub.wait_until(lab.hub.now_ns + 5_000_000, 60)
+    assert counters(two)["malformed"] == before + 2
+    assert not [frame for frame in dcos_frames(lab, REPLY) if frame[2] == 2 and frame[1] == 1]

@@ -22,7 +22,8 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/system/DeviceCommands.cpp \
 	firmware/dcos/src/network/NetworkAddress.cpp \
 	firmware/dcos/src/network/RemoteMessage.cpp \
-	firmware/dcos/src/network/PublicationMessage.cpp
+	firmware/dcos/src/network/PublicationMessage.cpp \
+	firmware/dcos/src/network/RemoteForward.cpp
 
 # Kernel sources that run only on the target: task switching, the tick, traps.
 DCOS_TARGET_SRCS := \
@@ -41,8 +42,8 @@ DCOS_TARGET_SRCS := \
 	firmware/dcos/src/application/ApplicationLoader.cpp \
 	firmware/dcos/src/application/ApplicationCommands.cpp \
 	firmware/dcos/src/network/NetworkInterfacesManager.cpp \
-	firmware/dcos/src/network/RemoteForward.cpp \
 	firmware/dcos/src/network/RemoteAgent.cpp \
+	firmware/dcos/src/network/NameService.cpp \
 	firmware/dcos/src/network/NetworkCommands.cpp
 
 # The full configuration's kernel, in link order (which is the order of the

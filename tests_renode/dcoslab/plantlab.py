@@ -9,7 +9,8 @@ dcoslab/remote.py's attach_redundant) and starts the loop's components
 with the application's `plant` console command:
 
     configuration "one": node 1 runs the sampler, the controller and the actuator;
-    configuration "two": node 1 the sampler and the actuator, node 2 the controller.
+    configuration "two": node 1 the sampler and the actuator, node 2 the controller,
+    each finding the publisher it reads by name on the other node.
 
 The seed's Test Case 2 (9.4.2, Fig. 9.7, instances 1 and 2); `make plant`
 (tests_renode/plant.py) and docs/examples/plant/tests use it.
@@ -107,10 +108,12 @@ class PlantLab:
             if len(ids) != 2 or "actuator started" not in output:
                 raise PlantError(f"plant all: {output!r}")
             return ids[0], ids[1]
+        # Each component finds its input by name: the controller node 1's
+        # "pv", the actuator node 2's "mv" (distributed names).
         pv = self._started(self.io, "plant io")
-        mv = self._started(self.control, f"plant control {pv}")
-        output = self.io.command(f"plant actuate {mv}", timeout=self.timeout)
-        if "actuator started" not in output:
+        mv = self._started(self.control, "plant control")
+        output = self.io.command("plant actuate", timeout=self.timeout)
+        if f"actuator started, reading {mv}" not in output:
             raise PlantError(f"plant actuate: {output!r}")
         return pv, mv
 

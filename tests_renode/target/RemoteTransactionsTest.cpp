@@ -17,6 +17,7 @@
 // priority, to show that a request of lower priority waits for it.
 #include "KernelTestSupport.hpp"
 
+#include <dcos/DsmAgent.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
@@ -130,6 +131,45 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         }
         return reportCreated(shell, "RSEM", semaphoreAgent.Create(attributes));
     }
+    if (textEquals(verb, "named") && argc == 4) {
+        // named <name> local|regional|global: a counting semaphore (count 1) with that name and visibility.
+        dcos::SemaphoreAttributes attributes;
+        attributes.name = argv[2];
+        attributes.kind = dcos::SemaphoreKind::Counting;
+        if (textEquals(argv[3], "local")) {
+            attributes.visibility = dcos::Visibility::Local;
+        } else if (textEquals(argv[3], "regional")) {
+            attributes.visibility = dcos::Visibility::Regional;
+        } else if (textEquals(argv[3], "global")) {
+            attributes.visibility = dcos::Visibility::Global;
+        } else {
+            return CommandResult::UsageError;
+        }
+        return reportCreated(shell, "RSEM", semaphoreAgent.Create(attributes));
+    }
+    if (textEquals(verb, "delete") && argc == 3 && parseObjectId(argv[2], id)) {
+        shell.print("RRES %s 0 0\r\n", dcos::statusName(semaphoreAgent.Delete(id)));
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "name") && argc == 4) {
+        // name <kind> <name>: NameToObject of that agent, local first, then the other nodes.
+        const char* const kind = argv[2];
+        const uint64_t start = timerAgent.Uptime();
+        Result<ObjectId> found = Status::InvalidArgument;
+        if (textEquals(kind, "task")) {
+            found = taskAgent.NameToObject(argv[3]);
+        } else if (textEquals(kind, "semaphore")) {
+            found = semaphoreAgent.NameToObject(argv[3]);
+        } else if (textEquals(kind, "publisher")) {
+            found = dcos::dsmAgent.NameToObject(argv[3]);
+        } else if (textEquals(kind, "timer")) {
+            found = timerAgent.NameToObject(argv[3]);
+        } else {
+            return CommandResult::UsageError;
+        }
+        printResult(shell, found.status(), found.ok() ? found.value().raw() : 0, start);
+        return CommandResult::Ok;
+    }
     if (textEquals(verb, "listener") && argc == 2) {
         return reportCreated(shell, "RTASK", createTask("listener", 10, listenerEntry));
     }
@@ -236,7 +276,8 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
 
 DCOS_SHELL_COMMAND_DETAILED(
     remoteCommand, "remote", "call primitives by id, local or remote, for the lab's tests (test image only)",
-    "remote sem <count> [max] | sem binary | listener | got | hog <priority> <ms> | waiter <id> | kill <task> | "
+    "remote sem <count> [max] | sem binary | named <name> local|regional|global | delete <semaphore> | "
+    "name task|semaphore|publisher|timer <name> | listener | got | hog <priority> <ms> | waiter <id> | kill <task> | "
     "acquire [at=P] <id> <ms> | release [at=P] <id> | count [at=P] <id> | post [at=P] <id> <events> | "
     "signal [at=P] <id> <n> | state [at=P] <task> | priority [at=P] <task> | holder [at=P] <semaphore>",
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"

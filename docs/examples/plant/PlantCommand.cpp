@@ -2,8 +2,10 @@
 // all or some, and show what each has done.
 //
 //     plant io                 the I/O board, the sampler (publishes "pv") and nothing else yet
-//     plant control <pv>       the controller, reading publisher <pv> (local or another node's)
-//     plant actuate <mv>       the actuator, reading publisher <mv>; on the node with the I/O board
+//     plant control [<pv>]     the controller, reading publisher <pv> (local or another node's;
+//                              by default the one named "pv", found on this node or another)
+//     plant actuate [<mv>]     the actuator, reading publisher <mv> (by default the one named
+//                              "mv"); on the node with the I/O board
 //     plant all                all three on this node
 //     plant setpoint <mV>      the controller's set point
 //     plant                    the components' statistics, a line each
@@ -12,6 +14,7 @@
 // command that starts the next component, here or on another node.
 #include "Plant.hpp"
 
+#include <dcos/DsmAgent.hpp>
 #include <runtime/Text.hpp>
 #include <shell/Shell.hpp>
 #include <shell/ShellCommand.hpp>
@@ -39,6 +42,27 @@ bool parseId(const char* text, ObjectId& id)
         return false;
     }
     id = ObjectId::fromRaw(static_cast<uint32_t>(raw));
+    return true;
+}
+
+// The publisher the command names: the id given, or the publisher called
+// @p name, on this node or, failing that, on another (distributed names).
+bool inputOf(shell::Shell& shell, int argc, char** argv, const char* name, ObjectId& id)
+{
+    if (argc == 3) {
+        if (!parseId(argv[2], id)) {
+            shell.print("plant: '%s' is not a publisher id\r\n", argv[2]);
+            return false;
+        }
+        return true;
+    }
+    const Result<ObjectId> found = dcos::dsmAgent.NameToObject(name);
+    if (!found.ok()) {
+        shell.print("plant: no publisher \"%s\" on this node or another: %s\r\n", name,
+                    dcos::statusName(found.status()));
+        return false;
+    }
+    id = found.value();
     return true;
 }
 
@@ -79,10 +103,16 @@ CommandResult plantCommand(shell::Shell& shell, int argc, char** argv)
     if (textEquals(verb, "io") && argc == 2) {
         return started(shell, "sampler", startSampler());
     }
-    if (textEquals(verb, "control") && argc == 3 && parseId(argv[2], id)) {
+    if (textEquals(verb, "control") && argc <= 3) {
+        if (!inputOf(shell, argc, argv, "pv", id)) {
+            return CommandResult::Failed;
+        }
         return started(shell, "controller", startController(id));
     }
-    if (textEquals(verb, "actuate") && argc == 3 && parseId(argv[2], id)) {
+    if (textEquals(verb, "actuate") && argc <= 3) {
+        if (!inputOf(shell, argc, argv, "mv", id)) {
+            return CommandResult::Failed;
+        }
         const Status status = startActuator(id);
         if (status != Status::Ok) {
             return failed(shell, "actuator", status);
@@ -124,10 +154,12 @@ CommandResult plantCommand(shell::Shell& shell, int argc, char** argv)
 } // namespace
 
 DCOS_SHELL_COMMAND_DETAILED(plantShellCommand, "plant", "the control loop's components: start them, show them",
-                            "plant [io | control <pv> | actuate <mv> | all | setpoint <mV>]",
+                            "plant [io | control [<pv>] | actuate [<mv>] | all | setpoint <mV>]",
                             "  io: the I/O board and the sampler, which publishes AI0 as \"pv\" every 10 ms\r\n"
-                            "  control: the controller, reading publisher <pv>, publishing \"mv\"\r\n"
-                            "  actuate: the actuator, reading publisher <mv>, writing AO0 (needs the I/O board)\r\n"
+                            "  control: the controller, reading publisher <pv> (default: the one named pv,\r\n"
+                            "    here or on another node), publishing \"mv\"\r\n"
+                            "  actuate: the actuator, reading publisher <mv> (default: the one named mv),\r\n"
+                            "    writing AO0 (needs the I/O board)\r\n"
                             "  all: the three on this node; setpoint: the controller's, in mV\r\n"
                             "  with no argument: each component's statistics",
                             plantCommand);

@@ -4,7 +4,10 @@
 //
 // Checks: a message the decoder accepts encodes back into exactly the same
 // bytes (the layout has no slack, so no two byte strings mean one message),
-// and a refused one is refused for a reason the specification gives.
+// and a refused one is refused for a reason the specification gives. The
+// input is also taken as a stream of name query parts (8 bytes each), put
+// back together as a serving node does: a query it completes has a name of
+// 1 to 15 characters, a type with names, and encodes back into its parts.
 #include "../../../fieldbus/can/fuzz/FuzzCheck.hpp"
 
 #include <dcos/internal/RemoteMessage.hpp>
@@ -39,6 +42,26 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     } else {
         FUZZ_CHECK(replyError == RemoteMessageError::WrongLength || replyError == RemoteMessageError::UnknownService ||
                    replyError == RemoteMessageError::UnknownStatus || replyError == RemoteMessageError::ReservedBits);
+    }
+    NameQueryAssembler assembler;
+    uint8_t lastParts[kNameQueryFrames][kRemoteMessageBytes]{};
+    for (size_t at = 0; at + kRemoteMessageBytes <= size; at += kRemoteMessageBytes) {
+        NameQueryPart part;
+        const NameQueryError error = decodeNameQueryPart(data + at, kRemoteMessageBytes, part);
+        if (error != NameQueryError::None) {
+            FUZZ_CHECK(error == NameQueryError::ReservedBits || error == NameQueryError::BadType);
+            continue;
+        }
+        FUZZ_CHECK(part.part < kNameQueryFrames && isNamedObjectType(part.type));
+        std::memcpy(lastParts[part.part], data + at, kRemoteMessageBytes);
+        if (!assembler.take(part)) {
+            continue;
+        }
+        const size_t length = std::strlen(assembler.name());
+        FUZZ_CHECK(length >= 1 && length < kNameQueryNameBytes);
+        uint8_t again[kNameQueryFrames][kRemoteMessageBytes];
+        encodeNameQuery(assembler.type(), assembler.transaction(), assembler.name(), again);
+        FUZZ_CHECK(std::memcmp(again, lastParts, sizeof again) == 0);
     }
     return 0;
 }

@@ -133,3 +133,102 @@ TEST(RemoteMessageTest, TimeOutsTravelAsWholeMillisecondsNeverShorter)
 }
 
 } // namespace
+
+namespace {
+
+using dcos::ObjectType;
+
+using Frame = std::array<uint8_t, kRemoteMessageBytes>;
+
+std::array<Frame, kNameQueryFrames> nameQuery(uint8_t type, uint8_t transaction, const char* name)
+{
+    uint8_t frames[kNameQueryFrames][kRemoteMessageBytes];
+    encodeNameQuery(type, transaction, name, frames);
+    std::array<Frame, kNameQueryFrames> out;
+    for (size_t part = 0; part < kNameQueryFrames; ++part) {
+        std::copy(frames[part], frames[part] + kRemoteMessageBytes, out[part].begin());
+    }
+    return out;
+}
+
+NameQueryPart decodedPart(const Frame& frame)
+{
+    NameQueryPart part;
+    EXPECT_EQ(decodeNameQueryPart(frame.data(), frame.size(), part), NameQueryError::None);
+    return part;
+}
+
+TEST(NameQueryTest, AQueryIsThreeFramesOfPartTypeTransactionAndTheNamePadded)
+{
+    const auto frames = nameQuery(static_cast<uint8_t>(ObjectType::DsmPublisher), 0x5A, "tank.level");
+    EXPECT_EQ(frames[0], (Frame{0x08, 0x5A, 't', 'a', 'n', 'k', '.', 'l'}));
+    EXPECT_EQ(frames[1], (Frame{0x48, 0x5A, 'e', 'v', 'e', 'l', 0, 0}));
+    EXPECT_EQ(frames[2], (Frame{0x88, 0x5A, 0, 0, 0, 0, 0, 0}));
+    NameQueryAssembler assembler;
+    EXPECT_FALSE(assembler.take(decodedPart(frames[0])));
+    EXPECT_FALSE(assembler.take(decodedPart(frames[1])));
+    ASSERT_TRUE(assembler.take(decodedPart(frames[2])));
+    EXPECT_STREQ(assembler.name(), "tank.level");
+    EXPECT_EQ(assembler.type(), static_cast<uint8_t>(ObjectType::DsmPublisher));
+    EXPECT_EQ(assembler.transaction(), 0x5A);
+}
+
+TEST(NameQueryTest, AFifteenCharacterNameFillsTheFieldAndALongerOneIsCut)
+{
+    const auto frames = nameQuery(static_cast<uint8_t>(ObjectType::Task), 1, "abcdefghijklmnopq");
+    EXPECT_EQ(frames[2], (Frame{0x81, 0x01, 'm', 'n', 'o', 0, 0, 0}));
+    NameQueryAssembler assembler;
+    for (const Frame& frame : frames) {
+        (void)assembler.take(decodedPart(frame));
+    }
+    EXPECT_STREQ(assembler.name(), "abcdefghijklmno");
+}
+
+TEST(NameQueryTest, TheDecoderRefusesWhatNoNodeSends)
+{
+    const auto frames = nameQuery(static_cast<uint8_t>(ObjectType::Semaphore), 7, "pump");
+    NameQueryPart part;
+    EXPECT_EQ(decodeNameQueryPart(frames[0].data(), 7, part), NameQueryError::WrongLength);
+    Frame bad = frames[0];
+    bad[0] = 0xCA; // Part 3.
+    EXPECT_EQ(decodeNameQueryPart(bad.data(), bad.size(), part), NameQueryError::ReservedBits);
+    bad = frames[0];
+    bad[0] |= 0x10;
+    EXPECT_EQ(decodeNameQueryPart(bad.data(), bad.size(), part), NameQueryError::ReservedBits);
+    bad = frames[2];
+    bad[7] = 1;
+    EXPECT_EQ(decodeNameQueryPart(bad.data(), bad.size(), part), NameQueryError::ReservedBits);
+    for (ObjectType type : {ObjectType::None, ObjectType::Process, ObjectType::DsmSubscription,
+                            ObjectType::NetworkInterface, ObjectType::Module, ObjectType::Reserved15}) {
+        bad = frames[0];
+        bad[0] = static_cast<uint8_t>(type);
+        EXPECT_EQ(decodeNameQueryPart(bad.data(), bad.size(), part), NameQueryError::BadType)
+            << static_cast<int>(type);
+    }
+}
+
+TEST(NameQueryTest, PartsOutOfTurnOrOfAnotherQueryAndMalformedNamesMakeNoQuery)
+{
+    const auto one = nameQuery(static_cast<uint8_t>(ObjectType::Task), 1, "first");
+    const auto two = nameQuery(static_cast<uint8_t>(ObjectType::Task), 2, "second");
+    NameQueryAssembler assembler;
+    EXPECT_FALSE(assembler.take(decodedPart(one[0])));
+    EXPECT_FALSE(assembler.take(decodedPart(two[1]))) << "another transaction";
+    EXPECT_FALSE(assembler.take(decodedPart(one[2]))) << "what was gathered was dropped";
+    EXPECT_FALSE(assembler.take(decodedPart(one[1])));
+    // An empty name, and a name with a character after its NUL.
+    const auto empty = nameQuery(static_cast<uint8_t>(ObjectType::Task), 3, "");
+    for (size_t part = 0; part < kNameQueryFrames; ++part) {
+        const bool complete = assembler.take(decodedPart(empty[part]));
+        EXPECT_FALSE(complete);
+    }
+    auto gap = nameQuery(static_cast<uint8_t>(ObjectType::Task), 4, "ab");
+    gap[1][2] = 'x';
+    bool complete = false;
+    for (const Frame& frame : gap) {
+        complete = assembler.take(decodedPart(frame));
+    }
+    EXPECT_FALSE(complete);
+}
+
+} // namespace

@@ -134,6 +134,22 @@ private:
     std::map<uint32_t, dcos::internal::PublicationAssembler> pages_;
 };
 
+// The name of an object type, as a name query carries it.
+const char* objectTypeName(uint8_t type)
+{
+    switch (static_cast<dcos::ObjectType>(type)) {
+    case dcos::ObjectType::Task: return "task";
+    case dcos::ObjectType::Timer: return "timer";
+    case dcos::ObjectType::Device: return "device";
+    case dcos::ObjectType::BufferPool: return "pool";
+    case dcos::ObjectType::Heap: return "heap";
+    case dcos::ObjectType::MessagePort: return "port";
+    case dcos::ObjectType::DsmPublisher: return "publisher";
+    case dcos::ObjectType::Semaphore: return "semaphore";
+    default: return "?";
+    }
+}
+
 DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& frame, PublicationPages& pages)
 {
     using namespace dcos::internal;
@@ -141,6 +157,31 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         return pages.decode(id, frame);
     }
     DataDecoding out;
+    if (id.type() == can::MessageType::NameQuery) {
+        out.key = "name_query";
+        NameQueryPart part;
+        const NameQueryError error = decodeNameQueryPart(frame.data(), frame.length(), part);
+        if (error != NameQueryError::None) {
+            out.text = fmt::format("malformed: {}", nameQueryErrorName(error));
+            out.json = {{"malformed", nameQueryErrorName(error)}};
+            return out;
+        }
+        // The name bytes this part carries, up to the first NUL.
+        std::string bytes;
+        for (uint8_t byte : part.bytes) {
+            if (byte == 0) {
+                break;
+            }
+            bytes += static_cast<char>(byte);
+        }
+        out.text = fmt::format("{} part {}/3 txn 0x{:02x} \"{}\"", objectTypeName(part.type), part.part + 1,
+                               part.transaction, bytes);
+        out.json = {{"type", objectTypeName(part.type)},
+                    {"part", part.part},
+                    {"transaction", part.transaction},
+                    {"name_bytes", bytes}};
+        return out;
+    }
     if (id.type() == can::MessageType::RemoteRequest) {
         out.key = "remote";
         RemoteRequest request;

@@ -23,6 +23,10 @@ enum class MessageType : uint8_t {
     RemoteReply = 0x10,
     /// A remote service request sent by a system agent for a task (seed 6.4).
     RemoteRequest = 0x11,
+    /// A name lookup asked of every node: which one has an object of this
+    /// type and name visible to the asker (seed 6.4, NameToObject). Answered
+    /// with a RemoteReply by the node that has one.
+    NameQuery = 0x12,
     /// A distributed shared memory publication (seed 7.10).
     DsmPublication = 0x20,
     /// A segmented transfer, ISO 15765-2 (IsoTpSender, IsoTpReceiver).
@@ -40,6 +44,7 @@ constexpr bool isAssignedMessageType(uint8_t raw)
     case MessageType::TimeSync:
     case MessageType::RemoteReply:
     case MessageType::RemoteRequest:
+    case MessageType::NameQuery:
     case MessageType::DsmPublication:
     case MessageType::Segmented:
     case MessageType::Configuration:
@@ -56,6 +61,7 @@ constexpr const char* messageTypeName(MessageType type)
     case MessageType::TimeSync: return "time sync";
     case MessageType::RemoteReply: return "remote reply";
     case MessageType::RemoteRequest: return "remote request";
+    case MessageType::NameQuery: return "name query";
     case MessageType::DsmPublication: return "DSM publication";
     case MessageType::Segmented: return "segmented";
     case MessageType::Configuration: return "configuration";

@@ -29,6 +29,7 @@ namespace dcos {
 enum class SystemMessageType : uint8_t {
     RemoteReply = 0x10,
     RemoteRequest = 0x11,
+    NameQuery = 0x12, ///< A part of a name query, to the broadcast address (docs/protocols/remote-transactions.md).
     DsmPublication = 0x20, ///< A part of a publication, to the broadcast address (docs/protocols/publications.md).
 };
 

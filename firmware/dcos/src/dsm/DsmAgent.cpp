@@ -433,6 +433,13 @@ void DsmManager::publishDeferred()
     }
 }
 
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmManager::publisherNameToObject(const char* name, Visibility askingScope)
+{
+    arch_x86::InterruptGuard guard;
+    start();
+    return publisherTable.NameToObject(name, askingScope);
+}
+
 DsmNetworkStatistics DsmManager::networkStatistics()
 {
     arch_x86::InterruptGuard guard;
@@ -699,9 +706,8 @@ Result<uint32_t> DsmAgent::Read(ObjectId id, uint32_t lastSeenDataId, DsmPage& p
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> DsmAgent::NameToObject(const char* name)
 {
-    arch_x86::InterruptGuard guard;
-    start();
-    return publisherTable.NameToObject(name, Visibility::Local);
+    return internal::orRemoteName(internal::DsmManager::publisherNameToObject(name, Visibility::Local),
+                                  ObjectType::DsmPublisher, name);
 }
 
 DCOS_CONFIGURATION_SERVICE Status DsmAgent::AddObjects(size_t count)

@@ -1,6 +1,7 @@
 // The buffer pool memory agent's interface object (seed 7.7): each primitive
 // forwards to the kernel side, internal::BufferPoolManager.
 #include <dcos/BufferPoolAgent.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/BufferPoolManager.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
 
@@ -25,7 +26,8 @@ Result<BufferPoolStatistics> BufferPoolAgent::GetStatistics(ObjectId pool)
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> BufferPoolAgent::NameToObject(const char* name)
 {
-    return BufferPoolManager::NameToObject(name, Visibility::Local);
+    return internal::orRemoteName(BufferPoolManager::NameToObject(name, Visibility::Local), ObjectType::BufferPool,
+                                  name);
 }
 
 DCOS_CONFIGURATION_SERVICE Status BufferPoolAgent::AddObjects(size_t count) { return BufferPoolManager::AddObjects(count); }

@@ -1,6 +1,7 @@
 // The segmented heap memory agent's interface object (seed 7.8): each
 // primitive forwards to the kernel side, internal::HeapManager.
 #include <dcos/HeapAgent.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/HeapManager.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
 
@@ -21,7 +22,7 @@ Result<HeapStatistics> HeapAgent::GetStatistics(ObjectId heap) { return HeapMana
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> HeapAgent::NameToObject(const char* name)
 {
-    return HeapManager::NameToObject(name, Visibility::Local);
+    return internal::orRemoteName(HeapManager::NameToObject(name, Visibility::Local), ObjectType::Heap, name);
 }
 
 DCOS_CONFIGURATION_SERVICE Status HeapAgent::AddObjects(size_t count) { return HeapManager::AddObjects(count); }

@@ -7,6 +7,7 @@
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/DsmManager.hpp>
 #include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/NameService.hpp>
 #include <dcos/internal/PublicationMessage.hpp>
 #include <dcos/internal/RemoteAgent.hpp>
 #include <dcos/internal/RemoteForward.hpp>
@@ -73,6 +74,8 @@ struct ServedEntry {
     uint32_t order = 0; // Arrival order while queued; completion order once done.
     uint64_t heardNs = 0; // Uptime when the request last arrived, retransmissions included.
     bool superseded = false; // Its requester has begun another transaction on the same call slot.
+    bool silent = false;     // Done, and nothing to answer: a name query this node has no object for.
+    char name[kNameQueryNameBytes]{}; // A name query's name (service NameToObject, type in request.object).
     uint8_t reply[kRemoteMessageBytes]{};
 };
 
@@ -168,6 +171,30 @@ CallSlot* takeCallSlot(Task& self)
     return nullptr;
 }
 
+// A call slot for @p self's transaction of @p service with @p peer on
+// @p interface, counted as a request; null (counted) when every slot is
+// in use. Under the lock.
+CallSlot* openCall(Task& self, RemoteService service, uint8_t interface, uint32_t peer)
+{
+    CallSlot* const slot = takeCallSlot(self);
+    if (slot == nullptr) {
+        ++statistics.noCallSlot;
+        return nullptr;
+    }
+    slot->interface = interface;
+    slot->peer = peer;
+    slot->service = service;
+    ++statistics.requests;
+    return slot;
+}
+
+// The caller's side once its call slot is taken: sends the request with
+// @p send, again after every silent watchdog period, and blocks until the
+// final reply (its status and value) or kRemoteSilentPeriods silent
+// periods in a row (Unreachable).
+template <typename Send>
+Result<uint32_t> awaitReply(CallSlot& slot, Send send);
+
 Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
 {
     if (inInterruptContext()) {
@@ -196,15 +223,10 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
         if (links[interface] == nullptr) {
             return Status::Unreachable;
         }
-        slot = takeCallSlot(self);
+        slot = openCall(self, service, interface, peer);
         if (slot == nullptr) {
-            ++statistics.noCallSlot;
             return Status::Busy;
         }
-        slot->interface = interface;
-        slot->peer = peer;
-        slot->service = service;
-        ++statistics.requests;
     }
 
     RemoteRequest request;
@@ -214,11 +236,70 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
     request.argument = argument;
     uint8_t data[kRemoteMessageBytes];
     encodeRequest(request, data);
+    // The running priority, so a task that inherited urgency asks with it.
+    return awaitReply(*slot, [&] {
+        (void)sendMessage(interface, SystemMessageType::RemoteRequest, self.priority, peer, data);
+    });
+}
 
+// Any interface, any sender: the call slot of a name query, asked of every node.
+constexpr uint8_t kAnyInterface = 0xFF;
+
+// NameToObject asked of every node with a link (RemoteForward.hpp's
+// resolver): the first node that has a visible object of that type and name
+// answers with its id; when none does, every node stays silent, and after
+// the watchdog's silent periods the answer is NotFound.
+Result<ObjectId> forwardName(ObjectType type, const char* name)
+{
+    if (inInterruptContext()) {
+        return Status::InInterrupt;
+    }
+    Task& self = Scheduler::current();
+    CallSlot* slot;
+    {
+        Lock lock;
+        bool anyLink = false;
+        for (NetworkLink* link : links) {
+            anyLink = anyLink || link != nullptr;
+        }
+        if (!anyLink) {
+            return Status::NotFound;
+        }
+        slot = openCall(self, RemoteService::NameToObject, kAnyInterface, NetworkLink::kBroadcast);
+        if (slot == nullptr) {
+            return Status::Busy;
+        }
+    }
+    uint8_t frames[kNameQueryFrames][kRemoteMessageBytes];
+    encodeNameQuery(static_cast<uint8_t>(type), slot->transaction, name, frames);
+    const Result<uint32_t> found = awaitReply(*slot, [&] {
+        for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
+            for (size_t part = 0; part < kNameQueryFrames; ++part) {
+                if (!sendMessage(interface, SystemMessageType::NameQuery, self.priority, NetworkLink::kBroadcast,
+                                 frames[part])) {
+                    break;
+                }
+            }
+        }
+    });
+    if (!found.ok()) {
+        return found.status() == Status::Unreachable ? Status::NotFound : found.status();
+    }
+    const ObjectId id = ObjectId::fromRaw(found.value());
+    // Outside input: an id of another type, or of this node, is no answer.
+    if (id.type() != type || id.node() == localNode()) {
+        return Status::Corrupted;
+    }
+    return id;
+}
+
+template <typename Send>
+Result<uint32_t> awaitReply(CallSlot& callSlot, Send send)
+{
+    CallSlot* const slot = &callSlot;
     unsigned silentPeriods = 0;
     for (;;) {
-        // The running priority, so a task that inherited urgency asks with it.
-        (void)sendMessage(interface, SystemMessageType::RemoteRequest, self.priority, peer, data);
+        send();
         Lock lock;
         if (!slot->done) {
             (void)TaskManager::blockOn(slot->waiter, kWatchdogNs);
@@ -259,8 +340,9 @@ void onReply(uint8_t interface, const SystemMessage& message)
         return;
     }
     CallSlot& slot = calls[index];
-    if (slot.caller.isNull() || slot.done || slot.transaction != reply.transaction ||
-        slot.interface != interface || slot.peer != message.source || slot.service != reply.service) {
+    const bool fromPeer = slot.interface == kAnyInterface || (slot.interface == interface && slot.peer == message.source);
+    if (slot.caller.isNull() || slot.done || slot.transaction != reply.transaction || !fromPeer ||
+        slot.service != reply.service) {
         ++statistics.strayReplies;
         return;
     }
@@ -340,14 +422,83 @@ ServedEntry* entryForNewRequest(ServedEntry* sameSlot)
 }
 
 // A request arrived on @p interface.
+void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
+                  const char* name);
+
+// A request arrived on @p interface.
 void onRequest(uint8_t interface, const SystemMessage& message)
 {
     RemoteRequest request;
-    if (decodeRequest(message.data, message.length, request) != RemoteMessageError::None) {
+    if (decodeRequest(message.data, message.length, request) != RemoteMessageError::None ||
+        request.service == RemoteService::NameToObject) {
+        // NameToObject comes only as a name query.
         Lock lock;
         ++statistics.malformed;
         return;
     }
+    admitRequest(interface, message, request, nullptr);
+}
+
+// Name queries being put back together, one per sender; a new sender takes
+// the entry heard from longest ago.
+struct NameQueryGathering {
+    bool used = false;
+    uint8_t interface = 0;
+    uint32_t source = 0;
+    uint32_t heard = 0;
+    NameQueryAssembler assembler;
+};
+
+constexpr size_t kNameQueriesGathered = 4;
+NameQueryGathering nameQueries[kNameQueriesGathered];
+uint32_t nameQueryClock = 0;
+
+// A part of a name query arrived on @p interface (the receiver task only).
+void onNameQuery(uint8_t interface, const SystemMessage& message)
+{
+    NameQueryPart part;
+    if (decodeNameQueryPart(message.data, message.length, part) != NameQueryError::None) {
+        Lock lock;
+        ++statistics.malformed;
+        return;
+    }
+    NameQueryGathering* gathering = nullptr;
+    for (NameQueryGathering& candidate : nameQueries) {
+        if (candidate.used && candidate.interface == interface && candidate.source == message.source) {
+            gathering = &candidate;
+            break;
+        }
+    }
+    if (gathering == nullptr) {
+        gathering = &nameQueries[0];
+        for (NameQueryGathering& candidate : nameQueries) {
+            if (!candidate.used || static_cast<int32_t>(candidate.heard - gathering->heard) < 0) {
+                gathering = &candidate;
+                if (!candidate.used) {
+                    break;
+                }
+            }
+        }
+        *gathering = NameQueryGathering{};
+        gathering->used = true;
+        gathering->interface = interface;
+        gathering->source = message.source;
+    }
+    gathering->heard = nameQueryClock++;
+    if (!gathering->assembler.take(part)) {
+        return;
+    }
+    RemoteRequest request;
+    request.service = RemoteService::NameToObject;
+    request.transaction = gathering->assembler.transaction();
+    request.object = gathering->assembler.type();
+    admitRequest(interface, message, request, gathering->assembler.name());
+}
+
+// A request to serve: a retransmission is answered from the served table,
+// a new one queued for the workers.
+void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request, const char* name)
+{
     RemoteReply answer;
     answer.service = request.service;
     answer.transaction = request.transaction;
@@ -369,7 +520,7 @@ void onRequest(uint8_t interface, const SystemMessage& message)
             known->heardNs = TimerAgent::Uptime();
             if (known->state == ServedState::Done) {
                 __builtin_memcpy(stored, known->reply, kRemoteMessageBytes);
-                action = Action::Stored;
+                action = known->silent ? Action::None : Action::Stored;
             } else {
                 action = Action::Pending;
             }
@@ -381,6 +532,11 @@ void onRequest(uint8_t interface, const SystemMessage& message)
             } else {
                 entry->state = ServedState::Queued;
                 entry->superseded = false;
+                entry->silent = false;
+                __builtin_memset(entry->name, 0, sizeof entry->name);
+                for (size_t i = 0; name != nullptr && i + 1 < sizeof entry->name && name[i] != '\0'; ++i) {
+                    entry->name[i] = name[i];
+                }
                 entry->interface = interface;
                 entry->priority = message.priority;
                 entry->source = message.source;
@@ -455,8 +611,9 @@ void replyWith(RemoteReply& reply, const Result<T>& result)
     reply.value = result.ok() ? replyValueOf(result.value()) : 0;
 }
 
-// Performs @p request on this node's object, as the worker that runs it.
-RemoteReply perform(const RemoteRequest& request, const ServedEntry& entry)
+// Performs @p request on this node's object, as the worker that runs it;
+// marks @p entry silent when there is nothing to answer.
+RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
 {
     RemoteReply reply;
     reply.service = request.service;
@@ -486,6 +643,22 @@ RemoteReply perform(const RemoteRequest& request, const ServedEntry& entry)
     case RemoteService::TaskGetState: replyWith(reply, TaskAgent::GetState(id)); break;
     case RemoteService::TaskGetPriority: replyWith(reply, TaskAgent::GetPriority(id)); break;
     case RemoteService::SemaphoreGetHolder: replyWith(reply, SemaphoreAgent::GetHolder(id)); break;
+    case RemoteService::NameToObject: {
+        // Seen from another node, a name is visible when its object is global,
+        // or regional and asked for within the controller (Visibility.hpp).
+        const Result<NetworkInterface> arrived = NetworkInterfacesManager::GetInterface(entry.interface);
+        const Visibility scope = arrived.ok() && arrived.value().kind == InterfaceKind::SharedMemory
+                                     ? Visibility::Regional
+                                     : Visibility::Global;
+        const Result<ObjectId> found =
+            localNameToObject(static_cast<ObjectType>(request.object), entry.name, scope);
+        if (found.ok()) {
+            reply.value = found.value().raw();
+        } else {
+            entry.silent = true; // Another node may have it; this one says nothing.
+        }
+        break;
+    }
     case RemoteService::DsmOpen: {
         const Result<NetworkInterface> arrived = NetworkInterfacesManager::GetInterface(entry.interface);
         const bool withinController = arrived.ok() && arrived.value().kind == InterfaceKind::SharedMemory;
@@ -542,13 +715,17 @@ void workerEntry(uintptr_t)
         // urgent than the requester keep the processor.
         (void)TaskManager::changePriority(self, priority);
         const RemoteReply reply = perform(request, *job);
+        bool silent;
         {
             Lock lock;
             encodeReply(reply, job->reply);
             job->state = ServedState::Done;
             job->order = completions++;
+            silent = job->silent;
         }
-        sendReply(interface, priority, source, reply);
+        if (!silent) {
+            sendReply(interface, priority, source, reply);
+        }
     }
 }
 
@@ -587,6 +764,7 @@ void receiverEntry(uintptr_t)
                 switch (message.type) {
                 case SystemMessageType::RemoteReply: onReply(interface, message); break;
                 case SystemMessageType::RemoteRequest: onRequest(interface, message); break;
+                case SystemMessageType::NameQuery: onNameQuery(interface, message); break;
                 case SystemMessageType::DsmPublication: onPublication(interface, message); break;
                 }
             }
@@ -627,6 +805,7 @@ Status startAgent()
         }
     }
     setRemoteForwarder(forward);
+    setRemoteNameResolver(forwardName);
     started = true;
     return Status::Ok;
 }

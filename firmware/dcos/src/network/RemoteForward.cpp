@@ -8,10 +8,22 @@ namespace {
 // Written once, by the remote agent's start in task context, before any
 // link delivers a frame; an aligned pointer store is atomic on x86.
 RemoteForwarder remoteForwarder = nullptr;
+RemoteNameResolver remoteNameResolver = nullptr;
 
 } // namespace
 
 void setRemoteForwarder(RemoteForwarder forwarder) { remoteForwarder = forwarder; }
+
+void setRemoteNameResolver(RemoteNameResolver resolver) { remoteNameResolver = resolver; }
+
+Result<ObjectId> remoteNameToObject(ObjectType type, const char* name)
+{
+    RemoteNameResolver const resolver = remoteNameResolver;
+    if (resolver == nullptr) {
+        return Status::NotFound;
+    }
+    return resolver(type, name);
+}
 
 Result<uint32_t> forwardRemote(RemoteService service, ObjectId id, uint32_t argument)
 {

@@ -46,6 +46,7 @@ const char* remoteServiceName(RemoteService service)
     case RemoteService::TaskGetPriority: return "priority";
     case RemoteService::SemaphoreGetHolder: return "holder";
     case RemoteService::DsmOpen: return "dsm-open";
+    case RemoteService::NameToObject: return "name";
     }
     return "?";
 }
@@ -135,6 +136,121 @@ RemoteMessageError decodeReply(const uint8_t* bytes, size_t length, RemoteReply&
     reply.pending = (bytes[3] & kReplyPending) != 0;
     reply.value = getBig32(bytes + 4);
     return RemoteMessageError::None;
+}
+
+// ---- name queries -----------------------------------------------------------
+
+namespace {
+
+constexpr uint8_t kNamePartShift = 6;
+constexpr uint8_t kNameReservedMask = 0x30;
+constexpr uint8_t kNameTypeMask = 0x0F;
+constexpr size_t kNameBytesPerPart = 6;
+constexpr size_t kLastPartNameBytes = kNameQueryNameBytes - 2 * kNameBytesPerPart;
+
+} // namespace
+
+bool isNamedObjectType(uint8_t type)
+{
+    switch (static_cast<ObjectType>(type)) {
+    case ObjectType::Task:
+    case ObjectType::Timer:
+    case ObjectType::Device:
+    case ObjectType::BufferPool:
+    case ObjectType::Heap:
+    case ObjectType::MessagePort:
+    case ObjectType::DsmPublisher:
+    case ObjectType::Semaphore: return true;
+    default: return false;
+    }
+}
+
+const char* nameQueryErrorName(NameQueryError error)
+{
+    switch (error) {
+    case NameQueryError::None: return "none";
+    case NameQueryError::WrongLength: return "wrong length";
+    case NameQueryError::ReservedBits: return "reserved bits set";
+    case NameQueryError::BadType: return "no such object type";
+    }
+    return "?";
+}
+
+void encodeNameQuery(uint8_t type, uint8_t transaction, const char* name,
+                     uint8_t (&frames)[kNameQueryFrames][kRemoteMessageBytes])
+{
+    char padded[kNameQueryNameBytes]{};
+    for (size_t i = 0; i + 1 < kNameQueryNameBytes && name[i] != '\0'; ++i) {
+        padded[i] = name[i];
+    }
+    for (size_t part = 0; part < kNameQueryFrames; ++part) {
+        uint8_t* frame = frames[part];
+        frame[0] = static_cast<uint8_t>((part << kNamePartShift) | (type & kNameTypeMask));
+        frame[1] = transaction;
+        const size_t count = part + 1 < kNameQueryFrames ? kNameBytesPerPart : kLastPartNameBytes;
+        for (size_t i = 0; i < kNameBytesPerPart; ++i) {
+            frame[2 + i] = i < count ? static_cast<uint8_t>(padded[part * kNameBytesPerPart + i]) : 0;
+        }
+    }
+}
+
+NameQueryError decodeNameQueryPart(const uint8_t* bytes, size_t length, NameQueryPart& part)
+{
+    if (length != kRemoteMessageBytes) {
+        return NameQueryError::WrongLength;
+    }
+    const uint8_t number = bytes[0] >> kNamePartShift;
+    if (number >= kNameQueryFrames || (bytes[0] & kNameReservedMask) != 0 ||
+        (number == kNameQueryFrames - 1 && (bytes[6] != 0 || bytes[7] != 0))) {
+        return NameQueryError::ReservedBits;
+    }
+    const uint8_t type = bytes[0] & kNameTypeMask;
+    if (!isNamedObjectType(type)) {
+        return NameQueryError::BadType;
+    }
+    part = NameQueryPart{};
+    part.part = number;
+    part.type = type;
+    part.transaction = bytes[1];
+    __builtin_memcpy(part.bytes, bytes + 2, kNameBytesPerPart);
+    return NameQueryError::None;
+}
+
+bool NameQueryAssembler::take(const NameQueryPart& part)
+{
+    if (part.part == 0) {
+        next_ = 1;
+        type_ = part.type;
+        transaction_ = part.transaction;
+        __builtin_memcpy(name_, part.bytes, kNameBytesPerPart);
+        return false;
+    }
+    if (part.part != next_ || part.type != type_ || part.transaction != transaction_) {
+        next_ = 0;
+        return false;
+    }
+    const size_t number = part.part;
+    const bool last = number + 1 == kNameQueryFrames;
+    __builtin_memcpy(name_ + number * kNameBytesPerPart, part.bytes, last ? kLastPartNameBytes : kNameBytesPerPart);
+    if (!last) {
+        ++next_;
+        return false;
+    }
+    next_ = 0;
+    // Well formed: 1 to 15 characters, then NULs only.
+    size_t length = 0;
+    while (length < kNameQueryNameBytes && name_[length] != '\0') {
+        ++length;
+    }
+    if (length == 0 || length == kNameQueryNameBytes) {
+        return false;
+    }
+    for (size_t i = length; i < kNameQueryNameBytes; ++i) {
+        if (name_[i] != '\0') {
+            return false;
+        }
+    }
+    return true;
 }
 
 } // namespace dcos::internal

@@ -17,6 +17,7 @@
 // Delete; only the owner transfers ownership.
 #include <dcos/MessagePortAgent.hpp>
 #include <dcos/TaskAgent.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/FastPath.hpp>
 #include <dcos/internal/KernelContext.hpp>
@@ -146,6 +147,13 @@ size_t PortManager::portCount()
     info.levelBits = port.queue.levelBits();
     info.receiverWaiting = !port.receivers.isEmpty();
     return true;
+}
+
+Result<ObjectId> PortManager::nameToObject(const char* name, Visibility askingScope)
+{
+    arch_x86::InterruptGuard guard;
+    start();
+    return portTable.NameToObject(name, askingScope);
 }
 
 MessageBufferCounts PortManager::bufferCounts()
@@ -323,9 +331,8 @@ DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddMsgBufs(size_t count)
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> MessagePortAgent::NameToObject(const char* name)
 {
-    arch_x86::InterruptGuard guard;
-    start();
-    return portTable.NameToObject(name, Visibility::Local);
+    return internal::orRemoteName(internal::PortManager::nameToObject(name, Visibility::Local),
+                                  ObjectType::MessagePort, name);
 }
 
 DCOS_CONFIGURATION_SERVICE Status MessagePortAgent::AddObjects(size_t count)

@@ -416,9 +416,15 @@ Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id)
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> SemaphoreAgent::NameToObject(const char* name)
 {
+    return internal::orRemoteName(internal::semaphoreNameToObject(name, Visibility::Local), ObjectType::Semaphore,
+                                  name);
+}
+
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> internal::semaphoreNameToObject(const char* name, Visibility askingScope)
+{
     arch_x86::InterruptGuard guard;
     internal::ensureTable();
-    return internal::table.NameToObject(name, Visibility::Local);
+    return internal::table.NameToObject(name, askingScope);
 }
 
 DCOS_CONFIGURATION_SERVICE Status SemaphoreAgent::XferOwnership(ObjectId id, ObjectId newOwner)

@@ -1,6 +1,7 @@
 // The system agent's device management (dissertation 7.3.2): the kernel-side
 // DeviceManager, the SystemAgent interface functions that forward to it, and
 // the agent's resource recovery.
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/DeviceManager.hpp>
 
 #include <dcos/SystemAgent.hpp>
@@ -376,7 +377,8 @@ Status SystemAgent::Control(ObjectId device, uint32_t command, void* argument, s
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> SystemAgent::NameToObject(const char* name)
 {
-    return internal::deviceManager().NameToObject(name, Visibility::Local);
+    return internal::orRemoteName(internal::deviceManager().NameToObject(name, Visibility::Local), ObjectType::Device,
+                                  name);
 }
 
 DCOS_CONFIGURATION_SERVICE Status SystemAgent::AddObjects(size_t count)

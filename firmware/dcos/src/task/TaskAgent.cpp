@@ -238,7 +238,10 @@ Status TaskAgent::ThrowException(ObjectId id, ExceptionClass exceptionClass, uin
 
 ObjectId TaskAgent::IdOfSelf() { return internal::currentTaskId(); }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::NameToObject(const char* name) { return TaskManager::nameToObject(name); }
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskAgent::NameToObject(const char* name)
+{
+    return internal::orRemoteName(TaskManager::nameToObject(name), ObjectType::Task, name);
+}
 
 Result<TaskState> TaskAgent::GetState(ObjectId id)
 {

@@ -891,10 +891,10 @@ DCOS_CONFIGURATION_SERVICE Status TaskManager::addObjects(size_t count)
     return table.AddObjects(count);
 }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskManager::nameToObject(const char* name)
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TaskManager::nameToObject(const char* name, Visibility askingScope)
 {
     arch_x86::InterruptGuard guard;
-    return table.NameToObject(name, Visibility::Local);
+    return table.NameToObject(name, askingScope);
 }
 
 const char* TaskManager::nameOf(ObjectId id)

@@ -1,5 +1,6 @@
 // The timer agent's interface object (seed 7.5).
 #include <dcos/TimerAgent.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/TimerManager.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
@@ -42,7 +43,10 @@ Status TimerAgent::SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNoti
 
 Status TimerAgent::CancelAlarm(ObjectId timer) { return TimerManager::cancelAlarm(timer, internal::currentTaskId()); }
 
-DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::NameToObject(const char* name) { return TimerManager::timerNameToObject(name); }
+DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::NameToObject(const char* name)
+{
+    return internal::orRemoteName(TimerManager::timerNameToObject(name), ObjectType::Timer, name);
+}
 
 DCOS_CONFIGURATION_SERVICE Status TimerAgent::XferOwnership(ObjectId timer, ObjectId newOwner)
 {

@@ -444,10 +444,10 @@ Status TimerManager::cancelAlarm(ObjectId id, ObjectId caller)
     return Status::Ok;
 }
 
-Result<ObjectId> TimerManager::timerNameToObject(const char* name)
+Result<ObjectId> TimerManager::timerNameToObject(const char* name, Visibility askingScope)
 {
     arch_x86::InterruptGuard guard;
-    return timerTable.NameToObject(name, Visibility::Local);
+    return timerTable.NameToObject(name, askingScope);
 }
 
 DCOS_CONFIGURATION_SERVICE Status TimerManager::xferOwnership(ObjectId id, ObjectId caller, ObjectId newOwner)

@@ -53,6 +53,8 @@ public:
     static void publishDeferred();
 
     static DsmNetworkStatistics networkStatistics();
+    /// A publisher named @p name visible from @p askingScope.
+    static Result<ObjectId> publisherNameToObject(const char* name, Visibility askingScope);
     /// Remote publisher slot @p slot (0 to kRemotePublishers - 1).
     static RemotePublisherInfo remotePublisher(size_t slot);
 };

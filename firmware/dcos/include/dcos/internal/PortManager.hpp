@@ -4,6 +4,8 @@
 
 #include <dcos/MessagePortAgent.hpp>
 #include <dcos/ObjectId.hpp>
+#include <dcos/Status.hpp>
+#include <dcos/Visibility.hpp>
 
 #include <stddef.h>
 #include <stdint.h>
@@ -38,6 +40,8 @@ public:
     static bool snapshot(size_t slot, PortInfo& info);
     /// The message-buffer area's counts.
     static MessageBufferCounts bufferCounts();
+    /// A port named @p name visible from @p askingScope.
+    static Result<ObjectId> nameToObject(const char* name, Visibility askingScope);
 };
 
 } // namespace dcos::internal

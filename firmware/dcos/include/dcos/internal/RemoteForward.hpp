@@ -24,6 +24,28 @@ using RemoteForwarder = Result<uint32_t> (*)(RemoteService service, ObjectId id,
 /// Set by the remote agent when it starts; null until then.
 void setRemoteForwarder(RemoteForwarder forwarder);
 
+/// Asks the other nodes for an object of @p type named @p name.
+using RemoteNameResolver = Result<ObjectId> (*)(ObjectType type, const char* name);
+
+/// Set by the remote agent when it starts; null until then.
+void setRemoteNameResolver(RemoteNameResolver resolver);
+
+/// Asks the other nodes for an object of @p type named @p name, or NotFound
+/// when no remote agent runs. Out of line: only a local miss calls it.
+[[gnu::noinline]] Result<ObjectId> remoteNameToObject(ObjectType type, const char* name);
+
+/// NameToObject's answer after the local table's (seed 6.4): @p local
+/// unless it is NotFound, in which case a running remote agent asks every
+/// node it has a link to for a visible object of that type and name
+/// (docs/protocols/remote-transactions.md, "Names").
+[[gnu::always_inline]] inline Result<ObjectId> orRemoteName(Result<ObjectId> local, ObjectType type, const char* name)
+{
+    if (local.status() != Status::NotFound) [[likely]] {
+        return local;
+    }
+    return remoteNameToObject(type, name);
+}
+
 /// Forwards a request for another node's object, or Status::Remote when no
 /// remote agent runs. Out of line: only an agent's miss path calls it.
 [[gnu::noinline]] Result<uint32_t> forwardRemote(RemoteService service, ObjectId id, uint32_t argument);

@@ -44,10 +44,12 @@ enum class RemoteService : uint8_t {
     /// argument: 0; value: the publisher's data identifier. The publisher
     /// sends its latest page again (docs/protocols/publications.md).
     DsmOpen = 9,
+    /// Only in replies, to a name query (below): value: the object's id.
+    NameToObject = 10,
 };
 
 /// The last service value assigned.
-constexpr uint8_t kLastRemoteService = 9;
+constexpr uint8_t kLastRemoteService = 10;
 
 /// A short name of a service, for the console and logs.
 const char* remoteServiceName(RemoteService service);
@@ -110,5 +112,72 @@ RemoteMessageError decodeReply(const uint8_t* bytes, size_t length, RemoteReply&
 
 /// Whether @p value is a status some node may send (every Status value).
 bool isStatusValue(uint8_t value);
+
+// ---- name queries --------------------------------------------------------
+//
+// NameToObject asked of every node (message type 0x12, to the broadcast
+// address): three frames of eight bytes, each
+//
+//     byte 0   bits 7-6 part (0, 1, 2), bits 5-4 zero, bits 3-0 the object type
+//     byte 1   transaction number, as in a request
+//     part 0   bytes 2-7 name bytes 0-5
+//     part 1   bytes 2-7 name bytes 6-11
+//     part 2   bytes 2-5 name bytes 12-15, bytes 6-7 zero
+//
+// The name is NUL-padded to 16 bytes: 1 to 15 characters and at least one
+// NUL. A node that has an object of that type and name visible to the
+// asker answers with a RemoteReply (service NameToObject, the transaction,
+// the id as its value); a node that has none says nothing.
+
+/// Frames of one name query, and the bytes of the name field.
+constexpr size_t kNameQueryFrames = 3;
+constexpr size_t kNameQueryNameBytes = 16;
+
+struct NameQueryPart {
+    uint8_t part = 0;        ///< 0, 1 or 2.
+    uint8_t type = 0;        ///< The ObjectType's value.
+    uint8_t transaction = 0;
+    uint8_t bytes[6]{};      ///< The name bytes it carries (4 in part 2).
+};
+
+enum class NameQueryError : uint8_t {
+    None,
+    WrongLength,   ///< Not eight bytes.
+    ReservedBits,  ///< A part number 3, bits 5-4 set, or part 2's last two bytes not zero.
+    BadType,       ///< A type whose objects have no names (see isNamedObjectType).
+};
+
+/// Whether objects of type @p type have names: tasks, timers, devices,
+/// buffer pools, heaps, message ports, publishers and semaphores.
+bool isNamedObjectType(uint8_t type);
+
+const char* nameQueryErrorName(NameQueryError error);
+
+/// The three frames asking for the object of @p type named @p name (1 to
+/// 15 characters; longer names are cut, which no table holds anyway).
+void encodeNameQuery(uint8_t type, uint8_t transaction, const char* name,
+                     uint8_t (&frames)[kNameQueryFrames][kRemoteMessageBytes]);
+
+/// Decodes one frame of @p length bytes; None and @p part filled in, or why not.
+NameQueryError decodeNameQueryPart(const uint8_t* bytes, size_t length, NameQueryPart& part);
+
+/// Puts one sender's name query back together; parts come in order on a bus.
+class NameQueryAssembler {
+public:
+    /// Takes a part; true when it completed a query whose name is well formed
+    /// (1 to 15 characters, NUL-padded): type(), transaction(), name().
+    bool take(const NameQueryPart& part);
+
+    uint8_t type() const { return type_; }
+    uint8_t transaction() const { return transaction_; }
+    /// The name, NUL-terminated.
+    const char* name() const { return name_; }
+
+private:
+    uint8_t next_ = 0;
+    uint8_t type_ = 0;
+    uint8_t transaction_ = 0;
+    char name_[kNameQueryNameBytes]{};
+};
 
 } // namespace dcos::internal

@@ -3,6 +3,7 @@
 
 #include <dcos/ObjectId.hpp>
 #include <dcos/Status.hpp>
+#include <dcos/Visibility.hpp>
 
 #include <stddef.h>
 
@@ -17,5 +18,8 @@ size_t semaphoreCount();
 /// semaphore is held by a task, and its holder cannot be a task of another
 /// node yet. O(1).
 Result<bool> isBinarySemaphore(ObjectId id);
+
+/// A semaphore named @p name visible from @p askingScope.
+Result<ObjectId> semaphoreNameToObject(const char* name, Visibility askingScope);
 
 } // namespace dcos::internal

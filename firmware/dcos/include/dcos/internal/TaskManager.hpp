@@ -97,7 +97,8 @@ public:
 
     static size_t taskCount();
     static Status addObjects(size_t count);
-    static Result<ObjectId> nameToObject(const char* name);
+    /// A task named @p name visible from @p askingScope (Local: every task of this node).
+    static Result<ObjectId> nameToObject(const char* name, Visibility askingScope = Visibility::Local);
     static const char* nameOf(ObjectId id);
 
     /// The task array, for forEachTask.

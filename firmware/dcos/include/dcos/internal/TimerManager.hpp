@@ -78,7 +78,7 @@ public:
     static Status setDayClockAlarm(ObjectId timer, ObjectId caller, const DateTime& time, AlarmNotification n);
     static Status setPeriodicAlarm(ObjectId timer, ObjectId caller, uint64_t periodNs, AlarmNotification n);
     static Status cancelAlarm(ObjectId timer, ObjectId caller);
-    static Result<ObjectId> timerNameToObject(const char* name);
+    static Result<ObjectId> timerNameToObject(const char* name, Visibility askingScope = Visibility::Local);
     static Status xferOwnership(ObjectId timer, ObjectId caller, ObjectId newOwner);
     static Status addTimerObjects(size_t count);
     static size_t timerCount();
