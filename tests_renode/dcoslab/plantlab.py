@@ -10,7 +10,10 @@ with the application's `plant` console command:
 
     configuration "one": node 1 runs the sampler, the controller and the actuator;
     configuration "two": node 1 the sampler and the actuator, node 2 the controller,
-    each finding the publisher it reads by name on the other node.
+    each finding the publisher it reads by name on the other node;
+    configuration "redundant": as "two", with a second controller on node 3;
+    node 1's actuator follows node 2's "mv" and falls back on node 3's
+    (active backup redundancy, the seed's Test Case 3, 9.4.3).
 
 The seed's Test Case 2 (9.4.2, Fig. 9.7, instances 1 and 2); `make plant`
 (tests_renode/plant.py) and docs/examples/plant/tests use it.
@@ -76,8 +79,8 @@ def statistics(board, timeout=120):
 class PlantLab:
     def __init__(self, boot, board_definition, image, directory, configuration="two", bit_rate=BIT_RATE,
                  timeout=120, pace=None):
-        if configuration not in ("one", "two"):
-            raise ValueError(f"configuration {configuration!r}: one or two")
+        if configuration not in ("one", "two", "redundant"):
+            raise ValueError(f"configuration {configuration!r}: one, two or redundant")
         self.configuration = configuration
         self.timeout = timeout
         self.csv_path = os.path.join(directory, "plant.csv")
@@ -86,16 +89,19 @@ class PlantLab:
         nodes = {"node1": {"bus0": "can0", "bus1": "can1", "append": "node=1",
                            "devices": {"isa-mfio": {"wiring": "plant", "plant": "plant"}},
                            "args": ["-chardev", f"socket,id=plant,path={socket_path}"]}}
-        if configuration == "two":
-            nodes["node2"] = {"bus0": "can0", "bus1": "can1", "append": "node=2"}
+        others = {"one": [], "two": [2], "redundant": [2, 3]}[configuration]
+        for node in others:
+            nodes[f"node{node}"] = {"bus0": "can0", "bus1": "can1", "append": f"node={node}"}
         try:
             self.lab = CanLab(boot, board_definition, {"can0": bit_rate, "can1": bit_rate}, nodes, pace=pace,
                               kind=image, timeout=timeout)
             self.io = self.lab.board("node1")
-            self.control = self.lab.board("node2") if configuration == "two" else self.io
-            if configuration == "two":
-                attach_redundant(self.io, 1, [2], bit_rate, timeout)
-                attach_redundant(self.control, 2, [1], bit_rate, timeout)
+            self.control = self.lab.board("node2") if others else self.io
+            self.backup = self.lab.board("node3") if configuration == "redundant" else None
+            everyone = [1, *others]
+            for node in everyone if others else []:
+                attach_redundant(self.lab.board(f"node{node}"), node, [peer for peer in everyone if peer != node],
+                                 bit_rate, timeout)
         except BaseException:
             self.close()
             raise
@@ -112,9 +118,15 @@ class PlantLab:
         # "pv", the actuator node 2's "mv" (distributed names).
         pv = self._started(self.io, "plant io")
         mv = self._started(self.control, "plant control")
-        output = self.io.command("plant actuate", timeout=self.timeout)
+        if self.backup is None:
+            line = "plant actuate"
+        else:
+            # Two publishers are called "mv": the actuator is given both ids.
+            self.backup_mv = self._started(self.backup, "plant control")
+            line = f"plant actuate {mv} {self.backup_mv}"
+        output = self.io.command(line, timeout=self.timeout)
         if f"actuator started, reading {mv}" not in output:
-            raise PlantError(f"plant actuate: {output!r}")
+            raise PlantError(f"{line}: {output!r}")
         return pv, mv
 
     def _started(self, board, line):
@@ -132,6 +144,10 @@ class PlantLab:
         output = self.control.command(f"plant setpoint {millivolts}", timeout=self.timeout)
         if "set point" not in output:
             raise PlantError(f"plant setpoint: {output!r}")
+
+    def kill(self, board):
+        """Stops a node's emulator: the node is dead, the others carry on."""
+        board.emulator.close()
 
     def statistics(self):
         """Every component's statistics, from the nodes that run them."""

@@ -57,6 +57,7 @@ ObjectId pvPublisher;
 ObjectId controllerInput;
 ObjectId mvPublisher;
 ObjectId actuatorInput;
+ObjectId actuatorBackup;
 
 // Runs @p update on the statistics under their semaphore. An update that
 // cannot take it within a period is dropped: the console shows a period late.
@@ -175,6 +176,23 @@ void controllerEntry(uintptr_t)
     record([] { ++controller.errors; });
 }
 
+// Writes one controller output to AO0 and counts it.
+void actuate(const Signal& mv)
+{
+    const Status status = iobus::writeWord(board, iobus::channel::kAnalogOutput0, dacCode(mv.microvolts));
+    const uint64_t delay = dcos::timerAgent.Uptime() - mv.sampledNs;
+    record([&] {
+        if (status != Status::Ok) {
+            ++actuator.errors;
+            return;
+        }
+        ++actuator.writes;
+        actuator.lastMv = mv.microvolts;
+        actuator.lastDelayNs = delay;
+        actuator.maxDelayNs = delay > actuator.maxDelayNs ? delay : actuator.maxDelayNs;
+    });
+}
+
 void actuatorEntry(uintptr_t)
 {
     const Result<ObjectId> subscription = dcos::dsmAgent.Open(actuatorInput);
@@ -182,24 +200,47 @@ void actuatorEntry(uintptr_t)
         record([] { ++actuator.errors; });
         return;
     }
-    follow(
-        subscription.value(),
-        [](const Signal& mv) {
-            const Status status = iobus::writeWord(board, iobus::channel::kAnalogOutput0, dacCode(mv.microvolts));
-            const uint64_t delay = dcos::timerAgent.Uptime() - mv.sampledNs;
-            record([&] {
-                if (status != Status::Ok) {
-                    ++actuator.errors;
-                    return;
-                }
-                ++actuator.writes;
-                actuator.lastMv = mv.microvolts;
-                actuator.lastDelayNs = delay;
-                actuator.maxDelayNs = delay > actuator.maxDelayNs ? delay : actuator.maxDelayNs;
-            });
-        },
-        [] { record([] { ++actuator.timeouts; }); });
-    record([] { ++actuator.errors; });
+    if (actuatorBackup.isNull()) {
+        follow(subscription.value(), actuate, [] { record([] { ++actuator.timeouts; }); });
+        record([] { ++actuator.errors; });
+        return;
+    }
+    const Result<ObjectId> backup = dcos::dsmAgent.Open(actuatorBackup);
+    if (!backup.ok()) {
+        record([] { ++actuator.errors; });
+        return;
+    }
+    // Active backup redundancy: wait on the followed controller's output,
+    // and take the other's pages too (polling, so that a take-over starts
+    // from its newest page, not an old one). Both compute from the same
+    // sample, so either is right.
+    ObjectId followed = subscription.value();
+    ObjectId other = backup.value();
+    uint32_t seenFollowed = dcos::kNoDsmData;
+    uint32_t seenOther = dcos::kNoDsmData;
+    for (;;) {
+        dcos::DsmPage page;
+        const Result<uint32_t> read = dcos::dsmAgent.Read(followed, seenFollowed, page, kFailoverNs);
+        if (read.ok()) {
+            seenFollowed = read.value();
+            actuate(decode(page));
+            dcos::DsmPage ignored;
+            const Result<uint32_t> polled = dcos::dsmAgent.Read(other, seenOther, ignored, dcos::kPoll);
+            seenOther = polled.ok() ? polled.value() : seenOther;
+            continue;
+        }
+        // Silent (or deleted): the other controller takes over.
+        const ObjectId silent = followed;
+        followed = other;
+        other = silent;
+        const uint32_t seen = seenFollowed;
+        seenFollowed = seenOther;
+        seenOther = seen;
+        record([] {
+            ++actuator.failovers;
+            ++actuator.timeouts;
+        });
+    }
 }
 
 Result<ObjectId> createTask(const char* name, uint8_t priority, dcos::TaskEntry entry)
@@ -308,7 +349,7 @@ Result<ObjectId> startController(ObjectId pv)
     return handOver(mvPublisher, createTask("controller", kControllerPriority, controllerEntry));
 }
 
-Status startActuator(ObjectId mv)
+Status startActuator(ObjectId mv, ObjectId backup)
 {
     if (!actuatorInput.isNull()) {
         return Status::AlreadyExists;
@@ -319,6 +360,7 @@ Status startActuator(ObjectId mv)
         return status;
     }
     actuatorInput = mv;
+    actuatorBackup = backup;
     return createTask("actuator", kActuatorPriority, actuatorEntry).status();
 }
 

@@ -59,6 +59,7 @@ struct ActuatorStatistics {
     uint64_t maxDelayNs = 0;
     uint32_t timeouts = 0;
     uint32_t errors = 0;
+    uint32_t failovers = 0; ///< Times the input it followed fell silent and the other took over.
 };
 
 /// Installs the I/O board (0x300, interrupt line 5) for the sampler and
@@ -72,7 +73,15 @@ dcos::Result<dcos::ObjectId> startSampler();
 /// task, which reads @p pv and writes the controller output. Returns "mv".
 dcos::Result<dcos::ObjectId> startController(dcos::ObjectId pv);
 /// Starts component 3: the actuator task, which reads @p mv and writes AO0.
-dcos::Status startActuator(dcos::ObjectId mv);
+///
+/// With a @p backup, a second controller's "mv" (active backup redundancy,
+/// seed 9.4.3), the actuator follows one of the two and keeps the other's
+/// pages read: when the one it follows is silent for kFailoverNs (its node
+/// or its bus died), it follows the other from then on.
+dcos::Status startActuator(dcos::ObjectId mv, dcos::ObjectId backup = dcos::ObjectId::null());
+
+/// How long the followed controller may be silent before its twin takes over: three periods.
+constexpr uint64_t kFailoverNs = 3 * kPeriodNs;
 
 /// The controller's set point; it applies from its next cycle.
 void setSetPoint(int32_t microvolts);

@@ -4,8 +4,9 @@
 //     plant io                 the I/O board, the sampler (publishes "pv") and nothing else yet
 //     plant control [<pv>]     the controller, reading publisher <pv> (local or another node's;
 //                              by default the one named "pv", found on this node or another)
-//     plant actuate [<mv>]     the actuator, reading publisher <mv> (by default the one named
-//                              "mv"); on the node with the I/O board
+//     plant actuate [<mv> [<backup>]]
+//                              the actuator, reading publisher <mv> (by default the one named
+//                              "mv"), and a second controller's <backup>; on the node with the I/O board
 //     plant all                all three on this node
 //     plant setpoint <mV>      the controller's set point
 //     plant                    the components' statistics, a line each
@@ -86,10 +87,11 @@ void printStatistics(shell::Shell& shell)
                 static_cast<unsigned long>(c.cycles), static_cast<long>(setPoint()), static_cast<long>(c.lastPv),
                 static_cast<long>(c.lastMv), static_cast<unsigned long>(c.timeouts),
                 static_cast<unsigned long>(c.errors));
-    shell.print("actuator: writes %lu, mv %ld uV, delay %lu us, max %lu us, timeouts %lu, errors %lu\r\n",
+    shell.print("actuator: writes %lu, mv %ld uV, delay %lu us, max %lu us, timeouts %lu, errors %lu, failovers %lu\r\n",
                 static_cast<unsigned long>(a.writes), static_cast<long>(a.lastMv),
                 static_cast<unsigned long>(a.lastDelayNs / 1000), static_cast<unsigned long>(a.maxDelayNs / 1000),
-                static_cast<unsigned long>(a.timeouts), static_cast<unsigned long>(a.errors));
+                static_cast<unsigned long>(a.timeouts), static_cast<unsigned long>(a.errors),
+                static_cast<unsigned long>(a.failovers));
 }
 
 CommandResult plantCommand(shell::Shell& shell, int argc, char** argv)
@@ -109,11 +111,16 @@ CommandResult plantCommand(shell::Shell& shell, int argc, char** argv)
         }
         return started(shell, "controller", startController(id));
     }
-    if (textEquals(verb, "actuate") && argc <= 3) {
-        if (!inputOf(shell, argc, argv, "mv", id)) {
+    if (textEquals(verb, "actuate") && argc <= 4) {
+        if (!inputOf(shell, argc < 4 ? argc : 3, argv, "mv", id)) {
             return CommandResult::Failed;
         }
-        const Status status = startActuator(id);
+        ObjectId backup;
+        if (argc == 4 && !parseId(argv[3], backup)) {
+            shell.print("plant: '%s' is not a publisher id\r\n", argv[3]);
+            return CommandResult::Failed;
+        }
+        const Status status = startActuator(id, backup);
         if (status != Status::Ok) {
             return failed(shell, "actuator", status);
         }
@@ -154,12 +161,13 @@ CommandResult plantCommand(shell::Shell& shell, int argc, char** argv)
 } // namespace
 
 DCOS_SHELL_COMMAND_DETAILED(plantShellCommand, "plant", "the control loop's components: start them, show them",
-                            "plant [io | control [<pv>] | actuate [<mv>] | all | setpoint <mV>]",
+                            "plant [io | control [<pv>] | actuate [<mv> [<backup mv>]] | all | setpoint <mV>]",
                             "  io: the I/O board and the sampler, which publishes AI0 as \"pv\" every 10 ms\r\n"
                             "  control: the controller, reading publisher <pv> (default: the one named pv,\r\n"
                             "    here or on another node), publishing \"mv\"\r\n"
                             "  actuate: the actuator, reading publisher <mv> (default: the one named mv),\r\n"
-                            "    writing AO0 (needs the I/O board)\r\n"
+                            "    writing AO0 (needs the I/O board); with a backup mv, the other takes over\r\n"
+                            "    when the one followed is silent for three periods\r\n"
                             "  all: the three on this node; setpoint: the controller's, in mV\r\n"
                             "  with no argument: each component's statistics",
                             plantCommand);

@@ -18,6 +18,7 @@ Times are emulated (-icount); the hub keeps the boards in step.
 import pytest
 
 from dcoslab.plantlab import PlantLab
+from dcoslab.plantlab import statistics as statistics_of
 
 SET_POINT_V = 2.0
 BAND_V = 0.020
@@ -77,3 +78,26 @@ def test_two_nodes_hold_it_the_same_with_the_controller_across_the_bus(plant):
     # Sample to DAC across the bus and back: two publications of three
     # frames at 500 kbit/s (about 0.8 ms each), well inside one period.
     assert 1_000 <= counts["actuator"]["max"] < 5_000, counts["actuator"]
+
+
+def test_a_redundant_controller_takes_over_when_its_twin_dies(plant):
+    """Seed 9.4.3 (Test Case 3): active backup redundancy. Controllers on
+    nodes 2 and 3 both publish "mv"; node 1's actuator follows node 2's.
+    Node 2 dies half way: node 3's output takes over within three periods,
+    and the plant stays at its set point."""
+    lab = plant("redundant")
+    lab.start()
+    lab.run_until(RUN_S / 2)
+    before = lab.statistics()["actuator"]
+    assert before["failovers"] == 0 and before["writes"] > 100
+    lab.kill(lab.control)
+    lab.run_until(RUN_S)
+    actuator = statistics_of(lab.io)["actuator"]
+    samples = statistics_of(lab.io)["sampler"]["samples"]
+    trajectory = lab.trajectory()
+    lab.close()
+    assert actuator["failovers"] == 1, actuator
+    # At most the failover time without a new output: three periods.
+    assert actuator["writes"] >= samples - 4, (actuator, samples)
+    assert actuator["errors"] == 0
+    assert settled(trajectory, RUN_S - 1.0) <= BAND_V
