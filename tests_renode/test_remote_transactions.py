@@ -368,6 +368,8 @@ def test_names_are_found_on_the_other_node_as_their_visibility_allows(pair):
     assert remote.call(one, "name semaphore pump")[0] == "not found"
     statistics = counters(two)
     assert statistics["malformed"] == 0 and statistics["refused-busy"] == 0
+    # Node 1's misses are names nobody has, not dead nodes.
+    assert counters(one)["names-not-found"] == 5 and counters(one)["unreachable"] == 0
 
 
 def test_a_name_query_nobody_can_answer_is_refused_not_served(pair):

@@ -131,7 +131,7 @@ void listRemote(shell::Shell& shell)
         {"abandoned", s.abandoned},
         {"malformed", s.malformed},       {"send-failures", s.sendFailures},
         {"publications-sent", s.publicationsSent}, {"publication-parts", s.publicationParts},
-        {"unknown-senders", s.unknownSenders},
+        {"unknown-senders", s.unknownSenders}, {"names-not-found", s.namesNotFound},
     };
     for (const auto& counter : counters) {
         shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));

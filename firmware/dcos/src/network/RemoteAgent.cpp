@@ -318,7 +318,12 @@ Result<uint32_t> awaitReply(CallSlot& callSlot, Send send)
             silentPeriods = 0;
         } else if (++silentPeriods >= kRemoteSilentPeriods) {
             slot->caller = ObjectId::null();
-            ++statistics.unreachable;
+            // A name query nobody answers is a name no node has, not a dead node.
+            if (slot->service == RemoteService::NameToObject) {
+                ++statistics.namesNotFound;
+            } else {
+                ++statistics.unreachable;
+            }
             return Status::Unreachable;
         }
         ++statistics.retransmissions;

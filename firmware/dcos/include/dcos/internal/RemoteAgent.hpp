@@ -62,6 +62,8 @@ struct RemoteStatistics {
     uint32_t publicationsSent = 0; ///< Publications and withdrawals queued whole, counted once per link.
     uint32_t publicationParts = 0; ///< Publication frames received and decoded.
     uint32_t unknownSenders = 0;   ///< Publication frames from a physical address the tables map to no node.
+    // Names (docs/protocols/remote-transactions.md, "Names").
+    uint32_t namesNotFound = 0;    ///< Name queries no node answered.
 };
 
 /// Counters since boot. O(1).
