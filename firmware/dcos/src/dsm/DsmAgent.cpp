@@ -246,6 +246,31 @@ unsigned recoverDsm(ObjectId deadTask)
     return static_cast<unsigned>(publishersRecovered + subscriptionsRecovered);
 }
 
+// What goes out on the links for one publication of a publisher, copied
+// under the guard so that it is sent with interrupts enabled.
+struct Outgoing {
+    ObjectId id;
+    uint32_t dataId = kNoDsmData;
+    DsmPage page{};
+    Visibility visibility = Visibility::Local;
+    uint8_t priority = 0;
+};
+
+// @p publisher's latest page as a publication, at the priority of its last
+// writing task. Under the guard.
+Outgoing outgoingOf(const PublisherObject& publisher)
+{
+    Outgoing out;
+    out.id = publisher.id;
+    out.dataId = publisher.dataId;
+    copySixteenBytes(out.page.bytes, publisher.page.bytes);
+    out.visibility = publisher.visibility;
+    out.priority = publisher.priority;
+    return out;
+}
+
+void send(const Outgoing& out) { sendPublication(out.id, out.visibility, out.dataId, out.page, out.priority); }
+
 // Takes @p page into @p publisher with the next data identifier, which it
 // returns, and hands it to the waiting readers. Under the guard.
 uint32_t publishLocally(PublisherObject& publisher, const DsmPage& page)
@@ -275,11 +300,11 @@ uint32_t publishLocally(PublisherObject& publisher, const DsmPage& page)
 // DsmAgent::Open for another node's publisher: a subscription to a remote
 // publisher of this node, once the publisher's node has said it exists
 // and may be read from here.
+//
+// Only a publisher's id reaches here: the table's miss path says WrongType
+// for any other type before it says Remote.
 Result<ObjectId> openRemote(ObjectId publisherId)
 {
-    if (publisherId.type() != ObjectType::DsmPublisher) {
-        return Status::WrongType;
-    }
     // The subscription is made first, owned by the caller, so that a caller
     // killed while it waits for the publisher's node leaves nothing behind:
     // recovery closes it like any other. The remote publisher is taken
@@ -381,9 +406,7 @@ void DsmManager::deliverPublication(uint8_t interface, uint16_t node, const Publ
 
 Result<uint32_t> DsmManager::serveRemoteOpen(ObjectId publisherId, bool withinController)
 {
-    DsmPage page;
-    uint32_t dataId;
-    Visibility visibility;
+    Outgoing out;
     {
         arch_x86::InterruptGuard guard;
         start();
@@ -393,43 +416,36 @@ Result<uint32_t> DsmManager::serveRemoteOpen(ObjectId publisherId, bool withinCo
         }
         // Visibility (seed 6.4): a local publisher is this node's alone, a
         // regional one the controller's.
-        visibility = publisher.value()->visibility;
+        const Visibility visibility = publisher.value()->visibility;
         if (visibility == Visibility::Local || (visibility == Visibility::Regional && !withinController)) {
             return Status::NotPermitted;
         }
-        dataId = publisher.value()->dataId;
-        copySixteenBytes(page.bytes, publisher.value()->page.bytes);
+        out = outgoingOf(*publisher.value());
     }
-    if (dataId != kNoDsmData) {
+    if (out.dataId != kNoDsmData) {
         // The new subscriber's node has the latest page at once, not at the
-        // next Write; the others drop it as a duplicate.
-        sendPublication(publisherId, visibility, dataId, page, Scheduler::current().priority);
+        // next Write, at the requester's priority; the others drop it as a
+        // duplicate.
+        out.priority = Scheduler::current().priority;
+        send(out);
     }
-    return dataId;
+    return out.dataId;
 }
 
 void DsmManager::publishDeferred()
 {
     // O(publishers): only an interrupt handler's Write asks for this.
     for (PublisherObject& publisher : publishers) {
-        DsmPage page;
-        uint32_t dataId;
-        ObjectId id;
-        Visibility visibility;
-        uint8_t priority;
+        Outgoing out;
         {
             arch_x86::InterruptGuard guard;
             if (!publisher.publishPending) {
                 continue;
             }
             publisher.publishPending = false;
-            id = publisher.id;
-            dataId = publisher.dataId;
-            visibility = publisher.visibility;
-            priority = publisher.priority;
-            copySixteenBytes(page.bytes, publisher.page.bytes);
+            out = outgoingOf(publisher);
         }
-        sendPublication(id, visibility, dataId, page, priority);
+        send(out);
     }
 }
 
@@ -526,10 +542,7 @@ namespace {
 // out on the links after the local hand-over, with interrupts enabled.
 [[gnu::noinline]] Result<uint32_t> writeFull(ObjectId id, const DsmPage* newPage)
 {
-    DsmPage published;
-    uint32_t written;
-    Visibility visibility;
-    uint8_t priority;
+    internal::Outgoing out;
     {
         arch_x86::InterruptGuard guard;
         start();
@@ -545,7 +558,7 @@ namespace {
             }
         }
         PublisherObject& publisher = *resolved.value();
-        written = internal::publishLocally(publisher, *newPage);
+        const uint32_t written = internal::publishLocally(publisher, *newPage);
         if ((publisher.slowWrite & internal::kNetworked) == 0) {
             return written;
         }
@@ -558,12 +571,10 @@ namespace {
             return written;
         }
         publisher.priority = internal::Scheduler::current().priority;
-        internal::copySixteenBytes(published.bytes, publisher.page.bytes);
-        visibility = publisher.visibility;
-        priority = publisher.priority;
+        out = internal::outgoingOf(publisher);
     }
-    internal::sendPublication(id, visibility, written, published, priority);
-    return written;
+    internal::send(out);
+    return out.dataId;
 }
 
 } // namespace

@@ -128,17 +128,21 @@ bool sendMessage(uint8_t interface, SystemMessageType type, uint8_t priority, ui
     return sendBytes(interface, type, priority, destination, data, kRemoteMessageBytes);
 }
 
+// Whether @p interface joins nodes of one controller (seed 6.4's regional
+// scope): the dual-Pentium board's shared-memory link, not a fieldbus.
+bool withinController(uint8_t interface)
+{
+    const Result<NetworkInterface> entry = NetworkInterfacesManager::GetInterface(interface);
+    return entry.ok() && entry.value().kind == InterfaceKind::SharedMemory;
+}
+
 // Whether a publisher of @p visibility is published over @p interface.
 bool reaches(Visibility visibility, uint8_t interface)
 {
     if (visibility == Visibility::Global) {
         return true;
     }
-    if (visibility == Visibility::Local) {
-        return false;
-    }
-    const Result<NetworkInterface> entry = NetworkInterfacesManager::GetInterface(interface);
-    return entry.ok() && entry.value().kind == InterfaceKind::SharedMemory;
+    return visibility == Visibility::Regional && withinController(interface);
 }
 
 void sendReply(uint8_t interface, uint8_t priority, uint32_t destination, const RemoteReply& reply)
@@ -651,10 +655,7 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
     case RemoteService::NameToObject: {
         // Seen from another node, a name is visible when its object is global,
         // or regional and asked for within the controller (Visibility.hpp).
-        const Result<NetworkInterface> arrived = NetworkInterfacesManager::GetInterface(entry.interface);
-        const Visibility scope = arrived.ok() && arrived.value().kind == InterfaceKind::SharedMemory
-                                     ? Visibility::Regional
-                                     : Visibility::Global;
+        const Visibility scope = withinController(entry.interface) ? Visibility::Regional : Visibility::Global;
         const Result<ObjectId> found =
             localNameToObject(static_cast<ObjectType>(request.object), entry.name, scope);
         if (found.ok()) {
@@ -665,9 +666,7 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
         break;
     }
     case RemoteService::DsmOpen: {
-        const Result<NetworkInterface> arrived = NetworkInterfacesManager::GetInterface(entry.interface);
-        const bool withinController = arrived.ok() && arrived.value().kind == InterfaceKind::SharedMemory;
-        replyWith(reply, DsmManager::serveRemoteOpen(id, withinController));
+        replyWith(reply, DsmManager::serveRemoteOpen(id, withinController(entry.interface)));
         break;
     }
     }
