@@ -19,7 +19,8 @@ import re
 
 import pytest
 
-from dcoslab.remote import attach_redundant, created, parse_result, publication_records, publish, subscribe, wait_tally
+from dcoslab.remote import (attach_redundant, created, net_counters, parse_result, publication_records, publish,
+                            subscribe, wait_tally)
 
 BIT_RATE = 500_000
 STEP = 120
@@ -41,10 +42,6 @@ def published(board):
     output = board.command("pubsub published")
     return int(re.search(r"PCOUNT (\d+)", output).group(1))
 
-
-def counters(board, verb):
-    output = board.command(f"net {verb}")
-    return {name: int(value) for name, value in re.findall(r"^  ([a-z-]+) (\d+)\r?$", output, re.M)}
 
 
 def publication_frames(lab, bus=None):
@@ -79,10 +76,10 @@ def test_every_write_reaches_a_remote_subscriber_once_over_two_buses(pair):
         # The parts in order, and the sequence numbers 1 to 40.
         assert [data[0] >> 6 for *_, data in frames] == [0, 1, 2] * 40
         assert [int.from_bytes(data[2:4], "big") for *_, data in frames[::3]] == list(range(1, 41))
-    statistics = counters(one, "publications")
+    statistics = net_counters(one, "publications")
     assert statistics["received"] == 40 and statistics["duplicates"] == 40, statistics
     assert statistics["torn"] == 0 and statistics["withdrawals"] == 0
-    assert counters(two, "remote")["publications-sent"] == 80
+    assert net_counters(two, "remote")["publications-sent"] == 80
 
 
 def test_a_bus_lost_during_publication_loses_no_sample(pair):
@@ -102,11 +99,11 @@ def test_a_bus_lost_during_publication_loses_no_sample(pair):
     can0, can1 = publication_frames(lab, "can0"), publication_frames(lab, "can1")
     assert len(can1) == 3 * 60
     assert len(can0) < 3 * 45, "can0 went quiet after the bus-off"
-    statistics = counters(one, "publications")
+    statistics = net_counters(one, "publications")
     assert statistics["received"] == 60
     assert statistics["duplicates"] < 45
     # A publication cut off on can0 half-way is dropped there, never mixed.
-    assert counters(two, "remote")["send-failures"] > 0
+    assert net_counters(two, "remote")["send-failures"] > 0
 
 
 def test_a_new_subscriber_gets_the_latest_page_at_once_and_the_deletion(pair):
@@ -120,12 +117,12 @@ def test_a_new_subscriber_gets_the_latest_page_at_once_and_the_deletion(pair):
     subscribe(one, publisher)
     status, counts = wait_tally(lab, one, lambda _, c: c["received"] == 1, "the latest page")
     assert status == "ok" and counts["last"] == 5 and counts["repeats"] == 0
-    assert counters(one, "publications")["received"] == 1
+    assert net_counters(one, "publications")["received"] == 1
     # Deleting the publisher withdraws it: the waiting reader gets Deleted.
     two.command("pubsub delete")
     status, counts = wait_tally(lab, one, lambda _, c: c["deleted"] == 1, "the withdrawal")
     assert counts["received"] == 1
-    statistics = counters(one, "publications")
+    statistics = net_counters(one, "publications")
     assert statistics["withdrawals"] == 1
     # The remote publisher is free again once its subscription is closed.
     assert "publisher 0x" not in one.command("net publications")
@@ -142,7 +139,7 @@ def test_an_interrupt_handlers_write_is_published_by_the_network_task(pair):
         assert parse_result(two.command(f"pubsub isr {counter}"))[0] == "ok"
         status, counts = wait_tally(lab, one, lambda _, c, n=counter: c["last"] == n, f"page {counter}")
     assert counts["received"] == 2 and counts["repeats"] == 0 and counts["torn"] == 0, counts
-    assert counters(two, "publications")["deferred"] == 2
+    assert net_counters(two, "publications")["deferred"] == 2
     # At the priority of the task that last wrote it, or created it: 10.
     assert {priority for _, priority, _, _, _ in publication_frames(lab)} == {10}
 
@@ -210,7 +207,7 @@ def test_the_remote_publisher_table_full_is_refused_and_recovers(pair):
     # Another subscription to one already read shares its slot.
     assert parse_result(one.command(f"pubsub hold {publishers[0]}"))[0] == "ok"
     assert parse_result(one.command(f"pubsub hold {publishers[capacity]}"))[0] == "object table full"
-    assert counters(one, "publications")["no-remote-publisher"] == 1
+    assert net_counters(one, "publications")["no-remote-publisher"] == 1
     assert len(remote_publishers(one)) == capacity
     assert parse_result(one.command("pubsub release"))[1] == capacity + 1
     assert remote_publishers(one) == []

@@ -23,7 +23,7 @@ import pytest
 
 from dcoslab import remote
 from dcoslab.canbus import Frame
-from dcoslab.remote import REPLY, REQUEST, attach_node, created, dcos_frames
+from dcoslab.remote import REPLY, REQUEST, attach_node, created, dcos_frames, net_counters
 
 BIT_RATE = 500_000
 WATCHDOG_MS = 50       # DCOS_CONFIG_REMOTE_WATCHDOG_MS
@@ -44,11 +44,6 @@ def call(board, line):
     """A `remote` primitive's (status, value, milliseconds)."""
     status, value, us = remote.call(board, line)
     return status, value, us / 1000
-
-
-def counters(board):
-    output = board.command("net remote")
-    return {name: int(value) for name, value in re.findall(r"^  ([a-z-]+) (\d+)\r?$", output, re.M)}
 
 
 SEMAPHORE_SEQUENCE = ["count {}", "acquire {} 0", "count {}", "acquire {} 0", "acquire {} 200", "release {}",
@@ -76,7 +71,7 @@ def test_a_remote_counting_semaphore_answers_as_a_local_one(pair):
     # Fixed-size primitives: one request frame and one final reply per call,
     # plus the keep-alives of the 200 ms wait (a retransmission, a pending reply).
     requests, replies = dcos_frames(lab, REQUEST), dcos_frames(lab, REPLY)
-    statistics = counters(one)
+    statistics = net_counters(one)
     assert statistics["requests"] == len(SEMAPHORE_SEQUENCE)
     assert statistics["replies"] == len(SEMAPHORE_SEQUENCE)
     assert len(requests) == len(SEMAPHORE_SEQUENCE) + statistics["retransmissions"]
@@ -85,8 +80,8 @@ def test_a_remote_counting_semaphore_answers_as_a_local_one(pair):
     # Every request went from CAN node 1 to 2, every reply back, 8 bytes each.
     assert {(destination, source, len(data)) for _, destination, source, data in requests} == {(2, 1, 8)}
     assert {(destination, source, len(data)) for _, destination, source, data in replies} == {(1, 2, 8)}
-    assert counters(two)["duplicates"] == statistics["retransmissions"]
-    assert counters(two)["served"] == len(SEMAPHORE_SEQUENCE)
+    assert net_counters(two)["duplicates"] == statistics["retransmissions"]
+    assert net_counters(two)["served"] == len(SEMAPHORE_SEQUENCE)
 
 
 def test_a_remote_acquire_waits_for_a_release_on_the_serving_node(pair):
@@ -103,7 +98,7 @@ def test_a_remote_acquire_waits_for_a_release_on_the_serving_node(pair):
     assert match.group(1) == b"ok"
     assert 300_000 <= int(match.group(3)) < 5_000_000
     assert call(two, f"count {semaphore}")[:2] == ("ok", 0)
-    statistics = counters(one)
+    statistics = net_counters(one)
     # The wait was kept alive: at least one retransmission answered as pending.
     assert statistics["pending-replies"] >= 300 // WATCHDOG_MS - 2
     assert statistics["unreachable"] == 0
@@ -161,7 +156,7 @@ def test_a_dead_node_gives_unreachable_within_the_watchdog_and_node_1_carries_on
     status, _, ms = call(one, f"acquire {semaphore} 10000")
     assert status == "node unreachable"
     assert SILENT_PERIODS * WATCHDOG_MS <= ms < (SILENT_PERIODS + 2) * WATCHDOG_MS
-    assert counters(one)["unreachable"] == 1
+    assert net_counters(one)["unreachable"] == 1
     # Node 1 is unharmed: its own objects work, and node 2 serves again once attached.
     local = created(one, "remote sem 1", "RSEM")
     assert call(one, f"acquire {local} 0")[0] == "ok"
@@ -188,12 +183,12 @@ def test_a_duplicated_request_is_answered_but_not_executed_again(pair):
     # time yet. 2 ms later node 2's receiver has surely taken it.
     lab.hub.wait_until(lab.hub.frames()[-1].end + 2_000_000, 60)
     assert call(two, f"count {semaphore}")[:2] == ("ok", 1)  # released once
-    served = counters(two)
+    served = net_counters(two)
     assert served["served"] == 1 and served["duplicates"] == 1 and served["malformed"] == 1
     replies = dcos_frames(lab, REPLY)
     assert len(replies) == 2 and replies[0][3] == replies[1][3] == bytes([2, 0xF7, 0, 0, 0, 0, 0, 0])
     # Node 1 had no such transaction: both replies are stray, and nothing else changed.
-    assert counters(one)["stray-replies"] == 2
+    assert net_counters(one)["stray-replies"] == 2
 
 
 def test_a_request_runs_at_the_requesters_priority_on_the_serving_node(pair):
@@ -257,7 +252,7 @@ def test_a_requester_that_dies_while_it_waits_frees_the_serving_nodes_workers(pa
     # lets 500 ms of its own time pass.
     sleeper = created(two, "remote sem 0", "RSEM")
     assert call(two, f"acquire {sleeper} 500")[0] == "timed out"
-    assert counters(two)["abandoned"] == 2
+    assert net_counters(two)["abandoned"] == 2
     # Nobody waits any more: a unit released on node 2 stays there.
     assert call(two, f"release {semaphore}")[0] == "ok"
     assert call(one, f"count {semaphore}")[:2] == ("ok", 1)
@@ -309,7 +304,7 @@ def test_a_corrupted_request_and_reply_change_no_result(pair):
     assert call(one, f"count {semaphore}")[:2] == ("ok", 1)
     outcomes = [r.outcome for r in lab.hub.frames() if r.frame.extended]
     assert outcomes.count("form-error") == 2, lab.hub.log_text()
-    assert counters(two)["served"] == 2 and counters(two)["duplicates"] == 0
+    assert net_counters(two)["served"] == 2 and net_counters(two)["duplicates"] == 0
 
 
 def test_every_one_of_many_calls_runs_exactly_once(pair):
@@ -321,7 +316,7 @@ def test_every_one_of_many_calls_runs_exactly_once(pair):
     for _ in range(calls):
         assert call(one, f"release {semaphore}")[0] == "ok"
     assert call(two, f"count {semaphore}")[:2] == ("ok", calls)
-    served = counters(two)
+    served = net_counters(two)
     assert served["served"] == calls and served["duplicates"] == 0
     transactions = [data[1] for _, _, _, data in dcos_frames(lab, REQUEST)]
     assert len(transactions) == calls and len(set(transactions)) == 16  # the numbers did wrap
@@ -366,20 +361,20 @@ def test_names_are_found_on_the_other_node_as_their_visibility_allows(pair):
     assert "RRES ok" in two.command(f"remote delete {pump}")
     assert "RRES ok" in one.command(f"remote delete {own}")
     assert remote.call(one, "name semaphore pump")[0] == "not found"
-    statistics = counters(two)
+    statistics = net_counters(two)
     assert statistics["malformed"] == 0 and statistics["refused-busy"] == 0
     # Node 1's misses are names nobody has, not dead nodes.
-    assert counters(one)["names-not-found"] == 5 and counters(one)["unreachable"] == 0
+    assert net_counters(one)["names-not-found"] == 5 and net_counters(one)["unreachable"] == 0
 
 
 def test_a_name_query_nobody_can_answer_is_refused_not_served(pair):
     lab, one, two = pair
     # A name query for a type without names, and a torn one, from node 1's
     # CAN node number: node 2 counts them as malformed and answers nothing.
-    before = counters(two)["malformed"]
+    before = net_counters(two)["malformed"]
     lab.hub.inject("can0", "lab", Frame(0x00120201, extended=True, dlc=8,
                                          data=bytes([0x09, 0x01]) + b"abcdef"))
     lab.hub.inject("can0", "lab", Frame(0x00120201, extended=True, dlc=3, data=bytes([0x08, 0x01, 0x00])))
     lab.hub.wait_until(lab.hub.now_ns + 5_000_000, 60)
-    assert counters(two)["malformed"] == before + 2
+    assert net_counters(two)["malformed"] == before + 2
     assert not [frame for frame in dcos_frames(lab, REPLY) if frame[2] == 2 and frame[1] == 1]

@@ -52,6 +52,12 @@ def attach_redundant(board, node, peers, bitrate, timeout=120, policy="auto"):
             output
 
 
+def net_counters(board, verb="remote"):
+    """The counters `net remote` or `net publications` prints, by name."""
+    output = board.command(f"net {verb}")
+    return {name: int(value) for name, value in re.findall(r"^  ([a-z-]+) (\d+)\r?$", output, re.M)}
+
+
 def created(board, line, tag):
     """Runs a `remote` command that creates an object ("remote sem 1", tag RSEM); its id."""
     output = board.command(line)

@@ -190,14 +190,6 @@ bool parseVisibility(const char* text, dcos::Visibility& visibility)
     return true;
 }
 
-Result<ObjectId> spawn(const char* name, unsigned long priority, dcos::TaskEntry entry)
-{
-    dcos::TaskAttributes attributes;
-    attributes.name = name;
-    attributes.priority = static_cast<uint8_t>(priority);
-    return taskAgent.Create(attributes, entry, 0);
-}
-
 CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
 {
     if (argc < 2) {
@@ -224,9 +216,8 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
         publisherRaw = 0;
         publishDelete = false;
         publishGo = false;
-        const Result<ObjectId> task = spawn("publisher", priority, publisherEntry);
-        if (!task.ok()) {
-            shell.print("error: %s\r\n", dcos::statusName(task.status()));
+        if (spawn("publisher", static_cast<uint8_t>(priority), publisherEntry).isNull()) {
+            shell.print("error: cannot create the publishing task\r\n");
             return CommandResult::Failed;
         }
         for (int tries = 0; publisherRaw == 0 && tries < 100; ++tries) {
@@ -281,12 +272,12 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
         gaps = 0;
         deleted = 0;
         waits = 0;
-        const Result<ObjectId> task = spawn("subscriber", priority, subscriberEntry);
-        if (!task.ok()) {
-            shell.print("error: %s\r\n", dcos::statusName(task.status()));
+        const ObjectId task = spawn("subscriber", static_cast<uint8_t>(priority), subscriberEntry);
+        if (task.isNull()) {
+            shell.print("error: cannot create the subscribing task\r\n");
             return CommandResult::Failed;
         }
-        shell.print("PTASK %s\r\n", dcos::internal::IdText(task.value()).c_str());
+        shell.print("PTASK %s\r\n", dcos::internal::IdText(task).c_str());
         return CommandResult::Ok;
     }
     if (textEquals(verb, "tally") && argc == 2) {
