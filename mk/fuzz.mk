@@ -32,7 +32,7 @@ HOST_MODBUS_FUZZ_REPORT := $(BUILD)/reports/fuzz-host-modbus-tests.xml
 # The kernel's parsers of outside input (firmware/dcos/fuzz): the network
 # interfaces manager's address text and tables, which the console sets, and
 # the remote transaction and publication messages every node decodes from the bus.
-DCOS_FUZZ_TARGETS := network_tables remote_message publication_message
+DCOS_FUZZ_TARGETS := network_tables remote_message publication_message time_sync
 DCOS_FUZZ_CORPUS := firmware/dcos/fuzz/corpus
 DCOS_FUZZ_REPORT := $(BUILD)/reports/fuzz-dcos-tests.xml
 
@@ -65,7 +65,9 @@ HOST_MODBUS_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/modbus/fuz
 HOST_MODBUS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOST_MODBUS_FUZZ_TARGETS))
 DCOS_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/dcos/src/network/NetworkAddress.cpp.o \
 	$(FUZZ_BUILD)/firmware/dcos/src/network/RemoteMessage.cpp.o \
-	$(FUZZ_BUILD)/firmware/dcos/src/network/PublicationMessage.cpp.o
+	$(FUZZ_BUILD)/firmware/dcos/src/network/PublicationMessage.cpp.o \
+	$(FUZZ_BUILD)/firmware/dcos/src/network/TimeSyncMessage.cpp.o \
+	$(FUZZ_BUILD)/firmware/dcos/src/network/ClockServo.cpp.o
 DCOS_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/dcos/fuzz/fuzz_%.cpp.o,$(DCOS_FUZZ_TARGETS))
 DCOS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(DCOS_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as

@@ -22,9 +22,11 @@ HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM)
 
 host-tools: $(HOST_TOOLS)
 
-# dcos-can decodes remote transactions and publications with the kernel's own codecs.
+# dcos-can decodes remote transactions, publications and the global time base's
+# frames with the kernel's own codecs.
 $(DCOS_CAN): $(BUILD)/host/host_tools/can/tools/dcos-can.cpp.o $(patsubst %,$(BUILD)/host/%.o,$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS) \
-	firmware/dcos/src/network/RemoteMessage.cpp firmware/dcos/src/network/PublicationMessage.cpp)
+	firmware/dcos/src/network/RemoteMessage.cpp firmware/dcos/src/network/PublicationMessage.cpp \
+	firmware/dcos/src/network/TimeSyncMessage.cpp)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS)

@@ -223,3 +223,27 @@ def test_dump_decodes_name_queries(hub):
     annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
     assert annotations[:2] == ['prio 24 name query 1->all: semaphore part 1/3 txn 0x10 "pump"',
                                'prio 24 name query 1->all: semaphore part 2/3 txn 0x10 ""'], lines
+
+
+def test_dump_decodes_the_global_time_base(hub):
+    # docs/protocols/time.md: node 1's Sync (sequence 5, second 0x12_3456_789A,
+    # rank 3, every 2.5 s), its FollowUp, a probe and a Sync with a bad rank.
+    output, lines = decoded_dumps(hub, [
+        Frame(0x0001FF01, extended=True, dlc=8, data=bytes([0x05, 0x12, 0x34, 0x56, 0x78, 0x9A, 0x03, 25])),
+        Frame(0x0001FF01, extended=True, dlc=8, data=bytes([0x45, 0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77])),
+        Frame(0x0001FF64, extended=True, dlc=1, data=bytes([0x89])),
+        Frame(0x0001FF01, extended=True, dlc=8, data=bytes([0x06, 0, 0, 0, 0, 1, 0x10, 10]))])
+    decoded = [json.loads(line)["dcos"]["time"] for line in output.splitlines()]
+    assert decoded == [
+        {"kind": "sync", "sequence": 5, "seconds": 0x123456789A, "rank": 3, "interval_ms": 2500},
+        {"kind": "follow-up", "sequence": 5, "nanoseconds_low56": 0x11223344556677},
+        {"kind": "probe", "sequence": 9},
+        {"malformed": "bad rank"},
+    ]
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations == [
+        "prio 0 time sync 1->all: sync seq 5 second 78187493530 rank 3 every 2500 ms",
+        "prio 0 time sync 1->all: follow-up seq 5 ns-low56 4822678189205111",
+        "prio 0 time sync 100->all: probe seq 9",
+        "prio 0 time sync 1->all: malformed: bad rank",
+    ], lines

@@ -23,6 +23,8 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/network/NetworkAddress.cpp \
 	firmware/dcos/src/network/RemoteMessage.cpp \
 	firmware/dcos/src/network/PublicationMessage.cpp \
+	firmware/dcos/src/network/TimeSyncMessage.cpp \
+	firmware/dcos/src/network/ClockServo.cpp \
 	firmware/dcos/src/network/RemoteForward.cpp
 
 # Kernel sources that run only on the target: task switching, the tick, traps.
@@ -44,6 +46,7 @@ DCOS_TARGET_SRCS := \
 	firmware/dcos/src/network/NetworkInterfacesManager.cpp \
 	firmware/dcos/src/network/RemoteAgent.cpp \
 	firmware/dcos/src/network/NameService.cpp \
+	firmware/dcos/src/network/GlobalTime.cpp \
 	firmware/dcos/src/network/NetworkCommands.cpp
 
 # The full configuration's kernel, in link order (which is the order of the

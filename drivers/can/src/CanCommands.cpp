@@ -767,11 +767,11 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
         // What the network link did with the channel's frames (can attach).
         const CanLinkStatistics l = networkLinks[channel].statistics();
         shell.print("%s link interface=%u sent=%lu received=%lu foreign=%lu other_nodes=%lu queue_full=%lu "
-                    "stale=%lu\r\n",
+                    "stale=%lu echoes=%lu\r\n",
                     kNames[channel], attachedInterface[channel], static_cast<unsigned long>(l.sent),
                     static_cast<unsigned long>(l.received), static_cast<unsigned long>(l.foreign),
                     static_cast<unsigned long>(l.otherNodes), static_cast<unsigned long>(l.queueFull),
-                    static_cast<unsigned long>(l.stale));
+                    static_cast<unsigned long>(l.stale), static_cast<unsigned long>(l.echoes));
     }
     return CommandResult::Ok;
 }

@@ -12,6 +12,8 @@ using dcos::Result;
 using dcos::Status;
 
 // The link passes the kernel's message types through as CAN message types.
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::TimeSync) ==
+              static_cast<uint8_t>(can::MessageType::TimeSync));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RemoteReply) ==
               static_cast<uint8_t>(can::MessageType::RemoteReply));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RemoteRequest) ==
@@ -27,7 +29,8 @@ namespace {
 bool isSystemMessage(can::MessageType type)
 {
     return type == can::MessageType::RemoteRequest || type == can::MessageType::RemoteReply ||
-           type == can::MessageType::NameQuery || type == can::MessageType::DsmPublication;
+           type == can::MessageType::NameQuery || type == can::MessageType::DsmPublication ||
+           type == can::MessageType::TimeSync;
 }
 
 } // namespace
@@ -51,9 +54,10 @@ Status CanNetworkLink::Start(dcos::ObjectId receiver, uint32_t receiveEvent, uin
     // Frames that waited in the driver while no link was attached are old:
     // a request among them may have been given up by its sender long ago,
     // and must not be served now.
-    can::CanFrame stale;
+    TimedFrame stale;
     while (true) {
-        const Result<size_t> read = dcos::systemAgent.Read(device_, 0, &stale, sizeof stale);
+        const Result<size_t> read = dcos::systemAgent.Read(device_, Sja1000Controller::kTimedChannel, &stale,
+                                                           sizeof stale);
         if (!read.ok() || read.value() == 0) {
             break;
         }
@@ -97,7 +101,10 @@ Status CanNetworkLink::Send(const dcos::SystemMessage& message)
     if (!frame.ok()) {
         return Status::InvalidArgument;
     }
-    const Result<size_t> written = dcos::systemAgent.Write(device_, 0, &frame.value(), sizeof(can::CanFrame));
+    // Frames written on the timed channel come back as echoes with the
+    // moment they went (Sja1000Controller.hpp).
+    const uint32_t channel = message.echo ? Sja1000Controller::kTimedChannel : Sja1000Controller::kFrameChannel;
+    const Result<size_t> written = dcos::systemAgent.Write(device_, channel, &frame.value(), sizeof(can::CanFrame));
     if (!written.ok()) {
         return written.status();
     }
@@ -112,21 +119,24 @@ Status CanNetworkLink::Send(const dcos::SystemMessage& message)
 Result<bool> CanNetworkLink::Receive(dcos::SystemMessage& message)
 {
     for (;;) {
-        can::CanFrame frame;
-        const Result<size_t> read = dcos::systemAgent.Read(device_, 0, &frame, sizeof frame);
+        TimedFrame timed;
+        const Result<size_t> read =
+            dcos::systemAgent.Read(device_, Sja1000Controller::kTimedChannel, &timed, sizeof timed);
         if (!read.ok()) {
             return read.status();
         }
         if (read.value() == 0) {
             return false;
         }
+        const can::CanFrame& frame = timed.frame;
+        const bool echo = (timed.flags & TimedFrame::kEcho) != 0;
         const can::LinkResult<can::MessageIdentifier> identifier = can::MessageIdentifier::fromFrame(frame);
         if (!identifier.ok() || !isSystemMessage(identifier.value().type())) {
             ++statistics_.foreign;
             continue;
         }
         const uint8_t destination = identifier.value().destination();
-        if (destination != ownPhysical_ && destination != can::MessageIdentifier::kBroadcast) {
+        if (!echo && destination != ownPhysical_ && destination != can::MessageIdentifier::kBroadcast) {
             ++statistics_.otherNodes;
             continue;
         }
@@ -137,6 +147,12 @@ Result<bool> CanNetworkLink::Receive(dcos::SystemMessage& message)
         message.source = identifier.value().source();
         message.length = frame.length();
         __builtin_memcpy(message.data, frame.data(), frame.length());
+        message.echo = echo;
+        message.timeNs = timed.timeNs;
+        if (echo) {
+            ++statistics_.echoes;
+            return true;
+        }
         ++statistics_.received;
         return true;
     }

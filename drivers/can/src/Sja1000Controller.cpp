@@ -3,6 +3,7 @@
 #include <arch_x86/Cpu.hpp>
 #include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
+#include <dcos/TimerAgent.hpp>
 
 #include <string.h>
 
@@ -210,26 +211,34 @@ void Sja1000Controller::stopChip()
 
 Result<size_t> Sja1000Controller::Read(uint32_t channel, void* buffer, size_t length)
 {
-    if (channel != 0 || length % sizeof(can::CanFrame) != 0) {
+    const bool timed = channel == kTimedChannel;
+    const size_t size = timed ? sizeof(TimedFrame) : sizeof(can::CanFrame);
+    if ((channel != kFrameChannel && !timed) || length % size != 0) {
         return Status::InvalidArgument;
     }
     auto* out = static_cast<uint8_t*>(buffer);
     size_t copied = 0;
-    const size_t wanted = length / sizeof(can::CanFrame);
+    const size_t wanted = length / size;
     arch_x86::InterruptGuard guard;
     while (copied < wanted && receiveCount_ != 0) {
-        memcpy(out + copied * sizeof(can::CanFrame), static_cast<const void*>(&receive_[receiveHead_]),
-               sizeof(can::CanFrame));
+        const TimedFrame& entry = receive_[receiveHead_];
         receiveHead_ = (receiveHead_ + 1) % kReceiveQueueLength;
         --receiveCount_;
+        if (timed) {
+            memcpy(out + copied * size, static_cast<const void*>(&entry), size);
+        } else if ((entry.flags & TimedFrame::kEcho) == 0) {
+            memcpy(out + copied * size, static_cast<const void*>(&entry.frame), size);
+        } else {
+            continue; // An echo is only for the timed channel's reader.
+        }
         ++copied;
     }
-    return copied * sizeof(can::CanFrame);
+    return copied * size;
 }
 
 Result<size_t> Sja1000Controller::Write(uint32_t channel, const void* buffer, size_t length)
 {
-    if (channel != 0 || length % sizeof(can::CanFrame) != 0) {
+    if ((channel != kFrameChannel && channel != kTimedChannel) || length % sizeof(can::CanFrame) != 0) {
         return Status::InvalidArgument;
     }
     const auto* in = static_cast<const uint8_t*>(buffer);
@@ -247,7 +256,7 @@ Result<size_t> Sja1000Controller::Write(uint32_t channel, const void* buffer, si
     for (; taken < count; ++taken) {
         can::CanFrame frame;
         (void)rebuild(in + taken * sizeof(can::CanFrame), frame); // Checked above.
-        if (!enqueue(frame)) {
+        if (!enqueue(frame, channel == kTimedChannel)) {
             break;
         }
     }
@@ -260,7 +269,7 @@ Result<size_t> Sja1000Controller::Write(uint32_t channel, const void* buffer, si
     return taken * sizeof(can::CanFrame);
 }
 
-bool Sja1000Controller::enqueue(const can::CanFrame& frame)
+bool Sja1000Controller::enqueue(const can::CanFrame& frame, bool echo)
 {
     if (transmitCount_ == kTransmitQueueLength) {
         return false;
@@ -269,15 +278,15 @@ bool Sja1000Controller::enqueue(const can::CanFrame& frame)
     // in arbitration order and frames with one identifier keep their order.
     // The frame in the chip (index 0) is never moved behind.
     size_t position = transmitCount_;
-    while (position > (inChip_ ? 1u : 0u) && winsArbitration(frame, transmit_[position - 1])) {
+    while (position > (inChip_ ? 1u : 0u) && winsArbitration(frame, transmit_[position - 1].frame)) {
         transmit_[position] = transmit_[position - 1];
         --position;
     }
-    transmit_[position] = frame;
+    transmit_[position] = {frame, echo};
     ++transmitCount_;
     // A more urgent frame than the one in the chip takes its place on the
     // bus: the chip aborts a frame not yet under way and raises TI.
-    if (inChip_ && !abortRequested_ && position == 1 && winsArbitration(frame, transmit_[0])) {
+    if (inChip_ && !abortRequested_ && position == 1 && winsArbitration(frame, transmit_[0].frame)) {
         chip_.abortTransmission();
         abortRequested_ = true;
     }
@@ -295,7 +304,7 @@ void Sja1000Controller::loadNext()
     if ((chip_.status() & reg::kStatusTransmitBuffer) == 0) {
         return; // Still busy with an earlier request; TI will call again.
     }
-    chip_.writeTransmitBuffer(transmit_[0]);
+    chip_.writeTransmitBuffer(transmit_[0].frame);
     chip_.transmit();
     inChip_ = true;
 }
@@ -304,8 +313,8 @@ void Sja1000Controller::loadNext()
 // frame taken back from the chip stays first among its equals only.
 void Sja1000Controller::settleHead()
 {
-    for (size_t i = 0; i + 1 < transmitCount_ && winsArbitration(transmit_[i + 1], transmit_[i]); ++i) {
-        const can::CanFrame displaced = transmit_[i];
+    for (size_t i = 0; i + 1 < transmitCount_ && winsArbitration(transmit_[i + 1].frame, transmit_[i].frame); ++i) {
+        const Outgoing displaced = transmit_[i];
         transmit_[i] = transmit_[i + 1];
         transmit_[i + 1] = displaced;
     }
@@ -335,7 +344,7 @@ void Sja1000Controller::removeHead()
     --transmitCount_;
 }
 
-void Sja1000Controller::onTransmitDone()
+void Sja1000Controller::onTransmitDone(uint64_t now)
 {
     if (!inChip_) {
         return;
@@ -347,9 +356,13 @@ void Sja1000Controller::onTransmitDone()
     if (completed) {
         dropInChip_ = false;
         acknowledgeErrorsInARow_ = 0;
+        const Outgoing sent = transmit_[0];
         removeHead();
         ++statistics_.framesSent;
         notify(notification_.sentEvent);
+        if (sent.echo && keep(sent.frame, TimedFrame::kEcho, now)) {
+            notify(notification_.receiveEvent);
+        }
         return;
     }
     if (dropInChip_) {
@@ -365,7 +378,23 @@ void Sja1000Controller::onTransmitDone()
     // Otherwise aborted for the lone-node hold: it stays first in the queue.
 }
 
-void Sja1000Controller::onReceive()
+// Puts a frame into the receive ring; false when the ring is full (the
+// newest is lost: the readers have the older ones in order).
+bool Sja1000Controller::keep(const can::CanFrame& frame, uint32_t flags, uint64_t now)
+{
+    if (receiveCount_ == kReceiveQueueLength) {
+        ++statistics_.receiveQueueOverruns;
+        return false;
+    }
+    TimedFrame& entry = receive_[(receiveHead_ + receiveCount_) % kReceiveQueueLength];
+    entry.frame = frame;
+    entry.flags = flags;
+    entry.timeNs = now;
+    ++receiveCount_;
+    return true;
+}
+
+void Sja1000Controller::onReceive(uint64_t now)
 {
     bool received = false;
     for (unsigned n = 0; n < kReceiveFifoMessages && (chip_.status() & reg::kStatusReceiveBuffer) != 0; ++n) {
@@ -381,12 +410,7 @@ void Sja1000Controller::onReceive()
         }
         ++statistics_.framesReceived;
         received = true;
-        if (receiveCount_ == kReceiveQueueLength) {
-            ++statistics_.receiveQueueOverruns; // The newest is lost; the readers have the older ones in order.
-            continue;
-        }
-        receive_[(receiveHead_ + receiveCount_) % kReceiveQueueLength] = frame.value();
-        ++receiveCount_;
+        (void)keep(frame.value(), 0, now);
     }
     if (received) {
         // Another node is on the bus: a held queue may try again.
@@ -484,6 +508,9 @@ void Sja1000Controller::notify(uint32_t events)
 
 void Sja1000Controller::handleInterrupt()
 {
+    // First, before the chip is even read: the closer to the frame's end on
+    // the bus, the closer two nodes' stamps of it (docs/protocols/time.md).
+    const uint64_t now = dcos::TimerAgent::Uptime();
     ++statistics_.interrupts;
     unsigned handled = 0;
     for (; handled < kInterruptLoopBound; ++handled) {
@@ -496,7 +523,7 @@ void Sja1000Controller::handleInterrupt()
             chip_.clearOverrun();
         }
         if ((causes & reg::kInterruptReceive) != 0) {
-            onReceive();
+            onReceive(now);
         }
         if ((causes & reg::kInterruptArbitrationLost) != 0) {
             (void)chip_.arbitrationLostBit(); // Frees ALC for the next loss.
@@ -511,7 +538,7 @@ void Sja1000Controller::handleInterrupt()
             onBusError();
         }
         if ((causes & reg::kInterruptTransmit) != 0) {
-            onTransmitDone();
+            onTransmitDone(now);
         }
         loadNext();
     }

@@ -296,7 +296,11 @@ TEST_F(Sja1000ControllerTest, BadFramesFromATaskAreRefusedWholeAndNothingIsSent)
     EXPECT_EQ(written.status(), Status::InvalidArgument);
     EXPECT_FALSE(fake->transmitting());
     EXPECT_EQ(systemAgent.Write(id, 0, frames.data(), sizeof(CanFrame) - 1).status(), Status::InvalidArgument);
-    EXPECT_EQ(systemAgent.Write(id, 1, frames.data(), sizeof(CanFrame)).status(), Status::InvalidArgument);
+    EXPECT_EQ(systemAgent.Write(id, 2, frames.data(), sizeof(CanFrame)).status(), Status::InvalidArgument);
+    EXPECT_EQ(systemAgent.Read(id, 2, frames.data(), sizeof(CanFrame)).status(), Status::InvalidArgument);
+    EXPECT_EQ(systemAgent.Read(id, Sja1000Controller::kTimedChannel, frames.data(), sizeof(CanFrame)).status(),
+              Status::InvalidArgument)
+        << "the timed channel reads whole TimedFrame objects";
 }
 
 TEST_F(Sja1000ControllerTest, ReceivedFramesAreQueuedInOrderAndTheListenerIsTold)
@@ -314,6 +318,77 @@ TEST_F(Sja1000ControllerTest, ReceivedFramesAreQueuedInOrderAndTheListenerIsTold
     EXPECT_EQ(frames[1], standard(0x222, {2, 2}));
     EXPECT_TRUE(readAll(id).empty()) << "a Read with nothing waiting returns at once";
     EXPECT_EQ(statistics(id).framesReceived, 2u);
+}
+
+TEST_F(Sja1000ControllerTest, TheTimedChannelStampsEachFrameWithItsInterrupt)
+{
+    const ObjectId id = open();
+    iobus_fake::uptimeNs() = 5'000'000;
+    fake->receive(extended(0x111, {1}));
+    interrupt();
+    iobus_fake::uptimeNs() = 7'000'123;
+    fake->receive(extended(0x222, {2}));
+    fake->receive(extended(0x333, {3}));
+    interrupt();
+    sja1000::TimedFrame timed[4];
+    const Result<size_t> read = systemAgent.Read(id, Sja1000Controller::kTimedChannel, timed, sizeof timed);
+    ASSERT_TRUE(read.ok());
+    ASSERT_EQ(read.value(), 3 * sizeof(sja1000::TimedFrame));
+    EXPECT_EQ(timed[0].frame, extended(0x111, {1}));
+    EXPECT_EQ(timed[0].timeNs, 5'000'000u);
+    EXPECT_EQ(timed[1].timeNs, 7'000'123u) << "the frames of one interrupt share its time";
+    EXPECT_EQ(timed[2].timeNs, 7'000'123u);
+    EXPECT_EQ(timed[2].flags, 0u);
+}
+
+TEST_F(Sja1000ControllerTest, AFrameWrittenOnTheTimedChannelComesBackAsAnEchoWhenSent)
+{
+    const ObjectId id = open();
+    const CanFrame sync = extended(0x0004FF01, {0, 1, 2, 3, 4, 5, 6, 7});
+    const CanFrame plain = extended(0x0A4FF01, {9});
+    ASSERT_EQ(systemAgent.Write(id, Sja1000Controller::kTimedChannel, &sync, sizeof sync).value(), sizeof sync);
+    ASSERT_EQ(systemAgent.Write(id, Sja1000Controller::kFrameChannel, &plain, sizeof plain).value(), sizeof plain);
+    iobus_fake::uptimeNs() = 42'000'000;
+    const std::vector<CanFrame> sent = drainBus();
+    ASSERT_EQ(sent.size(), 2u);
+    EXPECT_EQ(sent[0], sync);
+    EXPECT_EQ(statistics(id).framesReceived, 0u) << "an echo is not a received frame";
+    // Channel 0 never sees the echo; channel 1 does, once, with the time of
+    // the transmit interrupt.
+    sja1000::TimedFrame timed[4];
+    const Result<size_t> read = systemAgent.Read(id, Sja1000Controller::kTimedChannel, timed, sizeof timed);
+    ASSERT_EQ(read.value(), sizeof(sja1000::TimedFrame)) << "only the frame written on the timed channel";
+    EXPECT_EQ(timed[0].frame, sync);
+    EXPECT_EQ(timed[0].flags, sja1000::TimedFrame::kEcho);
+    EXPECT_EQ(timed[0].timeNs, 42'000'000u);
+
+    ASSERT_EQ(systemAgent.Write(id, Sja1000Controller::kTimedChannel, &sync, sizeof sync).value(), sizeof sync);
+    fake->receive(extended(0x555, {5}));
+    (void)drainBus();
+    const std::vector<CanFrame> plainRead = readAll(id);
+    ASSERT_EQ(plainRead.size(), 1u) << "channel 0 skips the echo";
+    EXPECT_EQ(plainRead[0], extended(0x555, {5}));
+}
+
+TEST_F(Sja1000ControllerTest, AnAbortedFrameComesBackOnlyWhenItIsFinallySent)
+{
+    const ObjectId id = open();
+    const CanFrame slow = extended(0x1F00000, {1});
+    const CanFrame urgent = extended(0x0000001, {2});
+    ASSERT_EQ(systemAgent.Write(id, Sja1000Controller::kTimedChannel, &slow, sizeof slow).value(), sizeof slow);
+    ASSERT_TRUE(fake->transmitting());
+    ASSERT_EQ(systemAgent.Write(id, Sja1000Controller::kFrameChannel, &urgent, sizeof urgent).value(), sizeof urgent);
+    ASSERT_EQ(fake->aborts, 1u);
+    interrupt(); // TI of the abort: no echo for a frame that did not go.
+    sja1000::TimedFrame none;
+    EXPECT_EQ(systemAgent.Read(id, Sja1000Controller::kTimedChannel, &none, sizeof none).value(), 0u);
+    const std::vector<CanFrame> sent = drainBus();
+    ASSERT_EQ(sent.size(), 2u);
+    EXPECT_EQ(sent[0], urgent);
+    sja1000::TimedFrame timed[4];
+    const Result<size_t> read = systemAgent.Read(id, Sja1000Controller::kTimedChannel, timed, sizeof timed);
+    ASSERT_EQ(read.value(), sizeof(sja1000::TimedFrame)) << "the echo once, after its own transmission";
+    EXPECT_EQ(timed[0].frame, slow);
 }
 
 TEST_F(Sja1000ControllerTest, AFrameWithALengthAboveEightIsDroppedAndCounted)

@@ -100,6 +100,43 @@ uint32_t tickTimerDivisor = 0;
 
 const BoardIdentity& identity() { return board; }
 
+namespace {
+
+// "crystal_ppm=N" (0 to 1000): the lab's model of a crystal N parts per
+// million fast, for the global time base's tests (docs/protocols/time.md).
+// An emulated 8254 counts at exactly its nominal rate, so the model counts
+// fewer per tick than the divisor the kernel believes: the tick comes
+// early and the clock gains. Returns the counts to take off a divisor of
+// @p divisor, the nearest to N ppm, and says what that gives.
+uint16_t crystalModel(const boot::BootInfo& bootInfo, uint16_t divisor)
+{
+    char text[8];
+    if (!boot::findCommandLineOption(bootInfo.commandLine, "crystal_ppm", text, sizeof text)) {
+        return 0;
+    }
+    uint32_t ppm = 0;
+    bool numeric = text[0] != '\0';
+    for (const char* p = text; *p != '\0' && numeric; ++p) {
+        numeric = p - text < 4 && *p >= '0' && *p <= '9';
+        ppm = ppm * 10 + static_cast<uint32_t>(*p - '0');
+    }
+    if (!numeric || ppm > 1000) {
+        runtime::format(uart, "warning: crystal_ppm=%s is not from 0 to 1000; the crystal is exact\r\n", text);
+        return 0;
+    }
+    // divisor / (divisor - k) - 1 = ppm / 1e6, so k = divisor * ppm / (1e6 + ppm), rounded.
+    const uint32_t shortenBy = (divisor * ppm + (1'000'000 + ppm) / 2) / (1'000'000 + ppm);
+    // The rate that gives, in tenths of a ppm: 1e7 * k / (divisor - k).
+    const uint32_t tenths =
+        static_cast<uint32_t>((uint64_t{10'000'000} * shortenBy + (divisor - shortenBy) / 2) / (divisor - shortenBy));
+    runtime::format(uart, "crystal model: the tick timer counts %lu of %u, the clock runs %lu.%lu ppm fast\r\n",
+                    static_cast<unsigned long>(divisor - shortenBy), unsigned(divisor),
+                    static_cast<unsigned long>(tenths / 10), static_cast<unsigned long>(tenths % 10));
+    return static_cast<uint16_t>(shortenBy);
+}
+
+} // namespace
+
 static_assert(Pit8254::minimumRateHz == minimumTickRateHz && Pit8254::maximumRateHz == maximumTickRateHz);
 
 void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
@@ -155,10 +192,14 @@ void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
                             static_cast<unsigned long>(tickRateHz));
         }
     }
-    if (pit.start(rate) != dcos::Status::Ok) {
+    const uint16_t shortenBy = crystalModel(bootInfo, Pit8254::divisorFor(rate));
+    if (pit.start(rate, shortenBy) != dcos::Status::Ok) {
         dcosPanic("the 8254 refused a tick of %lu Hz", static_cast<unsigned long>(rate));
     }
-    tickTimerDivisor = pit.divisor();
+    // The counts the timer really makes per tick: with a crystal model the
+    // clock's reading within a tick runs over those, and the tick itself
+    // still counts as the nominal period, so the clock runs fast.
+    tickTimerDivisor = pit.programmedDivisor();
 }
 
 dcos::Status attachInterrupt(unsigned line, InterruptHandler handler, void* context)

@@ -2,16 +2,17 @@
 
 namespace bsp {
 
-dcos::Status Pit8254::start(uint32_t rateHz)
+dcos::Status Pit8254::start(uint32_t rateHz, uint16_t shortenBy)
 {
-    if (rateHz < minimumRateHz || rateHz > maximumRateHz) {
+    if (rateHz < minimumRateHz || rateHz > maximumRateHz || shortenBy > divisorFor(rateHz) / 2) {
         return dcos::Status::InvalidArgument;
     }
     requestedRateHz_ = rateHz;
     divisor_ = divisorFor(rateHz);
+    programmed_ = static_cast<uint16_t>(divisor_ - shortenBy);
     window_.write8(controlWordRegister, selectCounter0 | accessLowThenHigh | modeRateGenerator | binaryCounting);
-    window_.write8(counter0Register, static_cast<uint8_t>(divisor_ & 0xFF));
-    window_.write8(counter0Register, static_cast<uint8_t>(divisor_ >> 8));
+    window_.write8(counter0Register, static_cast<uint8_t>(programmed_ & 0xFF));
+    window_.write8(counter0Register, static_cast<uint8_t>(programmed_ >> 8));
     return dcos::Status::Ok;
 }
 

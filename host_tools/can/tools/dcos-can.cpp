@@ -24,6 +24,7 @@
 #include <dcos/Version.hpp>
 #include <dcos/internal/PublicationMessage.hpp>
 #include <dcos/internal/RemoteMessage.hpp>
+#include <dcos/internal/TimeSyncMessage.hpp>
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -157,6 +158,37 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         return pages.decode(id, frame);
     }
     DataDecoding out;
+    if (id.type() == can::MessageType::TimeSync) {
+        out.key = "time";
+        TimeSyncFrame time;
+        const TimeSyncError error = decodeTimeSync(frame.data(), frame.length(), time);
+        if (error != TimeSyncError::None) {
+            out.text = fmt::format("malformed: {}", timeSyncErrorName(error));
+            out.json = {{"malformed", timeSyncErrorName(error)}};
+            return out;
+        }
+        switch (time.kind) {
+        case TimeSyncKind::Sync:
+            out.text = fmt::format("sync seq {} second {} rank {} every {} ms", time.sequence, time.seconds, time.rank,
+                                   time.intervalMs);
+            out.json = {{"kind", "sync"},
+                        {"sequence", time.sequence},
+                        {"seconds", time.seconds},
+                        {"rank", time.rank},
+                        {"interval_ms", time.intervalMs}};
+            break;
+        case TimeSyncKind::FollowUp:
+            // The low 56 bits of the master's nanoseconds: the Sync before it says which 2.28 years.
+            out.text = fmt::format("follow-up seq {} ns-low56 {}", time.sequence, time.nanosecondsLow);
+            out.json = {{"kind", "follow-up"}, {"sequence", time.sequence}, {"nanoseconds_low56", time.nanosecondsLow}};
+            break;
+        case TimeSyncKind::Probe:
+            out.text = fmt::format("probe seq {}", time.sequence);
+            out.json = {{"kind", "probe"}, {"sequence", time.sequence}};
+            break;
+        }
+        return out;
+    }
     if (id.type() == can::MessageType::NameQuery) {
         out.key = "name_query";
         NameQueryPart part;

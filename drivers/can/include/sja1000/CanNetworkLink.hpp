@@ -32,6 +32,7 @@ struct CanLinkStatistics {
     uint32_t otherNodes = 0;   ///< DCOS system messages for another node.
     uint32_t queueFull = 0;    ///< Sends the driver's transmit queue did not take.
     uint32_t stale = 0;        ///< Frames found waiting at Start, from before the link was attached, dropped.
+    uint32_t echoes = 0;       ///< The node's own messages handed back with the moment they went.
 };
 
 class CanNetworkLink final : public dcos::NetworkLink {

@@ -23,6 +23,15 @@
 // - Read hands out received frames, oldest first, and returns 0 bytes when
 //   none is waiting: a driver never waits (dcos/Device.hpp). A task waits
 //   for the receive event it asked for with kSetNotification.
+// - Channel 1 (kTimedChannel) moves the same frames with timestamps: Read
+//   gives TimedFrame objects, each with the uptime read when the interrupt
+//   that took it from the chip began, and a frame written on channel 1
+//   comes back through channel 1's Read once it has gone, flagged as an
+//   echo and stamped with its transmit interrupt (as SocketCAN loops back
+//   a sent frame with its timestamp). On the bus a frame ends for every
+//   node at once, so the sender's echo and the receivers' frames carry the
+//   same moment (the global time base, docs/protocols/time.md). Channel
+//   0's Read skips echoes.
 //
 // Errors: the interrupt service routine follows the chip's error counters
 // and reports every change of state (error-active, warning, passive,
@@ -88,6 +97,18 @@ struct ChannelStatistics {
     uint32_t interruptLoopLimits = 0;  ///< Calls that stopped at kInterruptLoopBound.
 };
 
+/// A frame with its time, as channel 1 (kTimedChannel) reads it.
+struct TimedFrame {
+    /// flags: the frame is this channel's own, sent after a write on channel 1.
+    static constexpr uint32_t kEcho = 1u << 0;
+
+    can::CanFrame frame{};
+    uint32_t flags = 0;
+    /// TimerAgent::Uptime at the start of the interrupt that received the
+    /// frame, or for an echo, that saw its transmission complete.
+    uint64_t timeNs = 0;
+};
+
 /// Whom the channel tells, and with which events (kSetNotification).
 struct Notification {
     dcos::ObjectId task{};      ///< Null: nobody.
@@ -138,6 +159,10 @@ public:
         kReadStateChanges = 10, ///< StateChanges: the error-state changes since the last read, oldest first.
     };
 
+    /// Read and Write plain can::CanFrame objects.
+    static constexpr uint32_t kFrameChannel = 0;
+    /// Read TimedFrame objects; Write frames that come back as echoes.
+    static constexpr uint32_t kTimedChannel = 1;
     /// Frames the transmit queue holds, the one in the chip included.
     static constexpr size_t kTransmitQueueLength = 16;
     /// Frames received and not yet read that the channel keeps.
@@ -193,13 +218,20 @@ private:
 
     dcos::Status startChip();
     void stopChip();
-    bool enqueue(const can::CanFrame& frame);
+    // A frame waiting to be sent, and whether it comes back as an echo.
+    struct Outgoing {
+        can::CanFrame frame{};
+        bool echo = false;
+    };
+
+    bool enqueue(const can::CanFrame& frame, bool echo);
     void settleHead();
     void takeBackFromChip();
     void removeHead();
     void loadNext();
-    void onTransmitDone();
-    void onReceive();
+    void onTransmitDone(uint64_t now);
+    void onReceive(uint64_t now);
+    bool keep(const can::CanFrame& frame, uint32_t flags, uint64_t now);
     void onBusError();
     void onStateChange();
     void notify(uint32_t events);
@@ -226,13 +258,13 @@ private:
     unsigned acknowledgeErrorsInARow_ = 0;
     // The transmit queue, sorted by winsArbitration, stable: transmit_[0] is
     // the next to send; inChip_ says it is already in the chip's buffer.
-    can::CanFrame transmit_[kTransmitQueueLength];
+    Outgoing transmit_[kTransmitQueueLength];
     size_t transmitCount_ = 0;
     bool inChip_ = false;
     bool abortRequested_ = false; // An abort for a more urgent frame is under way.
     bool dropInChip_ = false;     // The frame in the chip was flushed: drop it when TI comes.
-    // The receive ring.
-    can::CanFrame receive_[kReceiveQueueLength];
+    // The receive ring, echoes included.
+    TimedFrame receive_[kReceiveQueueLength];
     size_t receiveHead_ = 0;
     size_t receiveCount_ = 0;
     ChannelStatistics statistics_{};

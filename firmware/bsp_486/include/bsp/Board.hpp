@@ -57,7 +57,9 @@ constexpr uint32_t consoleBaud = 115200;
 /// that order, with every interrupt line masked except those attached.
 /// Interrupts stay disabled in the CPU; the kernel enables them. The tick
 /// runs at @p tickRateHz (the linked application's rate, or the default)
-/// unless the command line says tick_hz=.
+/// unless the command line says tick_hz=. "crystal_ppm=N" (0 to 1000) makes
+/// the tick timer model a crystal N ppm fast, for the global time base's
+/// tests: an emulated board's clock is otherwise exact.
 void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz = defaultTickRateHz);
 
 /// Called with interrupts disabled for each interrupt on a line.

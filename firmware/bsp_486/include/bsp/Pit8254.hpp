@@ -46,12 +46,19 @@ public:
 
     /// Starts counter 0 as a rate generator at rateHz, or refuses a rate
     /// outside [minimumRateHz, maximumRateHz] with InvalidArgument.
-    dcos::Status start(uint32_t rateHz);
+    /// @p shortenBy counts less per period than the rate's divisor, while
+    /// divisor() and tickPeriodNanoseconds() still say the rate's: the
+    /// lab's model of a crystal that runs fast (the crystal_ppm= option of
+    /// Board.hpp), since an emulated 8254 counts at exactly 1,193,182 Hz.
+    /// InvalidArgument when it would leave fewer than half the counts.
+    dcos::Status start(uint32_t rateHz, uint16_t shortenBy = 0);
 
     /// The rate that was asked for.
     uint32_t requestedRateHz() const { return requestedRateHz_; }
-    /// The divisor programmed into the counter.
+    /// The divisor of the rate asked for.
     uint16_t divisor() const { return divisor_; }
+    /// The divisor programmed into the counter: divisor() less start's shortenBy.
+    uint16_t programmedDivisor() const { return programmed_; }
     /// The exact tick period the divisor gives, in nanoseconds (rounded).
     uint64_t tickPeriodNanoseconds() const;
     /// Reads the current count of counter 0 (counts down to 1 each period).
@@ -61,6 +68,7 @@ private:
     arch_x86::IoWindow window_;
     uint32_t requestedRateHz_ = 0;
     uint16_t divisor_ = 0;
+    uint16_t programmed_ = 0;
 };
 
 } // namespace bsp

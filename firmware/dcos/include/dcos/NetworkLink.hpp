@@ -27,6 +27,7 @@ namespace dcos {
 /// The kinds of system message, with the values of the CAN message types
 /// (docs/protocols/can.md) so that a CAN link passes them through.
 enum class SystemMessageType : uint8_t {
+    TimeSync = 0x01, ///< The global time base's Sync, FollowUp and Probe, to the broadcast address (docs/protocols/time.md).
     RemoteReply = 0x10,
     RemoteRequest = 0x11,
     NameQuery = 0x12, ///< A part of a name query, to the broadcast address (docs/protocols/remote-transactions.md).
@@ -44,6 +45,16 @@ struct SystemMessage {
     uint32_t source = 0;
     uint8_t length = 0;
     uint8_t data[8]{};
+    /// Send: hand the message back through Receive once it has gone, with
+    /// echo set and timeNs the moment it left (the end of its frame on a
+    /// bus); the global time base's master learns so when its Sync went. A
+    /// link that cannot refuses the Send with NotSupported.
+    /// Receive: this is such an echo of the node's own message.
+    bool echo = false;
+    /// Receive: the uptime (TimerAgent::Uptime) at which the message
+    /// arrived, read in the driver's interrupt; 0 from a link that does not
+    /// timestamp.
+    uint64_t timeNs = 0;
 };
 
 class NetworkLink {

@@ -2,6 +2,7 @@
 // lists its tables, resolves a node and, for the super user the console
 // runs as, changes them. Output is one entry per line, so the lab's tests
 // and a control engineer's scripts can read it.
+#include <dcos/GlobalTime.hpp>
 #include <dcos/NetworkInterfacesManager.hpp>
 #include <dcos/internal/DsmManager.hpp>
 #include <dcos/internal/IdText.hpp>
@@ -173,6 +174,78 @@ void listPublications(shell::Shell& shell)
     }
 }
 
+// The global time base: the role, the master followed, the counters, the
+// measured bound and the probes noted (docs/protocols/time.md).
+void listTime(shell::Shell& shell)
+{
+    const GlobalTimeStatus s = globalTime.GetStatus();
+    if (s.role == TimeRole::Master) {
+        shell.print("time: master, rank %u, every %lu ms, %s\r\n", unsigned(s.rank),
+                    static_cast<unsigned long>(s.intervalMs), s.sending ? "sending" : "quiet");
+    } else {
+        shell.print("time: %s\r\n", timeRoleName(s.role));
+    }
+    if (s.following && !s.sending) {
+        shell.print("  following node %u, rank %u, every %lu ms, interface %u, %s\r\n", unsigned(s.masterNode),
+                    unsigned(s.masterRank), static_cast<unsigned long>(s.masterIntervalMs),
+                    unsigned(s.masterInterface), s.inStep ? "in step" : "not yet in step");
+    } else if (!s.sending && s.role != TimeRole::Off) {
+        shell.print("  no master heard\r\n");
+    }
+    const struct {
+        const char* name;
+        uint32_t value;
+    } counters[] = {
+        {"syncs-sent", s.syncsSent},           {"follow-ups-sent", s.followUpsSent},
+        {"syncs-received", s.syncsReceived},   {"follow-ups-received", s.followUpsReceived},
+        {"corrections", s.corrections},        {"unpaired", s.unpaired},
+        {"ignored", s.ignored},                {"held", s.held},
+        {"malformed", s.malformed},            {"probes", s.probes},
+    };
+    for (const auto& counter : counters) {
+        shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));
+    }
+    shell.print("  last-offset-ns %lld\r\n", static_cast<long long>(s.lastOffsetNs));
+    shell.print("  largest-offset-ns %llu\r\n", static_cast<unsigned long long>(s.largestOffsetNs));
+    shell.print("  drift-ppb %ld\r\n", static_cast<long>(s.driftPpb));
+    TimeProbe probes[GlobalTime::kProbes];
+    const size_t count = globalTime.GetProbes(probes, GlobalTime::kProbes);
+    for (size_t i = 0; i < count; ++i) {
+        shell.print("  probe %u interface %u source %lu time %llu\r\n", unsigned(probes[i].sequence),
+                    unsigned(probes[i].interface), static_cast<unsigned long>(probes[i].source),
+                    static_cast<unsigned long long>(probes[i].timeOfDayNs));
+    }
+}
+
+shell::CommandResult timeBase(shell::Shell& shell, int argc, char** argv)
+{
+    if (argc == 2) {
+        listTime(shell);
+        return shell::CommandResult::Ok;
+    }
+    unsigned long number = 0;
+    if (textEquals(argv[2], "master") && argc <= 5) {
+        unsigned long rank = 0;
+        unsigned long interval = kDefaultTimeSyncIntervalMs;
+        if ((argc >= 4 && !shell::Shell::parseUnsigned(argv[3], rank)) ||
+            (argc == 5 && !shell::Shell::parseUnsigned(argv[4], interval)) || rank > 0xFF || interval > 0xFFFFFFFFul) {
+            return shell::CommandResult::UsageError;
+        }
+        return report(shell, globalTime.SetRole(TimeRole::Master, static_cast<uint8_t>(rank),
+                                                static_cast<uint32_t>(interval)));
+    }
+    if (textEquals(argv[2], "follow") && argc == 3) {
+        return report(shell, globalTime.SetRole(TimeRole::Follower));
+    }
+    if (textEquals(argv[2], "off") && argc == 3) {
+        return report(shell, globalTime.SetRole(TimeRole::Off));
+    }
+    if (textEquals(argv[2], "probe") && argc == 4 && shell::Shell::parseUnsigned(argv[3], number) && number <= 63) {
+        return report(shell, globalTime.SendProbe(static_cast<uint8_t>(number)));
+    }
+    return shell::CommandResult::UsageError;
+}
+
 shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
 {
     if (argc == 1) {
@@ -186,6 +259,9 @@ shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
     if (argc == 2 && textEquals(argv[1], "publications")) {
         listPublications(shell);
         return shell::CommandResult::Ok;
+    }
+    if (argc >= 2 && textEquals(argv[1], "time")) {
+        return timeBase(shell, argc, argv);
     }
     const bool remove = argc >= 3 && textEquals(argv[2], "remove");
     const char* const what = argv[1];
@@ -244,7 +320,8 @@ shell::CommandResult net(shell::Shell& shell, int argc, char** argv)
 
 DCOS_SHELL_COMMAND_DETAILED(
     netCommand, "net", "network interfaces manager: list, resolve or change the tables",
-    "net [remote | publications | resolve NODE | interface can|modbus|shm CHANNEL A.B.C.D/LEN PHYSICAL | interface remove N"
+    "net [remote | publications | time | time master [RANK [INTERVAL_MS]] | time follow | time off | time probe SEQ"
+    " | resolve NODE | interface can|modbus|shm CHANNEL A.B.C.D/LEN PHYSICAL | interface remove N"
     " | map|unmap NODE A.B.C.D | neighbour A.B.C.D PHYSICAL | neighbour remove A.B.C.D"
     " | route A.B.C.D/LEN GATEWAY | route remove A.B.C.D/LEN]",
     "  interfaces: number, kind, channel, own address/subnet prefix, own physical address\r\n"
@@ -253,6 +330,10 @@ DCOS_SHELL_COMMAND_DETAILED(
     "  routes: a destination subnet and the gateway it goes through\r\n"
     "  remote: the remote agent's counters and the remote transactions under way\r\n"
     "  publications: publications received from other nodes, and their publishers read here\r\n"
+    "  time: the global time base: this node's role, the master it follows, the corrections,\r\n"
+    "    the largest since in step (the measured bound) and the probes noted; master RANK (0-15,\r\n"
+    "    0 preferred) INTERVAL_MS (100-25500, by 100) makes it a time master; probe SEQ (0-63)\r\n"
+    "    sends a probe every node notes with its time of day\r\n"
     "  changing the tables needs a super user (the console is one)",
     net);
 

@@ -6,6 +6,7 @@
 #include <dcos/TimerAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/DsmManager.hpp>
+#include <dcos/internal/GlobalTimeService.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/NameService.hpp>
 #include <dcos/internal/PublicationMessage.hpp>
@@ -100,26 +101,13 @@ ObjectId receiverTask;
 bool sendBytes(uint8_t interface, SystemMessageType type, uint8_t priority, uint32_t destination,
                const uint8_t* data, uint8_t length)
 {
-    NetworkLink* link;
-    {
-        Lock lock;
-        link = links[interface];
-    }
-    if (link == nullptr) {
-        return false;
-    }
     SystemMessage message;
     message.priority = priority;
     message.type = type;
     message.destination = destination;
     message.length = length;
     __builtin_memcpy(message.data, data, length);
-    if (link->Send(message) != Status::Ok) {
-        Lock lock;
-        ++statistics.sendFailures;
-        return false;
-    }
-    return true;
+    return sendOnLink(interface, message);
 }
 
 bool sendMessage(uint8_t interface, SystemMessageType type, uint8_t priority, uint32_t destination,
@@ -770,6 +758,7 @@ void receiverEntry(uintptr_t)
                 case SystemMessageType::RemoteRequest: onRequest(interface, message); break;
                 case SystemMessageType::NameQuery: onNameQuery(interface, message); break;
                 case SystemMessageType::DsmPublication: onPublication(interface, message); break;
+                case SystemMessageType::TimeSync: onTimeSyncMessage(interface, message); break;
                 }
             }
         }
@@ -884,6 +873,33 @@ void requestDeferredPublications()
     if (started) {
         (void)TaskAgent::PostEvent(receiverTask, kDeferredPublicationsEvent);
     }
+}
+
+bool sendOnLink(uint8_t interface, const SystemMessage& message)
+{
+    if (interface >= kNetworkInterfaces) {
+        return false;
+    }
+    NetworkLink* link;
+    {
+        Lock lock;
+        link = links[interface];
+    }
+    if (link == nullptr) {
+        return false;
+    }
+    if (link->Send(message) != Status::Ok) {
+        Lock lock;
+        ++statistics.sendFailures;
+        return false;
+    }
+    return true;
+}
+
+bool linkAttached(uint8_t interface)
+{
+    Lock lock;
+    return interface < kNetworkInterfaces && links[interface] != nullptr;
 }
 
 void detachRemoteLink(uint8_t interface)

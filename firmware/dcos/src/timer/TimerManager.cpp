@@ -289,6 +289,23 @@ using arch_x86::restoreFlags;
     return time;
 }
 
+// The first nanosecond past TimerAgent::kLastClockYear: 1 January 2400,
+// 157,054 days after 1 January 1970 (430 years, 104 of them leap years).
+constexpr uint64_t lastClockNs = uint64_t{157'054} * 86'400 * 1'000'000'000 - 1;
+static_assert(TimerAgent::kLastClockYear == 2399);
+
+// Changes the base (seed 7.5), with interrupts disabled; @p elapsed is the
+// uptime now. Day-clock alarms and SleepTill are keyed by time of day
+// (DayClockWheel), so none of them is touched: the time with interrupts
+// held off is the same for any number of timers and tasks.
+void setBase(uint64_t base, uint64_t elapsed)
+{
+    baseNs = base;
+    dayClock.setBase(baseNs, tickCount);
+    ++clockGeneration;
+    calendar.invalidate(elapsed);
+}
+
 // GetSystemClock, inlined into both of its entry points.
 [[gnu::always_inline]] inline Result<DateTime> readSystemClock()
 {
@@ -326,14 +343,23 @@ Status TimerManager::setSystemClock(const DateTime& time)
     if (target.value() < elapsed) {
         return Status::InvalidArgument; // Before the node was started.
     }
-    // Only the base changes (seed 7.5). Day-clock alarms and SleepTill are
-    // keyed by time of day (DayClockWheel), so none of them is touched: the
-    // time with interrupts held off is the same for any number of timers
-    // and tasks.
-    baseNs = target.value() - elapsed;
-    dayClock.setBase(baseNs, tickCount);
-    ++clockGeneration;
-    calendar.invalidate(elapsed);
+    setBase(target.value() - elapsed, elapsed);
+    return Status::Ok;
+}
+
+uint64_t TimerManager::timeOfDayAtUptime(uint64_t uptimeNs)
+{
+    arch_x86::InterruptGuard guard;
+    return baseNs + uptimeNs;
+}
+
+Status TimerManager::setTimeOfDayAt(uint64_t timeOfDayNs, uint64_t uptimeNs)
+{
+    if (timeOfDayNs < uptimeNs || timeOfDayNs > lastClockNs) {
+        return Status::InvalidArgument;
+    }
+    arch_x86::InterruptGuard guard;
+    setBase(timeOfDayNs - uptimeNs, preciseUptime());
     return Status::Ok;
 }
 

@@ -98,6 +98,15 @@ void sendWithdrawal(ObjectId publisher, Visibility visibility, uint8_t priority)
 /// (DsmManager::publishDeferred). Interrupt context.
 void requestDeferredPublications();
 
+/// Sends @p message over @p interface's link as it is (its type, priority,
+/// destination, data and echo request); false when the interface has no
+/// link or the link refused it (counted as a send failure). Task context.
+/// The global time base sends its messages so (GlobalTime.cpp).
+bool sendOnLink(uint8_t interface, const SystemMessage& message);
+
+/// Whether @p interface has a link attached.
+bool linkAttached(uint8_t interface);
+
 /// Detaches the link of @p interface if it has one; for RemoveInterface,
 /// under nothing (task context).
 void detachRemoteLink(uint8_t interface);

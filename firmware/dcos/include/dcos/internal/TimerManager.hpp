@@ -68,6 +68,15 @@ public:
     static uint64_t timeOfDayNs();
     static Result<DateTime> getSystemClock();
     static Status setSystemClock(const DateTime& time);
+    /// The time of day at @p uptimeNs (an uptime read earlier, such as a
+    /// frame's interrupt timestamp), with the base in force now.
+    static uint64_t timeOfDayAtUptime(uint64_t uptimeNs);
+    /// Sets the base so that the time of day at @p uptimeNs is
+    /// @p timeOfDayNs: the global time base's correction (GlobalTime.hpp),
+    /// which, like setSystemClock, changes only the base. InvalidArgument
+    /// when that would put the base before 1970 or the time past
+    /// TimerAgent::kLastClockYear.
+    static Status setTimeOfDayAt(uint64_t timeOfDayNs, uint64_t uptimeNs);
     /// Ticks from now until a time of day; 0 when it has passed.
     static Result<uint64_t> nanosecondsUntil(const DateTime& time);
 
