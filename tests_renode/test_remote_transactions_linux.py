@@ -11,7 +11,9 @@ semaphores by sending the board requests of its own. Last, publications
 (docs/protocols/publications.md): the board subscribes to the peer's
 publisher, which publishes pages with a duplicate, a malformed frame and a
 torn page among them, then withdraws it; and the peer reads the board's
-publisher from its frames.
+publisher from its frames. Then the global time base
+(docs/protocols/time.md): the peer decodes the board's Syncs and FollowUps,
+and the board follows the peer as its time master.
 
 Emulated time is paced at a fiftieth of wall time, so that the VM's
 answers, slow under an emulated CPU on a busy host, come well within the
@@ -205,6 +207,53 @@ while pages < 3:
             gathering = None
     else:
         gathering = None
+
+# Phase 4: the global time base (docs/protocols/time.md). First the board is
+# the master: read three of its Sync and FollowUp pairs and put each time
+# back together from the Sync's seconds and the FollowUp's 56 bits.
+TIME, TIME_GO = 0x01, 0x7F7
+LOW56 = (1 << 56) - 1
+syncs = {}
+pairs = 0
+while pairs < 3:
+    message = receive()
+    if not message.is_extended_id:
+        continue
+    priority, kind, destination, source = fields(message)
+    if kind != TIME or source != BOARD:
+        continue
+    data = bytes(message.data)
+    sort, sequence = data[0] >> 6, data[0] & 0x3F
+    if sort == 0 and len(data) == 8:
+        syncs[sequence] = (int.from_bytes(data[1:6], "big"), data[6], data[7] * 100)
+    elif sort == 1 and len(data) == 8 and sequence in syncs:
+        seconds, rank, interval = syncs.pop(sequence)
+        low = int.from_bytes(data[1:8], "big")
+        start = seconds * 1_000_000_000
+        time = (start & ~LOW56) | low
+        if time < start:
+            time += 1 << 56
+        print(f"@@PEER TIME priority={priority} destination={destination} sequence={sequence} rank={rank} "
+              f"interval={interval} seconds={seconds} time={time}@@", flush=True)
+        pairs += 1
+# Then this node is the master, of rank 0, announcing a second's interval:
+# its clock says 2030-01-01 00:00:00.5 UTC at the end of its first Sync.
+# A second round follows 0.2 s later, which the paced lab makes 4 ms of
+# emulated time, and says 4 ms later. It starts at the go frame.
+while True:
+    message = receive()
+    if not message.is_extended_id and message.arbitration_id == TIME_GO:
+        break
+import time as wall
+first = 1_893_456_000 * 1_000_000_000 + 500_000_000
+for sequence in range(2):
+    moment = first + sequence * 4_000_000
+    bus.send(can.Message(arbitration_id=identifier(0, TIME, 0xFF, ME), is_extended_id=True,
+                         data=bytes([sequence]) + (moment // 1_000_000_000).to_bytes(5, "big") + bytes([0, 10])))
+    bus.send(can.Message(arbitration_id=identifier(0, TIME, 0xFF, ME), is_extended_id=True,
+                         data=bytes([0x40 | sequence]) + (moment & LOW56).to_bytes(7, "big")))
+    wall.sleep(0.2)
+print("@@PEER SYNCED@@", flush=True)
 bus.shutdown()
 """
 
@@ -322,4 +371,33 @@ def test_publications_between_the_board_and_a_python_can_node(world):
     pages = [peer_line(world, "PAGE") for _ in range(3)]
     assert pages == [f"priority=7 destination=255 index={index:03X} sequence={n} page={page_of(n).hex()}"
                      for n in (1, 2, 3)], pages
+
+
+def test_the_global_time_base_between_the_board_and_a_python_can_node(world):
+    # The board is the master, rank 2, once a second: the peer decodes its
+    # Syncs and FollowUps (docs/protocols/time.md) and puts the times back
+    # together; they follow one another by the interval of the board's clock.
+    assert "error" not in world.board.command("net time master 2 1000", timeout=STEP)
+    times = [peer_line(world, "TIME") for _ in range(3)]
+    fields = [dict(item.split("=") for item in line.split()) for line in times]
+    assert {(f["priority"], f["destination"], f["rank"], f["interval"]) for f in fields} == {("0", "255", "2", "1000")}
+    moments = [int(f["time"]) for f in fields]
+    for f, moment in zip(fields, moments):
+        assert 0 <= moment - int(f["seconds"]) * 1_000_000_000 < 2_000_000_000, f
+    # One Sync a second of the board's clock (its sync task's wake-up, a few
+    # hundred microseconds late at most), in sequence.
+    assert all(999_000_000 < b - a < 1_002_000_000 for a, b in zip(moments, moments[1:])), moments
+    assert [int(f["sequence"]) for f in fields] == [int(fields[0]["sequence"]) + n for n in range(3)]
+    # Then the board follows the peer, a master of rank 0 whose clock says
+    # 2030: the board's clock goes there, only its base changing.
+    assert "error" not in world.board.command("net time follow", timeout=STEP)
+    world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7F7, b""))
+    world.vm.expect(r"@@PEER SYNCED@@", timeout=STEP)
+    status = world.board.command("net time", timeout=STEP)
+    assert "following node 3, rank 0, every 1000 ms, interface 0" in status, status
+    # The first correction steps the clock; the second, 4 ms of the peer's
+    # time later, lands within the step limit of the first (10 ms).
+    assert re.search(r"^  corrections 2\r?$", status, re.M), status
+    assert re.search(r"^  unpaired 0\r?$", status, re.M) and re.search(r"^  malformed 0\r?$", status, re.M), status
+    assert "2030-01-01 00:00:0" in world.board.command("date", timeout=STEP)
     world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
