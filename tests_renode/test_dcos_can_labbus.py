@@ -225,6 +225,26 @@ def test_dump_decodes_name_queries(hub):
                                'prio 24 name query 1->all: semaphore part 2/3 txn 0x10 ""'], lines
 
 
+def test_dump_decodes_a_port_send(hub):
+    # docs/protocols/remote-transactions.md, "Port sends": node 1 sends node
+    # 2's port 0x7123 sixteen bytes E0..EF at priority -3, transaction 0x5B.
+    output, lines = decoded_dumps(hub, [
+        Frame(0x14110201, extended=True, dlc=8, data=bytes([11, 0x5B, 0x71, 0x23, 0xFD, 0xE0, 0xE1, 0xE2])),
+        Frame(0x14110201, extended=True, dlc=8, data=bytes([0x9B]) + bytes(range(0xE3, 0xEA))),
+        Frame(0x14110201, extended=True, dlc=7, data=bytes([0xAB]) + bytes(range(0xEA, 0xF0))),
+        Frame(0x14110201, extended=True, dlc=8, data=bytes([0xBB]) + bytes(7))])
+    remote = [json.loads(line)["dcos"]["remote"] for line in output.splitlines()]
+    assert remote == [
+        {"service": "port-send", "transaction": 0x5B, "object": 0x7123, "argument": 0xFDE0E1E2},
+        {"service": "port-send", "part": 1, "slot": 0xB},
+        {"service": "port-send", "part": 2, "slot": 0xB},
+        {"malformed": "unknown service"},
+    ]
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations[1:3] == ["prio 20 remote request 1->2: port-send part 2/3 slot 11",
+                                "prio 20 remote request 1->2: port-send part 3/3 slot 11"], lines
+
+
 def test_dump_decodes_the_global_time_base(hub):
     # docs/protocols/time.md: node 1's Sync (sequence 5, second 0x12_3456_789A,
     # rank 3, every 2.5 s), its FollowUp, a probe and a Sync with a bad rank.

@@ -13,7 +13,9 @@ publisher, which publishes pages with a duplicate, a malformed frame and a
 torn page among them, then withdraws it; and the peer reads the board's
 publisher from its frames. Then the global time base
 (docs/protocols/time.md): the peer decodes the board's Syncs and FollowUps,
-and the board follows the peer as its time master.
+and the board follows the peer as its time master. Last, the peer sends a
+message to a port of the board (docs/protocols/remote-transactions.md,
+"Port sends").
 
 Emulated time is paced at a fiftieth of wall time, so that the VM's
 answers, slow under an emulated CPU on a busy host, come well within the
@@ -69,6 +71,19 @@ def receive(seconds=120):
         print("@@PEER silence@@", flush=True)
         sys.exit(1)
     return message
+
+def await_reply(tag):
+    # The board's reply to this node's request, printed field by field.
+    while True:
+        message = receive()
+        if not message.is_extended_id:
+            continue
+        priority, kind, destination, source = fields(message)
+        if kind == REPLY and destination == ME and source == BOARD:
+            break
+    got_service, got_transaction, status, flags, value = struct.unpack(">BBBBI", bytes(message.data))
+    print(f"@@PEER {tag} priority={priority} service={got_service} transaction={got_transaction:02X} "
+          f"status={status} flags={flags} value={value}@@", flush=True)
 
 # Phase 1: serve node 1 until the go frame, whose data is the object of a
 # semaphore of node 1. Semaphore 0xA003 has no unit: an Acquire that waits
@@ -128,16 +143,7 @@ while True:
 for transaction, service in ((0x21, RELEASE), (0x22, COUNT)):
     bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True,
                          data=struct.pack(">BBHI", service, transaction, board_object, 0)))
-    while True:
-        message = receive()
-        if not message.is_extended_id:
-            continue
-        priority, kind, destination, source = fields(message)
-        if kind == REPLY and destination == ME and source == BOARD:
-            break
-    got_service, got_transaction, status, flags, value = struct.unpack(">BBBBI", bytes(message.data))
-    print(f"@@PEER REPLY priority={priority} service={got_service} transaction={got_transaction:02X} "
-          f"status={status} flags={flags} value={value}@@", flush=True)
+    await_reply("REPLY")
 
 # Phase 3: publications (docs/protocols/publications.md). The board opens a
 # subscription to this node's publisher 0x00038005: answer its DsmOpen
@@ -254,6 +260,24 @@ for sequence in range(2):
                          data=bytes([0x40 | sequence]) + (moment & LOW56).to_bytes(7, "big")))
     wall.sleep(0.2)
 print("@@PEER SYNCED@@", flush=True)
+
+# Phase 5: a port send (docs/protocols/remote-transactions.md, "Port sends")
+# to the board's port, whose object comes in the go frame PORT: sixteen
+# bytes 0xA0 to 0xAF at priority 4, transaction 0x35, in three frames;
+# then the reply.
+PORT_GO, PORT_SEND = 0x7F8, 11
+while True:
+    message = receive()
+    if not message.is_extended_id and message.arbitration_id == PORT_GO:
+        port = struct.unpack(">H", bytes(message.data))[0]
+        break
+body = bytes(range(0xA0, 0xB0))
+transaction = 0x35
+for data in (struct.pack(">BBHb", PORT_SEND, transaction, port, 4) + body[0:3],
+             bytes([0x80 | 1 << 4 | transaction & 0x0F]) + body[3:10],
+             bytes([0x80 | 2 << 4 | transaction & 0x0F]) + body[10:16]):
+    bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True, data=data))
+await_reply("PORTREPLY")
 bus.shutdown()
 """
 
@@ -400,4 +424,14 @@ def test_the_global_time_base_between_the_board_and_a_python_can_node(world):
     assert re.search(r"^  corrections 2\r?$", status, re.M), status
     assert re.search(r"^  unpaired 0\r?$", status, re.M) and re.search(r"^  malformed 0\r?$", status, re.M), status
     assert "2030-01-01 00:00:0" in world.board.command("date", timeout=STEP)
+
+
+def test_a_python_can_node_sends_a_message_to_a_port_of_the_board(world):
+    # docs/protocols/remote-transactions.md, "Port sends": the peer's three
+    # frames, put together by the board and sent to its port; one reply.
+    port = created(world.board, "remote port", "RPORT")
+    world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7F8, (int(port, 16) & 0xFFFF).to_bytes(2, "big")))
+    assert peer_line(world, "PORTREPLY") == "priority=9 service=11 transaction=35 status=0 flags=0 value=0"
+    output = world.board.command("remote portgot", timeout=STEP)
+    assert f"RPGOT 1 a0 {bytes(range(0xA0, 0xB0)).hex()}" in output, output
     world.vm.expect(r"@@PEER status=0@@", timeout=STEP)

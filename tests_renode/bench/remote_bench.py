@@ -104,11 +104,14 @@ def main():
         attach_redundant(server, 2, [1], BIT_RATE, arguments.timeout)
         semaphore = created(server, "remote sem 1000000", "RSEM")
         listener = created(server, "remote listener", "RTASK")
+        port = created(server, "remote port", "RPORT")
         results = measure(world.lab, caller, [
             ("SemaphoreGetCount", f"count {semaphore}"),
             ("SemaphoreAcquire (no wait)", f"acquire {semaphore} 0"),
             ("SemaphoreRelease", f"release {semaphore}"),
             ("PostEvent", f"post {listener} 0x1"),
+            # Sixteen bytes at priority 5: a request of three frames.
+            ("MessagePortSend", f"send {port} {5 * 256 + 1}"),
         ], calls_per_primitive)
         publications = measure_publications(world.lab, server, caller, arguments.writes, arguments.timeout)
     except (EmulatorError, AssertionError) as error:

@@ -11,6 +11,12 @@
 //     RGOT <events> <signals>     what the listener has received so far
 //     RHOG <ms>                   the busy task ran that long
 //     RKILL <status>              KillTask's status
+//     RPORT <id>                  the porter's port was created
+//     RPGOT <count> <priorities> <last message>
+//                                 what the porter has received: how many
+//                                 messages, the first byte of each of the
+//                                 first eight in the order received, and
+//                                 the last one's sixteen bytes, in hex
 //
 // The listener is a task that collects every event posted and every signal
 // sent to it; the hog is a task that keeps the processor busy at a chosen
@@ -18,6 +24,7 @@
 #include "KernelTestSupport.hpp"
 
 #include <dcos/DsmAgent.hpp>
+#include <dcos/MessagePortAgent.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
@@ -54,6 +61,33 @@ void listenerEntry(uintptr_t)
         if (got.ok()) {
             listenerEvents = listenerEvents | got.value();
         }
+    }
+}
+
+// The porter: a task that creates the global port "inbox", then receives
+// from it for ever (only a port's owner receives), keeping what came.
+volatile uint32_t porterPort = 0;
+volatile uint32_t porterCount = 0;
+uint8_t porterFirstBytes[8];
+dcos::Message porterLast{};
+
+void porterEntry(uintptr_t)
+{
+    const Result<ObjectId> port = dcos::messagePortAgent.Create("inbox", dcos::Visibility::Global);
+    if (!port.ok()) {
+        return;
+    }
+    porterPort = port.value().raw();
+    for (;;) {
+        dcos::Message message;
+        if (dcos::messagePortAgent.Receive(port.value(), message, dcos::kWaitForever) != Status::Ok) {
+            continue;
+        }
+        if (porterCount < sizeof porterFirstBytes) {
+            porterFirstBytes[porterCount] = message.bytes[0];
+        }
+        porterLast = message;
+        porterCount = porterCount + 1;
     }
 }
 
@@ -183,6 +217,29 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         shell.print("RKILL %s\r\n", dcos::statusName(taskAgent.KillTask(id)));
         return CommandResult::Ok;
     }
+    if (textEquals(verb, "port") && argc == 2) {
+        // More urgent than the console: it has made its port when this returns.
+        const Result<ObjectId> porter = createTask("porter", 9, porterEntry);
+        if (!porter.ok() || porterPort == 0) {
+            shell.print("error: %s\r\n", dcos::statusName(porter.ok() ? Status::NoMemory : porter.status()));
+            return CommandResult::Failed;
+        }
+        shell.print("RPORT %s\r\n", dcos::internal::IdText(ObjectId::fromRaw(porterPort)).c_str());
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "portgot") && argc == 2) {
+        shell.print("RPGOT %lu ", static_cast<unsigned long>(porterCount));
+        const uint32_t listed = porterCount < sizeof porterFirstBytes ? porterCount : sizeof porterFirstBytes;
+        for (uint32_t i = 0; i < listed; ++i) {
+            shell.print("%02x", porterFirstBytes[i]);
+        }
+        shell.print(listed == 0 ? "- " : " ");
+        for (uint8_t byte : porterLast.bytes) {
+            shell.print("%02x", byte);
+        }
+        shell.print("\r\n");
+        return CommandResult::Ok;
+    }
     if (textEquals(verb, "got") && argc == 2) {
         shell.print("RGOT 0x%lx 0x%lx\r\n", static_cast<unsigned long>(listenerEvents),
                     static_cast<unsigned long>(listenerSignals));
@@ -255,6 +312,17 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         const Result<uint8_t> taskPriority = taskAgent.GetPriority(id);
         status = taskPriority.status();
         value = taskPriority.ok() ? taskPriority.value() : 0;
+    } else if (textEquals(verb, "send") && extra == 1) {
+        // The message: sixteen bytes counting up from the argument's low
+        // byte; its priority: the argument's second byte (0 to 31).
+        dcos::Message message;
+        for (size_t i = 0; i < dcos::kMessageSize; ++i) {
+            message.bytes[i] = static_cast<uint8_t>(argument + i);
+        }
+        status = dcos::messagePortAgent.Send(id, message, static_cast<int>((argument >> 8) & 0xFF));
+    } else if (textEquals(verb, "receive") && extra == 0) {
+        dcos::Message message;
+        status = dcos::messagePortAgent.Receive(id, message, dcos::kPoll);
     } else if (textEquals(verb, "holder") && extra == 0) {
         const Result<ObjectId> holder = semaphoreAgent.GetHolder(id);
         status = holder.status();
@@ -279,11 +347,14 @@ DCOS_SHELL_COMMAND_DETAILED(
     "remote sem <count> [max] | sem binary | named <name> local|regional|global | delete <semaphore> | "
     "name task|semaphore|publisher|timer <name> | listener | got | hog <priority> <ms> | waiter <id> | kill <task> | "
     "acquire [at=P] <id> <ms> | release [at=P] <id> | count [at=P] <id> | post [at=P] <id> <events> | "
-    "signal [at=P] <id> <n> | state [at=P] <task> | priority [at=P] <task> | holder [at=P] <semaphore>",
+    "signal [at=P] <id> <n> | state [at=P] <task> | priority [at=P] <task> | holder [at=P] <semaphore> | "
+    "port | portgot | send [at=P] <port> <priority*256+first byte> | receive <port>",
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
     "  hog: a task that keeps the processor busy at a priority for a time\r\n"
     "  waiter: a task that acquires the semaphore for ever; kill: KillTask\r\n"
     "  acquire ms: 0 polls, 4294967295 waits for ever; at=P calls at priority P\r\n"
+    "  port: a task that owns the global port \"inbox\" and receives from it (portgot shows what came)\r\n"
+    "  send: sixteen bytes counting up from the argument's low byte, at the priority in its second byte\r\n"
     "  prints RRES <status> <value> <microseconds taken>",
     remote);
 

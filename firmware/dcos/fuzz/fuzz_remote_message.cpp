@@ -8,6 +8,9 @@
 // input is also taken as a stream of name query parts (8 bytes each), put
 // back together as a serving node does: a query it completes has a name of
 // 1 to 15 characters, a type with names, and encodes back into its parts.
+// Last, as a stream of port send frames (a length byte, then the frame): a
+// port send the assembler completes encodes back into exactly the frames
+// that made it.
 #include "../../../fieldbus/can/fuzz/FuzzCheck.hpp"
 
 #include <dcos/internal/RemoteMessage.hpp>
@@ -62,6 +65,44 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         uint8_t again[kNameQueryFrames][kRemoteMessageBytes];
         encodeNameQuery(assembler.type(), assembler.transaction(), assembler.name(), again);
         FUZZ_CHECK(std::memcmp(again, lastParts, sizeof again) == 0);
+    }
+    PortSendAssembler portSends;
+    uint8_t made[kPortSendFrames][kRemoteMessageBytes]{};
+    uint8_t madeLengths[kPortSendFrames]{};
+    for (size_t at = 0; at < size;) {
+        const size_t length = data[at++] & 0x0F;
+        if (length > size - at) {
+            break;
+        }
+        const uint8_t* frame = data + at;
+        at += length;
+        if (isContinuation(frame, length)) {
+            PortSendContinuation part;
+            const RemoteMessageError error = decodePortSendContinuation(frame, length, part);
+            if (error != RemoteMessageError::None) {
+                FUZZ_CHECK(error == RemoteMessageError::WrongLength || error == RemoteMessageError::UnknownService);
+                continue;
+            }
+            FUZZ_CHECK(part.part == 1 || part.part == 2);
+            std::memcpy(made[part.part], frame, length);
+            madeLengths[part.part] = static_cast<uint8_t>(length);
+            if (portSends.take(part) != PortSendAssembler::Outcome::Complete) {
+                continue;
+            }
+            uint8_t again[kPortSendFrames][kRemoteMessageBytes];
+            uint8_t lengths[kPortSendFrames];
+            encodePortSend(portSends.request(), again, lengths);
+            for (size_t i = 0; i < kPortSendFrames; ++i) {
+                FUZZ_CHECK(lengths[i] == madeLengths[i] && std::memcmp(again[i], made[i], lengths[i]) == 0);
+            }
+            continue;
+        }
+        RemoteRequest first;
+        if (decodeRequest(frame, length, first) == RemoteMessageError::None && first.service == RemoteService::PortSend) {
+            std::memcpy(made[0], frame, length);
+            madeLengths[0] = static_cast<uint8_t>(length);
+            FUZZ_CHECK(portSends.start(first) == PortSendAssembler::Outcome::Started);
+        }
     }
     return 0;
 }

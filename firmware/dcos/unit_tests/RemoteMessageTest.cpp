@@ -10,6 +10,7 @@
 #include <array>
 #include <random>
 #include <type_traits>
+#include <vector>
 
 namespace {
 
@@ -232,3 +233,104 @@ TEST(NameQueryTest, PartsOutOfTurnOrOfAnotherQueryAndMalformedNamesMakeNoQuery)
 }
 
 } // namespace
+
+namespace {
+
+using Frames = std::array<std::vector<uint8_t>, kPortSendFrames>;
+
+Frames portSendFrames(const PortSendRequest& request)
+{
+    uint8_t frames[kPortSendFrames][kRemoteMessageBytes];
+    uint8_t lengths[kPortSendFrames];
+    encodePortSend(request, frames, lengths);
+    Frames out;
+    for (size_t part = 0; part < kPortSendFrames; ++part) {
+        out[part].assign(frames[part], frames[part] + lengths[part]);
+    }
+    return out;
+}
+
+PortSendRequest counting(uint8_t transaction, int8_t priority)
+{
+    PortSendRequest request;
+    request.transaction = transaction;
+    request.object = 0x7123; // A message port (type 7), index 0x123.
+    request.priority = priority;
+    for (size_t i = 0; i < kPortMessageBytes; ++i) {
+        request.message[i] = static_cast<uint8_t>(0xE0 + i);
+    }
+    return request;
+}
+
+// Feeds frames to an assembler as the serving node does.
+PortSendAssembler::Outcome feed(PortSendAssembler& assembler, const std::vector<uint8_t>& frame)
+{
+    if (isContinuation(frame.data(), frame.size())) {
+        PortSendContinuation part;
+        EXPECT_EQ(decodePortSendContinuation(frame.data(), frame.size(), part), RemoteMessageError::None);
+        return assembler.take(part);
+    }
+    RemoteRequest first;
+    EXPECT_EQ(decodeRequest(frame.data(), frame.size(), first), RemoteMessageError::None);
+    EXPECT_EQ(first.service, RemoteService::PortSend);
+    return assembler.start(first);
+}
+
+} // namespace
+
+TEST(RemoteMessageTest, APortSendIsThreeFramesLaidOutAsTheSpecificationSays)
+{
+    const Frames frames = portSendFrames(counting(0x5B, -3));
+    EXPECT_EQ(frames[0], (std::vector<uint8_t>{11, 0x5B, 0x71, 0x23, 0xFD, 0xE0, 0xE1, 0xE2}));
+    EXPECT_EQ(frames[1], (std::vector<uint8_t>{0x9B, 0xE3, 0xE4, 0xE5, 0xE6, 0xE7, 0xE8, 0xE9}));
+    EXPECT_EQ(frames[2], (std::vector<uint8_t>{0xAB, 0xEA, 0xEB, 0xEC, 0xED, 0xEE, 0xEF}));
+    EXPECT_STREQ(remoteServiceName(RemoteService::PortSend), "port-send");
+}
+
+TEST(RemoteMessageTest, APortSendIsPutBackTogetherWhole)
+{
+    PortSendAssembler assembler;
+    const Frames frames = portSendFrames(counting(0x07, 31));
+    EXPECT_EQ(feed(assembler, frames[0]), PortSendAssembler::Outcome::Started);
+    EXPECT_EQ(feed(assembler, frames[1]), PortSendAssembler::Outcome::Taken);
+    EXPECT_EQ(feed(assembler, frames[2]), PortSendAssembler::Outcome::Complete);
+    const PortSendRequest& whole = assembler.request();
+    EXPECT_EQ(whole.transaction, 0x07);
+    EXPECT_EQ(whole.object, 0x7123);
+    EXPECT_EQ(whole.priority, 31);
+    const PortSendRequest sent = counting(0x07, 31);
+    EXPECT_EQ(std::vector<uint8_t>(whole.message, whole.message + kPortMessageBytes),
+              std::vector<uint8_t>(sent.message, sent.message + kPortMessageBytes));
+}
+
+TEST(RemoteMessageTest, APortSendOutOfTurnOrOfAnotherTransactionIsDroppedNeverMixed)
+{
+    PortSendAssembler assembler;
+    const Frames a = portSendFrames(counting(0x01, 0));
+    const Frames b = portSendFrames(counting(0x02, 0));
+    // Part 1 lost: part 2 alone is out of turn.
+    (void)feed(assembler, a[0]);
+    EXPECT_EQ(feed(assembler, a[2]), PortSendAssembler::Outcome::Dropped);
+    // Another transaction's part 1 after this one's part 0.
+    (void)feed(assembler, a[0]);
+    EXPECT_EQ(feed(assembler, b[1]), PortSendAssembler::Outcome::Dropped);
+    EXPECT_EQ(feed(assembler, a[1]), PortSendAssembler::Outcome::Dropped) << "nothing is gathering any more";
+    // A continuation with no part 0 at all.
+    PortSendAssembler fresh;
+    EXPECT_EQ(feed(fresh, a[1]), PortSendAssembler::Outcome::Dropped);
+}
+
+TEST(RemoteMessageTest, EveryMalformedContinuationIsRefused)
+{
+    PortSendContinuation part;
+    const std::vector<uint8_t> partOne{0x91, 1, 2, 3, 4, 5, 6, 7};
+    EXPECT_EQ(decodePortSendContinuation(partOne.data(), 7, part), RemoteMessageError::WrongLength);
+    const std::vector<uint8_t> partTwo{0xA1, 1, 2, 3, 4, 5, 6, 7};
+    EXPECT_EQ(decodePortSendContinuation(partTwo.data(), 8, part), RemoteMessageError::WrongLength);
+    for (uint8_t header : {uint8_t{0x81}, uint8_t{0xB1}, uint8_t{0xD1}}) {
+        const std::vector<uint8_t> bad{header, 1, 2, 3, 4, 5, 6, 7};
+        EXPECT_EQ(decodePortSendContinuation(bad.data(), 8, part), RemoteMessageError::UnknownService)
+            << int(header);
+    }
+    EXPECT_FALSE(isContinuation(partOne.data(), 0));
+}

@@ -214,6 +214,20 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
                     {"name_bytes", bytes}};
         return out;
     }
+    if (id.type() == can::MessageType::RemoteRequest && isContinuation(frame.data(), frame.length())) {
+        // Parts 1 and 2 of a port send (docs/protocols/remote-transactions.md, "Port sends").
+        out.key = "remote";
+        PortSendContinuation part;
+        const RemoteMessageError error = decodePortSendContinuation(frame.data(), frame.length(), part);
+        if (error != RemoteMessageError::None) {
+            out.text = fmt::format("malformed: {}", remoteMessageErrorName(error));
+            out.json = {{"malformed", remoteMessageErrorName(error)}};
+            return out;
+        }
+        out.text = fmt::format("port-send part {}/3 slot {}", part.part + 1, part.slot);
+        out.json = {{"service", "port-send"}, {"part", part.part}, {"slot", part.slot}};
+        return out;
+    }
     if (id.type() == can::MessageType::RemoteRequest) {
         out.key = "remote";
         RemoteRequest request;

@@ -114,16 +114,27 @@ shell::CommandResult resolve(shell::Shell& shell, const char* nodeText)
     return shell::CommandResult::Ok;
 }
 
+struct Counter {
+    const char* name;
+    uint32_t value;
+};
+
+// Counters, one "  name value" line each, for the lab's tests and scripts.
+template <size_t N>
+void printCounters(shell::Shell& shell, const Counter (&counters)[N])
+{
+    for (const Counter& counter : counters) {
+        shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));
+    }
+}
+
 // The remote agent's counters, one "name value" per line, then the
 // transactions under way.
 void listRemote(shell::Shell& shell)
 {
     const RemoteStatistics s = remoteStatistics();
     shell.print("remote agent %s\r\n", remoteAgentStarted() ? "running" : "not started (no link attached)");
-    const struct {
-        const char* name;
-        uint32_t value;
-    } counters[] = {
+    const Counter counters[] = {
         {"requests", s.requests},         {"retransmissions", s.retransmissions},
         {"replies", s.replies},           {"pending-replies", s.pendingReplies},
         {"stray-replies", s.strayReplies}, {"unreachable", s.unreachable},
@@ -134,9 +145,7 @@ void listRemote(shell::Shell& shell)
         {"publications-sent", s.publicationsSent}, {"publication-parts", s.publicationParts},
         {"unknown-senders", s.unknownSenders}, {"names-not-found", s.namesNotFound},
     };
-    for (const auto& counter : counters) {
-        shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));
-    }
+    printCounters(shell, counters);
     for (size_t slot = 0; slot < kRemoteCalls; ++slot) {
         const RemoteCallInfo call = remoteCall(slot);
         if (call.inUse) {
@@ -152,18 +161,13 @@ void listRemote(shell::Shell& shell)
 void listPublications(shell::Shell& shell)
 {
     const DsmNetworkStatistics s = DsmManager::networkStatistics();
-    const struct {
-        const char* name;
-        uint32_t value;
-    } counters[] = {
+    const Counter counters[] = {
         {"received", s.received},         {"duplicates", s.duplicates},
         {"torn", s.torn},                 {"unsubscribed", s.unsubscribed},
         {"withdrawals", s.withdrawals},   {"deferred", s.deferred},
         {"no-remote-publisher", s.noRemotePublisher},
     };
-    for (const auto& counter : counters) {
-        shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));
-    }
+    printCounters(shell, counters);
     for (size_t slot = 0; slot < kRemotePublishers; ++slot) {
         const RemotePublisherInfo remote = DsmManager::remotePublisher(slot);
         if (remote.inUse) {
@@ -192,19 +196,14 @@ void listTime(shell::Shell& shell)
     } else if (!s.sending && s.role != TimeRole::Off) {
         shell.print("  no master heard\r\n");
     }
-    const struct {
-        const char* name;
-        uint32_t value;
-    } counters[] = {
+    const Counter counters[] = {
         {"syncs-sent", s.syncsSent},           {"follow-ups-sent", s.followUpsSent},
         {"syncs-received", s.syncsReceived},   {"follow-ups-received", s.followUpsReceived},
         {"corrections", s.corrections},        {"unpaired", s.unpaired},
         {"ignored", s.ignored},                {"held", s.held},
         {"malformed", s.malformed},            {"probes", s.probes},
     };
-    for (const auto& counter : counters) {
-        shell.print("  %s %lu\r\n", counter.name, static_cast<unsigned long>(counter.value));
-    }
+    printCounters(shell, counters);
     shell.print("  last-offset-ns %lld\r\n", static_cast<long long>(s.lastOffsetNs));
     shell.print("  largest-offset-ns %llu\r\n", static_cast<unsigned long long>(s.largestOffsetNs));
     shell.print("  drift-ppb %ld\r\n", static_cast<long>(s.driftPpb));

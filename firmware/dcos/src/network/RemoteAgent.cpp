@@ -1,5 +1,6 @@
 // The remote agent (RemoteAgent.hpp; seed 6.4, Fig. 6.3): remote
 // transactions over the links of the network interfaces manager.
+#include <dcos/MessagePortAgent.hpp>
 #include <dcos/NetworkInterfacesManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
@@ -43,6 +44,8 @@ constexpr uint32_t eventOf(uint8_t interface) { return 1u << interface; }
 // The receiver's event for publications written by interrupt handlers.
 constexpr uint32_t kDeferredPublicationsEvent = 1u << 31;
 static_assert(kNetworkInterfaces <= 31);
+static_assert(kNameQueryNameBytes == kPortMessageBytes && kPortMessageBytes == kMessageSize,
+              "a served entry's payload holds a name or a port message");
 
 // ---- the requesting side ----------------------------------------------------
 
@@ -76,7 +79,9 @@ struct ServedEntry {
     uint64_t heardNs = 0; // Uptime when the request last arrived, retransmissions included.
     bool superseded = false; // Its requester has begun another transaction on the same call slot.
     bool silent = false;     // Done, and nothing to answer: a name query this node has no object for.
-    char name[kNameQueryNameBytes]{}; // A name query's name (service NameToObject, type in request.object).
+    // A name query's name, NUL-padded (service NameToObject, the type in
+    // request.object), or a port send's message (service PortSend).
+    uint8_t payload[kPortMessageBytes]{};
     uint8_t reply[kRemoteMessageBytes]{};
 };
 
@@ -187,7 +192,10 @@ CallSlot* openCall(Task& self, RemoteService service, uint8_t interface, uint32_
 template <typename Send>
 Result<uint32_t> awaitReply(CallSlot& slot, Send send);
 
-Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
+// The call slot of @p self's transaction of @p service on the object @p id
+// of another node: the node resolved to an interface and a physical
+// address, and a slot taken; or why not.
+Result<CallSlot*> openRemoteCall(Task& self, RemoteService service, ObjectId id)
 {
     if (inInterruptContext()) {
         return Status::InInterrupt; // A remote transaction blocks its caller.
@@ -206,20 +214,27 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
         return Status::NotSupported;
     }
     const uint8_t interface = hop.value().interface;
-    const uint32_t peer = hop.value().physical;
-
-    Task& self = Scheduler::current();
-    CallSlot* slot;
-    {
-        Lock lock;
-        if (links[interface] == nullptr) {
-            return Status::Unreachable;
-        }
-        slot = openCall(self, service, interface, peer);
-        if (slot == nullptr) {
-            return Status::Busy;
-        }
+    Lock lock;
+    if (links[interface] == nullptr) {
+        return Status::Unreachable;
     }
+    CallSlot* const slot = openCall(self, service, interface, hop.value().physical);
+    if (slot == nullptr) {
+        return Status::Busy;
+    }
+    return slot;
+}
+
+Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
+{
+    Task& self = Scheduler::current();
+    const Result<CallSlot*> opened = openRemoteCall(self, service, id);
+    if (!opened.ok()) {
+        return opened.status();
+    }
+    CallSlot* const slot = opened.value();
+    const uint8_t interface = slot->interface;
+    const uint32_t peer = slot->peer;
 
     RemoteRequest request;
     request.service = service;
@@ -232,6 +247,40 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
     return awaitReply(*slot, [&] {
         (void)sendMessage(interface, SystemMessageType::RemoteRequest, self.priority, peer, data);
     });
+}
+
+// MessagePortAgent::Send to another node's port (RemoteForward.hpp's port
+// sender): the three frames of a port send, again after every silent
+// watchdog period, and the reply's status.
+Status forwardPortSend(ObjectId port, const Message& message, int priority)
+{
+    Task& self = Scheduler::current();
+    const Result<CallSlot*> opened = openRemoteCall(self, RemoteService::PortSend, port);
+    if (!opened.ok()) {
+        return opened.status();
+    }
+    CallSlot* const slot = opened.value();
+    PortSendRequest request;
+    request.transaction = slot->transaction;
+    request.object = static_cast<uint16_t>(port.raw() & 0xFFFF);
+    request.priority = static_cast<int8_t>(priority);
+    __builtin_memcpy(request.message, message.bytes, kPortMessageBytes);
+    uint8_t frames[kPortSendFrames][kRemoteMessageBytes];
+    uint8_t lengths[kPortSendFrames];
+    encodePortSend(request, frames, lengths);
+    const uint8_t interface = slot->interface;
+    const uint32_t peer = slot->peer;
+    return awaitReply(*slot, [&] {
+        // The parts in a row: a part the link did not take leaves a request
+        // the server drops, so the rest is not sent; the watchdog sends all
+        // three again.
+        for (size_t part = 0; part < kPortSendFrames; ++part) {
+            if (!sendBytes(interface, SystemMessageType::RemoteRequest, self.priority, peer, frames[part],
+                           lengths[part])) {
+                break;
+            }
+        }
+    }).status();
 }
 
 // Any interface, any sender: the call slot of a name query, asked of every node.
@@ -418,57 +467,43 @@ ServedEntry* entryForNewRequest(ServedEntry* sameSlot)
     return oldestDone;
 }
 
-// A request arrived on @p interface.
+// A request arrived on @p interface; @p payload, when not null, is a
+// name query's name or a port send's message (kPortMessageBytes bytes).
 void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
-                  const char* name);
+                  const uint8_t* payload);
 
-// A request arrived on @p interface.
-void onRequest(uint8_t interface, const SystemMessage& message)
+void countMalformed()
 {
-    RemoteRequest request;
-    if (decodeRequest(message.data, message.length, request) != RemoteMessageError::None ||
-        request.service == RemoteService::NameToObject) {
-        // NameToObject comes only as a name query.
-        Lock lock;
-        ++statistics.malformed;
-        return;
-    }
-    admitRequest(interface, message, request, nullptr);
+    Lock lock;
+    ++statistics.malformed;
 }
 
-// Name queries being put back together, one per sender; a new sender takes
-// the entry heard from longest ago.
-struct NameQueryGathering {
+// Requests of several frames being put back together (name queries, port
+// sends), one per sender: a sender's entry, or a new one taking the entry
+// heard from longest ago. The receiver task only.
+template <typename Assembler>
+struct Gathering {
     bool used = false;
     uint8_t interface = 0;
     uint32_t source = 0;
     uint32_t heard = 0;
-    NameQueryAssembler assembler;
+    Assembler assembler;
 };
 
-constexpr size_t kNameQueriesGathered = 4;
-NameQueryGathering nameQueries[kNameQueriesGathered];
-uint32_t nameQueryClock = 0;
-
-// A part of a name query arrived on @p interface (the receiver task only).
-void onNameQuery(uint8_t interface, const SystemMessage& message)
+template <typename Assembler, size_t N>
+Gathering<Assembler>& gatheringFor(Gathering<Assembler> (&table)[N], uint32_t& clock, uint8_t interface,
+                                   uint32_t source)
 {
-    NameQueryPart part;
-    if (decodeNameQueryPart(message.data, message.length, part) != NameQueryError::None) {
-        Lock lock;
-        ++statistics.malformed;
-        return;
-    }
-    NameQueryGathering* gathering = nullptr;
-    for (NameQueryGathering& candidate : nameQueries) {
-        if (candidate.used && candidate.interface == interface && candidate.source == message.source) {
+    Gathering<Assembler>* gathering = nullptr;
+    for (Gathering<Assembler>& candidate : table) {
+        if (candidate.used && candidate.interface == interface && candidate.source == source) {
             gathering = &candidate;
             break;
         }
     }
     if (gathering == nullptr) {
-        gathering = &nameQueries[0];
-        for (NameQueryGathering& candidate : nameQueries) {
+        gathering = &table[0];
+        for (Gathering<Assembler>& candidate : table) {
             if (!candidate.used || static_cast<int32_t>(candidate.heard - gathering->heard) < 0) {
                 gathering = &candidate;
                 if (!candidate.used) {
@@ -476,25 +511,79 @@ void onNameQuery(uint8_t interface, const SystemMessage& message)
                 }
             }
         }
-        *gathering = NameQueryGathering{};
+        *gathering = Gathering<Assembler>{};
         gathering->used = true;
         gathering->interface = interface;
-        gathering->source = message.source;
+        gathering->source = source;
     }
-    gathering->heard = nameQueryClock++;
-    if (!gathering->assembler.take(part)) {
+    gathering->heard = clock++;
+    return *gathering;
+}
+
+constexpr size_t kRequestsGathered = 4;
+Gathering<NameQueryAssembler> nameQueries[kRequestsGathered];
+Gathering<PortSendAssembler> portSends[kRequestsGathered];
+uint32_t gatheringClock = 0;
+
+// A request arrived on @p interface: one frame, or a part of a port send.
+void onRequest(uint8_t interface, const SystemMessage& message)
+{
+    if (isContinuation(message.data, message.length)) {
+        PortSendContinuation part;
+        if (decodePortSendContinuation(message.data, message.length, part) != RemoteMessageError::None) {
+            countMalformed();
+            return;
+        }
+        Gathering<PortSendAssembler>& gathering = gatheringFor(portSends, gatheringClock, interface, message.source);
+        if (gathering.assembler.take(part) != PortSendAssembler::Outcome::Complete) {
+            return; // In turn and not the last, or out of turn and dropped: the requester sends it again.
+        }
+        const PortSendRequest& whole = gathering.assembler.request();
+        RemoteRequest request;
+        request.service = RemoteService::PortSend;
+        request.transaction = whole.transaction;
+        request.object = whole.object;
+        request.argument = static_cast<uint8_t>(whole.priority);
+        admitRequest(interface, message, request, whole.message);
+        return;
+    }
+    RemoteRequest request;
+    if (decodeRequest(message.data, message.length, request) != RemoteMessageError::None ||
+        request.service == RemoteService::NameToObject) {
+        // NameToObject comes only as a name query.
+        countMalformed();
+        return;
+    }
+    if (request.service == RemoteService::PortSend) {
+        (void)gatheringFor(portSends, gatheringClock, interface, message.source).assembler.start(request);
+        return;
+    }
+    admitRequest(interface, message, request, nullptr);
+}
+
+// A part of a name query arrived on @p interface (the receiver task only).
+void onNameQuery(uint8_t interface, const SystemMessage& message)
+{
+    NameQueryPart part;
+    if (decodeNameQueryPart(message.data, message.length, part) != NameQueryError::None) {
+        countMalformed();
+        return;
+    }
+    Gathering<NameQueryAssembler>& gathering = gatheringFor(nameQueries, gatheringClock, interface, message.source);
+    if (!gathering.assembler.take(part)) {
         return;
     }
     RemoteRequest request;
     request.service = RemoteService::NameToObject;
-    request.transaction = gathering->assembler.transaction();
-    request.object = gathering->assembler.type();
-    admitRequest(interface, message, request, gathering->assembler.name());
+    request.transaction = gathering.assembler.transaction();
+    request.object = gathering.assembler.type();
+    admitRequest(interface, message, request, reinterpret_cast<const uint8_t*>(gathering.assembler.name()));
 }
 
 // A request to serve: a retransmission is answered from the served table,
 // a new one queued for the workers.
-void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request, const char* name)
+void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
+                  const uint8_t* payload)
 {
     RemoteReply answer;
     answer.service = request.service;
@@ -530,9 +619,10 @@ void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteR
                 entry->state = ServedState::Queued;
                 entry->superseded = false;
                 entry->silent = false;
-                __builtin_memset(entry->name, 0, sizeof entry->name);
-                for (size_t i = 0; name != nullptr && i + 1 < sizeof entry->name && name[i] != '\0'; ++i) {
-                    entry->name[i] = name[i];
+                if (payload != nullptr) {
+                    __builtin_memcpy(entry->payload, payload, sizeof entry->payload);
+                } else {
+                    __builtin_memset(entry->payload, 0, sizeof entry->payload);
                 }
                 entry->interface = interface;
                 entry->priority = message.priority;
@@ -644,8 +734,9 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
         // Seen from another node, a name is visible when its object is global,
         // or regional and asked for within the controller (Visibility.hpp).
         const Visibility scope = withinController(entry.interface) ? Visibility::Regional : Visibility::Global;
-        const Result<ObjectId> found =
-            localNameToObject(static_cast<ObjectType>(request.object), entry.name, scope);
+        // The assembler let through only names of 1 to 15 characters, NUL-padded.
+        const Result<ObjectId> found = localNameToObject(static_cast<ObjectType>(request.object),
+                                                         reinterpret_cast<const char*>(entry.payload), scope);
         if (found.ok()) {
             reply.value = found.value().raw();
         } else {
@@ -655,6 +746,14 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
     }
     case RemoteService::DsmOpen: {
         replyWith(reply, DsmManager::serveRemoteOpen(id, withinController(entry.interface)));
+        break;
+    }
+    case RemoteService::PortSend: {
+        // Sent as any local task sends: the port's own checks (priority,
+        // buffers, deletion) answer for it.
+        Message message;
+        __builtin_memcpy(message.bytes, entry.payload, kPortMessageBytes);
+        reply.status = MessagePortAgent::Send(id, message, static_cast<int8_t>(request.argument));
         break;
     }
     }
@@ -799,6 +898,7 @@ Status startAgent()
     }
     setRemoteForwarder(forward);
     setRemoteNameResolver(forwardName);
+    setRemotePortSender(forwardPortSend);
     started = true;
     return Status::Ok;
 }

@@ -9,12 +9,24 @@ namespace {
 // link delivers a frame; an aligned pointer store is atomic on x86.
 RemoteForwarder remoteForwarder = nullptr;
 RemoteNameResolver remoteNameResolver = nullptr;
+RemotePortSender remotePortSender = nullptr;
 
 } // namespace
 
 void setRemoteForwarder(RemoteForwarder forwarder) { remoteForwarder = forwarder; }
 
 void setRemoteNameResolver(RemoteNameResolver resolver) { remoteNameResolver = resolver; }
+
+void setRemotePortSender(RemotePortSender sender) { remotePortSender = sender; }
+
+Status forwardRemotePortSend(ObjectId port, const Message& message, int priority)
+{
+    RemotePortSender const sender = remotePortSender;
+    if (sender == nullptr) {
+        return Status::Remote;
+    }
+    return sender(port, message, priority);
+}
 
 Result<ObjectId> remoteNameToObject(ObjectType type, const char* name)
 {

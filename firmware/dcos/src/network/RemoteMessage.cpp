@@ -47,6 +47,7 @@ const char* remoteServiceName(RemoteService service)
     case RemoteService::SemaphoreGetHolder: return "holder";
     case RemoteService::DsmOpen: return "dsm-open";
     case RemoteService::NameToObject: return "name";
+    case RemoteService::PortSend: return "port-send";
     }
     return "?";
 }
@@ -214,6 +215,89 @@ NameQueryError decodeNameQueryPart(const uint8_t* bytes, size_t length, NameQuer
     part.transaction = bytes[1];
     __builtin_memcpy(part.bytes, bytes + 2, kNameBytesPerPart);
     return NameQueryError::None;
+}
+
+namespace {
+
+constexpr uint8_t kContinuationFlag = 0x80;
+constexpr uint8_t kContinuationPartShift = 4;
+constexpr uint8_t kContinuationReservedBit = 0x40;
+constexpr uint8_t kSlotMask = 0x0F;
+// Message bytes in part 0 (request bytes 5-7), part 1 and part 2.
+constexpr size_t kPortSendBytes[kPortSendFrames] = {3, 7, 6};
+static_assert(kPortSendBytes[0] + kPortSendBytes[1] + kPortSendBytes[2] == kPortMessageBytes);
+
+} // namespace
+
+void encodePortSend(const PortSendRequest& request, uint8_t (&frames)[kPortSendFrames][kRemoteMessageBytes],
+                    uint8_t (&lengths)[kPortSendFrames])
+{
+    RemoteRequest first;
+    first.service = RemoteService::PortSend;
+    first.transaction = request.transaction;
+    first.object = request.object;
+    first.argument = (uint32_t{static_cast<uint8_t>(request.priority)} << 24) |
+                     (uint32_t{request.message[0]} << 16) | (uint32_t{request.message[1]} << 8) | request.message[2];
+    encodeRequest(first, frames[0]);
+    lengths[0] = kRemoteMessageBytes;
+    size_t from = kPortSendBytes[0];
+    for (size_t part = 1; part < kPortSendFrames; ++part) {
+        frames[part][0] = static_cast<uint8_t>(kContinuationFlag | (part << kContinuationPartShift) |
+                                               (request.transaction & kSlotMask));
+        __builtin_memcpy(frames[part] + 1, request.message + from, kPortSendBytes[part]);
+        lengths[part] = static_cast<uint8_t>(1 + kPortSendBytes[part]);
+        from += kPortSendBytes[part];
+    }
+    frames[2][7] = 0; // Not sent: part 2 is seven bytes.
+}
+
+RemoteMessageError decodePortSendContinuation(const uint8_t* bytes, size_t length, PortSendContinuation& part)
+{
+    if (!isContinuation(bytes, length) || (bytes[0] & kContinuationReservedBit) != 0) {
+        return RemoteMessageError::UnknownService;
+    }
+    const uint8_t number = (bytes[0] >> kContinuationPartShift) & 0x3;
+    if (number != 1 && number != 2) {
+        return RemoteMessageError::UnknownService;
+    }
+    if (length != 1 + kPortSendBytes[number]) {
+        return RemoteMessageError::WrongLength;
+    }
+    part.part = number;
+    part.slot = bytes[0] & kSlotMask;
+    part.count = static_cast<uint8_t>(kPortSendBytes[number]);
+    __builtin_memset(part.bytes, 0, sizeof part.bytes);
+    __builtin_memcpy(part.bytes, bytes + 1, part.count);
+    return RemoteMessageError::None;
+}
+
+PortSendAssembler::Outcome PortSendAssembler::start(const RemoteRequest& first)
+{
+    request_ = PortSendRequest{};
+    request_.transaction = first.transaction;
+    request_.object = first.object;
+    request_.priority = static_cast<int8_t>(first.argument >> 24);
+    request_.message[0] = static_cast<uint8_t>(first.argument >> 16);
+    request_.message[1] = static_cast<uint8_t>(first.argument >> 8);
+    request_.message[2] = static_cast<uint8_t>(first.argument);
+    next_ = 1;
+    return Outcome::Started;
+}
+
+PortSendAssembler::Outcome PortSendAssembler::take(const PortSendContinuation& part)
+{
+    if (next_ == 0 || part.part != next_ || part.slot != (request_.transaction & kSlotMask)) {
+        next_ = 0;
+        return Outcome::Dropped;
+    }
+    const size_t from = part.part == 1 ? kPortSendBytes[0] : kPortSendBytes[0] + kPortSendBytes[1];
+    __builtin_memcpy(request_.message + from, part.bytes, part.count);
+    if (part.part + 1u < kPortSendFrames) {
+        ++next_;
+        return Outcome::Taken;
+    }
+    next_ = 0;
+    return Outcome::Complete;
 }
 
 bool NameQueryAssembler::take(const NameQueryPart& part)

@@ -182,11 +182,21 @@ namespace {
 
 // The complete Send and Receive: every case, from a resolved id. The
 // agent's fast paths (below) come here for all they do not handle.
+Status sendLocal(ObjectId id, const Message& message, int priority);
+
 [[gnu::noinline]] Status sendFull(ObjectId id, const Message& message, int priority)
 {
     if (!MessageQueue::isValidPriority(priority)) {
         return Status::InvalidArgument;
     }
+    const Status status = sendLocal(id, message, priority);
+    // Another node's port: the request goes over the network and blocks the
+    // caller, so it is made after the local attempt has let interrupts in.
+    return internal::orRemotePortSend(status, id, message, priority);
+}
+
+Status sendLocal(ObjectId id, const Message& message, int priority)
+{
     arch_x86::InterruptGuard guard;
     start();
     const Result<PortObject*> resolved = resolvePort(id);
@@ -219,7 +229,8 @@ namespace {
     start();
     const Result<PortObject*> resolved = resolvePort(id);
     if (!resolved.ok()) {
-        return resolved.status();
+        // Another node's port has its owner there, the only one who receives.
+        return resolved.status() == Status::Remote ? Status::NotOwner : resolved.status();
     }
     const Status owner = portTable.checkOwner(id, internal::currentTaskId());
     if (owner != Status::Ok) {

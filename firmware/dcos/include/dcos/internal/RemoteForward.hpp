@@ -9,6 +9,7 @@
 // otherwise: the minimal kernel links no remote agent.
 #pragma once
 
+#include <dcos/MessagePortAgent.hpp>
 #include <dcos/ObjectId.hpp>
 #include <dcos/Status.hpp>
 #include <dcos/internal/RemoteMessage.hpp>
@@ -23,6 +24,27 @@ using RemoteForwarder = Result<uint32_t> (*)(RemoteService service, ObjectId id,
 
 /// Set by the remote agent when it starts; null until then.
 void setRemoteForwarder(RemoteForwarder forwarder);
+
+/// Sends @p message at @p priority to another node's port: its status.
+using RemotePortSender = Status (*)(ObjectId port, const Message& message, int priority);
+
+/// Set by the remote agent when it starts; null until then.
+void setRemotePortSender(RemotePortSender sender);
+
+/// MessagePortAgent::Send to another node's port, or Status::Remote when no
+/// remote agent runs. Out of line: only Send's miss path calls it.
+[[gnu::noinline]] Status forwardRemotePortSend(ObjectId port, const Message& message, int priority);
+
+/// Send's status after its local attempt: @p local unless it is Remote, in
+/// which case the message goes to the other node's port.
+[[gnu::always_inline]] inline Status orRemotePortSend(Status local, ObjectId port, const Message& message,
+                                                      int priority)
+{
+    if (local != Status::Remote) [[likely]] {
+        return local;
+    }
+    return forwardRemotePortSend(port, message, priority);
+}
 
 /// Asks the other nodes for an object of @p type named @p name.
 using RemoteNameResolver = Result<ObjectId> (*)(ObjectType type, const char* name);

@@ -46,10 +46,13 @@ enum class RemoteService : uint8_t {
     DsmOpen = 9,
     /// Only in replies, to a name query (below): value: the object's id.
     NameToObject = 10,
+    /// A request of three frames (port sends, below): the message, its
+    /// priority; the reply's value is 0.
+    PortSend = 11,
 };
 
 /// The last service value assigned.
-constexpr uint8_t kLastRemoteService = 10;
+constexpr uint8_t kLastRemoteService = 11;
 
 /// A short name of a service, for the console and logs.
 const char* remoteServiceName(RemoteService service);
@@ -112,6 +115,78 @@ RemoteMessageError decodeReply(const uint8_t* bytes, size_t length, RemoteReply&
 
 /// Whether @p value is a status some node may send (every Status value).
 bool isStatusValue(uint8_t value);
+
+// ---- port sends ----------------------------------------------------------
+//
+// MessagePortAgent::Send to another node's port carries a 16-byte message:
+// a request of three frames (message type 0x11, to the port's node), sent
+// in a row at the requester's priority, so they arrive in order:
+//
+//     part 0   a request (the layout above), service PortSend: byte 4 the
+//              message priority (signed: -32 to 31), bytes 5-7 message
+//              bytes 0-2; 8 bytes
+//     part 1   byte 0 0x80 | 1 << 4 | the transaction's low four bits,
+//              bytes 1-7 message bytes 3-9; 8 bytes
+//     part 2   byte 0 0x80 | 2 << 4 | the transaction's low four bits,
+//              bytes 1-6 message bytes 10-15; 7 bytes
+//
+// Byte 0's bit 7, never set in a service, marks a continuation. A requester
+// has at most one transaction in flight per value of the low four bits (in
+// DCOS they are its call slot), so with its source address they name the
+// request a continuation belongs to. The reply is an ordinary reply; a
+// retransmission sends all three parts again, with the same transaction.
+
+/// Frames of one port send, and the message bytes each carries.
+constexpr size_t kPortSendFrames = 3;
+constexpr size_t kPortMessageBytes = 16;
+
+/// A port send, whole.
+struct PortSendRequest {
+    uint8_t transaction = 0;
+    uint16_t object = 0;      ///< The port id's low 16 bits.
+    int8_t priority = 0;      ///< MessagePortAgent::Send's priority.
+    uint8_t message[kPortMessageBytes]{};
+};
+
+/// One continuation frame (part 1 or 2), decoded.
+struct PortSendContinuation {
+    uint8_t part = 0;         ///< 1 or 2.
+    uint8_t slot = 0;         ///< The transaction's low four bits.
+    uint8_t bytes[7]{};
+    uint8_t count = 0;        ///< Message bytes it carries: 7, or 6 in part 2.
+};
+
+/// Whether a request frame is a continuation (byte 0's bit 7).
+constexpr bool isContinuation(const uint8_t* bytes, size_t length) { return length > 0 && (bytes[0] & 0x80) != 0; }
+
+/// The three frames of @p request and their lengths (8, 8, 7).
+void encodePortSend(const PortSendRequest& request, uint8_t (&frames)[kPortSendFrames][kRemoteMessageBytes],
+                    uint8_t (&lengths)[kPortSendFrames]);
+
+/// Decodes a continuation of @p length bytes: None, WrongLength (part 1
+/// not 8 bytes, part 2 not 7), or UnknownService (a part number other than
+/// 1 or 2, or bits 6 set).
+RemoteMessageError decodePortSendContinuation(const uint8_t* bytes, size_t length, PortSendContinuation& part);
+
+/// Puts one requester's port send back together: part 0 (a decoded request
+/// of service PortSend), then its continuations in order.
+class PortSendAssembler {
+public:
+    enum class Outcome : uint8_t {
+        Started,   ///< Part 0 taken.
+        Taken,     ///< A continuation in turn, not the last.
+        Complete,  ///< The last part: request() is whole.
+        Dropped,   ///< Out of turn or of another transaction: what was gathered is dropped.
+    };
+
+    Outcome start(const RemoteRequest& first);
+    Outcome take(const PortSendContinuation& part);
+    const PortSendRequest& request() const { return request_; }
+
+private:
+    uint8_t next_ = 0;        // The part expected; 0 when none.
+    PortSendRequest request_{};
+};
 
 // ---- name queries --------------------------------------------------------
 //
