@@ -429,3 +429,31 @@ def test_a_port_of_another_node_refuses_as_a_local_port_would(pair):
     assert call(two, f"send {missing} {5 * 256}")[:2] == ("invalid id", 0)
     assert porter_got(two)[0] == 0
     assert len(dcos_frames(lab, REQUEST)) == 3, "only the Send to the missing port went over the bus"
+
+
+def test_a_port_send_duplicated_or_torn_on_the_bus_is_sent_to_the_port_once(pair):
+    lab, one, two = pair
+    port = created(two, "remote port", "RPORT")
+    index = int(port, 16) & 0xFFFF
+    # A port send "from CAN node 1" (transaction 0xE6, priority 2, bytes 0x50
+    # to 0x5F) put on the bus by a hub node: first torn (its part 1 lost, so
+    # part 2 comes out of turn), then whole, then whole again as a
+    # retransmission would be.
+    identifier = (8 << 24) | (REQUEST << 16) | (2 << 8) | 1
+    body = bytes(range(0x50, 0x60))
+    parts = [bytes([11, 0xE6, index >> 8, index & 0xFF, 2]) + body[0:3], bytes([0x80 | 1 << 4 | 6]) + body[3:10],
+             bytes([0x80 | 2 << 4 | 6]) + body[10:16]]
+    for frames, replies in (([parts[0], parts[2]], 0), (parts, 1), (parts, 2)):
+        for data in frames:
+            lab.hub.inject("can0", "injector", Frame.data_frame(identifier, data, extended=True))
+        lab.hub.wait_for_records(lambda records: len(dcos_frames(lab, REQUEST, records)) >= 2 + 3 * replies, 60,
+                                 "the frames")
+        if replies:
+            lab.hub.wait_for_records(lambda records: len(dcos_frames(lab, REPLY, records)) >= replies, 60,
+                                     "the reply")
+    lab.hub.wait_until(lab.hub.frames()[-1].end + 2_000_000, 60)
+    assert porter_got(two) == (1, "50", body.hex()), "sent to the port once, whole"
+    served = net_counters(two)
+    assert served["served"] == 1 and served["duplicates"] == 1, served
+    replies = dcos_frames(lab, REPLY)
+    assert [data for *_, data in replies] == [bytes([11, 0xE6, 0, 0, 0, 0, 0, 0])] * 2
