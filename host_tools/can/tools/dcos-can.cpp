@@ -85,6 +85,14 @@ struct DataDecoding {
     nlohmann::json json;
 };
 
+// A frame of a DCOS type whose data its decoder refused, and why.
+DataDecoding malformed(DataDecoding out, const char* reason)
+{
+    out.text = fmt::format("malformed: {}", reason);
+    out.json = {{"malformed", reason}};
+    return out;
+}
+
 // Puts each sender's publications back together, as a receiving node
 // does, so that the third part of one shows the whole page.
 class PublicationPages {
@@ -97,9 +105,7 @@ public:
         PublicationPart part;
         const PublicationMessageError error = decodePublicationPart(frame.data(), frame.length(), part);
         if (error != PublicationMessageError::None) {
-            out.text = fmt::format("malformed: {}", publicationMessageErrorName(error));
-            out.json = {{"malformed", publicationMessageErrorName(error)}};
-            return out;
+            return malformed(out, publicationMessageErrorName(error));
         }
         out.json = {{"index", part.index}};
         if (part.kind == PublicationPartKind::Withdrawal) {
@@ -163,9 +169,7 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         TimeSyncFrame time;
         const TimeSyncError error = decodeTimeSync(frame.data(), frame.length(), time);
         if (error != TimeSyncError::None) {
-            out.text = fmt::format("malformed: {}", timeSyncErrorName(error));
-            out.json = {{"malformed", timeSyncErrorName(error)}};
-            return out;
+            return malformed(out, timeSyncErrorName(error));
         }
         switch (time.kind) {
         case TimeSyncKind::Sync:
@@ -194,9 +198,7 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         NameQueryPart part;
         const NameQueryError error = decodeNameQueryPart(frame.data(), frame.length(), part);
         if (error != NameQueryError::None) {
-            out.text = fmt::format("malformed: {}", nameQueryErrorName(error));
-            out.json = {{"malformed", nameQueryErrorName(error)}};
-            return out;
+            return malformed(out, nameQueryErrorName(error));
         }
         // The name bytes this part carries, up to the first NUL.
         std::string bytes;
@@ -220,9 +222,7 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         PortSendContinuation part;
         const RemoteMessageError error = decodePortSendContinuation(frame.data(), frame.length(), part);
         if (error != RemoteMessageError::None) {
-            out.text = fmt::format("malformed: {}", remoteMessageErrorName(error));
-            out.json = {{"malformed", remoteMessageErrorName(error)}};
-            return out;
+            return malformed(out, remoteMessageErrorName(error));
         }
         out.text = fmt::format("port-send part {}/3 slot {}", part.part + 1, part.slot);
         out.json = {{"service", "port-send"}, {"part", part.part}, {"slot", part.slot}};
@@ -233,9 +233,7 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         RemoteRequest request;
         const RemoteMessageError error = decodeRequest(frame.data(), frame.length(), request);
         if (error != RemoteMessageError::None) {
-            out.text = fmt::format("malformed: {}", remoteMessageErrorName(error));
-            out.json = {{"malformed", remoteMessageErrorName(error)}};
-            return out;
+            return malformed(out, remoteMessageErrorName(error));
         }
         out.text = fmt::format("{} txn 0x{:02x} object 0x{:04x} argument {}", remoteServiceName(request.service),
                                request.transaction, request.object, request.argument);
@@ -248,9 +246,7 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         RemoteReply reply;
         const RemoteMessageError error = decodeReply(frame.data(), frame.length(), reply);
         if (error != RemoteMessageError::None) {
-            out.text = fmt::format("malformed: {}", remoteMessageErrorName(error));
-            out.json = {{"malformed", remoteMessageErrorName(error)}};
-            return out;
+            return malformed(out, remoteMessageErrorName(error));
         }
         out.text = fmt::format("{} txn 0x{:02x} {}{} value {}", remoteServiceName(reply.service), reply.transaction,
                                dcos::statusName(reply.status), reply.pending ? " pending" : "", reply.value);
