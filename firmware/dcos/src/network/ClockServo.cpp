@@ -149,6 +149,9 @@ ClockCorrection ClockServo::judge(uint64_t masterTime, uint64_t localTime, uint6
     const int64_t offset = static_cast<int64_t>(masterTime - localTime);
     const uint64_t elapsed = syncUptime - lastSyncUptime_;
     const bool wasInStep = inStepCount_ >= 1;
+    // A step the next sync confirmed: applied, but no measure of the drift
+    // or of the bound, and the node stays in step.
+    bool step = false;
     if (wasInStep) {
         // What the drift measured so far says this offset should be; a
         // first correction from a new master, or one before the drift is
@@ -162,26 +165,20 @@ ClockCorrection ClockServo::judge(uint64_t masterTime, uint64_t localTime, uint6
         const int64_t residual = offset - predicted;
         if (magnitude(residual) > limit) {
             // One bad timestamp, one bad message, or the master's clock was
-            // set: only the next sync tells. A step it confirms is applied,
-            // but is no measure of the drift or of the bound.
+            // set: only the next sync tells.
             if (!holding_ || magnitude(residual - heldResidual_) > limit) {
                 holding_ = true;
                 heldResidual_ = residual;
                 ++status_.held;
                 return {};
             }
-            holding_ = false;
-            masterChanged_ = false;
-            ++status_.corrections;
-            status_.lastOffsetNs = offset;
-            lastSyncUptime_ = syncUptime;
-            return {true, masterTime, syncUptime};
+            step = true;
         }
     }
     holding_ = false;
     ++status_.corrections;
     status_.lastOffsetNs = offset;
-    if (wasInStep) {
+    if (wasInStep && !step) {
         const uint64_t size = magnitude(offset);
         if (size > status_.largestOffsetNs) {
             status_.largestOffsetNs = size;
@@ -198,12 +195,14 @@ ClockCorrection ClockServo::judge(uint64_t masterTime, uint64_t localTime, uint6
             driftKnown_ = true;
         }
     }
-    if (masterChanged_) {
+    if (masterChanged_ && !step) {
         driftKnown_ = false; // A rate against the previous master.
     }
     masterChanged_ = false;
     lastSyncUptime_ = syncUptime;
-    ++inStepCount_;
+    if (!step) {
+        ++inStepCount_;
+    }
     return {true, masterTime, syncUptime};
 }
 

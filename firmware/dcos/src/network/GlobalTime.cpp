@@ -38,21 +38,11 @@ constexpr uint8_t kSyncTaskPriority = 1;
 // Everything below is shared by the receiver task, the sync task and the
 // callers of GlobalTime; each touch is under the lock and O(1).
 ClockServo servo;
-bool servoNodeSet = false;
 // The sequence number of the Sync last sent on each interface, whose echo
 // is waiting to be answered with a FollowUp.
 uint8_t sentSequence[kNetworkInterfaces];
 bool echoAwaited[kNetworkInterfaces];
 ObjectId syncTask;
-
-ClockServo& theServo()
-{
-    if (!servoNodeSet) {
-        servo.setOwnNode(localNode());
-        servoNodeSet = true;
-    }
-    return servo;
-}
 
 SystemMessage timeSyncMessage(const uint8_t* data, uint8_t length, bool echo)
 {
@@ -72,18 +62,17 @@ void sendSyncs(uint8_t rank, uint32_t intervalMs)
     uint8_t sequence;
     {
         Lock lock;
-        sequence = theServo().nextSequence();
+        sequence = servo.nextSequence();
     }
     const uint64_t seconds = TimerManager::timeOfDayNs() / kNanosecondsPerSecond;
     uint8_t frame[kTimeSyncBytes];
     encodeTimeSync(sequence, seconds, rank, intervalMs, frame);
     const SystemMessage message = timeSyncMessage(frame, kTimeSyncBytes, true);
     for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
-        if (!linkAttached(interface)) {
-            continue;
-        }
         {
-            // Noted before it is sent: the echo may come before Send returns.
+            // Noted before it is sent: the echo may come before Send
+            // returns. An interface with no link takes nothing, and the
+            // note is taken back below.
             Lock lock;
             sentSequence[interface] = sequence;
             echoAwaited[interface] = true;
@@ -101,7 +90,7 @@ void syncTaskEntry(uintptr_t)
         GlobalTimeStatus configured;
         {
             Lock lock;
-            configured = theServo().status(TimerAgent::Uptime());
+            configured = servo.status(TimerAgent::Uptime());
         }
         if (configured.role != TimeRole::Master) {
             (void)TaskAgent::ReceiveEvent(kRoleChanged, EventWait::Any, kWaitForever);
@@ -116,7 +105,7 @@ void syncTaskEntry(uintptr_t)
         bool sending;
         {
             Lock lock;
-            sending = theServo().sending(TimerAgent::Uptime());
+            sending = servo.sending(TimerAgent::Uptime());
         }
         if (sending) {
             sendSyncs(configured.rank, configured.intervalMs);
@@ -138,7 +127,7 @@ void answerEcho(uint8_t interface, uint8_t sequence, uint64_t sentAt)
     encodeTimeFollowUp(sequence, TimerManager::timeOfDayAtUptime(sentAt), frame);
     if (sendOnLink(interface, timeSyncMessage(frame, kTimeSyncBytes, false))) {
         Lock lock;
-        theServo().countFollowUpSent();
+        servo.countFollowUpSent();
     }
 }
 
@@ -152,7 +141,7 @@ void onTimeSyncMessage(uint8_t interface, const SystemMessage& message)
     TimeSyncFrame frame;
     if (decodeTimeSync(message.data, message.length, frame) != TimeSyncError::None) {
         Lock lock;
-        theServo().countMalformed();
+        servo.countMalformed();
         return;
     }
     // A link that does not timestamp gives the time the message is handled:
@@ -165,7 +154,7 @@ void onTimeSyncMessage(uint8_t interface, const SystemMessage& message)
         probe.source = message.source;
         probe.timeOfDayNs = TimerManager::timeOfDayAtUptime(at);
         Lock lock;
-        theServo().onProbe(probe);
+        servo.onProbe(probe);
         return;
     }
     if (message.echo) {
@@ -178,18 +167,18 @@ void onTimeSyncMessage(uint8_t interface, const SystemMessage& message)
     const Result<uint16_t> node = NetworkInterfacesManager::NodeAt(interface, message.source);
     if (!node.ok()) {
         Lock lock;
-        theServo().countMalformed();
+        servo.countMalformed();
         return;
     }
     if (frame.kind == TimeSyncKind::Sync) {
         Lock lock;
-        theServo().onSync(interface, node.value(), frame, at);
+        servo.onSync(interface, node.value(), frame, at);
         return;
     }
     ClockCorrection correction;
     {
         Lock lock;
-        correction = theServo().onFollowUp(interface, node.value(), frame, at,
+        correction = servo.onFollowUp(interface, node.value(), frame, at,
                                            [](uint64_t uptime) { return TimerManager::timeOfDayAtUptime(uptime); });
     }
     if (correction.apply) {
@@ -233,7 +222,10 @@ Status GlobalTime::SetRole(TimeRole role, uint8_t rank, uint32_t intervalMs)
     }
     {
         internal::Lock lock;
-        internal::theServo().configure(role, rank, intervalMs);
+        // The node ranks itself among masters by its own number, known
+        // once the board has read its command line, long before any role.
+        internal::servo.setOwnNode(internal::localNode());
+        internal::servo.configure(role, rank, intervalMs);
     }
     if (!internal::syncTask.isNull()) {
         (void)TaskAgent::PostEvent(internal::syncTask, internal::kRoleChanged);
@@ -244,7 +236,7 @@ Status GlobalTime::SetRole(TimeRole role, uint8_t rank, uint32_t intervalMs)
 GlobalTimeStatus GlobalTime::GetStatus()
 {
     internal::Lock lock;
-    return internal::theServo().status(TimerAgent::Uptime());
+    return internal::servo.status(TimerAgent::Uptime());
 }
 
 size_t GlobalTime::GetProbes(TimeProbe* probes, size_t capacity)
@@ -253,7 +245,7 @@ size_t GlobalTime::GetProbes(TimeProbe* probes, size_t capacity)
         return 0;
     }
     internal::Lock lock;
-    return internal::theServo().probes(probes, capacity);
+    return internal::servo.probes(probes, capacity);
 }
 
 Status GlobalTime::SendProbe(uint8_t sequence)

@@ -371,6 +371,13 @@ Result<uint32_t> awaitReply(CallSlot& callSlot, Send send)
     }
 }
 
+// A message its decoder refused.
+void countMalformed()
+{
+    Lock lock;
+    ++statistics.malformed;
+}
+
 // A reply arrived on @p interface from @p source.
 void onReply(uint8_t interface, const SystemMessage& message)
 {
@@ -409,8 +416,7 @@ void onPublication(uint8_t interface, const SystemMessage& message)
 {
     PublicationPart part;
     if (decodePublicationPart(message.data, message.length, part) != PublicationMessageError::None) {
-        Lock lock;
-        ++statistics.malformed;
+        countMalformed();
         return;
     }
     const Result<uint16_t> node = NetworkInterfacesManager::NodeAt(interface, message.source);
@@ -471,12 +477,6 @@ ServedEntry* entryForNewRequest(ServedEntry* sameSlot)
 // name query's name or a port send's message (kPortMessageBytes bytes).
 void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
                   const uint8_t* payload);
-
-void countMalformed()
-{
-    Lock lock;
-    ++statistics.malformed;
-}
 
 // Requests of several frames being put back together (name queries, port
 // sends), one per sender: a sender's entry, or a new one taking the entry
@@ -994,12 +994,6 @@ bool sendOnLink(uint8_t interface, const SystemMessage& message)
         return false;
     }
     return true;
-}
-
-bool linkAttached(uint8_t interface)
-{
-    Lock lock;
-    return interface < kNetworkInterfaces && links[interface] != nullptr;
 }
 
 void detachRemoteLink(uint8_t interface)

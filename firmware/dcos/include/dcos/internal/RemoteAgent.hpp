@@ -104,9 +104,6 @@ void requestDeferredPublications();
 /// The global time base sends its messages so (GlobalTime.cpp).
 bool sendOnLink(uint8_t interface, const SystemMessage& message);
 
-/// Whether @p interface has a link attached.
-bool linkAttached(uint8_t interface);
-
 /// Detaches the link of @p interface if it has one; for RemoveInterface,
 /// under nothing (task context).
 void detachRemoteLink(uint8_t interface);
