@@ -357,3 +357,96 @@ def test_the_answers_stop_quietly_when_their_reader_goes():
         stderr = process.stderr.read()
         process.wait(timeout=TIMEOUT)
     assert process.returncode == 0 and "Traceback" not in stderr, stderr
+
+
+# -- several boards (--boards): redundant controllers wired to one plant ---------------------------
+
+
+def test_several_boards_drive_the_process_with_the_highest_output():
+    simulator = make_simulator("--boards", "3", "--tau", "0", "--gain", "1", "--input-channel", "1",
+                               "--output-channel", "0")
+    # Board 0 only measures (0 V); boards 1 and 2 are controllers with slightly different outputs.
+    simulator.handle_line(sample(0, dacs_with(1, 0.0)), 1, 0)
+    simulator.handle_line(sample(1_000, dacs_with(1, 2.0)), 1, 1)
+    simulator.handle_line(sample(2_000, dacs_with(1, 2.1)), 1, 2)
+    volts, _ = parse_input(simulator.handle_line(sample(3_000, dacs_with(1, 0.0)), 2, 0))
+    assert volts[0] == pytest.approx(2.1, abs=1e-6)
+    # Board 2 dies: board 1's output drives from that moment on.
+    simulator.disconnect(2)
+    volts, _ = parse_input(simulator.handle_line(sample(4_000, dacs_with(1, 0.0)), 3, 0))
+    assert volts[0] == pytest.approx(2.0, abs=1e-6)
+    # The last controller dies too: nothing drives the process but the measuring board's 0 V.
+    simulator.disconnect(1)
+    volts, _ = parse_input(simulator.handle_line(sample(5_000, dacs_with(1, 0.0)), 4, 0))
+    assert volts[0] == pytest.approx(0.0, abs=1e-6)
+    assert simulator.errors == 0
+
+
+def test_a_board_slightly_behind_is_taken_at_the_simulations_time_and_one_far_behind_is_refused():
+    simulator = make_simulator("--boards", "2", "--tau", "0.2", "--max-skew", "1")
+    first = simulator.handle_line(sample(10_000_000, dacs_with(0, 1.0)), 1, 0)
+    behind = simulator.handle_line(sample(9_500_000, dacs_with(0, 1.0)), 1, 1)
+    assert simulator.errors == 0 and simulator.process.time_ns == 10_000_000
+    assert parse_input(behind)[0][0] == pytest.approx(parse_input(first)[0][0], abs=1e-9)
+    # 2 ms behind is beyond the skew: malformed, answered with that board's previous answer.
+    assert simulator.handle_line(sample(8_000_000, dacs_with(0, 5.0)), 2, 1) == behind
+    assert simulator.errors == 1
+    # Board 0's malformed line gets board 0's previous answer, not board 1's.
+    assert simulator.handle_line("SAMPLE oops", 2, 0) == first
+    # A board that never sent a good line gets the initial inputs.
+    assert simulator.handle_line("SAMPLE oops", 1, 2) == simulator.initial_reply
+    with_one_board = make_simulator("--tau", "0.2")
+    with_one_board.handle_line(sample(10_000_000), 1)
+    with_one_board.handle_line(sample(9_999_999), 2)
+    assert with_one_board.errors == 1, "one board's time never goes backwards"
+
+
+def test_several_boards_need_a_socket():
+    result = subprocess.run([sys.executable, PLANT, "--boards", "2"], capture_output=True, text=True,
+                            timeout=TIMEOUT, input="")
+    assert result.returncode == 2 and "--boards" in result.stderr
+
+
+def test_socket_mode_serves_several_boards_and_ends_when_the_last_has_gone():
+    with tempfile.TemporaryDirectory() as directory:
+        path = os.path.join(directory, "plant.sock")
+        log = os.path.join(directory, "plant.csv")
+        process = subprocess.Popen([sys.executable, PLANT, "--socket", path, "--boards", "2", "--tau", "0",
+                                    "--input-channel", "1", "--accept-timeout", "20", "--csv", log],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            controller = connect_with_retry(path, time.monotonic() + TIMEOUT)
+            sensor = connect_with_retry(path, time.monotonic() + TIMEOUT)
+            for client in (controller, sensor):
+                client.settimeout(TIMEOUT)
+            controller_lines = controller.makefile("r", encoding="latin-1")
+            sensor_lines = sensor.makefile("r", encoding="latin-1")
+            controller.sendall((sample(1_000, dacs_with(1, 3.0)) + "\n").encode())
+            assert parse_input(controller_lines.readline())[0][0] == pytest.approx(3.0, abs=1e-6)
+            sensor.sendall((sample(2_000) + "\n").encode())
+            assert parse_input(sensor_lines.readline())[0][0] == pytest.approx(3.0, abs=1e-6)
+            # The controller's emulator stops: the sensor goes on and sees the process fall back to 0 V.
+            controller_lines.close()
+            controller.close()
+            # The simulator learns of it when it reads the end of the connection, a moment later.
+            deadline = time.monotonic() + TIMEOUT
+            for number in range(10_000):
+                sensor.sendall((sample(3_000 + number) + "\n").encode())
+                volts, _ = parse_input(sensor_lines.readline())
+                if volts[0] == pytest.approx(0.0, abs=1e-6) or time.monotonic() > deadline:
+                    break
+                time.sleep(0.02)
+            assert volts[0] == pytest.approx(0.0, abs=1e-6)
+            sensor_lines.close()
+            sensor.close()
+            _, stderr = process.communicate(timeout=TIMEOUT)
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait(timeout=TIMEOUT)
+        assert process.returncode == 0, stderr
+        assert "board 0 connected" in stderr and "board 1 connected" in stderr
+        assert "board 0 gone" in stderr and "board 1 gone" in stderr
+        with open(log, newline="", encoding="utf-8") as handle:
+            rows = list(csv.DictReader(handle))
+        assert [row["board"] for row in rows[:2]] == ["0", "1"]

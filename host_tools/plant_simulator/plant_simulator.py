@@ -21,6 +21,16 @@ every interval is split at those changes and at the disturbance step, each
 piece solved by the analytical step response. The result depends only on the
 lines received, so a closed loop under -icount is repeatable run for run.
 
+With --boards N the simulator serves N emulated boards at once over the
+socket, one connection each: every board's ADC reads the same process, and
+the process input is the highest of the connected boards' DAC outputs, as
+when several controllers' outputs are wired through diodes to one actuator
+(redundant outputs). A board whose connection closes (its emulator stopped,
+its node dead) no longer drives the process, as de-energised outputs would
+not. The boards are kept in lock-step by the lab, so their lines arrive
+within its quantum of each other; a line slightly behind the simulation is
+taken at the simulation's time.
+
 The digital part copies DO to DI by default, or follows a configurable
 mapping. Every line in gets exactly one line out: a malformed line is
 answered with the previous inputs and counted, never fatal. Every line is
@@ -320,11 +330,16 @@ class PlantSimulator:
         self.di_map = options.di_map
         self.samples = 0
         self.errors = 0
+        # With several boards (--boards), each board's DAC --input-channel
+        # as its last SAMPLE gave it; the process sees the highest.
+        self.drives = {}
+        self.max_skew_ns = int(round(options.max_skew * 1e6))
         self.messages_left = options.max_error_messages
-        self.last_dacs = [0.0] * CHANNELS
-        self.last_do = 0
-        self.last_di = self._digital(0)
-        self.last_reply = format_input(self._analog(options.initial, [0.0] * CHANNELS, noise=False), self.last_di)
+        # What a malformed line is answered with: its board's previous
+        # answer, or before the board's first sample the initial inputs.
+        self.initial_reply = format_input(self._analog(options.initial, [0.0] * CHANNELS, noise=False),
+                                          self._digital(0))
+        self.last_replies = {}
         self.csv_writer = None
         self._csv_file = None
         if options.csv:
@@ -335,6 +350,7 @@ class PlantSimulator:
                 ["time_ns", "time_s"] + [f"dac{i}" for i in range(CHANNELS)]
                 + ["do", "process_input", "process_output", "disturbance"]
                 + [f"ai{i}" for i in range(CHANNELS)] + ["di"]
+                + (["board"] if options.boards > 1 else [])
             )
 
     def close(self):
@@ -373,14 +389,20 @@ class PlantSimulator:
             if self.messages_left == 0:
                 print("plant: further line errors are counted but not printed", file=self.log)
 
-    def _step(self, time_ns, dacs, do_word):
+    def _step(self, time_ns, dacs, do_word, board):
         """Advances the simulation to one sample; undoes it all and raises ProtocolError if anything would
         not be finite, so that no line can poison the state for the lines after it."""
         if self.process.time_ns is not None and time_ns < self.process.time_ns:
-            raise ProtocolError(f"time went backwards from {self.process.time_ns} to {time_ns} ns")
+            # Boards kept in step (--boards) differ by less than the lab's
+            # quantum: a sample that far behind is taken at the simulation's time.
+            if self.options.boards == 1 or self.process.time_ns - time_ns > self.max_skew_ns:
+                raise ProtocolError(f"time went backwards from {self.process.time_ns} to {time_ns} ns")
+            time_ns = self.process.time_ns
+        drives = dict(self.drives)
+        drives[board] = dacs[self.options.input_channel]
         saved, noise_state = self.process.save(), self.random.getstate()
         try:
-            self.process.apply_input(time_ns, dacs[self.options.input_channel])
+            self.process.apply_input(time_ns, max(drives.values()))
             y = self.process.advance(time_ns)
             volts = self._analog(y, dacs)
             if not math.isfinite(y) or not all(math.isfinite(v) for v in volts):
@@ -389,27 +411,38 @@ class PlantSimulator:
             self.process.restore(saved)
             self.random.setstate(noise_state)
             raise ProtocolError(str(error)) from None
-        return y, volts
+        self.drives = drives
+        return time_ns, y, volts
 
-    def handle_line(self, line, number=0):
-        """Returns the reply (without newline) to one received line; never raises for what the line holds."""
+    def disconnect(self, board):
+        """The board numbered board has gone (its emulator stopped): its
+        outputs no longer drive the process, from the simulation's present
+        time on, as a controller's de-energised outputs would not."""
+        if self.drives.pop(board, None) is None or self.process.time_ns is None:
+            return
+        self.process.apply_input(self.process.time_ns, max(self.drives.values(), default=0.0))
+
+    def handle_line(self, line, number=0, board=0):
+        """Returns the reply (without newline) to one received line of the
+        board numbered board (0 to --boards - 1); never raises for what the
+        line holds."""
         if not isinstance(line, OverlongLine):
             line = line.strip("\r\n")
         try:
             time_ns, dacs, do_word = parse_sample(line)
-            y, volts = self._step(time_ns, dacs, do_word)
+            time_ns, y, volts = self._step(time_ns, dacs, do_word, board)
         except ProtocolError as error:
-            self._error(number, error)
-            return self.last_reply
+            self._error(number if self.options.boards == 1 else f"{number} of board {board}", error)
+            return self.last_replies.get(board, self.initial_reply)
         self.samples += 1
         di = self._digital(do_word)
         reply = format_input(volts, di)
         if self.csv_writer is not None:
-            self._log(time_ns, dacs, do_word, y, volts, di)
-        self.last_dacs, self.last_do, self.last_di, self.last_reply = dacs, do_word, di, reply
+            self._log(time_ns, dacs, do_word, y, volts, di, board)
+        self.last_replies[board] = reply
         return reply
 
-    def _log(self, time_ns, dacs, do_word, y, volts, di):
+    def _log(self, time_ns, dacs, do_word, y, volts, di, board):
         disturbance = 0.0
         if self.process.disturbance_at_ns is not None and time_ns >= self.process.disturbance_at_ns:
             disturbance = self.process.disturbance
@@ -418,6 +451,7 @@ class PlantSimulator:
                 [time_ns, f"{time_ns / 1e9:.9f}"] + [f"{v:.6f}" for v in dacs]
                 + [f"{do_word:04x}", f"{self.process.delayed_input:.6f}", f"{y:.6f}", f"{disturbance:.6f}"]
                 + [f"{v:.6f}" for v in volts] + [f"{di:04x}"]
+                + ([board] if self.options.boards > 1 else [])
             )
             self._csv_file.flush()
         except OSError as error:
@@ -464,39 +498,57 @@ class LineReader:
         self.eof = False
         self.overlong = None  # the start of a line being dropped
 
+    def take(self):
+        """The next whole line already read: a str ending in a newline, an
+        OverlongLine, or at end of input the unterminated rest; None when
+        there is none (yet, or at end of input any more)."""
+        if b"\n" in self.buffer:
+            line, _, self.buffer = self.buffer.partition(b"\n")
+            if self.overlong is not None or len(line) > MAX_LINE_LENGTH:
+                start = self.overlong if self.overlong is not None else line[:40].decode("latin-1")
+                self.overlong = None
+                return OverlongLine(start)
+            # A line is at least "\n"-terminated; keep it non-empty so '' means time-out.
+            return line.decode("latin-1") + "\n"
+        if len(self.buffer) > MAX_LINE_LENGTH:
+            if self.overlong is None:
+                self.overlong = self.buffer[:40].decode("latin-1")
+            self.buffer = b""
+        if self.eof:
+            if self.overlong is not None:
+                line, self.overlong, self.buffer = self.overlong, None, b""
+                return OverlongLine(line)
+            if self.buffer:
+                line, self.buffer = self.buffer, b""
+                return line.decode("latin-1")
+        return None
+
+    def fill(self, timeout=None):
+        """Reads what the descriptor has, waiting at most timeout seconds
+        (None: without a limit); False on time-out."""
+        ready, _, _ = select.select([self.fd], [], [], timeout)
+        if not ready:
+            return False
+        data = os.read(self.fd, 65536)
+        if not data:
+            self.eof = True
+        self.buffer += data
+        return True
+
     def __call__(self, timeout):
         """A decoded line, None at end of input, '' on time-out."""
         deadline = time.monotonic() + timeout if timeout > 0 else None
-        while b"\n" not in self.buffer:
-            if len(self.buffer) > MAX_LINE_LENGTH:
-                if self.overlong is None:
-                    self.overlong = self.buffer[:40].decode("latin-1")
-                self.buffer = b""
+        while True:
+            line = self.take()
+            if line is not None:
+                return line
             if self.eof:
-                if self.overlong is not None:
-                    line, self.overlong, self.buffer = self.overlong, None, b""
-                    return OverlongLine(line)
-                if self.buffer:
-                    line, self.buffer = self.buffer, b""
-                    return line.decode("latin-1")
                 return None
             remaining = None if deadline is None else deadline - time.monotonic()
             if remaining is not None and remaining <= 0:
                 return ""
-            ready, _, _ = select.select([self.fd], [], [], remaining)
-            if not ready:
+            if not self.fill(remaining):
                 return ""
-            data = os.read(self.fd, 65536)
-            if not data:
-                self.eof = True
-            self.buffer += data
-        line, _, self.buffer = self.buffer.partition(b"\n")
-        if self.overlong is not None or len(line) > MAX_LINE_LENGTH:
-            start = self.overlong if self.overlong is not None else line[:40].decode("latin-1")
-            self.overlong = None
-            return OverlongLine(start)
-        # A line is at least "\n"-terminated; keep it non-empty so '' means time-out.
-        return line.decode("latin-1") + "\n"
 
 
 def run_stdio(simulator, options):
@@ -513,6 +565,80 @@ def run_stdio(simulator, options):
     return why
 
 
+class Board:
+    """One connected board of several (--boards): its socket, its reader, its number."""
+
+    def __init__(self, connection, number):
+        self.connection = connection
+        self.number = number
+        self.reader = LineReader(connection.fileno())
+        self.lines = 0
+
+    def fileno(self):
+        return self.connection.fileno()
+
+    def answer(self, text):
+        """Sends one answer; False when the board is gone."""
+        try:
+            self.connection.sendall((text + "\n").encode("latin-1"))
+        except OSError:
+            return False
+        return True
+
+
+def serve_boards(simulator, listener, options):
+    """Serves up to --boards connections at once, each one board, in the
+    order their lines arrive. A board's number is the lowest free one. The
+    session ends when every board that came has gone (unless
+    --keep-listening), when none comes within --accept-timeout, or after
+    --idle-timeout seconds without a line from any."""
+    boards = []
+    came = False
+    started = time.monotonic()
+    last_line = started
+    while True:
+        now = time.monotonic()
+        if not boards and not came and options.accept_timeout > 0 and now - started > options.accept_timeout:
+            print(f"plant: no client connected within {options.accept_timeout:g} s (--accept-timeout)",
+                  file=sys.stderr)
+            return EXIT_CONNECTION
+        if options.idle_timeout > 0 and came and now - last_line > options.idle_timeout:
+            print(f"plant: no line for {options.idle_timeout:g} s (--idle-timeout)", file=sys.stderr, flush=True)
+            return EXIT_OK
+        waiting = list(boards) + ([listener] if len(boards) < options.boards else [])
+        ready, _, _ = select.select(waiting, [], [], 0.2)
+        for source in ready:
+            if source is listener:
+                connection, _ = listener.accept()
+                connection.settimeout(None)
+                taken = {board.number for board in boards}
+                number = min(n for n in range(options.boards) if n not in taken)
+                boards.append(Board(connection, number))
+                came = True
+                print(f"plant: board {number} connected", file=sys.stderr, flush=True)
+                continue
+            board = source
+            board.reader.fill(0)
+            gone = None
+            while gone is None:
+                line = board.reader.take()
+                if line is None:
+                    gone = "end of input" if board.reader.eof else ""
+                    break
+                board.lines += 1
+                last_line = time.monotonic()
+                if not board.answer(simulator.handle_line(line, board.lines, board.number)):
+                    gone = "the output closed"
+            if gone:
+                boards.remove(board)
+                board.connection.close()
+                simulator.disconnect(board.number)
+                print(f"plant: board {board.number} gone ({gone}); it no longer drives the process",
+                      file=sys.stderr, flush=True)
+                if not boards and not options.keep_listening:
+                    return EXIT_OK
+
+
 def run_socket(simulator, options):
     path = options.socket
     if os.path.exists(path):
@@ -524,12 +650,14 @@ def run_socket(simulator, options):
     listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     try:
         listener.bind(path)
-        listener.listen(1)
+        listener.listen(options.boards)
     except OSError as error:
         print(f"plant: cannot listen on {path}: {error}", file=sys.stderr)
         return EXIT_CONNECTION
     print(f"plant: listening on {path}", file=sys.stderr, flush=True)
     try:
+        if options.boards > 1:
+            return serve_boards(simulator, listener, options)
         while True:
             listener.settimeout(options.accept_timeout if options.accept_timeout > 0 else None)
             try:
@@ -606,6 +734,8 @@ def build_parser():
     transport.add_argument("--socket", metavar="PATH", help="listen on this Unix socket for the emulator (default: use stdin and stdout)")
     transport.add_argument("--accept-timeout", type=float_in(0.0, MAX_TIMEOUT_S), default=120.0, help="seconds to wait for the emulator to connect, 0 to 1e6; 0 waits forever (default 120)")
     transport.add_argument("--idle-timeout", type=float_in(0.0, MAX_TIMEOUT_S), default=3600.0, help="seconds without a line after which the session ends, 0 to 1e6; 0 waits forever (default 3600)")
+    transport.add_argument("--boards", type=int_in(1, 16), default=1, help="with --socket, serve this many emulated boards at once, 1 to 16: every board's ADC reads the process, and the process input is the highest of the connected boards' DAC --input-channel (their outputs wired through diodes); a board that disconnects no longer drives it (default 1)")
+    transport.add_argument("--max-skew", type=float_in(0.0, 1000.0), default=1.0, metavar="MS", help="with --boards, a SAMPLE at most this many milliseconds behind the simulation (boards in lock-step differ by the lab's quantum) is taken at the simulation's time, 0 to 1000 (default 1)")
     transport.add_argument("--keep-listening", action="store_true", help="after the client disconnects, wait for the next one (the process state carries on)")
     transport.add_argument("--csv", metavar="PATH", help="write the trajectory, one row per SAMPLE: time, DACs, DO, process input (after the dead time), output, disturbance, AIs, DI")
     transport.add_argument("--max-error-messages", type=int_in(0, 10**9), default=20, help="print at most this many malformed-line messages on stderr; all are counted (default 20)")
@@ -615,6 +745,8 @@ def build_parser():
 def main(argv=None):
     parser = build_parser()
     options = parser.parse_args(argv)
+    if options.boards > 1 and not options.socket:
+        parser.error("--boards: several boards need --socket; stdin and stdout serve one")
     try:
         simulator = PlantSimulator(options)
     except OSError as error:

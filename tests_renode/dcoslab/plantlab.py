@@ -13,7 +13,12 @@ with the application's `plant` console command:
     each finding the publisher it reads by name on the other node;
     configuration "redundant": as "two", with a second controller on node 3;
     node 1's actuator follows node 2's "mv" and falls back on node 3's
-    (active backup redundancy, the seed's Test Case 3, 9.4.3).
+    (active backup redundancy, the seed's Test Case 3, 9.4.3);
+    configuration "voting": the seed's Test Case 3 on four nodes, every one
+    with an I/O board wired to the simulator (--boards 4): nodes 1 and 2
+    each run a sampler publishing "pv", nodes 3 and 4 each a voter reading
+    both and writing AO1, which the plant takes through a diode (the higher
+    of the two voters' outputs drives it; a dead node's output does not).
 
 The seed's Test Case 2 (9.4.2, Fig. 9.7, instances 1 and 2); `make plant`
 (tests_renode/plant.py) and docs/examples/plant/tests use it.
@@ -33,6 +38,11 @@ from .remote import attach_redundant
 PLANT_OPTIONS = ["--gain", "1", "--tau", "0.2", "--dead-time", "0.02", "--input-channel", "0",
                  "--output-channel", "0"]
 BIT_RATE = 500_000
+
+# Test Case 3's plant input is AO1, read back on AI1 (loopback); AI0 measures the process.
+VOTING_OPTIONS = ["--input-channel", "1", "--other-inputs", "loopback", "--boards", "4"]
+CONFIGURATIONS = ("one", "two", "redundant", "voting")
+COMPONENTS = ("sampler", "controller", "actuator", "voter")
 
 _STARTED = re.compile(r"plant: \w+ started, publisher (0x[0-9a-f]{8})")
 
@@ -65,13 +75,13 @@ def read_trajectory(csv_path):
 
 
 def statistics(board, timeout=120):
-    """The `plant` command's three lines, as {component: {field: number}}."""
+    """The `plant` command's lines, a line a component, as {component: {field: number}}."""
     output = board.command("plant", timeout=timeout)
     result = {}
-    for component, fields in re.findall(r"^(sampler|controller|actuator): (.*?)\r?$", output, re.M):
+    for component, fields in re.findall(rf"^({'|'.join(COMPONENTS)}): (.*?)\r?$", output, re.M):
         result[component] = {name.strip().replace(" ", "_"): int(value)
                              for name, value in re.findall(r"([a-z ]+?) (-?\d+)(?: uV| us)?(?:,|$)", fields)}
-    if len(result) != 3:
+    if len(result) != len(COMPONENTS):
         raise PlantError(f"unexpected `plant` output: {output!r}")
     return result
 
@@ -79,25 +89,27 @@ def statistics(board, timeout=120):
 class PlantLab:
     def __init__(self, boot, board_definition, image, directory, configuration="two", bit_rate=BIT_RATE,
                  timeout=120, pace=None):
-        if configuration not in ("one", "two", "redundant"):
-            raise ValueError(f"configuration {configuration!r}: one, two or redundant")
+        if configuration not in CONFIGURATIONS:
+            raise ValueError(f"configuration {configuration!r}: {', '.join(CONFIGURATIONS)}")
         self.configuration = configuration
         self.timeout = timeout
         self.csv_path = os.path.join(directory, "plant.csv")
         socket_path = os.path.join(directory, "plant.sock")
-        self.simulator = start_plant_simulator(socket_path, self.csv_path)
-        nodes = {"node1": {"bus0": "can0", "bus1": "can1", "append": "node=1",
-                           "devices": {"isa-mfio": {"wiring": "plant", "plant": "plant"}},
-                           "args": ["-chardev", f"socket,id=plant,path={socket_path}"]}}
-        others = {"one": [], "two": [2], "redundant": [2, 3]}[configuration]
+        voting = configuration == "voting"
+        self.simulator = start_plant_simulator(socket_path, self.csv_path, VOTING_OPTIONS if voting else ())
+        wired = {"devices": {"isa-mfio": {"wiring": "plant", "plant": "plant"}},
+                 "args": ["-chardev", f"socket,id=plant,path={socket_path}"]}
+        nodes = {"node1": {"bus0": "can0", "bus1": "can1", "append": "node=1", **wired}}
+        others = {"one": [], "two": [2], "redundant": [2, 3], "voting": [2, 3, 4]}[configuration]
         for node in others:
-            nodes[f"node{node}"] = {"bus0": "can0", "bus1": "can1", "append": f"node={node}"}
+            nodes[f"node{node}"] = {"bus0": "can0", "bus1": "can1", "append": f"node={node}", **(wired if voting else {})}
         try:
             self.lab = CanLab(boot, board_definition, {"can0": bit_rate, "can1": bit_rate}, nodes, pace=pace,
                               kind=image, timeout=timeout)
             self.io = self.lab.board("node1")
             self.control = self.lab.board("node2") if others else self.io
             self.backup = self.lab.board("node3") if configuration == "redundant" else None
+            self.nodes = {node: self.lab.board(f"node{node}") for node in [1, *others]}
             everyone = [1, *others]
             for node in everyone if others else []:
                 attach_redundant(self.lab.board(f"node{node}"), node, [peer for peer in everyone if peer != node],
@@ -107,7 +119,18 @@ class PlantLab:
             raise
 
     def start(self):
-        """Starts the components where the configuration puts them; (pv, mv) publisher ids."""
+        """Starts the components where the configuration puts them; (pv, mv)
+        publisher ids ("voting": the two samplers' pv)."""
+        if self.configuration == "voting":
+            # Two publishers are called "pv": each voter is given both ids, the
+            # one it follows first (node 3 follows node 1's, node 4 node 2's).
+            pv = [self._started(self.nodes[node], "plant io") for node in (1, 2)]
+            for node, order in ((3, pv), (4, pv[::-1])):
+                line = f"plant vote {order[0]} {order[1]}"
+                output = self.nodes[node].command(line, timeout=self.timeout)
+                if "voter started" not in output:
+                    raise PlantError(f"{line}: {output!r}")
+            return pv[0], pv[1]
         if self.configuration == "one":
             output = self.io.command("plant all", timeout=self.timeout)
             ids = _STARTED.findall(output)

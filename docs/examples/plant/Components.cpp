@@ -12,6 +12,10 @@
 // set point divided by the plant's gain (1 here), which holds the set
 // point without the offset a pure P controller leaves: the law the
 // single-board closed loop test uses (tests_renode/target/ClosedLoopTest.cpp).
+//
+// The voter (the seed's Test Case 3, Plant.hpp) is the controller and the
+// actuator in one task, fed by two samplers: it votes on their process
+// values, computes the same law and writes its own I/O board's output.
 #include "Plant.hpp"
 
 #include <iobus/AnalogScaling.hpp>
@@ -58,6 +62,8 @@ ObjectId controllerInput;
 ObjectId mvPublisher;
 ObjectId actuatorInput;
 ObjectId actuatorBackup;
+ObjectId voterInputs[2];
+VoterStatistics voter;
 
 // Runs @p update on the statistics under their semaphore. An update that
 // cannot take it within a period is dropped: the console shows a period late.
@@ -161,9 +167,7 @@ void controllerEntry(uintptr_t)
     follow(
         subscription.value(),
         [](const Signal& pv) {
-            const int32_t target = setPointMicrovolts;
-            const int32_t error = target - pv.microvolts;
-            const Signal mv{target + error * kGainNumerator / kGainDenominator, pv.sampledNs};
+            const Signal mv{controlOutput(setPointMicrovolts, pv.microvolts), pv.sampledNs};
             const Status status = dcos::dsmAgent.Write(mvPublisher, encode(mv)).status();
             record([&] {
                 ++controller.cycles;
@@ -239,6 +243,90 @@ void actuatorEntry(uintptr_t)
         record([] {
             ++actuator.failovers;
             ++actuator.timeouts;
+        });
+    }
+}
+
+// One of the voter's two samplers: its subscription, the last page's data
+// identifier and value, and how many cycles ago that page came.
+struct Source {
+    ObjectId subscription;
+    uint32_t seen = dcos::kNoDsmData;
+    int32_t microvolts = 0;
+    uint32_t age = kFreshCycles + 1;
+    bool gone = false; ///< Its publisher was deleted.
+};
+
+// Takes the other sampler's newest page, if one came, without waiting.
+void poll(Source& source)
+{
+    dcos::DsmPage page;
+    const Result<uint32_t> polled = dcos::dsmAgent.Read(source.subscription, source.seen, page, dcos::kPoll);
+    if (polled.ok()) {
+        source.seen = polled.value();
+        source.microvolts = decode(page).microvolts;
+        source.age = 0;
+    } else if (source.age <= kFreshCycles) {
+        ++source.age;
+    }
+}
+
+void voterEntry(uintptr_t)
+{
+    Source sources[2];
+    for (unsigned i = 0; i < 2; ++i) {
+        const Result<ObjectId> opened = dcos::dsmAgent.Open(voterInputs[i]);
+        if (!opened.ok()) {
+            record([] { ++voter.errors; });
+            return;
+        }
+        sources[i].subscription = opened.value();
+    }
+    Source* followed = &sources[0];
+    Source* other = &sources[1];
+    bool haveLast = false;
+    int32_t lastPv = 0;
+    for (;;) {
+        dcos::DsmPage page;
+        const Result<uint32_t> read = dcos::dsmAgent.Read(followed->subscription, followed->seen, page, kFailoverNs);
+        if (!read.ok()) {
+            // Silent (its node or its bus died) or deleted: follow the other.
+            followed->gone = read.status() != Status::Timeout;
+            followed->age = kFreshCycles + 1;
+            Source* const silent = followed;
+            followed = other;
+            other = silent;
+            record([] { ++voter.failovers; });
+            if (followed->gone && other->gone) {
+                record([] { ++voter.errors; });
+                return; // Both publishers deleted: nothing left to vote on.
+            }
+            continue;
+        }
+        followed->seen = read.value();
+        followed->microvolts = decode(page).microvolts;
+        poll(*other);
+        const Vote chosen = vote(followed->microvolts, other->age <= kFreshCycles, other->microvolts, haveLast, lastPv);
+        haveLast = true;
+        lastPv = chosen.microvolts;
+        const int32_t mv = controlOutput(setPointMicrovolts, chosen.microvolts);
+        Status status = iobus::writeWord(board, iobus::channel::kAnalogOutput0 + kVoterOutput, dacCode(mv));
+        // The read-back checks the output took; its conversion is also what
+        // tells the lab's plant the output changed (one exchange per conversion).
+        const Result<iobus::AnalogValue> readBack =
+            status == Status::Ok ? iobus::readAnalogInputMicrovolts(board, kVoterReadBack) : Result<iobus::AnalogValue>(status);
+        status = readBack.status();
+        const int32_t deviation = readBack.ok() ? readBack.value().microvolts - mv : 0;
+        record([&] {
+            ++voter.cycles;
+            voter.lastPv = chosen.microvolts;
+            voter.lastMv = mv;
+            voter.agreed += chosen.kind == VoteKind::Agreed ? 1 : 0;
+            voter.disagreed += chosen.kind == VoteKind::Disagreed ? 1 : 0;
+            voter.single += chosen.kind == VoteKind::Single ? 1 : 0;
+            voter.errors += status == Status::Ok ? 0 : 1;
+            voter.readBackErrors +=
+                (deviation > kReadBackToleranceMicrovolts || deviation < -kReadBackToleranceMicrovolts) ? 1 : 0;
         });
     }
 }
@@ -364,12 +452,55 @@ Status startActuator(ObjectId mv, ObjectId backup)
     return createTask("actuator", kActuatorPriority, actuatorEntry).status();
 }
 
+Status startVoter(ObjectId pv, ObjectId otherPv)
+{
+    if (!voterInputs[0].isNull()) {
+        return Status::AlreadyExists;
+    }
+    if (pv.isNull() || otherPv.isNull() || pv == otherPv) {
+        return Status::InvalidArgument;
+    }
+    Status status = ensureLock();
+    status = status == Status::Ok ? installBoard() : status;
+    if (status != Status::Ok) {
+        return status;
+    }
+    voterInputs[0] = pv;
+    voterInputs[1] = otherPv;
+    return createTask("voter", kActuatorPriority, voterEntry).status();
+}
+
+int32_t controlOutput(int32_t setPointMicrovolts, int32_t pvMicrovolts)
+{
+    const int32_t error = setPointMicrovolts - pvMicrovolts;
+    return setPointMicrovolts + error * kGainNumerator / kGainDenominator;
+}
+
+Vote vote(int32_t followed, bool otherFresh, int32_t other, bool haveLast, int32_t last)
+{
+    if (!otherFresh) {
+        return Vote{followed, VoteKind::Single};
+    }
+    const int64_t difference = int64_t{followed} - other;
+    if (difference <= kAgreeMicrovolts && difference >= -kAgreeMicrovolts) {
+        return Vote{static_cast<int32_t>((int64_t{followed} + other) / 2), VoteKind::Agreed};
+    }
+    if (!haveLast) {
+        return Vote{followed, VoteKind::Disagreed};
+    }
+    const int64_t fromFollowed = int64_t{followed} - last;
+    const int64_t fromOther = int64_t{other} - last;
+    const bool otherNearer = (fromOther < 0 ? -fromOther : fromOther) < (fromFollowed < 0 ? -fromFollowed : fromFollowed);
+    return Vote{otherNearer ? other : followed, VoteKind::Disagreed};
+}
+
 void setSetPoint(int32_t microvolts) { setPointMicrovolts = microvolts; }
 int32_t setPoint() { return setPointMicrovolts; }
 
 SamplerStatistics samplerStatistics() { return copyOf(sampler); }
 ControllerStatistics controllerStatistics() { return copyOf(controller); }
 ActuatorStatistics actuatorStatistics() { return copyOf(actuator); }
+VoterStatistics voterStatistics() { return copyOf(voter); }
 
 // The application declares no objects: the console command starts the
 // components a node is to run, so one image serves every configuration.

@@ -83,12 +83,63 @@ dcos::Status startActuator(dcos::ObjectId mv, dcos::ObjectId backup = dcos::Obje
 /// How long the followed controller may be silent before its twin takes over: three periods.
 constexpr uint64_t kFailoverNs = 3 * kPeriodNs;
 
+/// The seed's Test Case 3 (9.4.3): a voting subscriber. It reads two
+/// samplers' "pv" publishers (two copies of component 1 on two nodes), votes
+/// on the process value, computes the controller's output and writes it to
+/// kVoterOutput, then reads that output back on kVoterReadBack. Two voters on
+/// two nodes drive the plant together: the plant takes the higher of their
+/// outputs (the lab wires them through diodes, host_tools/plant_simulator,
+/// "Several boards"), so either carries the loop alone when the other dies.
+///
+/// The vote, each time the followed sampler's page arrives: when the other
+/// sampler's page is fresh (it came within kFreshCycles cycles) and the two
+/// agree within kAgreeMicrovolts, their mean; when they disagree, the one
+/// nearer the value used last (a sensor that jumps away is the suspect);
+/// when only the followed one is fresh, that one. When the followed sampler
+/// is silent for kFailoverNs, the voter follows the other.
+dcos::Status startVoter(dcos::ObjectId pv, dcos::ObjectId otherPv);
+
+/// The voter's output channel (AO1) and the input that reads it back (AI1).
+constexpr unsigned kVoterOutput = 1;
+constexpr unsigned kVoterReadBack = 1;
+/// Two samples of one process taken within a period agree within this.
+constexpr int32_t kAgreeMicrovolts = 50'000;
+/// The other sampler's page counts as fresh this many cycles after it came.
+constexpr uint32_t kFreshCycles = 2;
+/// A read-back further than this from the output written counts as an error:
+/// two LSBs of the 12-bit DAC and ADC over 20 V, about 10 mV.
+constexpr int32_t kReadBackToleranceMicrovolts = 10'000;
+
+/// The voter's vote on one cycle: pure, so that the host can test it.
+enum class VoteKind : uint8_t { Agreed, Disagreed, Single };
+struct Vote {
+    int32_t microvolts = 0;
+    VoteKind kind = VoteKind::Single;
+};
+Vote vote(int32_t followed, bool otherFresh, int32_t other, bool haveLast, int32_t last);
+
+/// The controller's law, shared by the controller and the voter.
+int32_t controlOutput(int32_t setPointMicrovolts, int32_t pvMicrovolts);
+
 /// The controller's set point; it applies from its next cycle.
+struct VoterStatistics {
+    uint32_t cycles = 0;
+    int32_t lastPv = 0;
+    int32_t lastMv = 0;
+    uint32_t agreed = 0;     ///< Cycles on the mean of both samplers.
+    uint32_t disagreed = 0;  ///< Cycles on which they disagreed; the nearer one was used.
+    uint32_t single = 0;     ///< Cycles with only the followed sampler fresh.
+    uint32_t failovers = 0;  ///< Times the followed sampler fell silent and the other was followed.
+    uint32_t readBackErrors = 0;
+    uint32_t errors = 0;
+};
+
 void setSetPoint(int32_t microvolts);
 int32_t setPoint();
 
 SamplerStatistics samplerStatistics();
 ControllerStatistics controllerStatistics();
 ActuatorStatistics actuatorStatistics();
+VoterStatistics voterStatistics();
 
 } // namespace plant

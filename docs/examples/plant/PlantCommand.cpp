@@ -7,6 +7,9 @@
 //     plant actuate [<mv> [<backup>]]
 //                              the actuator, reading publisher <mv> (by default the one named
 //                              "mv"), and a second controller's <backup>; on the node with the I/O board
+//     plant vote <pv> <other pv>
+//                              the voter (Test Case 3): reads two samplers' publishers, votes,
+//                              computes the output and writes AO1; on a node with the I/O board
 //     plant all                all three on this node
 //     plant setpoint <mV>      the controller's set point
 //     plant                    the components' statistics, a line each
@@ -92,6 +95,13 @@ void printStatistics(shell::Shell& shell)
                 static_cast<unsigned long>(a.lastDelayNs / 1000), static_cast<unsigned long>(a.maxDelayNs / 1000),
                 static_cast<unsigned long>(a.timeouts), static_cast<unsigned long>(a.errors),
                 static_cast<unsigned long>(a.failovers));
+    const VoterStatistics v = voterStatistics();
+    shell.print("voter: cycles %lu, pv %ld uV, mv %ld uV, agreed %lu, disagreed %lu, single %lu, failovers %lu, "
+                "readback errors %lu, errors %lu\r\n",
+                static_cast<unsigned long>(v.cycles), static_cast<long>(v.lastPv), static_cast<long>(v.lastMv),
+                static_cast<unsigned long>(v.agreed), static_cast<unsigned long>(v.disagreed),
+                static_cast<unsigned long>(v.single), static_cast<unsigned long>(v.failovers),
+                static_cast<unsigned long>(v.readBackErrors), static_cast<unsigned long>(v.errors));
 }
 
 CommandResult plantCommand(shell::Shell& shell, int argc, char** argv)
@@ -125,6 +135,22 @@ CommandResult plantCommand(shell::Shell& shell, int argc, char** argv)
             return failed(shell, "actuator", status);
         }
         shell.print("plant: actuator started, reading 0x%08lx\r\n", static_cast<unsigned long>(id.raw()));
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "vote") && argc == 4) {
+        ObjectId other;
+        for (int i = 2; i < 4; ++i) {
+            if (!parseId(argv[i], i == 2 ? id : other)) {
+                shell.print("plant: '%s' is not a publisher id\r\n", argv[i]);
+                return CommandResult::Failed;
+            }
+        }
+        const Status status = startVoter(id, other);
+        if (status != Status::Ok) {
+            return failed(shell, "voter", status);
+        }
+        shell.print("plant: voter started, reading 0x%08lx and 0x%08lx\r\n", static_cast<unsigned long>(id.raw()),
+                    static_cast<unsigned long>(other.raw()));
         return CommandResult::Ok;
     }
     if (textEquals(verb, "all") && argc == 2) {
@@ -161,14 +187,17 @@ CommandResult plantCommand(shell::Shell& shell, int argc, char** argv)
 } // namespace
 
 DCOS_SHELL_COMMAND_DETAILED(plantShellCommand, "plant", "the control loop's components: start them, show them",
-                            "plant [io | control [<pv>] | actuate [<mv> [<backup mv>]] | all | setpoint <mV>]",
+                            "plant [io | control [<pv>] | actuate [<mv> [<backup mv>]] | vote <pv> <other pv> | all |\r\n"
+                            "       setpoint <mV>]",
                             "  io: the I/O board and the sampler, which publishes AI0 as \"pv\" every 10 ms\r\n"
                             "  control: the controller, reading publisher <pv> (default: the one named pv,\r\n"
                             "    here or on another node), publishing \"mv\"\r\n"
                             "  actuate: the actuator, reading publisher <mv> (default: the one named mv),\r\n"
                             "    writing AO0 (needs the I/O board); with a backup mv, the other takes over\r\n"
                             "    when the one followed is silent for three periods\r\n"
-                            "  all: the three on this node; setpoint: the controller's, in mV\r\n"
+                            "  vote: the voter, reading two samplers' publishers, voting on the process value\r\n"
+                            "    and writing the output to AO1, read back on AI1 (needs the I/O board)\r\n"
+                            "  all: the three on this node; setpoint: the controller's and the voter's, in mV\r\n"
                             "  with no argument: each component's statistics",
                             plantCommand);
 
