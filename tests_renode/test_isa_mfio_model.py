@@ -302,6 +302,24 @@ def test_plant_wiring_exchanges_samples_for_inputs(boot, isa486, plant_stub):
     assert "missed" not in dump["emulator"].emulator_messages()
 
 
+def test_plant_on_write_tells_the_plant_of_each_dac_write(boot, isa486, plant_stub):
+    """With plant-on-write every DAC write is an exchange too, carrying the
+    new value at the write's time; conversions exchange as before."""
+    stub = plant_stub(lambda index, fields: input_line(PLANT_VOLTS, 0x1234))
+    dump = run_dump(boot, isa486, {"wiring": "plant", "plant": "plant", "plant-on-write": "on"},
+                    extra_args=stub.chardev_args())
+    assert stub.errors == []
+    # mfiodump writes DAC0 to DAC7 once each, then converts 18 times as without the switch.
+    assert len(stub.samples) == 8 + 18
+    for channel, fields in enumerate(stub.samples[:8]):
+        volts = [float(value) for value in fields[2:10]]
+        assert volts == [dac_volts(DUMP_DAC[n]) if n <= channel else 0.0 for n in range(8)], (channel, fields)
+    times = [int(sample[1]) for sample in stub.samples]
+    assert times == sorted(times)
+    # The conversions still read the plant's inputs.
+    assert dump["adc"] == {channel: (channel << 12) | adc_code(PLANT_VOLTS[channel]) for channel in range(8)}
+
+
 def test_plant_silence_and_garbage_keep_the_previous_inputs(boot, isa486, plant_stub):
     before = input_line([1.0] * 8, 0x0001)
     after = input_line([-1.0] * 8, 0x0002)

@@ -11,6 +11,8 @@ with the application's `plant` console command:
     configuration "one": node 1 runs the sampler, the controller and the actuator;
     configuration "two": node 1 the sampler and the actuator, node 2 the controller,
     each finding the publisher it reads by name on the other node;
+    configuration "three": node 1 the sampler, node 2 the controller, node 3
+    the actuator, nodes 1 and 3 both wired to the simulator (--boards 2);
     configuration "redundant": as "two", with a second controller on node 3;
     node 1's actuator follows node 2's "mv" and falls back on node 3's
     (active backup redundancy, the seed's Test Case 3, 9.4.3);
@@ -20,7 +22,10 @@ with the application's `plant` console command:
     both and writing AO1, which the plant takes through a diode (the higher
     of the two voters' outputs drives it; a dead node's output does not).
 
-The seed's Test Case 2 (9.4.2, Fig. 9.7, instances 1 and 2); `make plant`
+Every I/O board is wired with plant-on-write, so the simulator learns an
+output when it is written (docs/iobus/mfio-register-map.md).
+
+The seed's Test Case 2 (9.4.2, Fig. 9.7, instances 1 to 3); `make plant`
 (tests_renode/plant.py) and docs/examples/plant/tests use it.
 """
 
@@ -41,7 +46,10 @@ BIT_RATE = 500_000
 
 # Test Case 3's plant input is AO1, read back on AI1 (loopback); AI0 measures the process.
 VOTING_OPTIONS = ["--input-channel", "1", "--other-inputs", "loopback", "--boards", "4"]
-CONFIGURATIONS = ("one", "two", "redundant", "voting")
+CONFIGURATIONS = ("one", "two", "three", "redundant", "voting")
+# The simulator's options beyond PLANT_OPTIONS, and the nodes wired to it, by configuration.
+SIMULATOR_OPTIONS = {"three": ["--boards", "2"], "voting": VOTING_OPTIONS}
+WIRED_NODES = {"three": (1, 3), "voting": (1, 2, 3, 4)}
 COMPONENTS = ("sampler", "controller", "actuator", "voter")
 
 _STARTED = re.compile(r"plant: \w+ started, publisher (0x[0-9a-f]{8})")
@@ -95,14 +103,14 @@ class PlantLab:
         self.timeout = timeout
         self.csv_path = os.path.join(directory, "plant.csv")
         socket_path = os.path.join(directory, "plant.sock")
-        voting = configuration == "voting"
-        self.simulator = start_plant_simulator(socket_path, self.csv_path, VOTING_OPTIONS if voting else ())
-        wired = {"devices": {"isa-mfio": {"wiring": "plant", "plant": "plant"}},
+        self.simulator = start_plant_simulator(socket_path, self.csv_path, SIMULATOR_OPTIONS.get(configuration, ()))
+        wired = {"devices": {"isa-mfio": {"wiring": "plant", "plant": "plant", "plant-on-write": "on"}},
                  "args": ["-chardev", f"socket,id=plant,path={socket_path}"]}
-        nodes = {"node1": {"bus0": "can0", "bus1": "can1", "append": "node=1", **wired}}
-        others = {"one": [], "two": [2], "redundant": [2, 3], "voting": [2, 3, 4]}[configuration]
-        for node in others:
-            nodes[f"node{node}"] = {"bus0": "can0", "bus1": "can1", "append": f"node={node}", **(wired if voting else {})}
+        others = {"one": [], "two": [2], "three": [2, 3], "redundant": [2, 3], "voting": [2, 3, 4]}[configuration]
+        nodes = {}
+        for node in [1, *others]:
+            nodes[f"node{node}"] = {"bus0": "can0", "bus1": "can1", "append": f"node={node}",
+                                    **(wired if node in WIRED_NODES.get(configuration, (1,)) else {})}
         try:
             self.lab = CanLab(boot, board_definition, {"can0": bit_rate, "can1": bit_rate}, nodes, pace=pace,
                               kind=image, timeout=timeout)
@@ -110,6 +118,7 @@ class PlantLab:
             self.control = self.lab.board("node2") if others else self.io
             self.backup = self.lab.board("node3") if configuration == "redundant" else None
             self.nodes = {node: self.lab.board(f"node{node}") for node in [1, *others]}
+            self.actuator = self.nodes[3] if configuration == "three" else self.io
             everyone = [1, *others]
             for node in everyone if others else []:
                 attach_redundant(self.lab.board(f"node{node}"), node, [peer for peer in everyone if peer != node],
@@ -141,13 +150,12 @@ class PlantLab:
         # "pv", the actuator node 2's "mv" (distributed names).
         pv = self._started(self.io, "plant io")
         mv = self._started(self.control, "plant control")
-        if self.backup is None:
-            line = "plant actuate"
-        else:
+        line = "plant actuate"
+        if self.backup is not None:
             # Two publishers are called "mv": the actuator is given both ids.
             self.backup_mv = self._started(self.backup, "plant control")
             line = f"plant actuate {mv} {self.backup_mv}"
-        output = self.io.command(line, timeout=self.timeout)
+        output = self.actuator.command(line, timeout=self.timeout)
         if f"actuator started, reading {mv}" not in output:
             raise PlantError(f"{line}: {output!r}")
         return pv, mv
@@ -182,7 +190,8 @@ class PlantLab:
         """Every component's statistics, from the nodes that run them."""
         io = statistics(self.io, self.timeout)
         control = statistics(self.control, self.timeout)
-        return {"sampler": io["sampler"], "controller": control["controller"], "actuator": io["actuator"]}
+        actuator = statistics(self.actuator, self.timeout) if self.actuator is not self.io else io
+        return {"sampler": io["sampler"], "controller": control["controller"], "actuator": actuator["actuator"]}
 
     def trajectory(self):
         return read_trajectory(self.csv_path)

@@ -9,7 +9,8 @@
  *
  * The board is wired either in loopback (DAC n drives ADC n, DO drives DI)
  * or to a plant simulator over a socket chardev, with which it exchanges one
- * SAMPLE/INPUT line pair at every conversion start. Noise is deterministic
+ * SAMPLE/INPUT line pair at every conversion start (and, with plant-on-write,
+ * at every DAC write). Noise is deterministic
  * from a seed, and faults (a stuck DI bit, a dead ADC channel, a missing
  * interrupt) are injected through properties.
  *
@@ -117,6 +118,8 @@ struct IsaMfioState {
     uint32_t stuck_di_value;
     int32_t dead_adc_channel;
     bool no_irq;
+    /* wiring=plant: a DAC write is an exchange too (plant-on-write). */
+    bool plant_on_write;
 
     /* Derived from the properties at realize time. */
     bool plant_wiring;
@@ -562,6 +565,13 @@ static void mfio_write(void *opaque, hwaddr addr, uint64_t value,
         break;
     case MFIO_DAC0 ... MFIO_DAC7:
         s->dac[(addr - MFIO_DAC0) / 2] = value & MFIO_CODE_MAX;
+        /*
+         * The plant otherwise learns the DACs at the next conversion, which
+         * a board that only drives outputs never starts.
+         */
+        if (s->plant_wiring && s->plant_on_write) {
+            mfio_plant_exchange(s);
+        }
         break;
     default:
         /* Read-only and unused offsets ignore writes. */
@@ -704,6 +714,7 @@ static Property mfio_properties[] = {
     DEFINE_PROP_UINT32("stuck-di-value", IsaMfioState, stuck_di_value, 0),
     DEFINE_PROP_INT32("dead-adc-channel", IsaMfioState, dead_adc_channel, -1),
     DEFINE_PROP_BOOL("no-irq", IsaMfioState, no_irq, false),
+    DEFINE_PROP_BOOL("plant-on-write", IsaMfioState, plant_on_write, false),
     DEFINE_PROP_END_OF_LIST(),
 };
 
@@ -740,6 +751,8 @@ static void mfio_class_init(ObjectClass *klass, void *data)
         "fault: this ADC channel always converts 0x800 (-1: none)");
     object_class_property_set_description(klass, "no-irq",
         "fault: conversions complete but never raise the interrupt");
+    object_class_property_set_description(klass, "plant-on-write",
+        "with wiring=plant, a DAC write is an exchange with the plant too");
     set_bit(DEVICE_CATEGORY_MISC, dc->categories);
 }
 

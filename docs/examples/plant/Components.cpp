@@ -184,7 +184,11 @@ void controllerEntry(uintptr_t)
 void actuate(const Signal& mv)
 {
     const Status status = iobus::writeWord(board, iobus::channel::kAnalogOutput0, dacCode(mv.microvolts));
-    const uint64_t delay = dcos::timerAgent.Uptime() - mv.sampledNs;
+    // The sample's uptime is the sampler's node's: on another node it is
+    // comparable only when the two clocks started together (as in the lab),
+    // and a sample that seems to come from the future counts as no delay.
+    const uint64_t now = dcos::timerAgent.Uptime();
+    const uint64_t delay = now > mv.sampledNs ? now - mv.sampledNs : 0;
     record([&] {
         if (status != Status::Ok) {
             ++actuator.errors;
@@ -311,8 +315,8 @@ void voterEntry(uintptr_t)
         lastPv = chosen.microvolts;
         const int32_t mv = controlOutput(setPointMicrovolts, chosen.microvolts);
         Status status = iobus::writeWord(board, iobus::channel::kAnalogOutput0 + kVoterOutput, dacCode(mv));
-        // The read-back checks the output took; its conversion is also what
-        // tells the lab's plant the output changed (one exchange per conversion).
+        // The read-back checks that the output took: a broken output stage or
+        // wire shows as a read-back error, not only as a plant that drifts.
         const Result<iobus::AnalogValue> readBack =
             status == Status::Ok ? iobus::readAnalogInputMicrovolts(board, kVoterReadBack) : Result<iobus::AnalogValue>(status);
         status = readBack.status();

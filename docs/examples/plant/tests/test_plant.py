@@ -1,4 +1,4 @@
-"""The seed's Test Case 2 (9.4.2, Fig. 9.7) with plain tasks: one copy of the loop, on one node and on two.
+"""The seed's Test Case 2 (9.4.2, Fig. 9.7) with plain tasks: one copy of the loop, on one, two and three nodes.
 
 Instance 1: the sampler, the controller and the actuator on node 1.
 Instance 2: the sampler and the actuator on node 1, with the I/O board
@@ -8,9 +8,8 @@ same image and the same commands but for where each component starts; the
 plant must be held at the set point within 20 mV in both, and end within
 5 mV of it: the same control result.
 
-(The seed's instance 3 puts the sampler and the actuator on different
-nodes, which needs the plant wired to two I/O boards; the plant simulator
-serves one.)
+Instance 3: the sampler on node 1, the controller on node 2, the actuator
+on node 3; nodes 1 and 3 each have an I/O board wired to the plant.
 
 Times are emulated (-icount); the hub keeps the boards in step.
 """
@@ -103,3 +102,19 @@ def test_a_redundant_controller_takes_over_when_its_twin_dies(plant):
     assert actuator["writes"] >= samples - 4, (actuator, samples)
     assert actuator["errors"] == 0
     assert settled(trajectory, RUN_S - 1.0) <= BAND_V
+
+
+def test_three_nodes_hold_it_the_same_with_each_component_on_its_own_node(plant):
+    """The seed's instance 3: the sampler on node 1, the controller on node 2,
+    the actuator on node 3, with the I/O boards of nodes 1 and 3 both wired
+    to the plant (the simulator's --boards)."""
+    pv, mv, counts, trajectory = run(plant, "three")
+    assert pv.startswith("0x00018") and mv.startswith("0x00028")
+    assert settled(trajectory, RUN_S - 1.0) <= BAND_V
+    assert abs(trajectory[-1][2] - SET_POINT_V) <= END_V, "the same control result as on one node"
+    assert counts["controller"]["timeouts"] == 0 and counts["controller"]["errors"] == 0
+    assert counts["actuator"]["errors"] == 0
+    assert counts["actuator"]["writes"] >= counts["sampler"]["samples"] - 2
+    # Two publications across the bus, as on two nodes; the lab starts the
+    # boards' clocks together, so the sampler's uptime holds on node 3.
+    assert 1_000 <= counts["actuator"]["max"] < 5_000, counts["actuator"]
