@@ -89,13 +89,13 @@ test-emulator: firmware sdk
 # The reports of the last run are removed first, so that the verdict never
 # reads a figure a failed step left behind.
 bench: deps
-	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH) $(IMAGE_486) $(IMAGE_486_MINIMAL) $(FOOTPRINT_MAP) $(FOOTPRINT_MAP_MINIMAL)
-	@rm -f $(PRIMITIVES_REPORT) $(THREAD_METRIC_REPORT) $(FOOTPRINT_REPORT) $(BUDGET_REPORT)
+	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH) $(IMAGE_486) $(IMAGE_486_MINIMAL) $(IMAGE_486_TEST_COUNTING) $(FOOTPRINT_MAP) $(FOOTPRINT_MAP_MINIMAL)
+	@rm -f $(PRIMITIVES_REPORT) $(THREAD_METRIC_REPORT) $(REMOTE_REPORT) $(FOOTPRINT_REPORT) $(BUDGET_REPORT)
 	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board isa486 --output $(BENCH_REPORT) --primitives $(PRIMITIVES_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/thread_metric/run_thread_metric.py --board isa486 --output $(THREAD_METRIC_REPORT) --budgets $(BENCH_BUDGETS)
-	@$(PYTHON) tests_renode/bench/remote_bench.py --output $(REMOTE_REPORT)
+	@$(PYTHON) tests_renode/bench/remote_bench.py --output $(REMOTE_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/bench/footprint.py --maps $(FOOTPRINT_MAPS) --build-directory $(FW_BUILD) --output $(FOOTPRINT_REPORT) --budgets $(BENCH_BUDGETS)
-	@$(PYTHON) tests_renode/bench/budgets.py --budgets $(BENCH_BUDGETS) --primitives $(PRIMITIVES_REPORT) --thread-metric $(THREAD_METRIC_REPORT) --footprint $(FOOTPRINT_REPORT) --output $(BUDGET_REPORT) $(BENCH_STRICT)
+	@$(PYTHON) tests_renode/bench/budgets.py --budgets $(BENCH_BUDGETS) --primitives $(PRIMITIVES_REPORT) --thread-metric $(THREAD_METRIC_REPORT) --footprint $(FOOTPRINT_REPORT) --remote $(REMOTE_REPORT) --output $(BUDGET_REPORT) $(BENCH_STRICT)
 
 clean:
 	rm -rf $(BUILD)

@@ -92,8 +92,26 @@ $(FOOTPRINT_MAP): $(FW_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 $(FOOTPRINT_MAP_MINIMAL): $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	$(call link_map,$(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS))
 
-# Built with the other images, so the emulator suite can check the framework.
-firmware: $(IMAGE_486_BENCH)
+# The counting image: the test image's objects, compiled once, plus the
+# instruction counter (tests_renode/bench/counter/InstructionCounter.cpp),
+# which defines the weak dcosInstructionCount the remote agent and the CAN
+# driver read (arch_x86/InstructionCounter.hpp). The remote bench boots it
+# on the board's benchmark CPU with -icount to count the instructions of a
+# remote transaction on each node (docs/performance.md, "Remote
+# transactions"). Like the bench image it holds CPUID and RDTSC, so it is
+# exempt from the i486 check; it tests for the counter at boot and runs on
+# a 486 too, counting nothing.
+IMAGE_486_TEST_COUNTING := $(BUILD)/486/dcos486-test-counting.elf
+FW_COUNTER_OBJS := $(call fw_objects,tests_renode/bench/counter/InstructionCounter.cpp)
+
+$(IMAGE_486_TEST_COUNTING): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_COUNTER_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_COUNTER_OBJS)
+
+# Built with the other images, so the emulator suite can check the framework
+# and run the remote bench.
+firmware: $(IMAGE_486_BENCH) $(IMAGE_486_TEST_COUNTING)
 
 $(IMAGE_486_BENCH): $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS) firmware/boot/link.ld
 	@mkdir -p $(dir $@)

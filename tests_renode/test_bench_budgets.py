@@ -24,6 +24,7 @@ sys.path.insert(0, os.path.join(HERE, "thread_metric"))
 
 import budgets  # noqa: E402
 import footprint  # noqa: E402
+import remote_bench  # noqa: E402
 import run_thread_metric  # noqa: E402
 
 BUDGETS_PY = os.path.join(BENCH, "budgets.py")
@@ -152,6 +153,55 @@ def test_the_budget_file_refuses_unknown_keys_and_entries_that_set_nothing():
         budgets.parse_budgets({"primitives": {"Port.Send": {"note": "nothing to check"}}})
     with pytest.raises(budgets.BudgetFileError, match="no budget"):
         budgets.parse_budgets({"thread_metric": {"message_processing": {"freertos": 236}}})
+
+
+def remote_entry(**figures):
+    """A remote.json primitive whose instruction figures are (min, max) pairs."""
+    return {"instructions": {figure: {"min": low, "median": low, "max": high}
+                             for figure, (low, high) in figures.items()}}
+
+
+def test_remote_counts_must_be_there_positive_identical_and_within_a_budget_where_one_is_set():
+    fixture = budgets.parse_budgets({"remote": {
+        "SemaphoreRelease": {"figures": ["caller_request", "callee"], "identical": True, "now": {"callee": 4070},
+                             "bound": "the same count on every call"},
+        "PostEvent": {"figures": ["callee"], "budget": {"callee": 4000}},
+        "MessagePortSend": {"figures": ["callee"], "identical": True, "measured": False}}})
+    rows = budgets.check_remote(fixture, {
+        "SemaphoreRelease": remote_entry(caller_request=(1881, 1881), callee=(4070, 4073)),
+        "PostEvent": remote_entry(callee=(4096, 4096))})
+    by_figure = {(row["primitive"], row["figure"]): row for row in rows}
+    request = by_figure["SemaphoreRelease", "caller_request"]
+    assert request["verdict"] == budgets.NO_COUNT and request["identical_agrees"] and request["offences"] == []
+    callee = by_figure["SemaphoreRelease", "callee"]
+    assert callee["identical_agrees"] is False and callee["now"] == 4070
+    assert callee["offences"] == ["remote SemaphoreRelease callee: 4070 to 4073 instructions: every call must count "
+                                  "the same"]
+    post = by_figure["PostEvent", "callee"]
+    assert post["verdict"] == budgets.OVER and post["identical_agrees"] is None
+    assert post["offences"] == ["remote PostEvent callee: 4096 instructions, over its budget of 4000"]
+    port = by_figure["MessagePortSend", "callee"]
+    assert port["verdict"] == budgets.NOT_MEASURED_YET and port["offences"] == []
+    assert "1 not identical; 2 offenders" in budgets.summary_text(rows)
+    # An image without the counter reports zeros, and a report without the figure is missing.
+    rows = budgets.check_remote(fixture, {"SemaphoreRelease": remote_entry(caller_request=(0, 0))})
+    assert any("0 instructions: not counted" in offence for offence in budgets.offenders(rows))
+    assert any("callee: no figure" in offence for offence in budgets.offenders(rows))
+    lines = budgets.remote_lines(budgets.check_remote(fixture, {}), budgets.DEFAULT_BUDGETS)
+    assert any("SemaphoreRelease: bound: the same count on every call" in line for line in lines)
+
+
+def test_the_budget_file_refuses_remote_entries_it_could_not_check():
+    with pytest.raises(budgets.BudgetFileError, match="names no figures"):
+        budgets.parse_budgets({"remote": {"PostEvent": {"identical": True}}})
+    with pytest.raises(budgets.BudgetFileError, match="unknown figure"):
+        budgets.parse_budgets({"remote": {"PostEvent": {"figures": ["calee"], "identical": True}}})
+    with pytest.raises(budgets.BudgetFileError, match="not among its figures"):
+        budgets.parse_budgets({"remote": {"PostEvent": {"figures": ["callee"], "budget": {"caller_reply": 1}}}})
+    with pytest.raises(budgets.BudgetFileError, match="neither"):
+        budgets.parse_budgets({"remote": {"PostEvent": {"figures": ["callee"]}}})
+    with pytest.raises(budgets.BudgetFileError, match="unknown keys"):
+        budgets.parse_budgets({"remote": {"PostEvent": {"figures": ["callee"], "flat": True}}})
 
 
 def run_verdict(tmp_path, primitives, strict):
@@ -379,6 +429,17 @@ def test_the_budget_file_holds_the_issues_budgets_under_registered_benchmark_nam
         assert real["primitives"][f"{agent}.NameToObject"]["flat"]
     for name in ("Timer.SetSystemClock", "Task.KillTask", "Task.Delete", "Heap.Allocate", "Heap.Return"):
         assert real["primitives"][name]["flat"], name
+
+
+def test_the_remote_budgets_name_every_primitive_the_remote_bench_measures_and_ask_for_identical_calls():
+    real = budgets.load_budgets()
+    assert set(real["remote"]) == {name for name, _ in remote_bench.PRIMITIVES}
+    for name, budget in real["remote"].items():
+        assert budget["identical"], name
+        assert {"caller_request", "caller_reply", "callee", "receive_interrupt_callee"} <= set(budget["figures"]), name
+        assert budget["note"], f"{name}: say in one line what the transaction is"
+        # Issue 14 sets no number: no budget is made up.
+        assert not budget["budget"] and budget["bound"], name
 
 
 def test_every_thread_metric_budget_is_half_of_freertos_and_the_footprint_budgets_are_the_issues():

@@ -210,14 +210,18 @@ def test_a_request_runs_at_the_requesters_priority_on_the_serving_node(pair):
     assert 20 in priorities and 2 in priorities
 
 
-def test_the_benchs_remote_figures_are_their_frames_and_at_least_their_bus_time(tmp_path):
-    """make bench's remote figures (bench/remote_bench.py), checked against the physics of the bus."""
-    output = tmp_path / "remote.json"
+def run_remote_bench(output):
+    """bench/remote_bench.py with 3 calls per primitive and 10 publications; its report."""
     run = subprocess.run([sys.executable, os.path.join(os.path.dirname(__file__), "bench", "remote_bench.py"),
                           "--calls", "3", "--writes", "10", "--output", str(output)], capture_output=True, text=True,
                          timeout=600)
     assert run.returncode == 0, run.stdout + run.stderr
-    report = json.loads(output.read_text())
+    return json.loads(output.read_text())
+
+
+def test_the_benchs_remote_figures_are_their_frames_and_at_least_their_bus_time(tmp_path):
+    """make bench's remote figures (bench/remote_bench.py), checked against the physics of the bus."""
+    report = run_remote_bench(tmp_path / "remote.json")
     # A request and its reply: two extended 8-byte frames one after the
     # other, each at least its length with no stuff bit at all (54 + 8n + 13
     # bits, docs/protocols/labbus.md), at 1 Mbit/s; a port send's request is
@@ -236,6 +240,61 @@ def test_the_benchs_remote_figures_are_their_frames_and_at_least_their_bus_time(
     for bus, entry in publications["buses"].items():
         assert entry["frames_per_publication"] == 3, bus
         assert entry["bus_time_us"]["min"] >= 3 * frame_us, (bus, entry, frame_us)
+
+
+# Instructions a node retires between the chip's transmit request and the
+# counter's read that ends the callee's count (the return through the link),
+# or between a frame's end and the start of its receive routine (the
+# kernel's interrupt entry): the callee's count and the bus gap between
+# request and reply measure one interval and differ by no more.
+COUNT_TO_BUS_SLACK = 200
+
+
+def test_the_benchs_remote_instruction_counts_are_exact_and_fit_the_bus(tmp_path):
+    """The instructions per remote primitive on each node (remote.json's "instructions"): present, positive,
+    the same on every call and from run to run, the caller's own work a small part of its span, the
+    callee's within the bus gap."""
+    report = run_remote_bench(tmp_path / "first.json")
+    assert report["cpu"] == "pentium" and report["image"].endswith("dcos486-test-counting.elf")
+    for name, entry in report["primitives"].items():
+        counts = entry["instructions"]
+        calls = counts["per_call"]
+        assert len(calls) == report["calls_per_primitive"] == 3, name
+        # A second identical call counts exactly what the first did, on both nodes.
+        assert all(call == calls[0] for call in calls), (name, calls)
+        first = calls[0]
+        for figure in ("caller_request", "caller_reply", "caller_span", "callee"):
+            assert first[figure] > 0, (name, figure, first)
+        assert counts["receive_interrupt_caller"] > 0 and counts["receive_interrupt_callee"] > 0, (name, counts)
+        # The caller's own work is a few thousand instructions of a span that
+        # is mostly the bus: under -icount the halted processor's time counts
+        # one per ns, so the span is the round trip in ns.
+        assert first["caller_own"] == first["caller_request"] + first["caller_reply"], (name, first)
+        assert first["caller_own"] * 20 < first["caller_span"], (name, first)
+        assert first["caller_waiting"] == first["caller_span"] - first["caller_own"], (name, first)
+        trip = entry["round_trip_us"]
+        assert (trip["min"] - 1) * 1000 <= first["caller_span"] <= (trip["max"] + 1) * 1000, (name, trip, first)
+        # The reply's receive routine is part of the caller's reply share.
+        assert counts["receive_interrupt_caller"] < first["caller_reply"], (name, counts)
+        # The callee's share, from the request's last frame to the reply,
+        # is the time between them on the bus (one instruction per ns, no
+        # halt in it), and holds the request's receive routine.
+        gap = entry["bus_gap_ns"]
+        assert gap["min"] == gap["max"], (name, gap)
+        last_frame = first["callee"] - first["callee_parts_before"]
+        assert abs(last_frame - gap["min"]) <= COUNT_TO_BUS_SLACK, (name, first, gap)
+        assert counts["receive_interrupt_callee"] < last_frame < 10_000, (name, counts, first)
+        if name == "MessagePortSend":
+            # Two earlier frames, each an interrupt and the receiver's share.
+            assert 2 * counts["receive_interrupt_callee"] < first["callee_parts_before"] < 10_000, (name, first)
+        else:
+            assert first["callee_parts_before"] == 0, (name, first)
+        # Every [remote] budget of budgets.toml holds.
+        assert entry["budgets"] and all(not row["offences"] for row in entry["budgets"]), (name, entry["budgets"])
+    # Exact: a second run of the two boards counts exactly the same.
+    again = run_remote_bench(tmp_path / "again.json")
+    for name, entry in report["primitives"].items():
+        assert again["primitives"][name]["instructions"] == entry["instructions"], name
 
 
 def test_a_requester_that_dies_while_it_waits_frees_the_serving_nodes_workers(pair):

@@ -15,7 +15,11 @@ when there is any offender:
   - a fixed-cost benchmark (cost "constant") that is NOT FLAT, budgeted or
     not: the design claims O(1) for it;
   - a budget whose benchmark or test reported no figure although it is
-    expected to be measured.
+    expected to be measured;
+  - a remote transaction's instruction count (remote_bench.py's
+    remote.json, the [remote] table) that is absent or not positive, over
+    a budget set for it, or not the same on every call where the entry
+    asks for identical calls.
 
 A budget marked `measured = false` is reported as "not measured yet" and is
 never an offender: its benchmark or image does not exist yet, and no figure
@@ -43,6 +47,12 @@ NO_COUNT = "no count"
 _PRIMITIVE_KEYS = {"budget", "flat", "now", "measured", "note", "bound"}
 _THREAD_METRIC_KEYS = {"freertos", "budget", "now", "note", "measured"}
 _FOOTPRINT_KEYS = {"image", "kernel", "text_budget", "now", "note", "measured"}
+_REMOTE_KEYS = {"figures", "identical", "budget", "now", "bound", "note", "measured"}
+# The instruction figures remote_bench.py reports per primitive: a spread
+# over the calls ({"min", "median", "max"}) each, in remote.json's
+# "instructions", and the two receive interrupts (one count each).
+REMOTE_FIGURES = ("caller_request", "caller_reply", "caller_own", "caller_span", "caller_waiting", "callee",
+                  "callee_parts_before", "receive_interrupt_caller", "receive_interrupt_callee")
 
 
 class BudgetFileError(Exception):
@@ -65,10 +75,10 @@ def load_budgets(path=DEFAULT_BUDGETS):
 
 def parse_budgets(data, origin="budgets"):
     """Checks a budget file's parsed TOML and fills in the defaults."""
-    unknown_tables = set(data) - {"primitives", "thread_metric", "footprint"}
+    unknown_tables = set(data) - {"primitives", "thread_metric", "footprint", "remote"}
     if unknown_tables:
         raise BudgetFileError(f"{origin}: unknown tables {sorted(unknown_tables)}")
-    budgets = {"primitives": {}, "thread_metric": {}, "footprint": {}}
+    budgets = {"primitives": {}, "thread_metric": {}, "footprint": {}, "remote": {}}
     for table, allowed in (("primitives", _PRIMITIVE_KEYS), ("thread_metric", _THREAD_METRIC_KEYS),
                            ("footprint", _FOOTPRINT_KEYS)):
         for name, entry in data.get(table, {}).items():
@@ -94,7 +104,40 @@ def parse_budgets(data, origin="budgets"):
                 if entry["measured"] and "image" not in entry:
                     raise BudgetFileError(f"{origin}: [footprint.{name}] is measured but names no image")
             budgets[table][name] = entry
+    for name, entry in data.get("remote", {}).items():
+        budgets["remote"][name] = _parse_remote(name, entry, origin)
     return budgets
+
+
+def _parse_remote(name, entry, origin):
+    """Checks one [remote."<primitive>"] entry and fills in the defaults."""
+    where = f'{origin}: [remote."{name}"]'
+    unknown = set(entry) - _REMOTE_KEYS
+    if unknown:
+        raise BudgetFileError(f"{where} has unknown keys {sorted(unknown)}")
+    entry = dict(entry)
+    entry.setdefault("measured", True)
+    entry.setdefault("note", "")
+    entry.setdefault("identical", False)
+    entry.setdefault("budget", {})
+    entry.setdefault("now", {})
+    figures = entry.get("figures")
+    if not isinstance(figures, list) or not figures:
+        raise BudgetFileError(f"{where} names no figures")
+    for figure in figures:
+        if figure not in REMOTE_FIGURES:
+            raise BudgetFileError(f"{where}: unknown figure {figure!r}; the figures are {', '.join(REMOTE_FIGURES)}")
+    for key in ("budget", "now"):
+        if not isinstance(entry[key], dict):
+            raise BudgetFileError(f"{where} {key} must be a table of figures")
+        for figure, value in entry[key].items():
+            if figure not in figures:
+                raise BudgetFileError(f"{where} {key} names {figure!r}, which is not among its figures")
+            if not isinstance(value, (int, float)) or value < 0:
+                raise BudgetFileError(f"{where} {key}.{figure} must be a number >= 0")
+    if not entry["budget"] and not entry["identical"] and "bound" not in entry:
+        raise BudgetFileError(f"{where} sets neither a budget, identical nor a bound")
+    return entry
 
 
 def _figure(report_entry, objects):
@@ -233,6 +276,91 @@ def check_footprint(budgets, images):
     return rows
 
 
+def _remote_spread(entry, figure):
+    """A figure of one primitive's remote.json entry as (min, max), or None when absent."""
+    counts = (entry or {}).get("instructions") or {}
+    value = counts.get(figure)
+    if isinstance(value, dict):
+        low, high = value.get("min"), value.get("max")
+    else:
+        low = high = value
+    if not isinstance(low, (int, float)) or not isinstance(high, (int, float)):
+        return None
+    return low, high
+
+
+def check_remote(budgets, results):
+    """Rows for every figure a [remote] budget names; results is remote.json's "primitives".
+
+    A row: "primitive", "figure", "budget" (or None), "now", "bound",
+    "note", "measured", "min" and "max" over the calls, "verdict" (within,
+    over, "no count" where no number is set, missing, not measured yet),
+    "identical" (whether it is asked for), "identical_agrees" (True, False,
+    or None where it is not asked for or cannot be told) and "offences".
+    """
+    rows = []
+    for name, budget in budgets.get("remote", {}).items():
+        entry = results.get(name)
+        for figure in budget["figures"]:
+            spread = _remote_spread(entry, figure)
+            row = {"primitive": name, "figure": figure, "budget": budget["budget"].get(figure),
+                   "now": budget["now"].get(figure), "bound": budget.get("bound"), "note": budget["note"],
+                   "measured": budget["measured"], "identical": budget["identical"],
+                   "min": spread[0] if spread else None, "max": spread[1] if spread else None,
+                   "identical_agrees": None, "offences": []}
+            label = f"remote {name} {figure}"
+            if spread is None:
+                row["verdict"] = NOT_MEASURED_YET if not budget["measured"] else MISSING
+                if budget["measured"]:
+                    row["offences"].append(f"{label}: no figure (remote.json has none)")
+                rows.append(row)
+                continue
+            low, high = spread
+            if low <= 0:
+                row["offences"].append(f"{label}: {low} instructions: not counted")
+            if row["budget"] is not None:
+                row["verdict"] = OVER if high > row["budget"] else WITHIN
+                if row["verdict"] == OVER:
+                    row["offences"].append(f"{label}: {high} instructions, over its budget of {row['budget']}")
+            else:
+                row["verdict"] = NO_COUNT
+            if budget["identical"]:
+                row["identical_agrees"] = low == high
+                if not row["identical_agrees"]:
+                    row["offences"].append(f"{label}: {low} to {high} instructions: every call must count the same")
+            rows.append(row)
+    return rows
+
+
+def remote_lines(rows, budget_path):
+    """The console table of the remote budgets."""
+    lines = [f"Remote budgets ({os.path.relpath(budget_path, REPOSITORY)}, [remote]): each figure's largest count "
+             "over the calls against its budget; identical: whether every call counted the same where it must"]
+    if not rows:
+        return lines + ["  (none)"]
+    table = [(row["primitive"], row["figure"], count_text(row["min"]), count_text(row["max"]),
+              count_text(row["budget"]) if row["budget"] is not None else (row["bound"] and "bound") or "-",
+              verdict_text(row), identical_text(row), count_text(row["now"])) for row in rows]
+    lines += _table(("primitive", "figure", "min", "max", "budget", "verdict", "identical", "now"), table,
+                    ("<", "<", ">", ">", ">", "<", "<", ">"))
+    bounds = {}
+    for row in rows:
+        if row["bound"] and row["primitive"] not in bounds.setdefault(row["bound"], []):
+            bounds[row["bound"]].append(row["primitive"])
+    for bound, primitives in bounds.items():
+        lines.append(f"  {', '.join(primitives)}: bound: {bound}")
+    lines.append("  " + summary_text(rows))
+    return lines
+
+
+def identical_text(row):
+    if not row["identical"]:
+        return "-"
+    if row["identical_agrees"] is None:
+        return "?"
+    return "agree" if row["identical_agrees"] else "DIFFER"
+
+
 def offenders(*row_lists):
     """Every offence of every row, in order."""
     return [offence for rows in row_lists for row in rows for offence in row["offences"]]
@@ -302,9 +430,12 @@ def summary_text(rows):
     for row in rows:
         counts[row["verdict"]] = counts.get(row["verdict"], 0) + 1
     differ = sum(1 for row in rows if row.get("flat_agrees") is False)
+    unequal = sum(1 for row in rows if row.get("identical_agrees") is False)
     parts = [f"{counts[key]} {key}" for key in (WITHIN, OVER, NO_COUNT, MISSING, NOT_MEASURED_YET) if key in counts]
     if differ:
         parts.append(f"{differ} not flat")
+    if unequal:
+        parts.append(f"{unequal} not identical")
     found = sum(len(row["offences"]) for row in rows)
     return "; ".join(parts) + f"; {found} offender{'' if found == 1 else 's'}"
 
@@ -325,6 +456,7 @@ def main():
     parser.add_argument("--primitives", default=os.path.join(bench, "primitives.json"))
     parser.add_argument("--thread-metric", default=os.path.join(bench, "thread_metric.json"))
     parser.add_argument("--footprint", default=os.path.join(bench, "footprint.json"))
+    parser.add_argument("--remote", default=os.path.join(bench, "remote.json"))
     parser.add_argument("--output", default=os.path.join(bench, "budgets.json"))
     parser.add_argument("--strict", action="store_true", help="exit 1 when any figure offends its budget")
     arguments = parser.parse_args()
@@ -341,20 +473,25 @@ def main():
     footprint_report = read_json(arguments.footprint) or {}
     footprint = check_footprint(budgets, {name: image["kernel"]["text"]
                                           for name, image in footprint_report.get("images", {}).items()})
-    found = offenders(primitives, thread_metric, footprint)
+    remote = check_remote(budgets, (read_json(arguments.remote) or {}).get("primitives", {}))
+    found = offenders(primitives, thread_metric, footprint, remote)
     not_measured = [row["name"] for rows in (primitives, thread_metric, footprint) for row in rows
                     if row["verdict"] == NOT_MEASURED_YET]
+    not_measured += [f"remote {row['primitive']} {row['figure']}" for row in remote
+                     if row["verdict"] == NOT_MEASURED_YET]
 
     os.makedirs(os.path.dirname(os.path.abspath(arguments.output)), exist_ok=True)
     with open(arguments.output, "w", encoding="utf-8") as handle:
         json.dump({"strict": arguments.strict, "offenders": found, "not_measured_yet": not_measured,
-                   "primitives": primitives, "thread_metric": thread_metric, "footprint": footprint},
+                   "primitives": primitives, "thread_metric": thread_metric, "footprint": footprint,
+                   "remote": remote},
                   handle, indent=2)
         handle.write("\n")
 
     print()
     print(f"Budget verdict: {len(found)} offender{'' if len(found) == 1 else 's'}; primitives: {summary_text(primitives)}; "
-          f"Thread-Metric: {summary_text(thread_metric)}; footprint: {summary_text(footprint)}")
+          f"Thread-Metric: {summary_text(thread_metric)}; footprint: {summary_text(footprint)}; "
+          f"remote: {summary_text(remote)}")
     if not_measured:
         print(f"not measured yet (budget recorded, no benchmark or image yet): {', '.join(not_measured)}")
     print(f"wrote {arguments.output}")

@@ -225,7 +225,7 @@ class CanLab:
     """A hub with named buses and the boards joined to it."""
 
     def __init__(self, boot, board_definition, buses, wiring, pace=None, kind="test", timeout=DEFAULT_TIMEOUT,
-                 lines=None, append=""):
+                 lines=None, append="", cpu=None):
         """buses maps bus names to bit rates; wiring maps board names to the
         card's channel wiring, e.g. {"board1": {"bus0": "can0", "bus1": "can1"}},
         where the key "rs485" names the lab RS-485 line the board's RS-485
@@ -235,7 +235,10 @@ class CanLab:
         kernel command line of every board; the key "append" of a board's
         wiring gives that board its own (e.g. "node=2"), the key "devices"
         more device properties ({"isa-mfio": {"wiring": "plant", ...}}) and
-        the key "args" more emulator arguments (a -chardev for them)."""
+        the key "args" more emulator arguments (a -chardev for them). cpu
+        replaces the board's CPU model on every board (the remote bench's
+        counting image runs on the board's benchmark_cpu, whose time-stamp
+        counter counts instructions under -icount)."""
         self._directory = tempfile.TemporaryDirectory(prefix="dcos-canlab-")
         self.socket_path = os.path.join(self._directory.name, "hub.sock")
         self.hub = Hub(self.socket_path, buses, expect=list(wiring), pace=pace, timeout=timeout, lines=lines)
@@ -264,6 +267,8 @@ class CanLab:
                 options = {"append": board_append} if board_append else {}
                 if line_ports:
                     options["line_ports"] = line_ports
+                if cpu:
+                    options["cpu"] = cpu
                 emulator = boot(board_definition, kind, icount=True, name=name,
                                 device_properties={"isa-sja1000": properties, **devices},
                                 extra_args=["-rtc", f"base={RTC_BASE}", *board_args], **options)

@@ -40,12 +40,15 @@ class World:
         self.timings = {}
         self._emulators = []
 
-    def boot(self, board, kind, icount=False, name=None, device_properties=None, extra_args=(), append=""):
+    def boot(self, board, kind, icount=False, name=None, device_properties=None, extra_args=(), append="",
+             cpu=None):
         """The lab plugin's boot fixture, for a module-scoped CanLab; the emulators close with the world.
 
-        kind is an image kind of the board or the path of an image file."""
+        kind is an image kind of the board or the path of an image file; cpu
+        replaces the board's CPU model (the remote bench's counting image
+        runs on the board's benchmark_cpu)."""
         image = kind if os.path.sep in kind else board.image(kind)
-        emulator = Emulator(board, image, append=append, icount=icount,
+        emulator = Emulator(board, image, append=append, icount=icount, cpu=cpu,
                             device_properties=device_properties, extra_args=extra_args, name=name)
         self._emulators.append(emulator)
         return emulator.start()

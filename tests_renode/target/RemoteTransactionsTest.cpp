@@ -264,14 +264,24 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         return CommandResult::Ok;
     }
     // The primitives, at the console's priority or at "at=P" (the request's
-    // priority, which the serving node inherits).
+    // priority, which the serving node inherits). "tick" begins the call just
+    // after a tick of the system clock: at 1 Mbit/s a round trip is well
+    // under the default tick period of 1 ms, so no tick interrupt lands in
+    // the call on either node (the lab's boards boot in step), and the
+    // remote bench's instruction counts are the same on every call.
     int first = 2;
     unsigned long priority = 0xFF;
-    if (argc >= 3 && argv[2][0] == 'a' && argv[2][1] == 't' && argv[2][2] == '=') {
-        if (!shell::Shell::parseUnsigned(argv[2] + 3, priority) || priority > dcos::kLowestPriority) {
-            return CommandResult::UsageError;
+    bool afterTick = false;
+    for (; first < argc; ++first) {
+        if (argv[first][0] == 'a' && argv[first][1] == 't' && argv[first][2] == '=') {
+            if (!shell::Shell::parseUnsigned(argv[first] + 3, priority) || priority > dcos::kLowestPriority) {
+                return CommandResult::UsageError;
+            }
+        } else if (textEquals(argv[first], "tick")) {
+            afterTick = true;
+        } else {
+            break;
         }
-        first = 3;
     }
     if (argc < first + 1 || !parseObjectId(argv[first], id)) {
         return CommandResult::UsageError;
@@ -287,6 +297,9 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         const Result<uint8_t> current = taskAgent.GetPriority(self);
         oldPriority = current.ok() ? current.value() : 0;
         (void)taskAgent.ChangePriority(self, static_cast<uint8_t>(priority));
+    }
+    if (afterTick) {
+        (void)taskAgent.SleepFor(1); // Wakes at the next tick.
     }
     const uint64_t start = timerAgent.Uptime();
     Status status = Status::InvalidArgument;
@@ -346,13 +359,14 @@ DCOS_SHELL_COMMAND_DETAILED(
     remoteCommand, "remote", "call primitives by id, local or remote, for the lab's tests (test image only)",
     "remote sem <count> [max] | sem binary | named <name> local|regional|global | delete <semaphore> | "
     "name task|semaphore|publisher|timer <name> | listener | got | hog <priority> <ms> | waiter <id> | kill <task> | "
-    "acquire [at=P] <id> <ms> | release [at=P] <id> | count [at=P] <id> | post [at=P] <id> <events> | "
-    "signal [at=P] <id> <n> | state [at=P] <task> | priority [at=P] <task> | holder [at=P] <semaphore> | "
-    "port | portgot | send [at=P] <port> <priority*256+first byte> | receive <port>",
+    "acquire [at=P] [tick] <id> <ms> | release [at=P] [tick] <id> | count [at=P] [tick] <id> | "
+    "post [at=P] [tick] <id> <events> | signal [at=P] [tick] <id> <n> | state [at=P] [tick] <task> | "
+    "priority [at=P] [tick] <task> | holder [at=P] [tick] <semaphore> | port | portgot | "
+    "send [at=P] [tick] <port> <priority*256+first byte> | receive [tick] <port>",
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
     "  hog: a task that keeps the processor busy at a priority for a time\r\n"
     "  waiter: a task that acquires the semaphore for ever; kill: KillTask\r\n"
-    "  acquire ms: 0 polls, 4294967295 waits for ever; at=P calls at priority P\r\n"
+    "  acquire ms: 0 polls, 4294967295 waits for ever; at=P calls at priority P; tick calls just after a tick\r\n"
     "  port: a task that owns the global port \"inbox\" and receives from it (portgot shows what came)\r\n"
     "  send: sixteen bytes counting up from the argument's low byte, at the priority in its second byte\r\n"
     "  prints RRES <status> <value> <microseconds taken>",

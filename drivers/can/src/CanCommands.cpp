@@ -751,7 +751,7 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
     shell.print("%s sent=%lu received=%lu rx_queue_overruns=%lu chip_overruns=%lu malformed=%lu bad_ids=%lu "
                 "bus_errors=%lu ack_errors=%lu arbitration_lost=%lu warnings=%lu passives=%lu bus_offs=%lu "
                 "restarts=%lu recoveries=%lu actives=%lu aborts=%lu lone_node_holds=%lu state_changes_lost=%lu "
-                "interrupts=%lu interrupt_loop_limits=%lu\r\n",
+                "interrupts=%lu interrupt_loop_limits=%lu receive_interrupt_instructions=%lu\r\n",
                 kNames[channel], static_cast<unsigned long>(s.framesSent),
                 static_cast<unsigned long>(s.framesReceived), static_cast<unsigned long>(s.receiveQueueOverruns),
                 static_cast<unsigned long>(s.chipOverruns), static_cast<unsigned long>(s.malformedFrames),
@@ -762,7 +762,8 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
                 static_cast<unsigned long>(s.recoveries), static_cast<unsigned long>(s.errorActives),
                 static_cast<unsigned long>(s.aborts), static_cast<unsigned long>(s.loneNodeHolds),
                 static_cast<unsigned long>(s.stateChangesLost), static_cast<unsigned long>(s.interrupts),
-                static_cast<unsigned long>(s.interruptLoopLimits));
+                static_cast<unsigned long>(s.interruptLoopLimits),
+                static_cast<unsigned long>(s.receiveInterruptInstructions));
     if (networkLinks[channel].started()) {
         // What the network link did with the channel's frames (can attach).
         const CanLinkStatistics l = networkLinks[channel].statistics();

@@ -149,6 +149,7 @@ Result<bool> CanNetworkLink::Receive(dcos::SystemMessage& message)
         __builtin_memcpy(message.data, frame.data(), frame.length());
         message.echo = echo;
         message.timeNs = timed.timeNs;
+        message.instructionStamp = timed.instructionStamp;
         if (echo) {
             ++statistics_.echoes;
             return true;

@@ -1,6 +1,7 @@
 #include <sja1000/Sja1000Controller.hpp>
 
 #include <arch_x86/Cpu.hpp>
+#include <arch_x86/InstructionCounter.hpp>
 #include <dcos/SystemAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
@@ -508,16 +509,27 @@ void Sja1000Controller::notify(uint32_t events)
 
 void Sja1000Controller::handleInterrupt()
 {
+    // In an image with an instruction counter (the remote bench's,
+    // docs/performance.md), the counter is read before anything else, so
+    // that the routine's own count and the stamp of the frames it keeps
+    // cover all of it. Every other image pays a compare and a branch here
+    // and at the end, and one OR per cause.
+    if (arch_x86::hasInstructionCounter()) {
+        countStart_ = dcosInstructionCount();
+        countKeptBefore_ = receiveCount_;
+    }
     // First, before the chip is even read: the closer to the frame's end on
     // the bus, the closer two nodes' stamps of it (docs/protocols/time.md).
     const uint64_t now = dcos::TimerAgent::Uptime();
     ++statistics_.interrupts;
+    uint8_t seen = 0;
     unsigned handled = 0;
     for (; handled < kInterruptLoopBound; ++handled) {
         const uint8_t causes = chip_.interrupts();
         if ((causes & kEnabledInterrupts) == 0) {
             break;
         }
+        seen |= causes;
         if ((causes & reg::kInterruptDataOverrun) != 0) {
             ++statistics_.chipOverruns;
             chip_.clearOverrun();
@@ -544,6 +556,33 @@ void Sja1000Controller::handleInterrupt()
     }
     if (handled == kInterruptLoopBound) {
         ++statistics_.interruptLoopLimits;
+    }
+    if (arch_x86::hasInstructionCounter()) {
+        finishCountedInterrupt(seen);
+    }
+}
+
+void Sja1000Controller::finishCountedInterrupt(uint8_t seen)
+{
+    // The routine's count is read first, so that this bookkeeping, which
+    // only a counting image does, stays out of it.
+    const uint64_t end = arch_x86::instructionCount();
+    if (countStart_ == 0) {
+        return; // The processor has no time-stamp counter.
+    }
+    // One received frame and nothing else: the figure the remote bench
+    // reports beside a transaction's.
+    if ((seen & kEnabledInterrupts) == reg::kInterruptReceive && receiveCount_ - countKeptBefore_ == 1) {
+        statistics_.receiveInterruptInstructions = static_cast<uint32_t>(end - countStart_);
+    }
+    // The frames kept carry the routine's start, from which the remote
+    // agent counts a transaction's work on this node; moved on by what this
+    // bookkeeping has cost so far, so that a transaction's count leaves it
+    // out as the routine's does, and counts about what a production image
+    // runs.
+    const uint64_t stamp = countStart_ + (arch_x86::instructionCount() - end);
+    for (size_t i = countKeptBefore_; i < receiveCount_; ++i) {
+        receive_[(receiveHead_ + i) % kReceiveQueueLength].instructionStamp = stamp;
     }
 }
 

@@ -95,6 +95,11 @@ struct ChannelStatistics {
     uint32_t loneNodeHolds = 0;        ///< Times the queue was held for want of an acknowledge.
     uint32_t interrupts = 0;           ///< Calls of the interrupt service routine.
     uint32_t interruptLoopLimits = 0;  ///< Calls that stopped at kInterruptLoopBound.
+    /// Instructions of the last call of the interrupt service routine that
+    /// received one frame and saw no other cause, from its first statement
+    /// to its last; 0 in an image without an instruction counter
+    /// (arch_x86/InstructionCounter.hpp).
+    uint32_t receiveInterruptInstructions = 0;
 };
 
 /// A frame with its time, as channel 1 (kTimedChannel) reads it.
@@ -107,6 +112,9 @@ struct TimedFrame {
     /// TimerAgent::Uptime at the start of the interrupt that received the
     /// frame, or for an echo, that saw its transmission complete.
     uint64_t timeNs = 0;
+    /// The instruction counter (arch_x86::instructionCount) at the start of
+    /// the same interrupt; 0 in an image without one, where nothing writes it.
+    uint64_t instructionStamp = 0;
 };
 
 /// Whom the channel tells, and with which events (kSetNotification).
@@ -235,6 +243,7 @@ private:
     void onBusError();
     void onStateChange();
     void notify(uint32_t events);
+    void finishCountedInterrupt(uint8_t seen);
     void releaseHold();
     void recordStateChange(ErrorState from, ErrorState to, bool holdChanged = false);
 
@@ -251,6 +260,11 @@ private:
     BusOffPolicy busOffPolicy_ = BusOffPolicy::RestartAtOnce;
     Notification notification_{};
 
+    // In an image with an instruction counter only: the counter at the
+    // start of the current call of the interrupt service routine, the stamp
+    // of the frames it keeps, and the receive ring's count then.
+    uint64_t countStart_ = 0;
+    size_t countKeptBefore_ = 0;
     // Shared with the interrupt service routine; changed with interrupts disabled.
     bool started_ = false;
     bool noAcknowledge_ = false;

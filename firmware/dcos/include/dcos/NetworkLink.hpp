@@ -55,6 +55,11 @@ struct SystemMessage {
     /// arrived, read in the driver's interrupt; 0 from a link that does not
     /// timestamp.
     uint64_t timeNs = 0;
+    /// Receive: the instruction counter (arch_x86/InstructionCounter.hpp)
+    /// read at the start of the same interrupt; 0 from a link that does not
+    /// stamp, or in an image without a counter. The remote agent counts a
+    /// transaction's work on each node from it (docs/performance.md).
+    uint64_t instructionStamp = 0;
 };
 
 class NetworkLink {

@@ -2,6 +2,7 @@
 // lists its tables, resolves a node and, for the super user the console
 // runs as, changes them. Output is one entry per line, so the lab's tests
 // and a control engineer's scripts can read it.
+#include <arch_x86/InstructionCounter.hpp>
 #include <dcos/GlobalTime.hpp>
 #include <dcos/NetworkInterfacesManager.hpp>
 #include <dcos/internal/DsmManager.hpp>
@@ -146,6 +147,19 @@ void listRemote(shell::Shell& shell)
         {"unknown-senders", s.unknownSenders}, {"names-not-found", s.namesNotFound},
     };
     printCounters(shell, counters);
+    // The last transaction's instructions on each side, in an image with an
+    // instruction counter (the remote bench's, docs/performance.md).
+    if (arch_x86::instructionCount() == 0) {
+        shell.print("  instructions not counted (no instruction counter in this image)\r\n");
+    } else {
+        const RemoteInstructions& i = s.instructions;
+        const Counter instructions[] = {
+            {"call-request-instructions", i.callRequest}, {"call-reply-instructions", i.callReply},
+            {"serve-instructions", i.serve},              {"serve-parts-instructions", i.servePartsBefore},
+        };
+        printCounters(shell, instructions);
+        shell.print("  call-span-instructions %llu\r\n", static_cast<unsigned long long>(i.callSpan));
+    }
     for (size_t slot = 0; slot < kRemoteCalls; ++slot) {
         const RemoteCallInfo call = remoteCall(slot);
         if (call.inUse) {

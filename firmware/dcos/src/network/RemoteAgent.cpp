@@ -19,6 +19,7 @@
 #include <dcos/internal/WaitQueue.hpp>
 
 #include <arch_x86/Cpu.hpp>
+#include <arch_x86/InstructionCounter.hpp>
 
 namespace dcos {
 
@@ -47,6 +48,20 @@ static_assert(kNetworkInterfaces <= 31);
 static_assert(kNameQueryNameBytes == kPortMessageBytes && kPortMessageBytes == kMessageSize,
               "a served entry's payload holds a name or a port message");
 
+// ---- instruction counts (RemoteInstructions) --------------------------------
+
+// The instruction counter (arch_x86/InstructionCounter.hpp), 0 in an image
+// without one. Out of line, like the records below: a transaction pays a
+// call per read, and the agent's code keeps the counting image's
+// bookkeeping in one place rather than in every caller's path.
+[[gnu::noinline]] uint64_t readCounter() { return arch_x86::instructionCount(); }
+
+// The instructions since @p start, a stamp or a read; 0 when it is 0.
+[[gnu::noinline]] uint32_t instructionsSince(uint64_t start)
+{
+    return start == 0 ? 0 : static_cast<uint32_t>(readCounter() - start);
+}
+
 // ---- the requesting side ----------------------------------------------------
 
 struct CallSlot {
@@ -61,6 +76,12 @@ struct CallSlot {
     bool heard = false;   // A pending reply came in this watchdog period.
     Status status = Status::Ok;
     uint32_t value = 0;
+    // The instruction counter at the transaction's start and once its
+    // request was on the link, and the final reply's stamp
+    // (SystemMessage::instructionStamp): RemoteInstructions' caller side.
+    uint64_t begun = 0;
+    uint64_t queued = 0;
+    uint64_t replyStamp = 0;
 };
 
 CallSlot calls[kRemoteCalls];
@@ -79,6 +100,10 @@ struct ServedEntry {
     uint64_t heardNs = 0; // Uptime when the request last arrived, retransmissions included.
     bool superseded = false; // Its requester has begun another transaction on the same call slot.
     bool silent = false;     // Done, and nothing to answer: a name query this node has no object for.
+    // The instruction stamp of the request's last frame, and what its
+    // earlier frames cost (RemoteInstructions::servePartsBefore).
+    uint64_t arrivalStamp = 0;
+    uint32_t partsBefore = 0;
     // A name query's name, NUL-padded (service NameToObject, the type in
     // request.object), or a port send's message (service PortSend).
     uint8_t payload[kPortMessageBytes]{};
@@ -188,9 +213,10 @@ CallSlot* openCall(Task& self, RemoteService service, uint8_t interface, uint32_
 // The caller's side once its call slot is taken: sends the request with
 // @p send, again after every silent watchdog period, and blocks until the
 // final reply (its status and value) or kRemoteSilentPeriods silent
-// periods in a row (Unreachable).
+// periods in a row (Unreachable). @p begun is the instruction counter at
+// the transaction's start (0 without a counter).
 template <typename Send>
-Result<uint32_t> awaitReply(CallSlot& slot, Send send);
+Result<uint32_t> awaitReply(CallSlot& slot, uint64_t begun, Send send);
 
 // The call slot of @p self's transaction of @p service on the object @p id
 // of another node: the node resolved to an interface and a physical
@@ -227,6 +253,8 @@ Result<CallSlot*> openRemoteCall(Task& self, RemoteService service, ObjectId id)
 
 Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
 {
+    // The transaction's instructions count from here (RemoteInstructions).
+    const uint64_t begun = readCounter();
     Task& self = Scheduler::current();
     const Result<CallSlot*> opened = openRemoteCall(self, service, id);
     if (!opened.ok()) {
@@ -244,7 +272,7 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
     uint8_t data[kRemoteMessageBytes];
     encodeRequest(request, data);
     // The running priority, so a task that inherited urgency asks with it.
-    return awaitReply(*slot, [&] {
+    return awaitReply(*slot, begun, [&] {
         (void)sendMessage(interface, SystemMessageType::RemoteRequest, self.priority, peer, data);
     });
 }
@@ -254,6 +282,7 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
 // watchdog period, and the reply's status.
 Status forwardPortSend(ObjectId port, const Message& message, int priority)
 {
+    const uint64_t begun = readCounter();
     Task& self = Scheduler::current();
     const Result<CallSlot*> opened = openRemoteCall(self, RemoteService::PortSend, port);
     if (!opened.ok()) {
@@ -270,7 +299,7 @@ Status forwardPortSend(ObjectId port, const Message& message, int priority)
     encodePortSend(request, frames, lengths);
     const uint8_t interface = slot->interface;
     const uint32_t peer = slot->peer;
-    return awaitReply(*slot, [&] {
+    return awaitReply(*slot, begun, [&] {
         // The parts in a row: a part the link did not take leaves a request
         // the server drops, so the rest is not sent; the watchdog sends all
         // three again.
@@ -292,6 +321,7 @@ constexpr uint8_t kAnyInterface = 0xFF;
 // the watchdog's silent periods the answer is NotFound.
 Result<ObjectId> forwardName(ObjectType type, const char* name)
 {
+    const uint64_t begun = readCounter();
     if (inInterruptContext()) {
         return Status::InInterrupt;
     }
@@ -313,7 +343,7 @@ Result<ObjectId> forwardName(ObjectType type, const char* name)
     }
     uint8_t frames[kNameQueryFrames][kRemoteMessageBytes];
     encodeNameQuery(static_cast<uint8_t>(type), slot->transaction, name, frames);
-    const Result<uint32_t> found = awaitReply(*slot, [&] {
+    const Result<uint32_t> found = awaitReply(*slot, begun, [&] {
         for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
             for (size_t part = 0; part < kNameQueryFrames; ++part) {
                 if (!sendMessage(interface, SystemMessageType::NameQuery, self.priority, NetworkLink::kBroadcast,
@@ -334,13 +364,33 @@ Result<ObjectId> forwardName(ObjectType type, const char* name)
     return id;
 }
 
+// The caller's instructions of @p slot's transaction, which got its final
+// reply (RemoteInstructions): the counter is read last, as close to the
+// return as the record allows. Nothing without a counter, or for a reply
+// from a link that does not stamp. Under the lock.
+[[gnu::noinline]] void recordCall(const CallSlot& slot)
+{
+    if (slot.begun == 0 || slot.replyStamp == 0) {
+        return;
+    }
+    RemoteInstructions& counts = statistics.instructions;
+    counts.callRequest = static_cast<uint32_t>(slot.queued - slot.begun);
+    const uint64_t now = readCounter();
+    counts.callReply = static_cast<uint32_t>(now - slot.replyStamp);
+    counts.callSpan = now - slot.begun;
+}
+
 template <typename Send>
-Result<uint32_t> awaitReply(CallSlot& callSlot, Send send)
+Result<uint32_t> awaitReply(CallSlot& callSlot, uint64_t begun, Send send)
 {
     CallSlot* const slot = &callSlot;
+    slot->begun = begun;
     unsigned silentPeriods = 0;
-    for (;;) {
+    for (bool first = true;; first = false) {
         send();
+        if (first) {
+            slot->queued = readCounter(); // The first request is on the link.
+        }
         Lock lock;
         if (!slot->done) {
             (void)TaskManager::blockOn(slot->waiter, kWatchdogNs);
@@ -349,6 +399,7 @@ Result<uint32_t> awaitReply(CallSlot& callSlot, Send send)
             const Status status = slot->status;
             const uint32_t value = slot->value;
             slot->caller = ObjectId::null();
+            recordCall(*slot);
             if (status != Status::Ok) {
                 return status;
             }
@@ -408,6 +459,7 @@ void onReply(uint8_t interface, const SystemMessage& message)
     slot.done = true;
     slot.status = reply.status;
     slot.value = reply.value;
+    slot.replyStamp = message.instructionStamp;
     (void)TaskManager::wakeFirst(slot.waiter, Status::Ok);
 }
 
@@ -475,8 +527,10 @@ ServedEntry* entryForNewRequest(ServedEntry* sameSlot)
 
 // A request arrived on @p interface; @p payload, when not null, is a
 // name query's name or a port send's message (kPortMessageBytes bytes).
+// @p partsBefore: the instructions its earlier frames cost
+// (RemoteInstructions::servePartsBefore), 0 for a request of one frame.
 void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
-                  const uint8_t* payload);
+                  const uint8_t* payload, uint32_t partsBefore = 0);
 
 // Requests of several frames being put back together (name queries, port
 // sends), one per sender: a sender's entry, or a new one taking the entry
@@ -487,8 +541,15 @@ struct Gathering {
     uint8_t interface = 0;
     uint32_t source = 0;
     uint32_t heard = 0;
+    // The instructions of the parts taken so far, each from its interrupt
+    // to the end of its handling (RemoteInstructions::servePartsBefore).
+    uint32_t partsInstructions = 0;
     Assembler assembler;
 };
+
+// The instructions from @p message's interrupt to now: the receiver's share
+// of one frame of a request of several. 0 without a counter.
+uint32_t partInstructions(const SystemMessage& message) { return instructionsSince(message.instructionStamp); }
 
 template <typename Assembler, size_t N>
 Gathering<Assembler>& gatheringFor(Gathering<Assembler> (&table)[N], uint32_t& clock, uint8_t interface,
@@ -536,6 +597,7 @@ void onRequest(uint8_t interface, const SystemMessage& message)
         }
         Gathering<PortSendAssembler>& gathering = gatheringFor(portSends, gatheringClock, interface, message.source);
         if (gathering.assembler.take(part) != PortSendAssembler::Outcome::Complete) {
+            gathering.partsInstructions += partInstructions(message);
             return; // In turn and not the last, or out of turn and dropped: the requester sends it again.
         }
         const PortSendRequest& whole = gathering.assembler.request();
@@ -544,7 +606,7 @@ void onRequest(uint8_t interface, const SystemMessage& message)
         request.transaction = whole.transaction;
         request.object = whole.object;
         request.argument = static_cast<uint8_t>(whole.priority);
-        admitRequest(interface, message, request, whole.message);
+        admitRequest(interface, message, request, whole.message, gathering.partsInstructions);
         return;
     }
     RemoteRequest request;
@@ -555,7 +617,9 @@ void onRequest(uint8_t interface, const SystemMessage& message)
         return;
     }
     if (request.service == RemoteService::PortSend) {
-        (void)gatheringFor(portSends, gatheringClock, interface, message.source).assembler.start(request);
+        Gathering<PortSendAssembler>& gathering = gatheringFor(portSends, gatheringClock, interface, message.source);
+        (void)gathering.assembler.start(request);
+        gathering.partsInstructions = partInstructions(message);
         return;
     }
     admitRequest(interface, message, request, nullptr);
@@ -583,7 +647,7 @@ void onNameQuery(uint8_t interface, const SystemMessage& message)
 // A request to serve: a retransmission is answered from the served table,
 // a new one queued for the workers.
 void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
-                  const uint8_t* payload)
+                  const uint8_t* payload, uint32_t partsBefore)
 {
     RemoteReply answer;
     answer.service = request.service;
@@ -630,6 +694,8 @@ void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteR
                 entry->request = request;
                 entry->order = arrivals++;
                 entry->heardNs = TimerAgent::Uptime();
+                entry->arrivalStamp = message.instructionStamp;
+                entry->partsBefore = partsBefore;
                 // The worker takes the request's priority as it wakes, not
                 // when it first runs: woken at its idle priority, it would
                 // wait behind every local task, however urgent the request.
@@ -779,6 +845,21 @@ ServedEntry* mostUrgentQueued()
     return best;
 }
 
+// The serving side's instructions of a request just answered
+// (RemoteInstructions): from @p arrived, its last frame's stamp, to now,
+// plus @p partsBefore. Nothing without a counter. The counter is read
+// before the lock is taken, so the figure ends with the reply on the link.
+[[gnu::noinline]] void recordServe(uint64_t arrived, uint32_t partsBefore)
+{
+    if (arrived == 0) {
+        return;
+    }
+    const uint32_t serve = instructionsSince(arrived) + partsBefore;
+    Lock lock;
+    statistics.instructions.serve = serve;
+    statistics.instructions.servePartsBefore = partsBefore;
+}
+
 void workerEntry(uintptr_t)
 {
     Task& self = Scheduler::current();
@@ -788,6 +869,8 @@ void workerEntry(uintptr_t)
         uint8_t interface;
         uint8_t priority;
         uint32_t source;
+        uint64_t arrivalStamp;
+        uint32_t partsBefore;
         {
             Lock lock;
             job = mostUrgentQueued();
@@ -800,6 +883,8 @@ void workerEntry(uintptr_t)
             interface = job->interface;
             priority = job->priority;
             source = job->source;
+            arrivalStamp = job->arrivalStamp;
+            partsBefore = job->partsBefore;
             ++statistics.served;
         }
         // Inherit the request's priority (seed 6.4): local tasks more
@@ -816,6 +901,7 @@ void workerEntry(uintptr_t)
         }
         if (!silent) {
             sendReply(interface, priority, source, reply);
+            recordServe(arrivalStamp, partsBefore);
         }
     }
 }

@@ -41,6 +41,37 @@
 
 namespace dcos::internal {
 
+/// The instructions of the last remote transaction on each side, counted
+/// with the image's instruction counter (arch_x86/InstructionCounter.hpp;
+/// the remote bench's counting image, docs/performance.md "Remote
+/// transactions"). All 0 in an image without a counter, and until a
+/// transaction has been completed or served.
+struct RemoteInstructions {
+    // The requesting side: the last transaction this node completed with a final reply.
+    /// From the remote agent's start of the transaction (the primitive's
+    /// forward to another node) to its request handed to the link, every
+    /// frame of it (the first send only, when the watchdog sent it again).
+    uint32_t callRequest = 0;
+    /// From the start of the receive interrupt that took the final reply to
+    /// the remote agent's return to the primitive.
+    uint32_t callReply = 0;
+    /// From the same start to the same return: the caller's whole span, the
+    /// wait for the bus included. Under -icount the halted processor's
+    /// time counts one per nanosecond, so this is mostly time, not work.
+    uint64_t callSpan = 0;
+    // The serving side: the last request this node answered.
+    /// From the start of the receive interrupt that took the request's last
+    /// frame to its reply handed to the link: the interrupt, the receiver
+    /// task, the worker's wake, the primitive and the reply. For a request
+    /// of several frames the earlier frames' interrupts and their handling
+    /// by the receiver are added (see servePartsBefore).
+    uint32_t serve = 0;
+    /// Of serve, what the earlier frames of a request of several frames
+    /// cost: each one's interrupt and the receiver's handling of it, to the
+    /// end of that handling. 0 for a request of one frame.
+    uint32_t servePartsBefore = 0;
+};
+
 /// What the remote agent has done since boot, for the console and the tests.
 struct RemoteStatistics {
     // The requesting side.
@@ -64,6 +95,8 @@ struct RemoteStatistics {
     uint32_t unknownSenders = 0;   ///< Publication frames from a physical address the tables map to no node.
     // Names (docs/protocols/remote-transactions.md, "Names").
     uint32_t namesNotFound = 0;    ///< Name queries no node answered.
+    // The instruction counts of the last transaction (the remote bench).
+    RemoteInstructions instructions{};
 };
 
 /// Counters since boot. O(1).
