@@ -245,6 +245,23 @@ def test_dump_decodes_a_port_send(hub):
                                 "prio 20 remote request 1->2: port-send part 3/3 slot 11"], lines
 
 
+def test_dump_decodes_a_routed_request(hub):
+    # docs/protocols/remote-transactions.md, "Gateways": node 1 asks gateway
+    # 2 to count node 3's semaphore 0xa001: a route header, then the request.
+    output, lines = decoded_dumps(hub, [
+        Frame(0x14130201, extended=True, dlc=4, data=bytes([0xC4, 0x21, 0x00, 0x03])),
+        Frame(0x14130201, extended=True, dlc=8, data=bytes([3, 0x21, 0xA0, 0x01, 0, 0, 0, 0])),
+        Frame(0x14130201, extended=True, dlc=4, data=bytes([0xC0, 0x21, 0x00, 0x03]))])
+    remote = [json.loads(line)["dcos"]["remote"] for line in output.splitlines()]
+    assert remote == [
+        {"route_to": 3, "hops_left": 4, "transaction": 0x21},
+        {"service": "count", "transaction": 0x21, "object": 0xA001, "argument": 0},
+        {"malformed": "reserved bits set"},
+    ]
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations[0] == "prio 20 routed request 1->2: route to node 3 hops 4 txn 0x21", lines
+
+
 def test_dump_decodes_the_global_time_base(hub):
     # docs/protocols/time.md: node 1's Sync (sequence 5, second 0x12_3456_789A,
     # rank 3, every 2.5 s), its FollowUp, a probe and a Sync with a bad rank.

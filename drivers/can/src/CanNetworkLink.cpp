@@ -20,6 +20,8 @@ static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RemoteRequest) ==
               static_cast<uint8_t>(can::MessageType::RemoteRequest));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::NameQuery) ==
               static_cast<uint8_t>(can::MessageType::NameQuery));
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RoutedRequest) ==
+              static_cast<uint8_t>(can::MessageType::RoutedRequest));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::DsmPublication) ==
               static_cast<uint8_t>(can::MessageType::DsmPublication));
 
@@ -29,7 +31,8 @@ namespace {
 bool isSystemMessage(can::MessageType type)
 {
     return type == can::MessageType::RemoteRequest || type == can::MessageType::RemoteReply ||
-           type == can::MessageType::NameQuery || type == can::MessageType::DsmPublication ||
+           type == can::MessageType::NameQuery || type == can::MessageType::RoutedRequest ||
+           type == can::MessageType::DsmPublication ||
            type == can::MessageType::TimeSync;
 }
 

@@ -10,7 +10,8 @@
 // 1 to 15 characters, a type with names, and encodes back into its parts.
 // Last, as a stream of port send frames (a length byte, then the frame): a
 // port send the assembler completes encodes back into exactly the frames
-// that made it.
+// that made it. A routed request's route header (RemoteMessage.hpp) that
+// decodes encodes back into the same four bytes and is never a request.
 #include "../../../fieldbus/can/fuzz/FuzzCheck.hpp"
 
 #include <dcos/internal/RemoteMessage.hpp>
@@ -45,6 +46,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     } else {
         FUZZ_CHECK(replyError == RemoteMessageError::WrongLength || replyError == RemoteMessageError::UnknownService ||
                    replyError == RemoteMessageError::UnknownStatus || replyError == RemoteMessageError::ReservedBits);
+    }
+    RouteHeader header;
+    const RemoteMessageError headerError = decodeRouteHeader(data, size, header);
+    if (headerError == RemoteMessageError::None) {
+        uint8_t again[kRouteHeaderBytes];
+        encodeRouteHeader(header, again);
+        FUZZ_CHECK(size == kRouteHeaderBytes && std::memcmp(again, data, size) == 0);
+        FUZZ_CHECK(header.hopsLeft >= 1 && header.hopsLeft <= kRouteHops);
+        // A header is neither a request nor a continuation a serving node would take.
+        FUZZ_CHECK(requestError != RemoteMessageError::None);
+    } else {
+        FUZZ_CHECK(headerError == RemoteMessageError::WrongLength || headerError == RemoteMessageError::ReservedBits);
     }
     NameQueryAssembler assembler;
     uint8_t lastParts[kNameQueryFrames][kRemoteMessageBytes]{};

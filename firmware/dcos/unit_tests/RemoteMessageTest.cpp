@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstring>
 #include <random>
 #include <type_traits>
 #include <vector>
@@ -333,4 +334,57 @@ TEST(RemoteMessageTest, EveryMalformedContinuationIsRefused)
             << int(header);
     }
     EXPECT_FALSE(isContinuation(partOne.data(), 0));
+}
+
+TEST(RemoteMessageTest, ARouteHeaderIsFourBytesLaidOutAsTheSpecificationSays)
+{
+    RouteHeader header;
+    header.hopsLeft = 3;
+    header.transaction = 0x5A;
+    header.destination = 0x0103;
+    uint8_t bytes[kRouteHeaderBytes];
+    encodeRouteHeader(header, bytes);
+    const uint8_t expected[kRouteHeaderBytes] = {0xC3, 0x5A, 0x01, 0x03};
+    EXPECT_EQ(0, std::memcmp(bytes, expected, sizeof bytes));
+    ASSERT_TRUE(isRouteHeader(bytes, sizeof bytes));
+    RouteHeader back;
+    ASSERT_EQ(RemoteMessageError::None, decodeRouteHeader(bytes, sizeof bytes, back));
+    EXPECT_EQ(3, back.hopsLeft);
+    EXPECT_EQ(0x5A, back.transaction);
+    EXPECT_EQ(0x0103, back.destination);
+}
+
+TEST(RemoteMessageTest, ARouteHeaderIsNeverARequestOrAContinuation)
+{
+    // Byte 0's bits 7-6: a service has bit 7 clear, a continuation 10, a header 11.
+    for (unsigned service = 1; service <= kLastRemoteService; ++service) {
+        const uint8_t first[1] = {static_cast<uint8_t>(service)};
+        EXPECT_FALSE(isRouteHeader(first, 1));
+    }
+    for (uint8_t part = 1; part <= 2; ++part) {
+        const uint8_t continuation[1] = {static_cast<uint8_t>(0x80 | part << 4 | 0x0F)};
+        EXPECT_FALSE(isRouteHeader(continuation, 1));
+    }
+    const uint8_t header[kRouteHeaderBytes] = {0xC1, 0x00, 0x00, 0x02};
+    RemoteRequest request;
+    EXPECT_NE(RemoteMessageError::None, decodeRequest(header, sizeof header, request));
+    PortSendContinuation part;
+    EXPECT_NE(RemoteMessageError::None, decodePortSendContinuation(header, sizeof header, part));
+}
+
+TEST(RemoteMessageTest, EveryMalformedRouteHeaderIsRefused)
+{
+    RouteHeader header;
+    const uint8_t tooShort[3] = {0xC1, 0x00, 0x00};
+    EXPECT_EQ(RemoteMessageError::WrongLength, decodeRouteHeader(tooShort, sizeof tooShort, header));
+    const uint8_t tooLong[5] = {0xC1, 0x00, 0x00, 0x02, 0x00};
+    EXPECT_EQ(RemoteMessageError::WrongLength, decodeRouteHeader(tooLong, sizeof tooLong, header));
+    const uint8_t noHopLeft[4] = {0xC0, 0x00, 0x00, 0x02};
+    EXPECT_EQ(RemoteMessageError::ReservedBits, decodeRouteHeader(noHopLeft, sizeof noHopLeft, header));
+    const uint8_t tooManyHops[4] = {static_cast<uint8_t>(0xC0 | (kRouteHops + 1)), 0x00, 0x00, 0x02};
+    EXPECT_EQ(RemoteMessageError::ReservedBits, decodeRouteHeader(tooManyHops, sizeof tooManyHops, header));
+    const uint8_t reserved[4] = {0xD1, 0x00, 0x00, 0x02};
+    EXPECT_EQ(RemoteMessageError::ReservedBits, decodeRouteHeader(reserved, sizeof reserved, header));
+    const uint8_t notAHeader[4] = {0x01, 0x00, 0x00, 0x02};
+    EXPECT_EQ(RemoteMessageError::ReservedBits, decodeRouteHeader(notAHeader, sizeof notAHeader, header));
 }

@@ -216,7 +216,22 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
                     {"name_bytes", bytes}};
         return out;
     }
-    if (id.type() == can::MessageType::RemoteRequest && isContinuation(frame.data(), frame.length())) {
+    // A routed request's frames are a request's, behind a route header
+    // (docs/protocols/remote-transactions.md, "Gateways").
+    const bool isRequest = id.type() == can::MessageType::RemoteRequest || id.type() == can::MessageType::RoutedRequest;
+    if (id.type() == can::MessageType::RoutedRequest && isRouteHeader(frame.data(), frame.length())) {
+        out.key = "remote";
+        RouteHeader header;
+        const RemoteMessageError error = decodeRouteHeader(frame.data(), frame.length(), header);
+        if (error != RemoteMessageError::None) {
+            return malformed(out, remoteMessageErrorName(error));
+        }
+        out.text = fmt::format("route to node {} hops {} txn 0x{:02x}", header.destination, header.hopsLeft,
+                               header.transaction);
+        out.json = {{"route_to", header.destination}, {"hops_left", header.hopsLeft}, {"transaction", header.transaction}};
+        return out;
+    }
+    if (isRequest && isContinuation(frame.data(), frame.length())) {
         // Parts 1 and 2 of a port send (docs/protocols/remote-transactions.md, "Port sends").
         out.key = "remote";
         PortSendContinuation part;
@@ -228,7 +243,7 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         out.json = {{"service", "port-send"}, {"part", part.part}, {"slot", part.slot}};
         return out;
     }
-    if (id.type() == can::MessageType::RemoteRequest) {
+    if (isRequest) {
         out.key = "remote";
         RemoteRequest request;
         const RemoteMessageError error = decodeRequest(frame.data(), frame.length(), request);

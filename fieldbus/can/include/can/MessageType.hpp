@@ -27,6 +27,10 @@ enum class MessageType : uint8_t {
     /// type and name visible to the asker (seed 6.4, NameToObject). Answered
     /// with a RemoteReply by the node that has one.
     NameQuery = 0x12,
+    /// A remote request for a node behind a gateway, sent to the gateway: a
+    /// route header naming the logical destination, then the request's
+    /// frames (docs/protocols/remote-transactions.md, "Gateways").
+    RoutedRequest = 0x13,
     /// A distributed shared memory publication (seed 7.10).
     DsmPublication = 0x20,
     /// A segmented transfer, ISO 15765-2 (IsoTpSender, IsoTpReceiver).
@@ -45,6 +49,7 @@ constexpr bool isAssignedMessageType(uint8_t raw)
     case MessageType::RemoteReply:
     case MessageType::RemoteRequest:
     case MessageType::NameQuery:
+    case MessageType::RoutedRequest:
     case MessageType::DsmPublication:
     case MessageType::Segmented:
     case MessageType::Configuration:
@@ -62,6 +67,7 @@ constexpr const char* messageTypeName(MessageType type)
     case MessageType::RemoteReply: return "remote reply";
     case MessageType::RemoteRequest: return "remote request";
     case MessageType::NameQuery: return "name query";
+    case MessageType::RoutedRequest: return "routed request";
     case MessageType::DsmPublication: return "DSM publication";
     case MessageType::Segmented: return "segmented";
     case MessageType::Configuration: return "configuration";

@@ -31,6 +31,7 @@ enum class SystemMessageType : uint8_t {
     RemoteReply = 0x10,
     RemoteRequest = 0x11,
     NameQuery = 0x12, ///< A part of a name query, to the broadcast address (docs/protocols/remote-transactions.md).
+    RoutedRequest = 0x13, ///< A route header or a request's frame, to a gateway (docs/protocols/remote-transactions.md, "Gateways").
     DsmPublication = 0x20, ///< A part of a publication, to the broadcast address (docs/protocols/publications.md).
 };
 

@@ -145,6 +145,7 @@ void listRemote(shell::Shell& shell)
         {"malformed", s.malformed},       {"send-failures", s.sendFailures},
         {"publications-sent", s.publicationsSent}, {"publication-parts", s.publicationParts},
         {"unknown-senders", s.unknownSenders}, {"names-not-found", s.namesNotFound},
+        {"routed-requests", s.routedRequests}, {"forwarded", s.forwarded}, {"unrouted", s.unrouted},
     };
     printCounters(shell, counters);
     // The last transaction's instructions on each side, in an image with an

@@ -82,6 +82,11 @@ struct CallSlot {
     uint64_t begun = 0;
     uint64_t queued = 0;
     uint64_t replyStamp = 0;
+    // A node behind a gateway: the request goes to the gateway (peer)
+    // behind a route header naming the node, with hops hops left.
+    bool routed = false;
+    uint16_t destination = 0;
+    uint8_t hops = 0;
 };
 
 CallSlot calls[kRemoteCalls];
@@ -104,6 +109,10 @@ struct ServedEntry {
     // earlier frames cost (RemoteInstructions::servePartsBefore).
     uint64_t arrivalStamp = 0;
     uint32_t partsBefore = 0;
+    // The node whose object the request names: this node, or for a routed
+    // request the destination of its route header, and the hops it has left.
+    uint16_t node = 0;
+    uint8_t hopsLeft = 0;
     // A name query's name, NUL-padded (service NameToObject, the type in
     // request.object), or a port send's message (service PortSend).
     uint8_t payload[kPortMessageBytes]{};
@@ -119,6 +128,11 @@ ServedEntry served[kRemoteServed];
 uint32_t arrivals = 0;
 uint32_t completions = 0;
 WaitQueue idleWorkers;
+// Each worker's task and the entry it runs (null when idle), so that a
+// worker that forwards a routed request through another gateway passes on
+// one hop fewer (routedHopsLeft).
+ObjectId workerIds[kRemoteWorkers];
+ServedEntry* workerJobs[kRemoteWorkers];
 
 RemoteStatistics statistics;
 bool started = false;
@@ -218,6 +232,18 @@ CallSlot* openCall(Task& self, RemoteService service, uint8_t interface, uint32_
 template <typename Send>
 Result<uint32_t> awaitReply(CallSlot& slot, uint64_t begun, Send send);
 
+// The hops left of the routed request @p self serves, when it is a worker
+// serving one (so it forwards the request on); 0 otherwise. Under the lock.
+uint8_t routedHopsLeft(const Task& self)
+{
+    for (size_t i = 0; i < kRemoteWorkers; ++i) {
+        if (workerIds[i] == self.id && workerJobs[i] != nullptr) {
+            return workerJobs[i]->node != localNode() ? workerJobs[i]->hopsLeft : 0;
+        }
+    }
+    return 0;
+}
+
 // The call slot of @p self's transaction of @p service on the object @p id
 // of another node: the node resolved to an interface and a physical
 // address, and a slot taken; or why not.
@@ -233,22 +259,61 @@ Result<CallSlot*> openRemoteCall(Task& self, RemoteService service, ObjectId id)
         // Unreachable.
         return hop.status() == Status::NotFound ? Status::Remote : Status::Unreachable;
     }
-    if (hop.value().via.raw() != hop.value().destination.raw()) {
-        // The request carries no logical destination, so a gateway could
-        // not tell whom it is for: forwarding through gateways comes with
-        // the routed messages of a later part (docs/protocols/remote-transactions.md).
-        return Status::NotSupported;
-    }
+    // A node behind a gateway is asked through it: the request goes to the
+    // gateway behind a route header that names the node (RemoteMessage.hpp,
+    // routed requests).
+    const bool routed = hop.value().via.raw() != hop.value().destination.raw();
     const uint8_t interface = hop.value().interface;
     Lock lock;
     if (links[interface] == nullptr) {
         return Status::Unreachable;
     }
+    uint8_t hops = kRouteHops;
+    if (routed) {
+        const uint8_t left = routedHopsLeft(self);
+        if (left == 1) {
+            return Status::Unreachable; // No hop left for another gateway: a loop in the routes.
+        }
+        hops = left == 0 ? kRouteHops : static_cast<uint8_t>(left - 1);
+    }
     CallSlot* const slot = openCall(self, service, interface, hop.value().physical);
     if (slot == nullptr) {
         return Status::Busy;
     }
+    slot->routed = routed;
+    slot->destination = id.node();
+    slot->hops = hops;
+    statistics.routedRequests += routed ? 1 : 0;
     return slot;
+}
+
+// Sends the @p count frames of @p slot's request to its peer at @p priority:
+// behind a route header, as routed requests, for a node behind a gateway.
+// Stops at a frame the link did not take: the peer drops the incomplete
+// request, and the watchdog sends all of it again.
+bool sendRequest(const CallSlot& slot, uint8_t priority, const uint8_t (*frames)[kRemoteMessageBytes],
+                 const uint8_t* lengths, size_t count)
+{
+    SystemMessageType type = SystemMessageType::RemoteRequest;
+    if (slot.routed) {
+        RouteHeader header;
+        header.hopsLeft = slot.hops;
+        header.transaction = slot.transaction;
+        header.destination = slot.destination;
+        uint8_t bytes[kRouteHeaderBytes];
+        encodeRouteHeader(header, bytes);
+        if (!sendBytes(slot.interface, SystemMessageType::RoutedRequest, priority, slot.peer, bytes,
+                       kRouteHeaderBytes)) {
+            return false;
+        }
+        type = SystemMessageType::RoutedRequest;
+    }
+    for (size_t i = 0; i < count; ++i) {
+        if (!sendBytes(slot.interface, type, priority, slot.peer, frames[i], lengths[i])) {
+            return false;
+        }
+    }
+    return true;
 }
 
 Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
@@ -261,20 +326,17 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
         return opened.status();
     }
     CallSlot* const slot = opened.value();
-    const uint8_t interface = slot->interface;
-    const uint32_t peer = slot->peer;
 
     RemoteRequest request;
     request.service = service;
     request.transaction = slot->transaction;
     request.object = static_cast<uint16_t>(id.raw() & 0xFFFF);
     request.argument = argument;
-    uint8_t data[kRemoteMessageBytes];
-    encodeRequest(request, data);
+    uint8_t frames[1][kRemoteMessageBytes];
+    encodeRequest(request, frames[0]);
+    const uint8_t lengths[1] = {kRemoteMessageBytes};
     // The running priority, so a task that inherited urgency asks with it.
-    return awaitReply(*slot, begun, [&] {
-        (void)sendMessage(interface, SystemMessageType::RemoteRequest, self.priority, peer, data);
-    });
+    return awaitReply(*slot, begun, [&] { (void)sendRequest(*slot, self.priority, frames, lengths, 1); });
 }
 
 // MessagePortAgent::Send to another node's port (RemoteForward.hpp's port
@@ -297,18 +359,10 @@ Status forwardPortSend(ObjectId port, const Message& message, int priority)
     uint8_t frames[kPortSendFrames][kRemoteMessageBytes];
     uint8_t lengths[kPortSendFrames];
     encodePortSend(request, frames, lengths);
-    const uint8_t interface = slot->interface;
-    const uint32_t peer = slot->peer;
+    // The parts in a row: a part the link did not take leaves a request the
+    // server drops, so the rest is not sent; the watchdog sends all three again.
     return awaitReply(*slot, begun, [&] {
-        // The parts in a row: a part the link did not take leaves a request
-        // the server drops, so the rest is not sent; the watchdog sends all
-        // three again.
-        for (size_t part = 0; part < kPortSendFrames; ++part) {
-            if (!sendBytes(interface, SystemMessageType::RemoteRequest, self.priority, peer, frames[part],
-                           lengths[part])) {
-                break;
-            }
-        }
+        (void)sendRequest(*slot, self.priority, frames, lengths, kPortSendFrames);
     }).status();
 }
 
@@ -529,8 +583,10 @@ ServedEntry* entryForNewRequest(ServedEntry* sameSlot)
 // name query's name or a port send's message (kPortMessageBytes bytes).
 // @p partsBefore: the instructions its earlier frames cost
 // (RemoteInstructions::servePartsBefore), 0 for a request of one frame.
+// @p node is the node whose object it names (this one, or a routed
+// request's destination), @p hopsLeft a routed request's hops left.
 void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
-                  const uint8_t* payload, uint32_t partsBefore = 0);
+                  const uint8_t* payload, uint32_t partsBefore, uint16_t node, uint8_t hopsLeft);
 
 // Requests of several frames being put back together (name queries, port
 // sends), one per sender: a sender's entry, or a new one taking the entry
@@ -581,13 +637,86 @@ Gathering<Assembler>& gatheringFor(Gathering<Assembler> (&table)[N], uint32_t& c
     return *gathering;
 }
 
+// The route headers heard lately (routed requests, RemoteMessage.hpp), by
+// requester and transaction: the frames of the request follow the header,
+// so the last few are enough. The receiver task only.
+struct HeardRoute {
+    bool used = false;
+    uint8_t interface = 0;
+    uint32_t source = 0;
+    RouteHeader header;
+    uint32_t heard = 0;
+};
+constexpr size_t kRoutesHeard = 8;
+HeardRoute routesHeard[kRoutesHeard];
+uint32_t routeClock = 0;
+
+// A route header arrived on @p interface: kept for the request's frames.
+void onRouteHeader(uint8_t interface, const SystemMessage& message)
+{
+    RouteHeader header;
+    if (decodeRouteHeader(message.data, message.length, header) != RemoteMessageError::None) {
+        countMalformed();
+        return;
+    }
+    HeardRoute* kept = &routesHeard[0];
+    for (HeardRoute& route : routesHeard) {
+        if (route.used && route.interface == interface && route.source == message.source &&
+            route.header.transaction == header.transaction) {
+            kept = &route;
+            break;
+        }
+        if (!route.used || static_cast<int32_t>(route.heard - kept->heard) < 0) {
+            kept = &route;
+        }
+    }
+    kept->used = true;
+    kept->interface = interface;
+    kept->source = message.source;
+    kept->header = header;
+    kept->heard = routeClock++;
+}
+
+// The route header of the routed request @p transaction from @p source on
+// @p interface, or null when none was heard (the request is dropped).
+const RouteHeader* routeOf(uint8_t interface, uint32_t source, uint8_t transaction)
+{
+    for (const HeardRoute& route : routesHeard) {
+        if (route.used && route.interface == interface && route.source == source &&
+            route.header.transaction == transaction) {
+            return &route.header;
+        }
+    }
+    return nullptr;
+}
+
+// Admits @p request from @p message, for this node's object or, when it
+// was @p routed, for the node its route header named; a routed request
+// whose header was not heard is dropped and counted.
+void admitFor(uint8_t interface, const SystemMessage& message, const RemoteRequest& request, bool routed,
+              const uint8_t* payload, uint32_t partsBefore)
+{
+    if (!routed) {
+        admitRequest(interface, message, request, payload, partsBefore, localNode(), 0);
+        return;
+    }
+    const RouteHeader* const route = routeOf(interface, message.source, request.transaction);
+    if (route == nullptr) {
+        Lock lock;
+        ++statistics.unrouted;
+        return;
+    }
+    admitRequest(interface, message, request, payload, partsBefore, route->destination, route->hopsLeft);
+}
+
 constexpr size_t kRequestsGathered = 4;
 Gathering<NameQueryAssembler> nameQueries[kRequestsGathered];
 Gathering<PortSendAssembler> portSends[kRequestsGathered];
 uint32_t gatheringClock = 0;
 
-// A request arrived on @p interface: one frame, or a part of a port send.
-void onRequest(uint8_t interface, const SystemMessage& message)
+// A request arrived on @p interface: one frame, or a part of a port send;
+// @p routed when it came as a routed request's frame.
+void onRequest(uint8_t interface, const SystemMessage& message, bool routed)
 {
     if (isContinuation(message.data, message.length)) {
         PortSendContinuation part;
@@ -606,7 +735,7 @@ void onRequest(uint8_t interface, const SystemMessage& message)
         request.transaction = whole.transaction;
         request.object = whole.object;
         request.argument = static_cast<uint8_t>(whole.priority);
-        admitRequest(interface, message, request, whole.message, gathering.partsInstructions);
+        admitFor(interface, message, request, routed, whole.message, gathering.partsInstructions);
         return;
     }
     RemoteRequest request;
@@ -622,7 +751,7 @@ void onRequest(uint8_t interface, const SystemMessage& message)
         gathering.partsInstructions = partInstructions(message);
         return;
     }
-    admitRequest(interface, message, request, nullptr);
+    admitFor(interface, message, request, routed, nullptr, 0);
 }
 
 // A part of a name query arrived on @p interface (the receiver task only).
@@ -641,13 +770,14 @@ void onNameQuery(uint8_t interface, const SystemMessage& message)
     request.service = RemoteService::NameToObject;
     request.transaction = gathering.assembler.transaction();
     request.object = gathering.assembler.type();
-    admitRequest(interface, message, request, reinterpret_cast<const uint8_t*>(gathering.assembler.name()));
+    admitRequest(interface, message, request, reinterpret_cast<const uint8_t*>(gathering.assembler.name()), 0,
+                 localNode(), 0);
 }
 
 // A request to serve: a retransmission is answered from the served table,
 // a new one queued for the workers.
 void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
-                  const uint8_t* payload, uint32_t partsBefore)
+                  const uint8_t* payload, uint32_t partsBefore, uint16_t node, uint8_t hopsLeft)
 {
     RemoteReply answer;
     answer.service = request.service;
@@ -696,6 +826,8 @@ void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteR
                 entry->heardNs = TimerAgent::Uptime();
                 entry->arrivalStamp = message.instructionStamp;
                 entry->partsBefore = partsBefore;
+                entry->node = node;
+                entry->hopsLeft = hopsLeft;
                 // The worker takes the request's priority as it wakes, not
                 // when it first runs: woken at its idle priority, it would
                 // wait behind every local task, however urgent the request.
@@ -771,13 +903,22 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
     RemoteReply reply;
     reply.service = request.service;
     reply.transaction = request.transaction;
-    const ObjectId id = request.objectOn(localNode());
+    // A routed request names another node's object: the primitive below
+    // takes the id's miss path and forwards it there, as its own remote
+    // transaction, at the requester's priority.
+    const bool routed = entry.node != localNode();
+    if (routed) {
+        Lock lock;
+        ++statistics.forwarded;
+    }
+    const ObjectId id = request.objectOn(entry.node);
     switch (request.service) {
     case RemoteService::SemaphoreAcquire:
     case RemoteService::SemaphoreRelease: {
         // A binary semaphore is held by a task: a worker cannot hold it for
         // a task of another node (see docs/protocols/remote-transactions.md).
-        const Result<bool> binary = isBinarySemaphore(id);
+        // A routed request's node decides that for itself.
+        const Result<bool> binary = routed ? Result<bool>(false) : isBinarySemaphore(id);
         if (!binary.ok()) {
             reply.status = binary.status();
         } else if (binary.value()) {
@@ -811,6 +952,11 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
         break;
     }
     case RemoteService::DsmOpen: {
+        if (routed) {
+            // Publications are multicast on a bus and no gateway relays them.
+            reply.status = Status::NotSupported;
+            break;
+        }
         replyWith(reply, DsmManager::serveRemoteOpen(id, withinController(entry.interface)));
         break;
     }
@@ -824,9 +970,10 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
     }
     }
     // The object is this node's, so a Remote status cannot come back; were
-    // it to, the requester must not take it for its own "no network".
+    // it to, the requester must not take it for its own "no network". For a
+    // routed request it means this gateway's tables do not know the node.
     if (reply.status == Status::Remote) {
-        reply.status = Status::InvalidId;
+        reply.status = routed ? Status::Unreachable : Status::InvalidId;
     }
     return reply;
 }
@@ -860,9 +1007,13 @@ ServedEntry* mostUrgentQueued()
     statistics.instructions.servePartsBefore = partsBefore;
 }
 
-void workerEntry(uintptr_t)
+void workerEntry(uintptr_t index)
 {
     Task& self = Scheduler::current();
+    {
+        Lock lock;
+        workerIds[index] = self.id;
+    }
     for (;;) {
         ServedEntry* job;
         RemoteRequest request;
@@ -879,6 +1030,7 @@ void workerEntry(uintptr_t)
                 continue;
             }
             job->state = ServedState::Running;
+            workerJobs[index] = job;
             request = job->request;
             interface = job->interface;
             priority = job->priority;
@@ -895,6 +1047,7 @@ void workerEntry(uintptr_t)
         {
             Lock lock;
             encodeReply(reply, job->reply);
+            workerJobs[index] = nullptr;
             job->state = ServedState::Done;
             job->order = completions++;
             silent = job->silent;
@@ -940,7 +1093,14 @@ void receiverEntry(uintptr_t)
                 }
                 switch (message.type) {
                 case SystemMessageType::RemoteReply: onReply(interface, message); break;
-                case SystemMessageType::RemoteRequest: onRequest(interface, message); break;
+                case SystemMessageType::RemoteRequest: onRequest(interface, message, false); break;
+                case SystemMessageType::RoutedRequest:
+                    if (isRouteHeader(message.data, message.length)) {
+                        onRouteHeader(interface, message);
+                    } else {
+                        onRequest(interface, message, true);
+                    }
+                    break;
                 case SystemMessageType::NameQuery: onNameQuery(interface, message); break;
                 case SystemMessageType::DsmPublication: onPublication(interface, message); break;
                 case SystemMessageType::TimeSync: onTimeSyncMessage(interface, message); break;

@@ -271,6 +271,32 @@ RemoteMessageError decodePortSendContinuation(const uint8_t* bytes, size_t lengt
     return RemoteMessageError::None;
 }
 
+void encodeRouteHeader(const RouteHeader& header, uint8_t (&bytes)[kRouteHeaderBytes])
+{
+    bytes[0] = static_cast<uint8_t>(0xC0 | (header.hopsLeft & 0x0F));
+    bytes[1] = header.transaction;
+    bytes[2] = static_cast<uint8_t>(header.destination >> 8);
+    bytes[3] = static_cast<uint8_t>(header.destination);
+}
+
+RemoteMessageError decodeRouteHeader(const uint8_t* bytes, size_t length, RouteHeader& header)
+{
+    if (!isRouteHeader(bytes, length)) {
+        return RemoteMessageError::ReservedBits;
+    }
+    if (length != kRouteHeaderBytes) {
+        return RemoteMessageError::WrongLength;
+    }
+    const uint8_t hops = bytes[0] & 0x0F;
+    if ((bytes[0] & 0x30) != 0 || hops == 0 || hops > kRouteHops) {
+        return RemoteMessageError::ReservedBits;
+    }
+    header.hopsLeft = hops;
+    header.transaction = bytes[1];
+    header.destination = static_cast<uint16_t>((bytes[2] << 8) | bytes[3]);
+    return RemoteMessageError::None;
+}
+
 PortSendAssembler::Outcome PortSendAssembler::start(const RemoteRequest& first)
 {
     request_ = PortSendRequest{};

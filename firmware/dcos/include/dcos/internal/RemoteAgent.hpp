@@ -95,6 +95,10 @@ struct RemoteStatistics {
     uint32_t unknownSenders = 0;   ///< Publication frames from a physical address the tables map to no node.
     // Names (docs/protocols/remote-transactions.md, "Names").
     uint32_t namesNotFound = 0;    ///< Name queries no node answered.
+    // Gateways (docs/protocols/remote-transactions.md, "Gateways").
+    uint32_t routedRequests = 0;   ///< Transactions begun with a node behind a gateway, through it.
+    uint32_t forwarded = 0;        ///< Routed requests this node served for another node, as a gateway.
+    uint32_t unrouted = 0;         ///< Routed request frames dropped: their route header was not heard.
     // The instruction counts of the last transaction (the remote bench).
     RemoteInstructions instructions{};
 };

@@ -188,6 +188,53 @@ private:
     PortSendRequest request_{};
 };
 
+// ---- routed requests -------------------------------------------------------
+//
+// A request for a node that is reached through a gateway (its network
+// address lies behind a route, NetworkInterfacesManager.hpp) goes to the
+// gateway as message type 0x13, RoutedRequest: a route header, then the
+// request's own frames exactly as above (one frame, or a port send's
+// three), in a row at the requester's priority:
+//
+//     header   byte 0   0xC0 | hops left (1 to kRouteHops)
+//              byte 1   the transaction number, as in the request
+//              bytes 2-3 the destination's logical node
+//
+// Byte 0's bits 7-6 both set mark a header: a service never has bit 7, a
+// continuation has bits 7-6 = 10. The gateway performs the request as its
+// own remote transaction to that node, on a worker at the requester's
+// priority, and replies with what it got: a request crosses one hop at a
+// time, each with its own watchdog and duplicate filter. A gateway that
+// must forward through another gateway sends a header with one hop fewer;
+// a request with no hop left is answered Unreachable, so a loop in the
+// routes costs a few transactions, never a circle without end. A request
+// frame of type 0x13 whose header did not arrive is dropped: without its
+// destination, it would name an object of the gateway.
+
+/// How many times a request may go as a routed request: from its requester
+/// to the first gateway, and from each gateway that must pass it to another.
+constexpr uint8_t kRouteHops = 4;
+/// Bytes of a route header.
+constexpr size_t kRouteHeaderBytes = 4;
+
+struct RouteHeader {
+    uint8_t hopsLeft = kRouteHops;
+    uint8_t transaction = 0;
+    uint16_t destination = 0;
+};
+
+/// Whether a routed request frame is a route header (byte 0's bits 7-6).
+constexpr bool isRouteHeader(const uint8_t* bytes, size_t length)
+{
+    return length > 0 && (bytes[0] & 0xC0) == 0xC0;
+}
+
+void encodeRouteHeader(const RouteHeader& header, uint8_t (&bytes)[kRouteHeaderBytes]);
+/// Decodes a header of @p length bytes: None, WrongLength (not
+/// kRouteHeaderBytes), ReservedBits (not a header, bits 5-4 set, or hops
+/// left 0 or above kRouteHops).
+RemoteMessageError decodeRouteHeader(const uint8_t* bytes, size_t length, RouteHeader& header);
+
 // ---- name queries --------------------------------------------------------
 //
 // NameToObject asked of every node (message type 0x12, to the broadcast
