@@ -15,7 +15,9 @@ publisher from its frames. Then the global time base
 (docs/protocols/time.md): the peer decodes the board's Syncs and FollowUps,
 and the board follows the peer as its time master. Last, the peer sends a
 message to a port of the board (docs/protocols/remote-transactions.md,
-"Port sends").
+"Port sends"), and asks the board, as its gateway, for its own semaphore
+("Gateways"): the board forwards the routed request back to the peer as
+its own request and relays the answer.
 
 Emulated time is paced at a fiftieth of wall time, so that the VM's
 answers, slow under an emulated CPU on a busy host, come well within the
@@ -278,6 +280,39 @@ for data in (struct.pack(">BBHb", PORT_SEND, transaction, port, 4) + body[0:3],
              bytes([0x80 | 2 << 4 | transaction & 0x0F]) + body[10:16]):
     bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True, data=data))
 await_reply("PORTREPLY")
+
+# Phase 6: the board as this node's gateway (docs/protocols/remote-
+# transactions.md, "Gateways"). At the go frame ROUTE, ask the board, as a
+# routed request (type 0x13), to count semaphore 0xA001 of node 3, which is
+# this node: a route header with 4 hops left naming node 3, then the
+# request, transaction 0x41. The board performs it as its own transaction
+# with node 3, so this node serves the board's request (and any
+# retransmission of it) until the board's reply to the routed request comes.
+ROUTED, ROUTE_GO = 0x13, 0x7F9
+while True:
+    message = receive()
+    if not message.is_extended_id and message.arbitration_id == ROUTE_GO:
+        break
+for data in (bytes([0xC0 | 4, 0x41, 0, ME]), struct.pack(">BBHI", COUNT, 0x41, 0xA001, 0)):
+    bus.send(can.Message(arbitration_id=identifier(9, ROUTED, BOARD, ME), is_extended_id=True, data=data))
+while True:
+    message = receive()
+    if not message.is_extended_id:
+        continue
+    priority, kind, destination, source = fields(message)
+    if destination != ME or source != BOARD:
+        continue
+    if kind == REQUEST:
+        service, transaction, obj, argument = struct.unpack(">BBHI", bytes(message.data))
+        print(f"@@PEER GATEWAYREQUEST priority={priority} service={service} object={obj:04X} "
+              f"argument={argument}@@", flush=True)
+        bus.send(can.Message(arbitration_id=identifier(priority, REPLY, source, ME), is_extended_id=True,
+                             data=struct.pack(">BBBBI", service, transaction, OK, 0, counts.get(obj, 0))))
+    elif kind == REPLY and bytes(message.data)[1] == 0x41 and not bytes(message.data)[3] & 1:
+        service, transaction, status, flags, value = struct.unpack(">BBBBI", bytes(message.data))
+        print(f"@@PEER ROUTEDREPLY priority={priority} service={service} transaction={transaction:02X} "
+              f"status={status} flags={flags} value={value}@@", flush=True)
+        break
 bus.shutdown()
 """
 
@@ -434,4 +469,17 @@ def test_a_python_can_node_sends_a_message_to_a_port_of_the_board(world):
     assert peer_line(world, "PORTREPLY") == "priority=9 service=11 transaction=35 status=0 flags=0 value=0"
     output = world.board.command("remote portgot", timeout=STEP)
     assert f"RPGOT 1 a0 {bytes(range(0xA0, 0xB0)).hex()}" in output, output
+
+
+def test_a_python_can_node_asks_through_the_board_as_its_gateway(world):
+    # The peer's routed request names node 3, itself: the board forwards it
+    # as its own request to node 3, at the peer's priority, and replies with
+    # what it got, the count of 0xA001 the peer keeps.
+    before = remote.net_counters(world.board)
+    world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7F9, b"\x00"))
+    forwarded = peer_line(world, "GATEWAYREQUEST")
+    assert forwarded == "priority=9 service=3 object=A001 argument=0", forwarded
+    assert peer_line(world, "ROUTEDREPLY") == "priority=9 service=3 transaction=41 status=0 flags=0 value=5"
     world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
+    after = remote.net_counters(world.board)
+    assert after["forwarded"] - before["forwarded"] == 1 and after["unrouted"] == before["unrouted"]
