@@ -209,3 +209,38 @@ def test_a_routed_request_without_its_header_is_dropped_not_served_as_the_gatewa
     assert call(two, f"count {gateway_semaphore}")[:2] == ("ok", 0)
     assert call(three, f"count {far_semaphore}")[:2] == ("ok", 0)
     assert frames(lab, "can0", REPLY) == []
+
+
+NAME_QUERY = 0x12
+
+
+def test_names_behind_the_gateway_are_found_through_it(triple):
+    lab, one, two, three = triple
+    pump = created(three, "remote named pump global", "RSEM")
+    status, value, _ = remote.call(one, "name semaphore pump")
+    assert (status, f"0x{value:08x}") == ("ok", pump)
+    # Node 1 broadcast its query on can0 and sent it to the gateway, which
+    # broadcast it on can1, the bus beyond, once; node 3 answered node 2, and
+    # node 2 node 1.
+    lab.hub.wait_until(lab.hub.now_ns + 2_000_000, 60)
+    near = frames(lab, "can0", NAME_QUERY)
+    assert sorted((destination, source) for _, destination, source, _ in near) == [(2, 1)] * 3 + [(255, 1)] * 3
+    assert [(destination, source) for _, destination, source, _ in frames(lab, "can1", NAME_QUERY)] == [(255, 2)] * 3
+    assert net_counters(two)["forwarded"] == 1
+    # The same the other way: node 3 finds node 1's global name through node 2.
+    vent = created(one, "remote named vent global", "RSEM")
+    status, value, _ = remote.call(three, "name semaphore vent")
+    assert (status, f"0x{value:08x}") == ("ok", vent)
+    # A local object stays unseen through the gateway too: not found, after the
+    # gateway's own query ran out (4 silent periods, node 1's retransmissions
+    # answered pending) and node 1's silent periods after it (407 ms measured).
+    created(three, "remote named door local", "RSEM")
+    status, _, us = remote.call(one, "name semaphore door")
+    assert status == "not found"
+    assert (2 * SILENT_PERIODS - 1) * WATCHDOG_MS * 1000 <= us < 3 * SILENT_PERIODS * WATCHDOG_MS * 1000, us
+    # The gateway's own object is found without asking beyond it.
+    before = len(frames(lab, "can1", NAME_QUERY))
+    gate = created(two, "remote named gate global", "RSEM")
+    status, value, _ = remote.call(one, "name semaphore gate")
+    assert (status, f"0x{value:08x}") == ("ok", gate)
+    assert len(frames(lab, "can1", NAME_QUERY)) == before

@@ -221,6 +221,31 @@ TEST(AddressMapTest, TheLongestRouteWins)
     EXPECT_EQ(map.removeRoute(address(140, 7, 0, 0), 16), Status::NotFound);
 }
 
+TEST(AddressMapTest, EachRoutesGatewayIsNamedOnceWhereItIsReached)
+{
+    Map map;
+    NextHop hops[Map::kRoutes];
+    EXPECT_EQ(map.gatewayHops(hops), 0u) << "no routes";
+    ASSERT_TRUE(map.addInterface(interfaceOf(InterfaceKind::Can, 0, address(130, 1, 0, 9), 16, 9)).ok());
+    ASSERT_TRUE(map.addInterface(interfaceOf(InterfaceKind::Can, 1, address(130, 2, 0, 9), 16, 9)).ok());
+    ASSERT_EQ(map.addRoute(address(140, 0, 0, 0), 8, address(130, 1, 0, 1)), Status::Ok);
+    ASSERT_EQ(map.addRoute(address(141, 0, 0, 0), 8, address(130, 1, 0, 1)), Status::Ok);
+    ASSERT_EQ(map.addRoute(address(142, 0, 0, 0), 8, address(130, 2, 0, 4)), Status::Ok);
+    ASSERT_EQ(map.addRoute(address(143, 0, 0, 0), 8, address(142, 0, 0, 1)), Status::Ok);
+    EXPECT_EQ(map.gatewayHops(hops), 0u) << "no gateway has a physical address yet";
+    ASSERT_EQ(map.setPhysicalAddress(address(130, 1, 0, 1), 1), Status::Ok);
+    ASSERT_EQ(map.setPhysicalAddress(address(130, 2, 0, 4), 4), Status::Ok);
+    ASSERT_EQ(map.gatewayHops(hops), 2u) << "two routes through one gateway name it once; a gateway behind a "
+                                            "route is not asked";
+    EXPECT_EQ(hops[0].interface, 0);
+    EXPECT_EQ(hops[0].physical, 1u);
+    EXPECT_EQ(hops[1].interface, 1);
+    EXPECT_EQ(hops[1].physical, 4u);
+    ASSERT_EQ(map.removeInterface(1), Status::Ok);
+    ASSERT_EQ(map.gatewayHops(hops), 1u) << "a gateway on a bus no longer attached";
+    EXPECT_EQ(hops[0].physical, 1u);
+}
+
 TEST(AddressMapTest, EveryTablesErrors)
 {
     Map map;

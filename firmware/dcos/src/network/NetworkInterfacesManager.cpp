@@ -112,6 +112,12 @@ void copyNetworkTables(NetworkTables& copy)
     copy = tables;
 }
 
+size_t gatewayHops(NextHop (&hops)[NetworkTables::kRoutes])
+{
+    Lock lock;
+    return tables.gatewayHops(hops);
+}
+
 } // namespace internal
 
 } // namespace dcos

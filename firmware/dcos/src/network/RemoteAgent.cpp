@@ -10,6 +10,7 @@
 #include <dcos/internal/GlobalTimeService.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/NameService.hpp>
+#include <dcos/internal/NetworkTables.hpp>
 #include <dcos/internal/PublicationMessage.hpp>
 #include <dcos/internal/RemoteAgent.hpp>
 #include <dcos/internal/RemoteForward.hpp>
@@ -113,6 +114,11 @@ struct ServedEntry {
     // request the destination of its route header, and the hops it has left.
     uint16_t node = 0;
     uint8_t hopsLeft = 0;
+    // A name query sent to this node alone, as a gateway: what it does not
+    // have, it asks the buses beyond (docs/protocols/remote-transactions.md,
+    // "Gateways"). A requester sends such a query with the same transaction
+    // as its broadcast one, so the two are told apart by this flag.
+    bool relay = false;
     // A name query's name, NUL-padded (service NameToObject, the type in
     // request.object), or a port send's message (service PortSend).
     uint8_t payload[kPortMessageBytes]{};
@@ -369,11 +375,13 @@ Status forwardPortSend(ObjectId port, const Message& message, int priority)
 // Any interface, any sender: the call slot of a name query, asked of every node.
 constexpr uint8_t kAnyInterface = 0xFF;
 
-// NameToObject asked of every node with a link (RemoteForward.hpp's
-// resolver): the first node that has a visible object of that type and name
-// answers with its id; when none does, every node stays silent, and after
-// the watchdog's silent periods the answer is NotFound.
-Result<ObjectId> forwardName(ObjectType type, const char* name)
+// NameToObject asked of other nodes: the query broadcast on every attached
+// link but @p except (kAnyInterface: none), and, @p throughGateways, sent
+// to each route's gateway too, which asks the buses beyond it. The first
+// node that has a visible object of that type and name answers with its
+// id; when none does, every node stays silent, and after the watchdog's
+// silent periods the answer is NotFound.
+Result<ObjectId> askForName(ObjectType type, const char* name, uint8_t except, bool throughGateways)
 {
     const uint64_t begun = readCounter();
     if (inInterruptContext()) {
@@ -384,8 +392,8 @@ Result<ObjectId> forwardName(ObjectType type, const char* name)
     {
         Lock lock;
         bool anyLink = false;
-        for (NetworkLink* link : links) {
-            anyLink = anyLink || link != nullptr;
+        for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
+            anyLink = anyLink || (links[interface] != nullptr && interface != except);
         }
         if (!anyLink) {
             return Status::NotFound;
@@ -395,16 +403,27 @@ Result<ObjectId> forwardName(ObjectType type, const char* name)
             return Status::Busy;
         }
     }
+    NextHop gateways[NetworkTables::kRoutes];
+    const size_t gatewayCount = throughGateways ? gatewayHops(gateways) : 0;
     uint8_t frames[kNameQueryFrames][kRemoteMessageBytes];
     encodeNameQuery(static_cast<uint8_t>(type), slot->transaction, name, frames);
+    // The parts in a row, to one destination; false when the link did not take one.
+    const auto sendQuery = [&](uint8_t interface, uint32_t destination) {
+        for (size_t part = 0; part < kNameQueryFrames; ++part) {
+            if (!sendMessage(interface, SystemMessageType::NameQuery, self.priority, destination, frames[part])) {
+                return false;
+            }
+        }
+        return true;
+    };
     const Result<uint32_t> found = awaitReply(*slot, begun, [&] {
         for (uint8_t interface = 0; interface < kNetworkInterfaces; ++interface) {
-            for (size_t part = 0; part < kNameQueryFrames; ++part) {
-                if (!sendMessage(interface, SystemMessageType::NameQuery, self.priority, NetworkLink::kBroadcast,
-                                 frames[part])) {
-                    break;
-                }
+            if (interface != except) {
+                (void)sendQuery(interface, NetworkLink::kBroadcast);
             }
+        }
+        for (size_t i = 0; i < gatewayCount; ++i) {
+            (void)sendQuery(gateways[i].interface, gateways[i].physical);
         }
     });
     if (!found.ok()) {
@@ -416,6 +435,14 @@ Result<ObjectId> forwardName(ObjectType type, const char* name)
         return Status::Corrupted;
     }
     return id;
+}
+
+// NameToObject asked of every node this node reaches (RemoteForward.hpp's
+// resolver): those on its buses, and through its routes' gateways those
+// one gateway beyond.
+Result<ObjectId> forwardName(ObjectType type, const char* name)
+{
+    return askForName(type, name, kAnyInterface, true);
 }
 
 // The caller's instructions of @p slot's transaction, which got its final
@@ -547,10 +574,11 @@ void onPublication(uint8_t interface, const SystemMessage& message)
 // the entry is never asked for again. Matching by the whole transaction
 // number alone would not do: the generation wraps after 16 transactions,
 // and an old entry of the same number would answer a new request.
-bool sameCallSlot(const ServedEntry& entry, uint8_t interface, uint32_t source, uint8_t transaction)
+bool sameCallSlot(const ServedEntry& entry, uint8_t interface, uint32_t source, uint8_t transaction, bool relay)
 {
     return entry.state != ServedState::Free && !entry.superseded && entry.interface == interface &&
-           entry.source == source && (entry.request.transaction & kSlotMask) == (transaction & kSlotMask);
+           entry.source == source && (entry.request.transaction & kSlotMask) == (transaction & kSlotMask) &&
+           entry.relay == relay;
 }
 
 // Where a new request goes: the finished entry of the same caller slot,
@@ -585,8 +613,10 @@ ServedEntry* entryForNewRequest(ServedEntry* sameSlot)
 // (RemoteInstructions::servePartsBefore), 0 for a request of one frame.
 // @p node is the node whose object it names (this one, or a routed
 // request's destination), @p hopsLeft a routed request's hops left.
+// @p relay: a name query sent to this node alone (ServedEntry::relay).
 void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
-                  const uint8_t* payload, uint32_t partsBefore, uint16_t node, uint8_t hopsLeft);
+                  const uint8_t* payload, uint32_t partsBefore, uint16_t node, uint8_t hopsLeft,
+                  bool relay = false);
 
 // Requests of several frames being put back together (name queries, port
 // sends), one per sender: a sender's entry, or a new one taking the entry
@@ -711,6 +741,7 @@ void admitFor(uint8_t interface, const SystemMessage& message, const RemoteReque
 
 constexpr size_t kRequestsGathered = 4;
 Gathering<NameQueryAssembler> nameQueries[kRequestsGathered];
+Gathering<NameQueryAssembler> relayedNameQueries[kRequestsGathered];
 Gathering<PortSendAssembler> portSends[kRequestsGathered];
 uint32_t gatheringClock = 0;
 
@@ -762,7 +793,12 @@ void onNameQuery(uint8_t interface, const SystemMessage& message)
         countMalformed();
         return;
     }
-    Gathering<NameQueryAssembler>& gathering = gatheringFor(nameQueries, gatheringClock, interface, message.source);
+    // Sent to this node alone, not broadcast: it is asked as a gateway. A
+    // requester sends such a query beside its broadcast one, and the two
+    // streams' frames may interleave on the bus, so each is put together apart.
+    const bool relay = message.destination != NetworkLink::kBroadcast;
+    Gathering<NameQueryAssembler>& gathering =
+        gatheringFor(relay ? relayedNameQueries : nameQueries, gatheringClock, interface, message.source);
     if (!gathering.assembler.take(part)) {
         return;
     }
@@ -771,13 +807,13 @@ void onNameQuery(uint8_t interface, const SystemMessage& message)
     request.transaction = gathering.assembler.transaction();
     request.object = gathering.assembler.type();
     admitRequest(interface, message, request, reinterpret_cast<const uint8_t*>(gathering.assembler.name()), 0,
-                 localNode(), 0);
+                 localNode(), 0, relay);
 }
 
 // A request to serve: a retransmission is answered from the served table,
 // a new one queued for the workers.
 void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteRequest& request,
-                  const uint8_t* payload, uint32_t partsBefore, uint16_t node, uint8_t hopsLeft)
+                  const uint8_t* payload, uint32_t partsBefore, uint16_t node, uint8_t hopsLeft, bool relay)
 {
     RemoteReply answer;
     answer.service = request.service;
@@ -788,7 +824,7 @@ void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteR
         Lock lock;
         ServedEntry* sameSlot = nullptr;
         for (ServedEntry& entry : served) {
-            if (sameCallSlot(entry, interface, message.source, request.transaction)) {
+            if (sameCallSlot(entry, interface, message.source, request.transaction, relay)) {
                 sameSlot = &entry;
                 break;
             }
@@ -828,6 +864,7 @@ void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteR
                 entry->partsBefore = partsBefore;
                 entry->node = node;
                 entry->hopsLeft = hopsLeft;
+                entry->relay = relay;
                 // The worker takes the request's priority as it wakes, not
                 // when it first runs: woken at its idle priority, it would
                 // wait behind every local task, however urgent the request.
@@ -942,8 +979,18 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
         // or regional and asked for within the controller (Visibility.hpp).
         const Visibility scope = withinController(entry.interface) ? Visibility::Regional : Visibility::Global;
         // The assembler let through only names of 1 to 15 characters, NUL-padded.
-        const Result<ObjectId> found = localNameToObject(static_cast<ObjectType>(request.object),
-                                                         reinterpret_cast<const char*>(entry.payload), scope);
+        const ObjectType type = static_cast<ObjectType>(request.object);
+        const char* const name = reinterpret_cast<const char*>(entry.payload);
+        Result<ObjectId> found = localNameToObject(type, name, scope);
+        if (!found.ok() && entry.relay) {
+            // Asked as a gateway: the buses beyond, not the one it came
+            // from, and no further gateway (a query is relayed once).
+            found = askForName(type, name, entry.interface, false);
+            if (found.ok()) {
+                Lock lock;
+                ++statistics.forwarded;
+            }
+        }
         if (found.ok()) {
             reply.value = found.value().raw();
         } else {

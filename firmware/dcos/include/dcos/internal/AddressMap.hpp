@@ -264,6 +264,29 @@ public:
         }
     }
 
+    /// The first hops to the routes' gateways, each once: a gateway on a
+    /// local subnet with a physical address, into @p hops; how many.
+    /// O(routes × (routes + interfaces + neighbours)).
+    size_t gatewayHops(NextHop (&hops)[kRoutes]) const
+    {
+        size_t count = 0;
+        for (size_t i = 0; i < kRoutes; ++i) {
+            NextHop hop;
+            if (!routeUsed_[i] || interfaceHolding(routes_[i].gateway) == kInterfaces ||
+                !hopTo(routes_[i].gateway, hop)) {
+                continue;
+            }
+            bool seen = false;
+            for (size_t j = 0; j < count; ++j) {
+                seen = seen || (hops[j].interface == hop.interface && hops[j].physical == hop.physical);
+            }
+            if (!seen) {
+                hops[count++] = hop;
+            }
+        }
+        return count;
+    }
+
 private:
     // The first free entry of a table whose use flags are @p used, after a
     // walk of the entries in use that stops at the first one @p clashes

@@ -14,4 +14,9 @@ using NetworkTables = AddressMap<AddressMapCapacities{kNetworkInterfaces, kNetwo
 /// them with interrupts enabled. O(size of the tables).
 void copyNetworkTables(NetworkTables& copy);
 
+/// The first hops to the routes' gateways, each once (AddressMap::gatewayHops),
+/// under the manager's guard: where a name query goes beyond the buses this
+/// node is attached to (docs/protocols/remote-transactions.md, "Gateways").
+size_t gatewayHops(NextHop (&hops)[NetworkTables::kRoutes]);
+
 } // namespace dcos::internal
