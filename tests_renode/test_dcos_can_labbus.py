@@ -232,7 +232,7 @@ def test_dump_decodes_a_port_send(hub):
         Frame(0x14110201, extended=True, dlc=8, data=bytes([11, 0x5B, 0x71, 0x23, 0xFD, 0xE0, 0xE1, 0xE2])),
         Frame(0x14110201, extended=True, dlc=8, data=bytes([0x9B]) + bytes(range(0xE3, 0xEA))),
         Frame(0x14110201, extended=True, dlc=7, data=bytes([0xAB]) + bytes(range(0xEA, 0xF0))),
-        Frame(0x14110201, extended=True, dlc=8, data=bytes([0xBB]) + bytes(7))])
+        Frame(0x14110201, extended=True, dlc=8, data=bytes([0xCB]) + bytes(7))])
     remote = [json.loads(line)["dcos"]["remote"] for line in output.splitlines()]
     assert remote == [
         {"service": "port-send", "transaction": 0x5B, "object": 0x7123, "argument": 0xFDE0E1E2},
@@ -284,3 +284,24 @@ def test_dump_decodes_the_global_time_base(hub):
         "prio 0 time sync 100->all: probe seq 9",
         "prio 0 time sync 1->all: malformed: bad rank",
     ], lines
+
+
+def test_dump_decodes_a_held_acquire(hub):
+    # docs/protocols/remote-transactions.md, "Binary semaphores": node 1's
+    # task 0x00011002 acquires node 2's binary semaphore 0xA004 waiting up to
+    # 250 ms, transaction 0x35; then releases it; a holder part whose last
+    # bytes are not zero.
+    output, lines = decoded_dumps(hub, [
+        Frame(0x18110201, extended=True, dlc=8, data=bytes([12, 0x35, 0xA0, 0x04, 0, 0, 0, 0xFA])),
+        Frame(0x18110201, extended=True, dlc=8, data=bytes([0xB5, 0x00, 0x01, 0x10, 0x02, 0, 0, 0])),
+        Frame(0x18110201, extended=True, dlc=8, data=bytes([13, 0x36, 0xA0, 0x04, 0x00, 0x01, 0x10, 0x02])),
+        Frame(0x18110201, extended=True, dlc=8, data=bytes([0xB5, 0x00, 0x01, 0x10, 0x02, 0, 0, 1]))])
+    remote = [json.loads(line)["dcos"]["remote"] for line in output.splitlines()]
+    assert remote == [
+        {"service": "held-acquire", "transaction": 0x35, "object": 0xA004, "argument": 250},
+        {"service": "held-acquire", "part": 3, "slot": 5, "holder": 0x00011002},
+        {"service": "held-release", "transaction": 0x36, "object": 0xA004, "argument": 0x00011002},
+        {"malformed": "reserved bits set"},
+    ], remote
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations[1] == "prio 24 remote request 1->2: held-acquire holder 0x00011002 slot 5", lines

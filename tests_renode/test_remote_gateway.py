@@ -133,9 +133,9 @@ def test_events_signals_reads_and_port_sends_cross_the_gateway(triple):
     assert got and got.groups() == ("1", "10", bytes(range(0x10, 0x20)).hex()), got
     routed = frames(lab, "can0", ROUTED)
     assert [len(data) for *_, data in routed[-4:]] == [4, 8, 8, 7]
-    # A binary semaphore answers as it does from any other node.
+    # A binary semaphore refuses as it does from any other node.
     binary = created(three, "remote sem binary", "RSEM")
-    assert call(one, f"acquire {binary} 0")[0] == "not supported"
+    assert call(one, f"release {binary}")[0] == call(three, f"release {binary}")[0] == "not owner"
     # An object node 3 never issued.
     never = "0x%08x" % (int(listener, 16) + 0x100)
     assert call(one, f"state {never}")[0] == call(three, f"state {never}")[0]
@@ -244,3 +244,30 @@ def test_names_behind_the_gateway_are_found_through_it(triple):
     status, value, _ = remote.call(one, "name semaphore gate")
     assert (status, f"0x{value:08x}") == ("ok", gate)
     assert len(frames(lab, "can1", NAME_QUERY)) == before
+
+
+def test_a_binary_semaphore_behind_the_gateway_is_held_by_the_far_task(triple):
+    lab, one, two, three = triple
+    binary = created(three, "remote sem binary", "RSEM")
+    # Node 1's console takes node 3's binary semaphore through node 2: node 3
+    # names node 1's task as the holder, not the gateway's worker.
+    assert call(one, f"acquire {binary} 0")[:2] == ("ok", 0)
+    status, holder, _ = call(three, f"holder {binary}")
+    assert status == "ok" and holder >> 16 == 1 and (holder >> 12) & 0xF == 1, hex(holder)
+    assert call(one, f"acquire {binary} 0")[0] == "would deadlock"
+    assert call(two, f"release {binary}")[0] == "not owner"
+    assert call(three, f"release {binary}")[0] == "not owner"
+    assert call(one, f"release {binary}")[:2] == ("ok", 0)
+    assert call(three, f"holder {binary}")[:2] == ("ok", 0)
+    # The held acquire crossed both buses, its holder unchanged.
+    for bus in ("can0", "can1"):
+        held = [data for _, _, _, data in frames(lab, bus, REQUEST) if data[0] & 0xF0 == 0xB0]
+        held += [data for _, _, _, data in frames(lab, bus, ROUTED) if data[0] & 0xF0 == 0xB0]
+        assert held and all(int.from_bytes(data[1:5], "big") == holder for data in held), bus
+    # Node 1 leaves while holding it: node 3's waiter probes node 1's task
+    # through the gateway, learns node 1 is unreachable, and gets it back.
+    assert call(one, f"acquire {binary} 0")[0] == "ok"
+    assert "error:" not in one.command("can detach can0")
+    status, _, us = remote.call(three, f"acquire {binary} 5000")
+    assert status == "holder ended", status
+    assert call(three, f"acquire {binary} 0")[0] == "ok"

@@ -139,9 +139,9 @@ def test_errors_come_back_as_the_local_call_gives_them(pair):
     assert call(one, f"count {never_issued}")[0] == call(two, f"count {never_issued}")[0] == "invalid id"
     wrong_type = "0x0002" + "1" + semaphore[7:]  # a task id of node 2 that was never handed out
     assert call(one, f"release {wrong_type}")[0] == call(two, f"release {wrong_type}")[0]
-    # A binary semaphore is held by a task: no task of node 1 can hold one of node 2 yet.
+    # A binary semaphore is released only by its holder, here as on node 2.
     binary = created(two, "remote sem binary", "RSEM")
-    assert call(one, f"acquire {binary} 0")[0] == "not supported"
+    assert call(one, f"release {binary}")[0] == call(two, f"release {binary}")[0] == "not owner"
     # A node the tables do not know.
     assert call(one, "count 0x0007" + semaphore[6:])[0] == "remote object unreachable"
 
@@ -516,3 +516,104 @@ def test_a_port_send_duplicated_or_torn_on_the_bus_is_sent_to_the_port_once(pair
     assert served["served"] == 1 and served["duplicates"] == 1, served
     replies = dcos_frames(lab, REPLY)
     assert [data for *_, data in replies] == [bytes([11, 0xE6, 0, 0, 0, 0, 0, 0])] * 2
+
+
+HELD_PART = 0xB0  # A held acquire's continuation: 0x80 | 3 << 4 | slot.
+
+
+def is_task_of(value, node):
+    return value >> 16 == node and (value >> 12) & 0xF == 1
+
+
+def test_a_task_of_another_node_holds_a_binary_semaphore_as_a_local_task_would(pair):
+    lab, one, two = pair
+    binary = created(two, "remote sem binary", "RSEM")
+    # Node 1's console task takes it: node 2 names that task as its holder.
+    assert call(one, f"acquire {binary} 0")[:2] == ("ok", 0)
+    status, holder, _ = call(two, f"holder {binary}")
+    assert status == "ok" and is_task_of(holder, 1), hex(holder)
+    assert call(one, f"holder {binary}")[:2] == ("ok", holder)
+    assert call(two, f"count {binary}")[:2] == ("ok", 0)
+    # The rules of a local binary semaphore: asked again by its holder, it
+    # would deadlock; no other task may release it; others wait.
+    assert call(one, f"acquire {binary} 100")[0] == "would deadlock"
+    assert call(two, f"release {binary}")[0] == "not owner"
+    assert call(two, f"acquire {binary} 0")[0] == "would block"
+    assert call(one, f"release {binary}")[:2] == ("ok", 0)
+    assert call(one, f"release {binary}")[0] == "not owner"
+    assert call(two, f"holder {binary}")[:2] == ("ok", 0)
+    assert call(two, f"count {binary}")[:2] == ("ok", 1)
+    # The first acquire asked in the plain form, was told to name its task,
+    # and asked again in the held form: two frames naming node 1's console.
+    # Later ones went in the held form at once.
+    requests = dcos_frames(lab, REQUEST)
+    held = [data for _, _, _, data in requests if data[0] & 0xF0 == HELD_PART]
+    assert len(held) == 2 and all(len(data) == 8 and data[5:] == bytes(3) for data in held)
+    assert all(int.from_bytes(data[1:5], "big") == holder for data in held)
+    services = [data[0] for _, _, _, data in requests if data[0] & 0x80 == 0]
+    assert services[:2] == [1, 12], services  # acquire, then held-acquire
+    assert services.count(1) == 1 and services.count(2) == 0, services
+
+
+def test_a_binary_semaphore_passes_between_tasks_of_two_nodes(pair):
+    lab, one, two = pair
+    binary = created(two, "remote sem binary", "RSEM")
+    assert call(two, f"acquire {binary} 0")[0] == "ok"  # node 2's console holds it
+    one.emulator.send(f"remote acquire {binary} 5000\r")
+    lab.hub.wait_for_records(
+        lambda records: any(data[0] & 0xF0 == HELD_PART for _, _, _, data in dcos_frames(lab, REQUEST, records)),
+        120, "node 1's held acquire")
+    assert call(two, f"release {binary}")[0] == "ok"  # handed to node 1's waiting task
+    match = one.emulator.expect(r"RRES (.+) (\d+) (\d+)\r\n", timeout=120)
+    one.emulator.expect(r"dcos> ")
+    assert match.group(1) == b"ok"
+    status, holder, _ = call(two, f"holder {binary}")
+    assert status == "ok" and is_task_of(holder, 1), hex(holder)
+    # And back: node 2's task waits, node 1 releases.
+    two.emulator.send(f"remote acquire {binary} 5000\r")
+    two.emulator.expect(r"remote acquire", timeout=60)
+    assert call(one, f"release {binary}")[0] == "ok"
+    match = two.emulator.expect(r"RRES (.+) (\d+) (\d+)\r\n", timeout=120)
+    two.emulator.expect(r"dcos> ")
+    assert match.group(1) == b"ok"
+    status, holder, _ = call(two, f"holder {binary}")
+    assert status == "ok" and is_task_of(holder, 2), hex(holder)
+
+
+def test_a_binary_semaphore_whose_remote_holder_is_gone_is_given_back_to_its_waiters(pair):
+    lab, one, two = pair
+    binary = created(two, "remote sem binary", "RSEM")
+    # A task of node 1 takes it and ends, holding it.
+    waiter = created(one, f"remote waiter {binary}", "RTASK")
+    lab.hub.wait_until(lab.hub.now_ns + 300_000_000, 120)
+    status, holder, _ = call(two, f"holder {binary}")
+    assert status == "ok" and f"0x{holder:08x}" == waiter
+    assert call(one, f"state {waiter}")[0] in ("invalid id", "stale id")
+    # Node 2 waits for it: after one probe slice it asks node 1 about the
+    # holder, learns it is gone, and the wait ends "holder ended", as when a
+    # local holder dies; the semaphore is free again.
+    status, _, ms = call(two, f"acquire {binary} 5000")
+    assert status == "holder ended"
+    assert SILENT_PERIODS * WATCHDOG_MS <= ms < 2 * SILENT_PERIODS * WATCHDOG_MS, ms
+    assert call(two, f"holder {binary}")[:2] == ("ok", 0)
+    assert call(two, f"acquire {binary} 0")[0] == "ok"
+    assert call(two, f"release {binary}")[0] == "ok"
+    # A remote waiter is served the same: node 2's worker waits for node 1's
+    # console task and probes the holder, another task of node 1 that ended.
+    waiter = created(one, f"remote waiter {binary}", "RTASK")
+    lab.hub.wait_until(lab.hub.now_ns + 300_000_000, 120)
+    assert f"0x{call(two, f'holder {binary}')[1]:08x}" == waiter
+    status, _, ms = call(one, f"acquire {binary} 5000")
+    assert status == "holder ended"
+    assert SILENT_PERIODS * WATCHDOG_MS <= ms < 3 * SILENT_PERIODS * WATCHDOG_MS, ms
+    assert call(one, f"acquire {binary} 0")[0] == "ok"
+    assert call(one, f"release {binary}")[0] == "ok"
+    # A holder whose node is lost: node 1's console holds it, node 1 leaves the bus.
+    assert call(one, f"acquire {binary} 0")[0] == "ok"
+    assert call(two, f"acquire {binary} 0")[0] == "would block"
+    assert "error:" not in one.command("can detach can0")
+    status, _, ms = call(two, f"acquire {binary} 5000")
+    assert status == "holder ended"
+    # One slice, then the probe's own watchdog: 4 silent periods.
+    assert 2 * SILENT_PERIODS * WATCHDOG_MS <= ms < (2 * SILENT_PERIODS + 2) * WATCHDOG_MS, ms
+    assert call(two, f"acquire {binary} 0")[0] == "ok"

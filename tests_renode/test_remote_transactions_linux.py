@@ -17,7 +17,8 @@ and the board follows the peer as its time master. Last, the peer sends a
 message to a port of the board (docs/protocols/remote-transactions.md,
 "Port sends"), and asks the board, as its gateway, for its own semaphore
 ("Gateways"): the board forwards the routed request back to the peer as
-its own request and relays the answer.
+its own request and relays the answer. Last, the peer's task holds a
+binary semaphore of the board ("Binary semaphores").
 
 Emulated time is paced at a fiftieth of wall time, so that the VM's
 answers, slow under an emulated CPU on a busy host, come well within the
@@ -313,6 +314,40 @@ while True:
         print(f"@@PEER ROUTEDREPLY priority={priority} service={service} transaction={transaction:02X} "
               f"status={status} flags={flags} value={value}@@", flush=True)
         break
+
+# Phase 7: a binary semaphore of the board, held by this node's task
+# 0x00031005 (docs/protocols/remote-transactions.md, "Binary semaphores").
+# At the go frame HELD, whose data is the semaphore's object: a plain
+# Acquire, which the board refuses naming the held form (status 18, value
+# 1); then the held acquire, two frames; at the go frame LET_GO, the held
+# acquire again (the holder asking again: would deadlock, 17) and the held
+# release.
+HELD_GO, LET_GO, HELD_ACQUIRE, HELD_RELEASE = 0x7FA, 0x7FB, 12, 13
+HOLDER = 0x00031005
+
+def go(identifier_wanted):
+    while True:
+        message = receive()
+        if not message.is_extended_id and message.arbitration_id == identifier_wanted:
+            return bytes(message.data)
+
+def held_acquire(transaction, semaphore):
+    for data in (struct.pack(">BBHI", HELD_ACQUIRE, transaction, semaphore, 0),
+                 bytes([0x80 | 3 << 4 | transaction & 0x0F]) + HOLDER.to_bytes(4, "big") + bytes(3)):
+        bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True, data=data))
+
+semaphore = struct.unpack(">H", go(HELD_GO))[0]
+bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True,
+                     data=struct.pack(">BBHI", ACQUIRE, 0x51, semaphore, 0)))
+await_reply("HELDASK")
+held_acquire(0x52, semaphore)
+await_reply("HELD")
+go(LET_GO)
+held_acquire(0x53, semaphore)
+await_reply("AGAIN")
+bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True,
+                     data=struct.pack(">BBHI", HELD_RELEASE, 0x54, semaphore, HOLDER)))
+await_reply("LETGO")
 bus.shutdown()
 """
 
@@ -480,6 +515,25 @@ def test_a_python_can_node_asks_through_the_board_as_its_gateway(world):
     forwarded = peer_line(world, "GATEWAYREQUEST")
     assert forwarded == "priority=9 service=3 object=A001 argument=0", forwarded
     assert peer_line(world, "ROUTEDREPLY") == "priority=9 service=3 transaction=41 status=0 flags=0 value=5"
-    world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
     after = remote.net_counters(world.board)
     assert after["forwarded"] - before["forwarded"] == 1 and after["unrouted"] == before["unrouted"]
+
+
+def test_a_python_can_node_holds_a_binary_semaphore_of_the_board(world):
+    # docs/protocols/remote-transactions.md, "Binary semaphores": the peer's
+    # plain Acquire is refused naming the held form; its held acquire makes
+    # its task 0x00031005 the holder, which the board's own task may not
+    # release; asked again by the holder it would deadlock; its release frees it.
+    binary = created(world.board, "remote sem binary", "RSEM")
+    world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7FA, (int(binary, 16) & 0xFFFF).to_bytes(2, "big")))
+    assert peer_line(world, "HELDASK") == "priority=9 service=1 transaction=51 status=18 flags=0 value=1"
+    assert peer_line(world, "HELD") == "priority=9 service=12 transaction=52 status=0 flags=0 value=0"
+    assert call(world, f"holder {binary}") == ("ok", 0x00031005)
+    assert call(world, f"release {binary}") == ("not owner", 0)
+    assert call(world, f"acquire {binary} 0") == ("would block", 0)
+    world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7FB, b""))
+    assert peer_line(world, "AGAIN") == "priority=9 service=12 transaction=53 status=17 flags=0 value=0"
+    assert peer_line(world, "LETGO") == "priority=9 service=13 transaction=54 status=0 flags=0 value=0"
+    world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
+    assert call(world, f"holder {binary}") == ("ok", 0)
+    assert call(world, f"acquire {binary} 0") == ("ok", 0)

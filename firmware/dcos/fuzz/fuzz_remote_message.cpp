@@ -9,8 +9,8 @@
 // back together as a serving node does: a query it completes has a name of
 // 1 to 15 characters, a type with names, and encodes back into its parts.
 // Last, as a stream of port send frames (a length byte, then the frame): a
-// port send the assembler completes encodes back into exactly the frames
-// that made it. A routed request's route header (RemoteMessage.hpp) that
+// port send or held acquire the assembler completes encodes back into
+// exactly the frames that made it. A routed request's route header (RemoteMessage.hpp) that
 // decodes encodes back into the same four bytes and is never a request.
 #include "../../../fieldbus/can/fuzz/FuzzCheck.hpp"
 
@@ -79,7 +79,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         encodeNameQuery(assembler.type(), assembler.transaction(), assembler.name(), again);
         FUZZ_CHECK(std::memcmp(again, lastParts, sizeof again) == 0);
     }
-    PortSendAssembler portSends;
+    ContinuedRequestAssembler portSends; // Port sends and held acquires.
     uint8_t made[kPortSendFrames][kRemoteMessageBytes]{};
     uint8_t madeLengths[kPortSendFrames]{};
     for (size_t at = 0; at < size;) {
@@ -90,31 +90,46 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         const uint8_t* frame = data + at;
         at += length;
         if (isContinuation(frame, length)) {
-            PortSendContinuation part;
-            const RemoteMessageError error = decodePortSendContinuation(frame, length, part);
+            Continuation part;
+            const RemoteMessageError error = decodeContinuation(frame, length, part);
             if (error != RemoteMessageError::None) {
-                FUZZ_CHECK(error == RemoteMessageError::WrongLength || error == RemoteMessageError::UnknownService);
+                FUZZ_CHECK(error == RemoteMessageError::WrongLength || error == RemoteMessageError::UnknownService ||
+                           error == RemoteMessageError::ReservedBits);
                 continue;
             }
-            FUZZ_CHECK(part.part == 1 || part.part == 2);
-            std::memcpy(made[part.part], frame, length);
-            madeLengths[part.part] = static_cast<uint8_t>(length);
-            if (portSends.take(part) != PortSendAssembler::Outcome::Complete) {
+            FUZZ_CHECK(part.part >= 1 && part.part <= 3);
+            // A held acquire's part (3) goes beside part 0; a port send's in its place.
+            const size_t slot = part.part == 3 ? 1 : part.part;
+            std::memcpy(made[slot], frame, length);
+            madeLengths[slot] = static_cast<uint8_t>(length);
+            if (portSends.take(part) != ContinuedRequestAssembler::Outcome::Complete) {
                 continue;
             }
+            if (portSends.service() == RemoteService::HeldAcquire) {
+                // Whole: it encodes back to the very frames it came from.
+                FUZZ_CHECK(part.part == 3);
+                uint8_t held[kHeldAcquireFrames][kRemoteMessageBytes];
+                encodeHeldAcquire(portSends.heldAcquire(), held);
+                FUZZ_CHECK(madeLengths[0] == kRemoteMessageBytes && madeLengths[1] == kRemoteMessageBytes);
+                FUZZ_CHECK(std::memcmp(held[0], made[0], kRemoteMessageBytes) == 0 &&
+                           std::memcmp(held[1], made[1], kRemoteMessageBytes) == 0);
+                continue;
+            }
+            FUZZ_CHECK(part.part == 2);
             uint8_t again[kPortSendFrames][kRemoteMessageBytes];
             uint8_t lengths[kPortSendFrames];
-            encodePortSend(portSends.request(), again, lengths);
+            encodePortSend(portSends.portSend(), again, lengths);
             for (size_t i = 0; i < kPortSendFrames; ++i) {
                 FUZZ_CHECK(lengths[i] == madeLengths[i] && std::memcmp(again[i], made[i], lengths[i]) == 0);
             }
             continue;
         }
         RemoteRequest first;
-        if (decodeRequest(frame, length, first) == RemoteMessageError::None && first.service == RemoteService::PortSend) {
+        if (decodeRequest(frame, length, first) == RemoteMessageError::None &&
+            (first.service == RemoteService::PortSend || first.service == RemoteService::HeldAcquire)) {
             std::memcpy(made[0], frame, length);
             madeLengths[0] = static_cast<uint8_t>(length);
-            FUZZ_CHECK(portSends.start(first) == PortSendAssembler::Outcome::Started);
+            FUZZ_CHECK(portSends.start(first) == ContinuedRequestAssembler::Outcome::Started);
         }
     }
     return 0;

@@ -264,11 +264,11 @@ PortSendRequest counting(uint8_t transaction, int8_t priority)
 }
 
 // Feeds frames to an assembler as the serving node does.
-PortSendAssembler::Outcome feed(PortSendAssembler& assembler, const std::vector<uint8_t>& frame)
+ContinuedRequestAssembler::Outcome feed(ContinuedRequestAssembler& assembler, const std::vector<uint8_t>& frame)
 {
     if (isContinuation(frame.data(), frame.size())) {
-        PortSendContinuation part;
-        EXPECT_EQ(decodePortSendContinuation(frame.data(), frame.size(), part), RemoteMessageError::None);
+        Continuation part;
+        EXPECT_EQ(decodeContinuation(frame.data(), frame.size(), part), RemoteMessageError::None);
         return assembler.take(part);
     }
     RemoteRequest first;
@@ -290,12 +290,12 @@ TEST(RemoteMessageTest, APortSendIsThreeFramesLaidOutAsTheSpecificationSays)
 
 TEST(RemoteMessageTest, APortSendIsPutBackTogetherWhole)
 {
-    PortSendAssembler assembler;
+    ContinuedRequestAssembler assembler;
     const Frames frames = portSendFrames(counting(0x07, 31));
-    EXPECT_EQ(feed(assembler, frames[0]), PortSendAssembler::Outcome::Started);
-    EXPECT_EQ(feed(assembler, frames[1]), PortSendAssembler::Outcome::Taken);
-    EXPECT_EQ(feed(assembler, frames[2]), PortSendAssembler::Outcome::Complete);
-    const PortSendRequest& whole = assembler.request();
+    EXPECT_EQ(feed(assembler, frames[0]), ContinuedRequestAssembler::Outcome::Started);
+    EXPECT_EQ(feed(assembler, frames[1]), ContinuedRequestAssembler::Outcome::Taken);
+    EXPECT_EQ(feed(assembler, frames[2]), ContinuedRequestAssembler::Outcome::Complete);
+    const PortSendRequest& whole = assembler.portSend();
     EXPECT_EQ(whole.transaction, 0x07);
     EXPECT_EQ(whole.object, 0x7123);
     EXPECT_EQ(whole.priority, 31);
@@ -306,34 +306,102 @@ TEST(RemoteMessageTest, APortSendIsPutBackTogetherWhole)
 
 TEST(RemoteMessageTest, APortSendOutOfTurnOrOfAnotherTransactionIsDroppedNeverMixed)
 {
-    PortSendAssembler assembler;
+    ContinuedRequestAssembler assembler;
     const Frames a = portSendFrames(counting(0x01, 0));
     const Frames b = portSendFrames(counting(0x02, 0));
     // Part 1 lost: part 2 alone is out of turn.
     (void)feed(assembler, a[0]);
-    EXPECT_EQ(feed(assembler, a[2]), PortSendAssembler::Outcome::Dropped);
+    EXPECT_EQ(feed(assembler, a[2]), ContinuedRequestAssembler::Outcome::Dropped);
     // Another transaction's part 1 after this one's part 0.
     (void)feed(assembler, a[0]);
-    EXPECT_EQ(feed(assembler, b[1]), PortSendAssembler::Outcome::Dropped);
-    EXPECT_EQ(feed(assembler, a[1]), PortSendAssembler::Outcome::Dropped) << "nothing is gathering any more";
+    EXPECT_EQ(feed(assembler, b[1]), ContinuedRequestAssembler::Outcome::Dropped);
+    EXPECT_EQ(feed(assembler, a[1]), ContinuedRequestAssembler::Outcome::Dropped) << "nothing is gathering any more";
     // A continuation with no part 0 at all.
-    PortSendAssembler fresh;
-    EXPECT_EQ(feed(fresh, a[1]), PortSendAssembler::Outcome::Dropped);
+    ContinuedRequestAssembler fresh;
+    EXPECT_EQ(feed(fresh, a[1]), ContinuedRequestAssembler::Outcome::Dropped);
 }
 
 TEST(RemoteMessageTest, EveryMalformedContinuationIsRefused)
 {
-    PortSendContinuation part;
+    Continuation part;
     const std::vector<uint8_t> partOne{0x91, 1, 2, 3, 4, 5, 6, 7};
-    EXPECT_EQ(decodePortSendContinuation(partOne.data(), 7, part), RemoteMessageError::WrongLength);
+    EXPECT_EQ(decodeContinuation(partOne.data(), 7, part), RemoteMessageError::WrongLength);
     const std::vector<uint8_t> partTwo{0xA1, 1, 2, 3, 4, 5, 6, 7};
-    EXPECT_EQ(decodePortSendContinuation(partTwo.data(), 8, part), RemoteMessageError::WrongLength);
-    for (uint8_t header : {uint8_t{0x81}, uint8_t{0xB1}, uint8_t{0xD1}}) {
+    EXPECT_EQ(decodeContinuation(partTwo.data(), 8, part), RemoteMessageError::WrongLength);
+    for (uint8_t header : {uint8_t{0x81}, uint8_t{0xC1}, uint8_t{0xD1}}) {
         const std::vector<uint8_t> bad{header, 1, 2, 3, 4, 5, 6, 7};
-        EXPECT_EQ(decodePortSendContinuation(bad.data(), 8, part), RemoteMessageError::UnknownService)
+        EXPECT_EQ(decodeContinuation(bad.data(), 8, part), RemoteMessageError::UnknownService)
             << int(header);
     }
+    const std::vector<uint8_t> heldPart{0xB1, 0x00, 0x01, 0x10, 0x02, 0, 0, 0};
+    EXPECT_EQ(decodeContinuation(heldPart.data(), 7, part), RemoteMessageError::WrongLength);
+    for (size_t reserved = 5; reserved < 8; ++reserved) {
+        std::vector<uint8_t> bad = heldPart;
+        bad[reserved] = 1;
+        EXPECT_EQ(decodeContinuation(bad.data(), 8, part), RemoteMessageError::ReservedBits) << reserved;
+    }
     EXPECT_FALSE(isContinuation(partOne.data(), 0));
+}
+
+TEST(RemoteMessageTest, AHeldAcquireIsTwoFramesLaidOutAsTheSpecificationSays)
+{
+    HeldAcquireRequest request;
+    request.transaction = 0x35;
+    request.object = 0xA004;
+    request.timeoutMs = 250;
+    request.holder = 0x00011002;
+    uint8_t frames[kHeldAcquireFrames][kRemoteMessageBytes];
+    encodeHeldAcquire(request, frames);
+    EXPECT_EQ(std::vector<uint8_t>(frames[0], frames[0] + 8),
+              (std::vector<uint8_t>{12, 0x35, 0xA0, 0x04, 0x00, 0x00, 0x00, 0xFA}));
+    EXPECT_EQ(std::vector<uint8_t>(frames[1], frames[1] + 8),
+              (std::vector<uint8_t>{0xB5, 0x00, 0x01, 0x10, 0x02, 0x00, 0x00, 0x00}));
+    EXPECT_STREQ(remoteServiceName(RemoteService::HeldAcquire), "held-acquire");
+    EXPECT_STREQ(remoteServiceName(RemoteService::HeldRelease), "held-release");
+
+    ContinuedRequestAssembler assembler;
+    RemoteRequest first;
+    ASSERT_EQ(decodeRequest(frames[0], 8, first), RemoteMessageError::None);
+    EXPECT_EQ(assembler.start(first), ContinuedRequestAssembler::Outcome::Started);
+    Continuation part;
+    ASSERT_EQ(decodeContinuation(frames[1], 8, part), RemoteMessageError::None);
+    EXPECT_EQ(part.part, 3);
+    EXPECT_EQ(assembler.take(part), ContinuedRequestAssembler::Outcome::Complete);
+    EXPECT_EQ(assembler.service(), RemoteService::HeldAcquire);
+    const HeldAcquireRequest whole = assembler.heldAcquire();
+    EXPECT_EQ(whole.transaction, 0x35);
+    EXPECT_EQ(whole.object, 0xA004);
+    EXPECT_EQ(whole.timeoutMs, 250u);
+    EXPECT_EQ(whole.holder, 0x00011002u);
+}
+
+TEST(RemoteMessageTest, AHeldAcquireAndAPortSendNeverTakeEachOthersParts)
+{
+    HeldAcquireRequest held;
+    held.transaction = 0x02;
+    held.object = 0xA001;
+    held.holder = 0x00011003;
+    uint8_t heldFrames[kHeldAcquireFrames][kRemoteMessageBytes];
+    encodeHeldAcquire(held, heldFrames);
+    const Frames port = portSendFrames(counting(0x02, 5));
+
+    ContinuedRequestAssembler assembler;
+    RemoteRequest first;
+    ASSERT_EQ(decodeRequest(heldFrames[0], 8, first), RemoteMessageError::None);
+    ASSERT_EQ(assembler.start(first), ContinuedRequestAssembler::Outcome::Started);
+    EXPECT_EQ(feed(assembler, port[1]), ContinuedRequestAssembler::Outcome::Dropped)
+        << "a port send's part 1 is not a held acquire's part";
+    EXPECT_EQ(feed(assembler, port[0]), ContinuedRequestAssembler::Outcome::Started);
+    Continuation part;
+    ASSERT_EQ(decodeContinuation(heldFrames[1], 8, part), RemoteMessageError::None);
+    EXPECT_EQ(assembler.take(part), ContinuedRequestAssembler::Outcome::Dropped)
+        << "a held acquire's part is not a port send's";
+    // A service of one frame starts nothing.
+    RemoteRequest plain;
+    plain.service = RemoteService::HeldRelease;
+    plain.object = 0xA001;
+    EXPECT_EQ(assembler.start(plain), ContinuedRequestAssembler::Outcome::Dropped);
+    EXPECT_EQ(assembler.take(part), ContinuedRequestAssembler::Outcome::Dropped);
 }
 
 TEST(RemoteMessageTest, ARouteHeaderIsFourBytesLaidOutAsTheSpecificationSays)
@@ -368,8 +436,8 @@ TEST(RemoteMessageTest, ARouteHeaderIsNeverARequestOrAContinuation)
     const uint8_t header[kRouteHeaderBytes] = {0xC1, 0x00, 0x00, 0x02};
     RemoteRequest request;
     EXPECT_NE(RemoteMessageError::None, decodeRequest(header, sizeof header, request));
-    PortSendContinuation part;
-    EXPECT_NE(RemoteMessageError::None, decodePortSendContinuation(header, sizeof header, part));
+    Continuation part;
+    EXPECT_NE(RemoteMessageError::None, decodeContinuation(header, sizeof header, part));
 }
 
 TEST(RemoteMessageTest, EveryMalformedRouteHeaderIsRefused)

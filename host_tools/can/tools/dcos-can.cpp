@@ -232,12 +232,20 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         return out;
     }
     if (isRequest && isContinuation(frame.data(), frame.length())) {
-        // Parts 1 and 2 of a port send (docs/protocols/remote-transactions.md, "Port sends").
+        // Parts 1 and 2 of a port send, part 3 of a held acquire
+        // (docs/protocols/remote-transactions.md, "Port sends", "Binary semaphores").
         out.key = "remote";
-        PortSendContinuation part;
-        const RemoteMessageError error = decodePortSendContinuation(frame.data(), frame.length(), part);
+        Continuation part;
+        const RemoteMessageError error = decodeContinuation(frame.data(), frame.length(), part);
         if (error != RemoteMessageError::None) {
             return malformed(out, remoteMessageErrorName(error));
+        }
+        if (part.part == 3) {
+            const uint32_t holder = (uint32_t{part.bytes[0]} << 24) | (uint32_t{part.bytes[1]} << 16) |
+                                    (uint32_t{part.bytes[2]} << 8) | part.bytes[3];
+            out.text = fmt::format("held-acquire holder 0x{:08x} slot {}", holder, part.slot);
+            out.json = {{"service", "held-acquire"}, {"part", part.part}, {"slot", part.slot}, {"holder", holder}};
+            return out;
         }
         out.text = fmt::format("port-send part {}/3 slot {}", part.part + 1, part.slot);
         out.json = {{"service", "port-send"}, {"part", part.part}, {"slot", part.slot}};

@@ -236,7 +236,7 @@ CallSlot* openCall(Task& self, RemoteService service, uint8_t interface, uint32_
 // periods in a row (Unreachable). @p begun is the instruction counter at
 // the transaction's start (0 without a counter).
 template <typename Send>
-Result<uint32_t> awaitReply(CallSlot& slot, uint64_t begun, Send send);
+Result<uint32_t> awaitReply(CallSlot& slot, uint64_t begun, Send send, uint32_t* errorValue = nullptr);
 
 // The hops left of the routed request @p self serves, when it is a worker
 // serving one (so it forwards the request on); 0 otherwise. Under the lock.
@@ -322,7 +322,11 @@ bool sendRequest(const CallSlot& slot, uint8_t priority, const uint8_t (*frames)
     return true;
 }
 
-Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
+// One transaction of @p service on @p id with @p argument: one request
+// frame, or for HeldAcquire the two frames naming @p holder; the reply's
+// status and value, a refusal's value in @p errorValue.
+Result<uint32_t> call(RemoteService service, ObjectId id, uint32_t argument, ObjectId holder,
+                      uint32_t* errorValue = nullptr)
 {
     // The transaction's instructions count from here (RemoteInstructions).
     const uint64_t begun = readCounter();
@@ -333,16 +337,87 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
     }
     CallSlot* const slot = opened.value();
 
-    RemoteRequest request;
-    request.service = service;
-    request.transaction = slot->transaction;
-    request.object = static_cast<uint16_t>(id.raw() & 0xFFFF);
-    request.argument = argument;
-    uint8_t frames[1][kRemoteMessageBytes];
-    encodeRequest(request, frames[0]);
-    const uint8_t lengths[1] = {kRemoteMessageBytes};
+    uint8_t frames[kHeldAcquireFrames][kRemoteMessageBytes];
+    const uint8_t lengths[kHeldAcquireFrames] = {kRemoteMessageBytes, kRemoteMessageBytes};
+    size_t count = 1;
+    if (service == RemoteService::HeldAcquire) {
+        HeldAcquireRequest request;
+        request.transaction = slot->transaction;
+        request.object = static_cast<uint16_t>(id.raw() & 0xFFFF);
+        request.timeoutMs = argument;
+        request.holder = holder.raw();
+        encodeHeldAcquire(request, frames);
+        count = kHeldAcquireFrames;
+    } else {
+        RemoteRequest request;
+        request.service = service;
+        request.transaction = slot->transaction;
+        request.object = static_cast<uint16_t>(id.raw() & 0xFFFF);
+        request.argument = argument;
+        encodeRequest(request, frames[0]);
+    }
     // The running priority, so a task that inherited urgency asks with it.
-    return awaitReply(*slot, begun, [&] { (void)sendRequest(*slot, self.priority, frames, lengths, 1); });
+    return awaitReply(
+        *slot, begun, [&] { (void)sendRequest(*slot, self.priority, frames, lengths, count); }, errorValue);
+}
+
+// Ids of other nodes' semaphores that answered kAskHeld: binary ones,
+// asked for with the held forms from the first frame on. Round robin.
+constexpr size_t kBinaryIdsKnown = 8;
+ObjectId binaryIds[kBinaryIdsKnown];
+size_t nextBinaryId = 0;
+
+bool knownBinary(ObjectId id)
+{
+    Lock lock;
+    for (const ObjectId known : binaryIds) {
+        if (known == id) {
+            return true;
+        }
+    }
+    return false;
+}
+
+void rememberBinary(ObjectId id)
+{
+    Lock lock;
+    binaryIds[nextBinaryId] = id;
+    nextBinaryId = (nextBinaryId + 1) % kBinaryIdsKnown;
+}
+
+// Whether @p self is a worker serving a routed request: it passes the
+// request on as it came, held forms and refusals included.
+bool servingRouted(const Task& self)
+{
+    Lock lock;
+    return routedHopsLeft(self) != 0;
+}
+
+// The held form of an Acquire or Release, for the calling task.
+Result<uint32_t> callHeld(RemoteService service, ObjectId id, uint32_t argument)
+{
+    const ObjectId self = Scheduler::current().id;
+    return service == RemoteService::SemaphoreAcquire ? call(RemoteService::HeldAcquire, id, argument, self)
+                                                      : call(RemoteService::HeldRelease, id, self.raw(), self);
+}
+
+// RemoteForward.hpp's forwarder. An Acquire or Release of a binary
+// semaphore goes in the held form, which names the calling task: at once
+// when the id is known to be binary, else after the plain form's kAskHeld.
+Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
+{
+    const bool semaphore = service == RemoteService::SemaphoreAcquire || service == RemoteService::SemaphoreRelease;
+    if (semaphore && knownBinary(id) && !servingRouted(Scheduler::current())) {
+        return callHeld(service, id, argument);
+    }
+    uint32_t errorValue = 0;
+    const Result<uint32_t> result = call(service, id, argument, ObjectId::null(), &errorValue);
+    if (semaphore && result.status() == Status::NotSupported && errorValue == kAskHeld &&
+        !servingRouted(Scheduler::current())) {
+        rememberBinary(id);
+        return callHeld(service, id, argument);
+    }
+    return result;
 }
 
 // MessagePortAgent::Send to another node's port (RemoteForward.hpp's port
@@ -462,7 +537,7 @@ Result<ObjectId> forwardName(ObjectType type, const char* name)
 }
 
 template <typename Send>
-Result<uint32_t> awaitReply(CallSlot& callSlot, uint64_t begun, Send send)
+Result<uint32_t> awaitReply(CallSlot& callSlot, uint64_t begun, Send send, uint32_t* errorValue)
 {
     CallSlot* const slot = &callSlot;
     slot->begun = begun;
@@ -482,6 +557,9 @@ Result<uint32_t> awaitReply(CallSlot& callSlot, uint64_t begun, Send send)
             slot->caller = ObjectId::null();
             recordCall(*slot);
             if (status != Status::Ok) {
+                if (errorValue != nullptr) {
+                    *errorValue = value; // A refusal's value says more (kAskHeld).
+                }
                 return status;
             }
             return value;
@@ -742,7 +820,7 @@ void admitFor(uint8_t interface, const SystemMessage& message, const RemoteReque
 constexpr size_t kRequestsGathered = 4;
 Gathering<NameQueryAssembler> nameQueries[kRequestsGathered];
 Gathering<NameQueryAssembler> relayedNameQueries[kRequestsGathered];
-Gathering<PortSendAssembler> portSends[kRequestsGathered];
+Gathering<ContinuedRequestAssembler> portSends[kRequestsGathered];
 uint32_t gatheringClock = 0;
 
 // A request arrived on @p interface: one frame, or a part of a port send;
@@ -750,17 +828,33 @@ uint32_t gatheringClock = 0;
 void onRequest(uint8_t interface, const SystemMessage& message, bool routed)
 {
     if (isContinuation(message.data, message.length)) {
-        PortSendContinuation part;
-        if (decodePortSendContinuation(message.data, message.length, part) != RemoteMessageError::None) {
+        Continuation part;
+        if (decodeContinuation(message.data, message.length, part) != RemoteMessageError::None) {
             countMalformed();
             return;
         }
-        Gathering<PortSendAssembler>& gathering = gatheringFor(portSends, gatheringClock, interface, message.source);
-        if (gathering.assembler.take(part) != PortSendAssembler::Outcome::Complete) {
+        Gathering<ContinuedRequestAssembler>& gathering = gatheringFor(portSends, gatheringClock, interface, message.source);
+        if (gathering.assembler.take(part) != ContinuedRequestAssembler::Outcome::Complete) {
             gathering.partsInstructions += partInstructions(message);
             return; // In turn and not the last, or out of turn and dropped: the requester sends it again.
         }
-        const PortSendRequest& whole = gathering.assembler.request();
+        if (gathering.assembler.service() == RemoteService::HeldAcquire) {
+            const HeldAcquireRequest held = gathering.assembler.heldAcquire();
+            RemoteRequest request;
+            request.service = RemoteService::HeldAcquire;
+            request.transaction = held.transaction;
+            request.object = held.object;
+            request.argument = held.timeoutMs;
+            // The holder rides in the entry's payload, big-endian.
+            uint8_t payload[kPortMessageBytes]{};
+            payload[0] = static_cast<uint8_t>(held.holder >> 24);
+            payload[1] = static_cast<uint8_t>(held.holder >> 16);
+            payload[2] = static_cast<uint8_t>(held.holder >> 8);
+            payload[3] = static_cast<uint8_t>(held.holder);
+            admitFor(interface, message, request, routed, payload, gathering.partsInstructions);
+            return;
+        }
+        const PortSendRequest whole = gathering.assembler.portSend();
         RemoteRequest request;
         request.service = RemoteService::PortSend;
         request.transaction = whole.transaction;
@@ -776,8 +870,8 @@ void onRequest(uint8_t interface, const SystemMessage& message, bool routed)
         countMalformed();
         return;
     }
-    if (request.service == RemoteService::PortSend) {
-        Gathering<PortSendAssembler>& gathering = gatheringFor(portSends, gatheringClock, interface, message.source);
+    if (request.service == RemoteService::PortSend || request.service == RemoteService::HeldAcquire) {
+        Gathering<ContinuedRequestAssembler>& gathering = gatheringFor(portSends, gatheringClock, interface, message.source);
         (void)gathering.assembler.start(request);
         gathering.partsInstructions = partInstructions(message);
         return;
@@ -895,7 +989,7 @@ void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteR
 // that a wait whose requester has gone silent ends (Timeout) within one
 // slice rather than holding a worker for ever. Between two slices the
 // worker joins the semaphore's waiters again, behind those of its priority.
-Status acquireForRequester(ObjectId id, uint32_t timeoutMs, const ServedEntry& entry)
+Status acquireForRequester(ObjectId id, uint32_t timeoutMs, const ServedEntry& entry, bool probeHolder = false)
 {
     const bool forever = timeoutMs == kRemoteForever;
     const uint64_t end = forever ? 0 : TimerAgent::Uptime() + remoteTimeoutNs(timeoutMs);
@@ -912,12 +1006,39 @@ Status acquireForRequester(ObjectId id, uint32_t timeoutMs, const ServedEntry& e
         if (status != Status::Timeout) {
             return status;
         }
-        Lock lock;
-        if (TimerAgent::Uptime() - entry.heardNs > kRequesterSilenceNs) {
-            ++statistics.abandoned;
-            return Status::Timeout;
+        {
+            Lock lock;
+            if (TimerAgent::Uptime() - entry.heardNs > kRequesterSilenceNs) {
+                ++statistics.abandoned;
+                return Status::Timeout;
+            }
+        }
+        // A binary semaphore held by a task of another node: is it still there?
+        if (probeHolder && probeRemoteHolder(id)) {
+            return Status::Abandoned;
         }
     }
+}
+
+// A held acquire of @p id for @p holder, a task of another node. Counting
+// semaphores have no holder: their Acquire is served as the plain form's.
+// A binary one is acquired by this worker, in slices as above, with its
+// remote holder probed between them; then handed to @p holder.
+Status acquireHeld(ObjectId id, uint32_t timeoutMs, ObjectId holder, const ServedEntry& entry)
+{
+    const Result<bool> binary = isBinarySemaphore(id);
+    if (!binary.ok()) {
+        return binary.status();
+    }
+    if (binary.value() && remoteHolderOf(id) == holder) {
+        return Status::Deadlock; // The holder asks again for what it holds.
+    }
+    const Status status = timeoutMs == kRemotePoll ? SemaphoreAgent::Acquire(id, kPoll)
+                                                   : acquireForRequester(id, timeoutMs, entry, binary.value());
+    if (status != Status::Ok || !binary.value()) {
+        return status;
+    }
+    return holdForRemote(id, holder);
 }
 
 // A read service's result as the reply's status and value.
@@ -952,9 +1073,11 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
     switch (request.service) {
     case RemoteService::SemaphoreAcquire:
     case RemoteService::SemaphoreRelease: {
-        // A binary semaphore is held by a task: a worker cannot hold it for
-        // a task of another node (see docs/protocols/remote-transactions.md).
-        // A routed request's node decides that for itself.
+        // A binary semaphore is held by a task, so the requester must name
+        // it: the plain form is answered kAskHeld, and the requester asks
+        // again with the held form (docs/protocols/remote-transactions.md,
+        // "Binary semaphores"). A routed request's node decides that for
+        // itself; its refusal is passed back as it came.
         const Result<bool> binary = routed ? Result<bool>(false) : isBinarySemaphore(id);
         if (!binary.ok()) {
             reply.status = binary.status();
@@ -965,6 +1088,33 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
                                                            : acquireForRequester(id, request.argument, entry);
         } else {
             reply.status = SemaphoreAgent::Release(id);
+        }
+        if (reply.status == Status::NotSupported) {
+            // The one refusal of these two services that says NotSupported,
+            // here or on a routed request's node.
+            reply.value = kAskHeld;
+        }
+        break;
+    }
+    case RemoteService::HeldAcquire:
+    case RemoteService::HeldRelease: {
+        const ObjectId holder = request.service == RemoteService::HeldRelease
+                                    ? ObjectId::fromRaw(request.argument)
+                                    : ObjectId::fromRaw((uint32_t{entry.payload[0]} << 24) |
+                                                        (uint32_t{entry.payload[1]} << 16) |
+                                                        (uint32_t{entry.payload[2]} << 8) | entry.payload[3]);
+        if (holder.type() != ObjectType::Task || holder.node() == localNode()) {
+            // A holder is a task of another node. Which one, the requester
+            // says: through a gateway the request comes from the gateway, so
+            // its sender's node is not the holder's.
+            reply.status = Status::InvalidArgument;
+        } else if (routed) {
+            // Passed on in the held form, naming the same task.
+            replyWith(reply, call(request.service, id, request.argument, holder));
+        } else if (request.service == RemoteService::HeldRelease) {
+            reply.status = releaseForRemote(id, holder);
+        } else {
+            reply.status = acquireHeld(id, request.argument, holder, entry);
         }
         break;
     }

@@ -48,6 +48,8 @@ const char* remoteServiceName(RemoteService service)
     case RemoteService::DsmOpen: return "dsm-open";
     case RemoteService::NameToObject: return "name";
     case RemoteService::PortSend: return "port-send";
+    case RemoteService::HeldAcquire: return "held-acquire";
+    case RemoteService::HeldRelease: return "held-release";
     }
     return "?";
 }
@@ -225,6 +227,11 @@ constexpr uint8_t kContinuationReservedBit = 0x40;
 constexpr uint8_t kSlotMask = 0x0F;
 // Message bytes in part 0 (request bytes 5-7), part 1 and part 2.
 constexpr size_t kPortSendBytes[kPortSendFrames] = {3, 7, 6};
+// A held acquire's continuation is part number 3, which no port send has,
+// so each continuation says what it belongs to; its bytes 1-4 are the
+// holder, 5-7 zero.
+constexpr uint8_t kHeldPart = 3;
+constexpr size_t kHeldPartBytes = 7;
 static_assert(kPortSendBytes[0] + kPortSendBytes[1] + kPortSendBytes[2] == kPortMessageBytes);
 
 } // namespace
@@ -251,21 +258,45 @@ void encodePortSend(const PortSendRequest& request, uint8_t (&frames)[kPortSendF
     frames[2][7] = 0; // Not sent: part 2 is seven bytes.
 }
 
-RemoteMessageError decodePortSendContinuation(const uint8_t* bytes, size_t length, PortSendContinuation& part)
+void encodeHeldAcquire(const HeldAcquireRequest& request,
+                       uint8_t (&frames)[kHeldAcquireFrames][kRemoteMessageBytes])
+{
+    RemoteRequest first;
+    first.service = RemoteService::HeldAcquire;
+    first.transaction = request.transaction;
+    first.object = request.object;
+    first.argument = request.timeoutMs;
+    encodeRequest(first, frames[0]);
+    frames[1][0] = static_cast<uint8_t>(kContinuationFlag | (kHeldPart << kContinuationPartShift) |
+                                        (request.transaction & kSlotMask));
+    frames[1][1] = static_cast<uint8_t>(request.holder >> 24);
+    frames[1][2] = static_cast<uint8_t>(request.holder >> 16);
+    frames[1][3] = static_cast<uint8_t>(request.holder >> 8);
+    frames[1][4] = static_cast<uint8_t>(request.holder);
+    frames[1][5] = 0;
+    frames[1][6] = 0;
+    frames[1][7] = 0;
+}
+
+RemoteMessageError decodeContinuation(const uint8_t* bytes, size_t length, Continuation& part)
 {
     if (!isContinuation(bytes, length) || (bytes[0] & kContinuationReservedBit) != 0) {
         return RemoteMessageError::UnknownService;
     }
     const uint8_t number = (bytes[0] >> kContinuationPartShift) & 0x3;
-    if (number != 1 && number != 2) {
+    if (number == 0) {
         return RemoteMessageError::UnknownService;
     }
-    if (length != 1 + kPortSendBytes[number]) {
+    const size_t count = number == kHeldPart ? kHeldPartBytes : kPortSendBytes[number];
+    if (length != 1 + count) {
         return RemoteMessageError::WrongLength;
+    }
+    if (number == kHeldPart && (bytes[5] | bytes[6] | bytes[7]) != 0) {
+        return RemoteMessageError::ReservedBits;
     }
     part.part = number;
     part.slot = bytes[0] & kSlotMask;
-    part.count = static_cast<uint8_t>(kPortSendBytes[number]);
+    part.count = static_cast<uint8_t>(count);
     __builtin_memset(part.bytes, 0, sizeof part.bytes);
     __builtin_memcpy(part.bytes, bytes + 1, part.count);
     return RemoteMessageError::None;
@@ -297,33 +328,57 @@ RemoteMessageError decodeRouteHeader(const uint8_t* bytes, size_t length, RouteH
     return RemoteMessageError::None;
 }
 
-PortSendAssembler::Outcome PortSendAssembler::start(const RemoteRequest& first)
+ContinuedRequestAssembler::Outcome ContinuedRequestAssembler::start(const RemoteRequest& first)
 {
-    request_ = PortSendRequest{};
-    request_.transaction = first.transaction;
-    request_.object = first.object;
-    request_.priority = static_cast<int8_t>(first.argument >> 24);
-    request_.message[0] = static_cast<uint8_t>(first.argument >> 16);
-    request_.message[1] = static_cast<uint8_t>(first.argument >> 8);
-    request_.message[2] = static_cast<uint8_t>(first.argument);
-    next_ = 1;
+    next_ = 0;
+    switch (first.service) {
+    case RemoteService::PortSend: next_ = 1; break;
+    case RemoteService::HeldAcquire: next_ = kHeldPart; break;
+    default: return Outcome::Dropped;
+    }
+    first_ = first;
+    __builtin_memset(bytes_, 0, sizeof bytes_);
     return Outcome::Started;
 }
 
-PortSendAssembler::Outcome PortSendAssembler::take(const PortSendContinuation& part)
+ContinuedRequestAssembler::Outcome ContinuedRequestAssembler::take(const Continuation& part)
 {
-    if (next_ == 0 || part.part != next_ || part.slot != (request_.transaction & kSlotMask)) {
+    if (next_ == 0 || part.part != next_ || part.slot != (first_.transaction & kSlotMask)) {
         next_ = 0;
         return Outcome::Dropped;
     }
-    const size_t from = part.part == 1 ? kPortSendBytes[0] : kPortSendBytes[0] + kPortSendBytes[1];
-    __builtin_memcpy(request_.message + from, part.bytes, part.count);
-    if (part.part + 1u < kPortSendFrames) {
+    const size_t from = part.part == 2 ? kPortSendBytes[1] : 0;
+    __builtin_memcpy(bytes_ + from, part.bytes, part.count);
+    if (part.part == 1) {
         ++next_;
         return Outcome::Taken;
     }
     next_ = 0;
     return Outcome::Complete;
+}
+
+PortSendRequest ContinuedRequestAssembler::portSend() const
+{
+    PortSendRequest request;
+    request.transaction = first_.transaction;
+    request.object = first_.object;
+    request.priority = static_cast<int8_t>(first_.argument >> 24);
+    request.message[0] = static_cast<uint8_t>(first_.argument >> 16);
+    request.message[1] = static_cast<uint8_t>(first_.argument >> 8);
+    request.message[2] = static_cast<uint8_t>(first_.argument);
+    __builtin_memcpy(request.message + kPortSendBytes[0], bytes_, kPortMessageBytes - kPortSendBytes[0]);
+    return request;
+}
+
+HeldAcquireRequest ContinuedRequestAssembler::heldAcquire() const
+{
+    HeldAcquireRequest request;
+    request.transaction = first_.transaction;
+    request.object = first_.object;
+    request.timeoutMs = first_.argument;
+    request.holder = (uint32_t{bytes_[0]} << 24) | (uint32_t{bytes_[1]} << 16) | (uint32_t{bytes_[2]} << 8) |
+                     bytes_[3];
+    return request;
 }
 
 bool NameQueryAssembler::take(const NameQueryPart& part)

@@ -10,6 +10,8 @@
 // drops back only as it releases the semaphores that lent it priority.
 #include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
+#include <dcos/TaskAgent.hpp>
+#include <dcos/TimerAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/FastPath.hpp>
 #include <dcos/internal/KernelContext.hpp>
@@ -44,7 +46,10 @@ struct Semaphore : InheritanceSource {
     // A binary semaphore without priority inheritance: the one kind whose
     // Acquire and Release fast paths need no more than the holder list.
     bool plainBinary = false;
-    // InheritanceSource::holder is the holding task of a binary semaphore.
+    // InheritanceSource::holder is the holding task of a binary semaphore
+    // of this node; remoteHolder the task of another node that holds it
+    // (holder then null, count 0; SemaphoreManager.hpp).
+    ObjectId remoteHolder;
 };
 
 ObjectTable<Semaphore*, kSemaphoreCapacity, TaskOwnerKeys> table(ObjectType::Semaphore, 0);
@@ -110,6 +115,7 @@ void dropHold(Semaphore& semaphore)
 void destroy(Semaphore& semaphore, Status why)
 {
     dropHold(semaphore);
+    semaphore.remoteHolder = ObjectId::null();
     semaphore.waiters.setObserver(nullptr, nullptr);
     TaskManager::wakeAll(semaphore.waiters, why);
     (void)table.Delete(semaphore.id); // Cannot fail: the callers resolved the id under the same lock.
@@ -160,6 +166,95 @@ Result<bool> isBinarySemaphore(ObjectId id)
         return semaphore.status();
     }
     return semaphore.value()->kind == SemaphoreKind::Binary;
+}
+
+ObjectId remoteHolderOf(ObjectId id)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> semaphore = resolve(id);
+    return semaphore.ok() ? semaphore.value()->remoteHolder : ObjectId::null();
+}
+
+Status holdForRemote(ObjectId id, ObjectId holder)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> resolved = resolve(id);
+    if (!resolved.ok()) {
+        return resolved.status();
+    }
+    Semaphore& semaphore = *resolved.value();
+    if (semaphore.kind != SemaphoreKind::Binary || inInterruptContext() ||
+        semaphore.holder != &Scheduler::current()) {
+        return Status::NotOwner;
+    }
+    dropHold(semaphore);
+    semaphore.remoteHolder = holder;
+    return Status::Ok;
+}
+
+Status releaseForRemote(ObjectId id, ObjectId holder)
+{
+    {
+        arch_x86::InterruptGuard guard;
+        const Result<Semaphore*> resolved = resolve(id);
+        if (!resolved.ok()) {
+            return resolved.status();
+        }
+        Semaphore& semaphore = *resolved.value();
+        if (semaphore.kind == SemaphoreKind::Binary) {
+            if (semaphore.remoteHolder.isNull() || semaphore.remoteHolder != holder) {
+                return Status::NotOwner;
+            }
+            semaphore.remoteHolder = ObjectId::null();
+            if (semaphore.waiters.isEmpty()) {
+                semaphore.count = 1;
+                return Status::Ok;
+            }
+            // Handed straight to the first waiter, as a local Release does.
+            Task& next = semaphore.waiters.first();
+            semaphore.waiters.remove(next);
+            next.waitingOn = nullptr;
+            takeHold(semaphore, next);
+            TaskManager::wake(next, Status::Ok);
+            return Status::Ok;
+        }
+    }
+    return SemaphoreAgent::Release(id);
+}
+
+namespace {
+
+// Whether a remote GetState of a holder says it is gone: it ended (its id
+// names no task any more), or its node does not answer.
+bool holderGone(ObjectId holder)
+{
+    const Result<TaskState> state = TaskAgent::GetState(holder);
+    if (state.ok()) {
+        return state.value() == TaskState::NonExistent || state.value() == TaskState::Terminating;
+    }
+    return state.status() == Status::InvalidId || state.status() == Status::StaleId ||
+           state.status() == Status::Unreachable;
+}
+
+} // namespace
+
+bool probeRemoteHolder(ObjectId id)
+{
+    const ObjectId holder = remoteHolderOf(id);
+    if (holder.isNull() || !holderGone(holder)) {
+        return false;
+    }
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> resolved = resolve(id);
+    // Asked with interrupts enabled: the holder may have released it meanwhile.
+    if (!resolved.ok() || resolved.value()->remoteHolder != holder) {
+        return false;
+    }
+    Semaphore& semaphore = *resolved.value();
+    semaphore.remoteHolder = ObjectId::null();
+    semaphore.count = 1;
+    TaskManager::wakeAll(semaphore.waiters, Status::Abandoned);
+    return true;
 }
 
 // The complete Acquire and Release: every case, from a resolved id.
@@ -257,6 +352,31 @@ Result<bool> isBinarySemaphore(ObjectId id)
 // transaction, with interrupts enabled again (it blocks).
 [[gnu::noinline]] Status acquireFull(ObjectId id, const uint64_t* timeoutIn)
 {
+    // A binary semaphore held by another node's task: waited for in slices,
+    // with the holder probed between them (SemaphoreManager.hpp), so a
+    // holder that died does not keep the semaphore for ever.
+    const uint64_t timeout = *timeoutIn;
+    if (timeout != kPoll && !remoteHolderOf(id).isNull()) {
+        const bool forever = timeout == kWaitForever;
+        const uint64_t end = forever ? 0 : TimerAgent::Uptime() + timeout;
+        for (;;) {
+            uint64_t slice = kHolderProbeNs;
+            if (!forever) {
+                const uint64_t now = TimerAgent::Uptime();
+                if (now >= end) {
+                    return Status::Timeout;
+                }
+                slice = end - now < slice ? end - now : slice;
+            }
+            const Status status = acquireLocal(id, &slice);
+            if (status != Status::Timeout) {
+                return status;
+            }
+            if (probeRemoteHolder(id)) {
+                return Status::Abandoned;
+            }
+        }
+    }
     return orRemote(acquireLocal(id, timeoutIn), RemoteService::SemaphoreAcquire, id, remoteTimeoutMs(*timeoutIn));
 }
 
@@ -407,7 +527,8 @@ Result<ObjectId> SemaphoreAgent::GetHolder(ObjectId id)
         arch_x86::InterruptGuard guard;
         const Result<Semaphore*> semaphore = internal::resolve(id);
         if (semaphore.ok()) {
-            return semaphore.value()->holder != nullptr ? semaphore.value()->holder->id : ObjectId::null();
+            return semaphore.value()->holder != nullptr ? semaphore.value()->holder->id
+                                                        : semaphore.value()->remoteHolder;
         }
         status = semaphore.status();
     }
@@ -473,7 +594,7 @@ shell::CommandResult listSemaphores(shell::Shell& shell, int argc, char**)
         shell.print("%-10s   %-16s %-8s %6lu  %-10s   %-8s  %s\r\n", internal::IdText(s.id).c_str(),
                     name.ok() && name.value()[0] != '\0' ? name.value() : "-",
                     s.kind == SemaphoreKind::Binary ? "binary" : "counting", static_cast<unsigned long>(s.count),
-                    internal::IdText(s.holder != nullptr ? s.holder->id : ObjectId::null()).c_str(),
+                    internal::IdText(s.holder != nullptr ? s.holder->id : s.remoteHolder).c_str(),
                     s.waiters.order() == internal::WaitQueue::Order::Fifo ? "fifo" : "priority",
                     s.inheritance ? "yes" : "no");
     }

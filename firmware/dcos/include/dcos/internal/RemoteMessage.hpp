@@ -49,10 +49,22 @@ enum class RemoteService : uint8_t {
     /// A request of three frames (port sends, below): the message, its
     /// priority; the reply's value is 0.
     PortSend = 11,
+    /// A request of two frames (held acquires, below): Acquire for a task
+    /// of the requesting node, which holds a binary semaphore when it gets
+    /// it; argument: the time-out, as SemaphoreAcquire's.
+    HeldAcquire = 12,
+    /// Release by the task that holds a binary semaphore; argument: that
+    /// task's id.
+    HeldRelease = 13,
 };
 
 /// The last service value assigned.
-constexpr uint8_t kLastRemoteService = 11;
+constexpr uint8_t kLastRemoteService = 13;
+
+/// The value of a reply NotSupported to SemaphoreAcquire or
+/// SemaphoreRelease of a binary semaphore: ask again with HeldAcquire or
+/// HeldRelease, which name the task that holds it.
+constexpr uint32_t kAskHeld = 1;
 
 /// A short name of a service, for the console and logs.
 const char* remoteServiceName(RemoteService service);
@@ -138,6 +150,8 @@ bool isStatusValue(uint8_t value);
 
 /// Frames of one port send, and the message bytes each carries.
 constexpr size_t kPortSendFrames = 3;
+/// Frames of one held acquire.
+constexpr size_t kHeldAcquireFrames = 2;
 constexpr size_t kPortMessageBytes = 16;
 
 /// A port send, whole.
@@ -148,9 +162,27 @@ struct PortSendRequest {
     uint8_t message[kPortMessageBytes]{};
 };
 
+/// A held acquire, whole (docs/protocols/remote-transactions.md, "Binary
+/// semaphores"):
+///
+///     part 0   a request (the layout above), service HeldAcquire: bytes
+///              4-7 the time-out in milliseconds, as SemaphoreAcquire's
+///     part 3   byte 0 0x80 | 3 << 4 | the transaction's low four bits,
+///              bytes 1-4 the holding task's id (big-endian), bytes 5-7
+///              zero; 8 bytes
+///
+/// Its continuation is numbered 3, a number no port send uses, so a
+/// continuation says alone what it belongs to.
+struct HeldAcquireRequest {
+    uint8_t transaction = 0;
+    uint16_t object = 0;      ///< The semaphore id's low 16 bits.
+    uint32_t timeoutMs = 0;
+    uint32_t holder = 0;      ///< The requesting task's id, whole.
+};
+
 /// One continuation frame (part 1 or 2), decoded.
-struct PortSendContinuation {
-    uint8_t part = 0;         ///< 1 or 2.
+struct Continuation {
+    uint8_t part = 0;         ///< 1 or 2 (a port send), 3 (a held acquire).
     uint8_t slot = 0;         ///< The transaction's low four bits.
     uint8_t bytes[7]{};
     uint8_t count = 0;        ///< Message bytes it carries: 7, or 6 in part 2.
@@ -163,29 +195,40 @@ constexpr bool isContinuation(const uint8_t* bytes, size_t length) { return leng
 void encodePortSend(const PortSendRequest& request, uint8_t (&frames)[kPortSendFrames][kRemoteMessageBytes],
                     uint8_t (&lengths)[kPortSendFrames]);
 
-/// Decodes a continuation of @p length bytes: None, WrongLength (part 1
-/// not 8 bytes, part 2 not 7), or UnknownService (a part number other than
-/// 1 or 2, or bits 6 set).
-RemoteMessageError decodePortSendContinuation(const uint8_t* bytes, size_t length, PortSendContinuation& part);
+/// The two frames of @p request.
+void encodeHeldAcquire(const HeldAcquireRequest& request,
+                       uint8_t (&frames)[kHeldAcquireFrames][kRemoteMessageBytes]);
 
-/// Puts one requester's port send back together: part 0 (a decoded request
-/// of service PortSend), then its continuations in order.
-class PortSendAssembler {
+/// Decodes a continuation of @p length bytes: None, WrongLength (part 1 or
+/// 3 not 8 bytes, part 2 not 7), UnknownService (part number 0, or bit 6
+/// set) or ReservedBits (part 3 whose bytes 5-7 are not zero).
+RemoteMessageError decodeContinuation(const uint8_t* bytes, size_t length, Continuation& part);
+
+/// Puts one requester's request of several frames back together: part 0
+/// (a decoded request of service PortSend or HeldAcquire), then its
+/// continuations in order.
+class ContinuedRequestAssembler {
 public:
     enum class Outcome : uint8_t {
         Started,   ///< Part 0 taken.
         Taken,     ///< A continuation in turn, not the last.
-        Complete,  ///< The last part: request() is whole.
-        Dropped,   ///< Out of turn or of another transaction: what was gathered is dropped.
+        Complete,  ///< The last part: the request is whole.
+        Dropped,   ///< Out of turn, of another transaction or malformed: what was gathered is dropped.
     };
 
+    /// Part 0; Dropped for a service of one frame.
     Outcome start(const RemoteRequest& first);
-    Outcome take(const PortSendContinuation& part);
-    const PortSendRequest& request() const { return request_; }
+    Outcome take(const Continuation& part);
+    /// The service of the request gathered.
+    RemoteService service() const { return first_.service; }
+    /// The request, once Complete, as what its service is.
+    PortSendRequest portSend() const;
+    HeldAcquireRequest heldAcquire() const;
 
 private:
     uint8_t next_ = 0;        // The part expected; 0 when none.
-    PortSendRequest request_{};
+    RemoteRequest first_{};
+    uint8_t bytes_[kPortMessageBytes]{}; // The continuations' bytes, in order.
 };
 
 // ---- routed requests -------------------------------------------------------
@@ -193,8 +236,8 @@ private:
 // A request for a node that is reached through a gateway (its network
 // address lies behind a route, NetworkInterfacesManager.hpp) goes to the
 // gateway as message type 0x13, RoutedRequest: a route header, then the
-// request's own frames exactly as above (one frame, or a port send's
-// three), in a row at the requester's priority:
+// request's own frames exactly as above (one frame, a held acquire's
+// two or a port send's three), in a row at the requester's priority:
 //
 //     header   byte 0   0xC0 | hops left (1 to kRouteHops)
 //              byte 1   the transaction number, as in the request
