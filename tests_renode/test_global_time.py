@@ -113,7 +113,10 @@ def test_followers_stay_within_the_bound_of_the_master_for_ten_minutes(trio):
     assert max(spreads) <= BOUND_NS, sorted(spreads)[-10:]
     assert max(spreads) >= 100_000, "the drift the bound is about is really there"
     _, master, _ = time_status(boards[1])
-    assert master["syncs-sent"] >= 600 and master["follow-ups-sent"] == master["syncs-sent"], master
+    # Read at any moment: a Sync's FollowUp may still be on its way (it goes
+    # once the Sync's own echo came back), so one may be missing.
+    assert master["syncs-sent"] >= 600, master
+    assert master["syncs-sent"] - 1 <= master["follow-ups-sent"] <= master["syncs-sent"], master
     for n in (2, 3):
         _, values, _ = time_status(boards[n])
         # The node's own measurement: its largest correction, and its rate against the master's.
