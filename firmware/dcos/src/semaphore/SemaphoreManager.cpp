@@ -11,7 +11,6 @@
 #include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
-#include <dcos/TimerAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/FastPath.hpp>
 #include <dcos/internal/KernelContext.hpp>
@@ -259,9 +258,11 @@ bool probeRemoteHolder(ObjectId id)
 
 // The complete Acquire and Release: every case, from a resolved id.
 // The agent's fast paths (below) come here for all they do not handle.
-[[gnu::always_inline]] inline Status acquireLocal(ObjectId id, const uint64_t* timeoutIn)
+// @p heldRemotely is set when the semaphore is held by another node's task:
+// the wait then lasts one probe slice at most (SemaphoreManager.hpp).
+[[gnu::always_inline]] inline Status acquireLocal(ObjectId id, const uint64_t* timeoutIn, bool& heldRemotely)
 {
-    const uint64_t timeout = *timeoutIn;
+    uint64_t timeout = *timeoutIn;
     arch_x86::InterruptGuard guard;
     const Result<Semaphore*> resolved = resolve(id);
     if (!resolved.ok()) {
@@ -290,6 +291,10 @@ bool probeRemoteHolder(ObjectId id)
     }
     if (inInterrupt) {
         return Status::InInterrupt;
+    }
+    if (!semaphore.remoteHolder.isNull()) [[unlikely]] {
+        heldRemotely = true;
+        timeout = timeout < kHolderProbeNs ? timeout : kHolderProbeNs;
     }
     Task& self = Scheduler::current();
     // The unit is handed over by Release, so success needs no retry.
@@ -350,34 +355,40 @@ bool probeRemoteHolder(ObjectId id)
 
 // The slow paths: the local cases, then, for another node's id, the remote
 // transaction, with interrupts enabled again (it blocks).
+// The rest of a wait for a binary semaphore held by another node's task,
+// after its first slice ended with @p first: slices of kHolderProbeNs, the
+// holder probed between them, so a holder that died does not keep the
+// semaphore for ever. Apart from acquireFull, whose common path it would
+// otherwise slow.
+[[gnu::noinline]] Status acquireFromRemoteHolder(ObjectId id, uint64_t timeout, Status first)
+{
+    const bool forever = timeout == kWaitForever;
+    uint64_t left = forever ? 0 : timeout - (timeout < kHolderProbeNs ? timeout : kHolderProbeNs);
+    for (Status status = first;; ) {
+        if (status != Status::Timeout) {
+            return status;
+        }
+        if (!forever && left == 0) {
+            return Status::Timeout;
+        }
+        if (probeRemoteHolder(id)) {
+            return Status::Abandoned;
+        }
+        uint64_t slice = forever || left > kHolderProbeNs ? kHolderProbeNs : left;
+        left -= forever ? 0 : slice;
+        bool heldRemotely = false;
+        status = acquireLocal(id, &slice, heldRemotely);
+    }
+}
+
 [[gnu::noinline]] Status acquireFull(ObjectId id, const uint64_t* timeoutIn)
 {
-    // A binary semaphore held by another node's task: waited for in slices,
-    // with the holder probed between them (SemaphoreManager.hpp), so a
-    // holder that died does not keep the semaphore for ever.
-    const uint64_t timeout = *timeoutIn;
-    if (timeout != kPoll && !remoteHolderOf(id).isNull()) {
-        const bool forever = timeout == kWaitForever;
-        const uint64_t end = forever ? 0 : TimerAgent::Uptime() + timeout;
-        for (;;) {
-            uint64_t slice = kHolderProbeNs;
-            if (!forever) {
-                const uint64_t now = TimerAgent::Uptime();
-                if (now >= end) {
-                    return Status::Timeout;
-                }
-                slice = end - now < slice ? end - now : slice;
-            }
-            const Status status = acquireLocal(id, &slice);
-            if (status != Status::Timeout) {
-                return status;
-            }
-            if (probeRemoteHolder(id)) {
-                return Status::Abandoned;
-            }
-        }
+    bool heldRemotely = false;
+    const Status status = acquireLocal(id, timeoutIn, heldRemotely);
+    if (heldRemotely) [[unlikely]] {
+        return acquireFromRemoteHolder(id, *timeoutIn, status);
     }
-    return orRemote(acquireLocal(id, timeoutIn), RemoteService::SemaphoreAcquire, id, remoteTimeoutMs(*timeoutIn));
+    return orRemote(status, RemoteService::SemaphoreAcquire, id, remoteTimeoutMs(*timeoutIn));
 }
 
 [[gnu::noinline]] Status releaseFull(ObjectId id) { return orRemote(releaseLocal(id), RemoteService::SemaphoreRelease, id, 0); }
