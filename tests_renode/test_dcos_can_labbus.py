@@ -305,3 +305,25 @@ def test_dump_decodes_a_held_acquire(hub):
     ], remote
     annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
     assert annotations[1] == "prio 24 remote request 1->2: held-acquire holder 0x00011002 slot 5", lines
+
+
+def test_dump_decodes_an_alarm_and_tells_its_parts_from_a_port_sends(hub):
+    # docs/protocols/remote-transactions.md, "Timers": node 1's task
+    # 0x00011002 sets a periodic alarm of 100 ms (flags 0x03, events 0x8) on
+    # node 2's timer 0x3001, transaction 0x27: laid out as a port send, so the
+    # dump names the parts by the request they continue.
+    record = bytes.fromhex("00011002" "00000008") + (100_000_000).to_bytes(8, "big")
+    output, lines = decoded_dumps(hub, [
+        Frame(0x18110201, extended=True, dlc=8, data=bytes([14, 0x27, 0x30, 0x01, 0x03]) + record[0:3]),
+        Frame(0x18110201, extended=True, dlc=8, data=bytes([0x97]) + record[3:10]),
+        Frame(0x18110201, extended=True, dlc=7, data=bytes([0xA7]) + record[10:16]),
+        Frame(0x18110201, extended=True, dlc=8, data=bytes([15, 0x28, 0x30, 0x01, 0x00, 0x01, 0x10, 0x02]))])
+    remote = [json.loads(line)["dcos"]["remote"] for line in output.splitlines()]
+    assert remote == [
+        {"service": "set-alarm", "transaction": 0x27, "object": 0x3001, "argument": 0x03000110},
+        {"service": "set-alarm", "part": 1, "slot": 7},
+        {"service": "set-alarm", "part": 2, "slot": 7},
+        {"service": "cancel-alarm", "transaction": 0x28, "object": 0x3001, "argument": 0x00011002},
+    ], remote
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations[2] == "prio 24 remote request 1->2: set-alarm part 3/3 slot 7", lines

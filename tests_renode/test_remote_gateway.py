@@ -271,3 +271,21 @@ def test_a_binary_semaphore_behind_the_gateway_is_held_by_the_far_task(triple):
     status, _, us = remote.call(three, f"acquire {binary} 5000")
     assert status == "holder ended", status
     assert call(three, f"acquire {binary} 0")[0] == "ok"
+
+
+def test_a_timer_behind_the_gateway_is_set_by_its_owner_and_notifies_it_through_the_gateway(triple):
+    lab, one, two, three = triple
+    console = created(one, "remote self", "RTASK")
+    timer = created(three, "remote timer", "RTIMER")
+    assert call(three, f"give {timer} {console}")[0] == "ok"  # node 3 asks node 1 about its task through node 2
+    assert call(one, f"alarm {timer} watchdog 50 2")[0] == "ok"
+    # The alarm goes off on node 3; its PostEvent reaches node 1 through node 2.
+    assert call(one, "events 2000")[:2] == ("ok", 2)
+    # Node 3 counts it once the answer came back through node 2.
+    lab.hub.wait_until(lab.hub.now_ns + 20_000_000, 60)
+    assert net_counters(three)["alarms-notified"] == 1
+    assert call(one, f"cancel {timer}")[0] == "invalid argument"  # the watch-dog went off: no alarm is set
+    assert call(one, f"alarm {timer} periodic 100 4")[0] == "ok"
+    assert call(one, "events 2000")[:2] == ("ok", 4)
+    assert call(one, f"cancel {timer}")[0] == "ok"
+    assert net_counters(two)["forwarded"] >= 5

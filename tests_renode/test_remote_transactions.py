@@ -617,3 +617,73 @@ def test_a_binary_semaphore_whose_remote_holder_is_gone_is_given_back_to_its_wai
     # One slice, then the probe's own watchdog: 4 silent periods.
     assert 2 * SILENT_PERIODS * WATCHDOG_MS <= ms < (2 * SILENT_PERIODS + 2) * WATCHDOG_MS, ms
     assert call(two, f"acquire {binary} 0")[0] == "ok"
+
+
+def self_id(board):
+    return created(board, "remote self", "RTASK")
+
+
+def test_a_timer_of_another_node_is_set_by_its_owner_there_and_its_alarms_reach_it(pair):
+    lab, one, two = pair
+    console = self_id(one)
+    timer = created(two, "remote timer", "RTIMER")
+    # Node 2's console gives its timer to node 1's console task, which node 2
+    # asks about first; a task that does not exist is refused.
+    assert call(two, f"give {timer} 0x{int(console, 16) + 0x100:08x}")[0] in ("invalid id", "stale id")
+    assert call(two, f"give {timer} {console}")[0] == "ok"
+    # Over the network only the owner sets a timer's alarms (a privilege is
+    # not carried): node 1's console may not touch another timer of node 2.
+    others = created(two, "remote timer", "RTIMER")
+    assert call(one, f"alarm {others} watchdog 50 4")[0] == "not owner"
+    assert call(one, f"cancel {others}")[0] == "not owner"
+    assert call(one, f"alarm {timer} watchdog 50 4")[0] == "ok"
+    status, events, ms = call(one, "events 2000")
+    assert (status, events) == ("ok", 4)
+    assert 40 <= ms < 50 + 2 * WATCHDOG_MS, ms
+    assert call(one, "events 0")[0] == "would block"
+    # A periodic alarm: each period's events come, until the owner cancels it.
+    assert call(one, f"alarm {timer} periodic 100 8")[0] == "ok"
+    for _ in range(3):
+        assert call(one, "events 2000")[:2] == ("ok", 8)
+    assert call(one, f"cancel {timer}")[0] == "ok"
+    call(one, "events 150")  # one notification may have been on its way
+    assert call(one, "events 300")[0] == "timed out"
+    assert call(one, f"cancel {timer}")[0] == "invalid argument"  # no alarm set, as locally
+    # A day-clock alarm, by node 2's calendar.
+    assert call(one, f"alarm {timer} day 100 16")[0] == "ok"
+    assert call(one, "events 2000")[:2] == ("ok", 16)
+    # Node 2 counts the last once node 1's answer is back.
+    lab.hub.wait_until(lab.hub.now_ns + 20_000_000, 60)
+    counters = net_counters(two)
+    assert counters["alarms-notified"] in (5, 6), counters
+    assert counters["alarm-owners-lost"] == 0 and counters["alarms-dropped"] == 0, counters
+    # The alarm's frames: three to set it (laid out as a port send's), one reply;
+    # each notification an ordinary PostEvent from node 2, at the notifier's priority 1.
+    sets = [data for _, _, _, data in dcos_frames(lab, REQUEST) if data[0] == 14]
+    assert len(sets) == 4 and all(data[4] & 0x03 in (1, 2, 3) for data in sets), sets
+    posts = [(priority, destination, source, data) for priority, destination, source, data in dcos_frames(lab, REQUEST)
+             if data[0] == 4]
+    assert posts and all(priority == 1 and (destination, source) == (1, 2) for priority, destination, source, _ in posts)
+
+
+def test_a_timer_whose_owner_on_another_node_is_gone_is_deleted(pair):
+    lab, one, two = pair
+    listener = created(one, "remote listener", "RTASK")
+    timer = created(two, "remote timer", "RTIMER")
+    # Node 2's console sets a periodic alarm, then gives the timer to node 1's
+    # listener: the alarm goes on, its events to the new owner.
+    assert call(two, f"alarm {timer} periodic 50 1")[0] == "ok"
+    assert call(two, f"give {timer} {listener}")[0] == "ok"
+    lab.hub.wait_until(lab.hub.now_ns + 300_000_000, 120)
+    got = one.command("remote got")
+    assert "RGOT 0x1 " in got, got
+    # The listener is killed: the next notification finds no owner, and node 2
+    # deletes the timer, as a local owner's death deletes its timers.
+    assert "RKILL ok" in one.command(f"remote kill {listener}")
+    lab.hub.wait_until(lab.hub.now_ns + 300_000_000, 120)
+    counters = net_counters(two)
+    assert counters["alarm-owners-lost"] == 1, counters
+    assert call(two, f"cancel {timer}")[0] in ("invalid id", "stale id")
+    sent = counters["alarms-notified"]
+    lab.hub.wait_until(lab.hub.now_ns + 200_000_000, 120)
+    assert net_counters(two)["alarms-notified"] == sent

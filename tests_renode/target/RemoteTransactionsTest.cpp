@@ -5,7 +5,8 @@
 // results. Each line it prints starts with a tag the test reads:
 //
 //     RSEM <id>                   a semaphore was created
-//     RTASK <id>                  the listener task was created
+//     RTASK <id>                  the listener task was created, or the console's id (self)
+//     RTIMER <id>                 a timer was created
 //     RRES <status> <value> <us>  a primitive's status, its value, and the
 //                                 microseconds of uptime it took
 //     RGOT <events> <signals>     what the listener has received so far
@@ -27,6 +28,7 @@
 #include <dcos/MessagePortAgent.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
+#include <dcos/GregorianCalendar.hpp>
 #include <dcos/TimerAgent.hpp>
 #include <dcos/internal/IdText.hpp>
 
@@ -204,6 +206,66 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         printResult(shell, found.status(), found.ok() ? found.value().raw() : 0, start);
         return CommandResult::Ok;
     }
+    if (textEquals(verb, "self") && argc == 2) {
+        shell.print("RTASK %s\r\n", dcos::internal::IdText(taskAgent.IdOfSelf()).c_str());
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "timer") && argc == 2) {
+        return reportCreated(shell, "RTIMER", timerAgent.Create(nullptr, dcos::Visibility::Global));
+    }
+    if (textEquals(verb, "give") && argc == 4 && parseObjectId(argv[2], id)) {
+        // give <timer> <task>: XferOwnership of a timer, to a task of this node or another.
+        ObjectId owner;
+        if (!parseObjectId(argv[3], owner)) {
+            return CommandResult::UsageError;
+        }
+        const uint64_t start = timerAgent.Uptime();
+        printResult(shell, timerAgent.XferOwnership(id, owner), 0, start);
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "alarm") && argc == 6 && parseObjectId(argv[2], id)) {
+        // alarm <timer> watchdog|periodic|day <ms> <events>: the alarm, its
+        // events posted to the timer's owner; day: the time of day <ms> from now.
+        unsigned long ms = 0;
+        unsigned long events = 0;
+        if (!shell::Shell::parseUnsigned(argv[4], ms) || !shell::Shell::parseUnsigned(argv[5], events)) {
+            return CommandResult::UsageError;
+        }
+        const dcos::AlarmNotification notification = dcos::AlarmNotification::event(static_cast<uint32_t>(events));
+        const uint64_t start = timerAgent.Uptime();
+        Status status;
+        if (textEquals(argv[3], "watchdog")) {
+            status = timerAgent.SetWatchDogAlarm(id, ms * kNsPerMs, notification);
+        } else if (textEquals(argv[3], "periodic")) {
+            status = timerAgent.SetPeriodicAlarm(id, ms * kNsPerMs, notification);
+        } else if (textEquals(argv[3], "day")) {
+            const Result<dcos::DateTime> now = timerAgent.GetSystemClock();
+            const Result<uint64_t> nowNs =
+                now.ok() ? dcos::GregorianCalendar::toNanoseconds(now.value()) : Result<uint64_t>(now.status());
+            status = nowNs.ok() ? timerAgent.SetDayClockAlarm(
+                                      id, dcos::GregorianCalendar::fromNanoseconds(nowNs.value() + ms * kNsPerMs),
+                                      notification)
+                                : nowNs.status();
+        } else {
+            return CommandResult::UsageError;
+        }
+        printResult(shell, status, 0, start);
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "cancel") && argc == 3 && parseObjectId(argv[2], id)) {
+        const uint64_t start = timerAgent.Uptime();
+        printResult(shell, timerAgent.CancelAlarm(id), 0, start);
+        return CommandResult::Ok;
+    }
+    if (textEquals(verb, "events") && argc == 3 && shell::Shell::parseUnsigned(argv[2], number)) {
+        // events <ms>: the console task's own events (an alarm's owner's), any of bits 1 to 15, waited for
+        // (bit 0 is the console's input event).
+        const uint64_t start = timerAgent.Uptime();
+        const Result<uint32_t> got =
+            taskAgent.ReceiveEvent(0xFFFE, dcos::EventWait::Any, number == 0 ? dcos::kPoll : number * kNsPerMs);
+        printResult(shell, got.status(), got.ok() ? got.value() : 0, start);
+        return CommandResult::Ok;
+    }
     if (textEquals(verb, "listener") && argc == 2) {
         return reportCreated(shell, "RTASK", createTask("listener", 10, listenerEntry));
     }
@@ -362,13 +424,15 @@ DCOS_SHELL_COMMAND_DETAILED(
     "acquire [at=P] [tick] <id> <ms> | release [at=P] [tick] <id> | count [at=P] [tick] <id> | "
     "post [at=P] [tick] <id> <events> | signal [at=P] [tick] <id> <n> | state [at=P] [tick] <task> | "
     "priority [at=P] [tick] <task> | holder [at=P] [tick] <semaphore> | port | portgot | "
-    "send [at=P] [tick] <port> <priority*256+first byte> | receive [tick] <port>",
+    "send [at=P] [tick] <port> <priority*256+first byte> | receive [tick] <port> | self | timer | "
+    "give <timer> <task> | alarm <timer> watchdog|periodic|day <ms> <events> | cancel <timer> | events <ms>",
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
     "  hog: a task that keeps the processor busy at a priority for a time\r\n"
     "  waiter: a task that acquires the semaphore for ever; kill: KillTask\r\n"
     "  acquire ms: 0 polls, 4294967295 waits for ever; at=P calls at priority P; tick calls just after a tick\r\n"
     "  port: a task that owns the global port \"inbox\" and receives from it (portgot shows what came)\r\n"
     "  send: sixteen bytes counting up from the argument's low byte, at the priority in its second byte\r\n"
+    "  timer: a global timer of the console; give: XferOwnership; alarm: its events to the owner; events: the console's\r\n"
     "  prints RRES <status> <value> <microseconds taken>",
     remote);
 

@@ -9,8 +9,8 @@
 // back together as a serving node does: a query it completes has a name of
 // 1 to 15 characters, a type with names, and encodes back into its parts.
 // Last, as a stream of port send frames (a length byte, then the frame): a
-// port send or held acquire the assembler completes encodes back into
-// exactly the frames that made it. A routed request's route header (RemoteMessage.hpp) that
+// port send, alarm or held acquire the assembler completes encodes back
+// into exactly the frames that made it. A routed request's route header (RemoteMessage.hpp) that
 // decodes encodes back into the same four bytes and is never a request.
 #include "../../../fieldbus/can/fuzz/FuzzCheck.hpp"
 
@@ -116,6 +116,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
                 continue;
             }
             FUZZ_CHECK(part.part == 2);
+            if (portSends.service() == RemoteService::TimerSetAlarm) {
+                // An alarm with defined flags encodes back to its frames; one
+                // without is refused whole.
+                AlarmRequest alarm;
+                if (!portSends.alarm(alarm)) {
+                    FUZZ_CHECK((made[0][4] & 0xEC) != 0 || (made[0][4] & 0x03) == 0);
+                    continue;
+                }
+                uint8_t again[kAlarmFrames][kRemoteMessageBytes];
+                uint8_t lengths[kAlarmFrames];
+                encodeAlarm(alarm, again, lengths);
+                for (size_t i = 0; i < kAlarmFrames; ++i) {
+                    FUZZ_CHECK(lengths[i] == madeLengths[i] && std::memcmp(again[i], made[i], lengths[i]) == 0);
+                }
+                continue;
+            }
             uint8_t again[kPortSendFrames][kRemoteMessageBytes];
             uint8_t lengths[kPortSendFrames];
             encodePortSend(portSends.portSend(), again, lengths);
@@ -126,7 +142,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         }
         RemoteRequest first;
         if (decodeRequest(frame, length, first) == RemoteMessageError::None &&
-            (first.service == RemoteService::PortSend || first.service == RemoteService::HeldAcquire)) {
+            (first.service == RemoteService::PortSend || first.service == RemoteService::HeldAcquire ||
+             first.service == RemoteService::TimerSetAlarm)) {
             std::memcpy(made[0], frame, length);
             madeLengths[0] = static_cast<uint8_t>(length);
             FUZZ_CHECK(portSends.start(first) == ContinuedRequestAssembler::Outcome::Started);

@@ -456,3 +456,72 @@ TEST(RemoteMessageTest, EveryMalformedRouteHeaderIsRefused)
     const uint8_t notAHeader[4] = {0x01, 0x00, 0x00, 0x02};
     EXPECT_EQ(RemoteMessageError::ReservedBits, decodeRouteHeader(notAHeader, sizeof notAHeader, header));
 }
+
+TEST(RemoteMessageTest, AnAlarmIsThreeFramesLaidOutAsAPortSend)
+{
+    AlarmRequest request;
+    request.transaction = 0x27;
+    request.object = 0x3001;
+    request.kind = RemoteAlarmKind::Periodic;
+    request.value = 8;
+    request.owner = 0x00011002;
+    request.timeNs = 100'000'000;
+    uint8_t frames[kAlarmFrames][kRemoteMessageBytes];
+    uint8_t lengths[kAlarmFrames];
+    encodeAlarm(request, frames, lengths);
+    EXPECT_EQ(lengths[0], 8);
+    EXPECT_EQ(lengths[1], 8);
+    EXPECT_EQ(lengths[2], 7);
+    EXPECT_EQ(std::vector<uint8_t>(frames[0], frames[0] + 8),
+              (std::vector<uint8_t>{14, 0x27, 0x30, 0x01, 0x03, 0x00, 0x01, 0x10}));
+    EXPECT_EQ(std::vector<uint8_t>(frames[1], frames[1] + 8),
+              (std::vector<uint8_t>{0x97, 0x02, 0x00, 0x00, 0x00, 0x08, 0x00, 0x00}));
+    EXPECT_EQ(std::vector<uint8_t>(frames[2], frames[2] + 7),
+              (std::vector<uint8_t>{0xA7, 0x00, 0x00, 0x05, 0xF5, 0xE1, 0x00}));
+    EXPECT_STREQ(remoteServiceName(RemoteService::TimerSetAlarm), "set-alarm");
+    EXPECT_STREQ(remoteServiceName(RemoteService::TimerCancelAlarm), "cancel-alarm");
+
+    ContinuedRequestAssembler assembler;
+    RemoteRequest first;
+    ASSERT_EQ(decodeRequest(frames[0], 8, first), RemoteMessageError::None);
+    ASSERT_EQ(assembler.start(first), ContinuedRequestAssembler::Outcome::Started);
+    for (size_t part = 1; part < kAlarmFrames; ++part) {
+        Continuation continuation;
+        ASSERT_EQ(decodeContinuation(frames[part], lengths[part], continuation), RemoteMessageError::None);
+        EXPECT_EQ(assembler.take(continuation), part == 2 ? ContinuedRequestAssembler::Outcome::Complete
+                                                          : ContinuedRequestAssembler::Outcome::Taken);
+    }
+    AlarmRequest whole;
+    ASSERT_TRUE(assembler.alarm(whole));
+    EXPECT_EQ(whole.transaction, 0x27);
+    EXPECT_EQ(whole.object, 0x3001);
+    EXPECT_EQ(whole.kind, RemoteAlarmKind::Periodic);
+    EXPECT_FALSE(whole.signal);
+    EXPECT_EQ(whole.value, 8u);
+    EXPECT_EQ(whole.owner, 0x00011002u);
+    EXPECT_EQ(whole.timeNs, 100'000'000u);
+}
+
+TEST(RemoteMessageTest, AnAlarmWhoseFlagsAreNotDefinedIsRefused)
+{
+    for (uint8_t flags : {uint8_t{0x00}, uint8_t{0x10}, uint8_t{0x04}, uint8_t{0x21}, uint8_t{0x81}}) {
+        RemoteRequest first;
+        first.service = RemoteService::TimerSetAlarm;
+        first.transaction = 0x01;
+        first.object = 0x3001;
+        first.argument = uint32_t{flags} << 24;
+        ContinuedRequestAssembler assembler;
+        ASSERT_EQ(assembler.start(first), ContinuedRequestAssembler::Outcome::Started);
+        Continuation one;
+        one.part = 1;
+        one.slot = 1;
+        one.count = 7;
+        Continuation two = one;
+        two.part = 2;
+        two.count = 6;
+        ASSERT_EQ(assembler.take(one), ContinuedRequestAssembler::Outcome::Taken);
+        ASSERT_EQ(assembler.take(two), ContinuedRequestAssembler::Outcome::Complete);
+        AlarmRequest alarm;
+        EXPECT_FALSE(assembler.alarm(alarm)) << int(flags);
+    }
+}

@@ -93,10 +93,27 @@ DataDecoding malformed(DataDecoding out, const char* reason)
     return out;
 }
 
-// Puts each sender's publications back together, as a receiving node
-// does, so that the third part of one shows the whole page.
-class PublicationPages {
+// What a frame's decoding needs of the frames before it: each sender's
+// publications, put back together as a receiving node does, so that the
+// third part of one shows the whole page; and the service of each sender's
+// request of several frames, which its continuations do not name (a port
+// send's and an alarm's are laid out alike).
+class FrameHistory {
 public:
+    /// Notes the service of a request's part 0 from @p source.
+    void started(uint8_t source, uint8_t transaction, dcos::internal::RemoteService service)
+    {
+        continued_[(uint32_t{source} << 4) | (transaction & 0x0F)] = service;
+    }
+
+    /// The service whose continuation @p source sent on @p slot: a port
+    /// send when its part 0 was not seen.
+    dcos::internal::RemoteService continuing(uint8_t source, uint8_t slot) const
+    {
+        const auto found = continued_.find((uint32_t{source} << 4) | slot);
+        return found == continued_.end() ? dcos::internal::RemoteService::PortSend : found->second;
+    }
+
     DataDecoding decode(const can::MessageIdentifier& id, const can::CanFrame& frame)
     {
         using namespace dcos::internal;
@@ -139,6 +156,7 @@ public:
 
 private:
     std::map<uint32_t, dcos::internal::PublicationAssembler> pages_;
+    std::map<uint32_t, dcos::internal::RemoteService> continued_;
 };
 
 // The name of an object type, as a name query carries it.
@@ -157,7 +175,7 @@ const char* objectTypeName(uint8_t type)
     }
 }
 
-DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& frame, PublicationPages& pages)
+DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& frame, FrameHistory& pages)
 {
     using namespace dcos::internal;
     if (id.type() == can::MessageType::DsmPublication) {
@@ -247,8 +265,9 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
             out.json = {{"service", "held-acquire"}, {"part", part.part}, {"slot", part.slot}, {"holder", holder}};
             return out;
         }
-        out.text = fmt::format("port-send part {}/3 slot {}", part.part + 1, part.slot);
-        out.json = {{"service", "port-send"}, {"part", part.part}, {"slot", part.slot}};
+        const char* const service = remoteServiceName(pages.continuing(id.source(), part.slot));
+        out.text = fmt::format("{} part {}/3 slot {}", service, part.part + 1, part.slot);
+        out.json = {{"service", service}, {"part", part.part}, {"slot", part.slot}};
         return out;
     }
     if (isRequest) {
@@ -258,6 +277,7 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         if (error != RemoteMessageError::None) {
             return malformed(out, remoteMessageErrorName(error));
         }
+        pages.started(id.source(), request.transaction, request.service);
         out.text = fmt::format("{} txn 0x{:02x} object 0x{:04x} argument {}", remoteServiceName(request.service),
                                request.transaction, request.object, request.argument);
         out.json = {{"service", remoteServiceName(request.service)},
@@ -285,7 +305,7 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
 // What the DCOS identifier layout says of a frame, or an empty string for a
 // frame that is not a DCOS frame (standard, remote, unassigned type); for a
 // remote transaction or a publication, what its data says too.
-std::string decoded(const can::CanFrame& frame, PublicationPages& pages)
+std::string decoded(const can::CanFrame& frame, FrameHistory& pages)
 {
     const can::LinkResult<can::MessageIdentifier> id = can::MessageIdentifier::fromFrame(frame);
     if (!id.ok()) {
@@ -301,7 +321,7 @@ std::string decoded(const can::CanFrame& frame, PublicationPages& pages)
     return text;
 }
 
-nlohmann::json frameJson(const Received& r, const std::string& interface, bool decode, PublicationPages& pages)
+nlohmann::json frameJson(const Received& r, const std::string& interface, bool decode, FrameHistory& pages)
 {
     nlohmann::json j{{"interface", interface},
                      {"timestamp_ns", r.timestamp.count()},
@@ -343,7 +363,7 @@ int dump(hostcan::Transport& transport, const DumpOptions& options, bool json)
 {
     const auto deadline = Clock::now() + std::chrono::milliseconds(options.timeoutMs);
     long shown = 0;
-    PublicationPages pages;
+    FrameHistory pages;
     while (options.count == 0 || shown < options.count) {
         auto wait = std::chrono::milliseconds(200);
         if (options.timeoutMs > 0) {

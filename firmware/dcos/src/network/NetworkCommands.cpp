@@ -146,6 +146,8 @@ void listRemote(shell::Shell& shell)
         {"publications-sent", s.publicationsSent}, {"publication-parts", s.publicationParts},
         {"unknown-senders", s.unknownSenders}, {"names-not-found", s.namesNotFound},
         {"routed-requests", s.routedRequests}, {"forwarded", s.forwarded}, {"unrouted", s.unrouted},
+        {"alarms-notified", s.alarmsNotified}, {"alarm-owners-lost", s.alarmOwnersLost},
+        {"alarms-dropped", s.alarmsDropped},
     };
     printCounters(shell, counters);
     // The last transaction's instructions on each side, in an image with an

@@ -17,6 +17,8 @@
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/internal/TaskManager.hpp>
+#include <dcos/internal/TimerManager.hpp>
+#include <dcos/GregorianCalendar.hpp>
 #include <dcos/internal/WaitQueue.hpp>
 
 #include <arch_x86/Cpu.hpp>
@@ -447,6 +449,41 @@ Status forwardPortSend(ObjectId port, const Message& message, int priority)
     }).status();
 }
 
+// An alarm of another node's timer, set for @p owner (RemoteForward.hpp's
+// alarm setter passes the calling task; a gateway the owner it was asked
+// for): the three frames of an alarm, again after every silent watchdog
+// period, and the reply's status.
+Status callAlarm(ObjectId timer, RemoteAlarmKind kind, const AlarmNotification& notification, uint64_t timeNs,
+                 ObjectId owner)
+{
+    const uint64_t begun = readCounter();
+    Task& self = Scheduler::current();
+    const Result<CallSlot*> opened = openRemoteCall(self, RemoteService::TimerSetAlarm, timer);
+    if (!opened.ok()) {
+        return opened.status();
+    }
+    CallSlot* const slot = opened.value();
+    AlarmRequest request;
+    request.transaction = slot->transaction;
+    request.object = static_cast<uint16_t>(timer.raw() & 0xFFFF);
+    request.kind = kind;
+    request.signal = notification.kind == AlarmNotification::Kind::Signal;
+    request.value = notification.value;
+    request.owner = owner.raw();
+    request.timeNs = timeNs;
+    uint8_t frames[kAlarmFrames][kRemoteMessageBytes];
+    uint8_t lengths[kAlarmFrames];
+    encodeAlarm(request, frames, lengths);
+    return awaitReply(*slot, begun, [&] {
+        (void)sendRequest(*slot, self.priority, frames, lengths, kAlarmFrames);
+    }).status();
+}
+
+Status forwardAlarm(ObjectId timer, RemoteAlarmKind kind, const AlarmNotification& notification, uint64_t timeNs)
+{
+    return callAlarm(timer, kind, notification, timeNs, Scheduler::current().id);
+}
+
 // Any interface, any sender: the call slot of a name query, asked of every node.
 constexpr uint8_t kAnyInterface = 0xFF;
 
@@ -838,6 +875,21 @@ void onRequest(uint8_t interface, const SystemMessage& message, bool routed)
             gathering.partsInstructions += partInstructions(message);
             return; // In turn and not the last, or out of turn and dropped: the requester sends it again.
         }
+        if (gathering.assembler.service() == RemoteService::TimerSetAlarm) {
+            AlarmRequest alarm;
+            if (!gathering.assembler.alarm(alarm)) {
+                countMalformed();
+                return;
+            }
+            const PortSendRequest whole = gathering.assembler.portSend();
+            RemoteRequest request;
+            request.service = RemoteService::TimerSetAlarm;
+            request.transaction = whole.transaction;
+            request.object = whole.object;
+            request.argument = static_cast<uint8_t>(whole.priority); // The flags; the record rides as the payload.
+            admitFor(interface, message, request, routed, whole.message, gathering.partsInstructions);
+            return;
+        }
         if (gathering.assembler.service() == RemoteService::HeldAcquire) {
             const HeldAcquireRequest held = gathering.assembler.heldAcquire();
             RemoteRequest request;
@@ -870,7 +922,8 @@ void onRequest(uint8_t interface, const SystemMessage& message, bool routed)
         countMalformed();
         return;
     }
-    if (request.service == RemoteService::PortSend || request.service == RemoteService::HeldAcquire) {
+    if (request.service == RemoteService::PortSend || request.service == RemoteService::HeldAcquire ||
+        request.service == RemoteService::TimerSetAlarm) {
         Gathering<ContinuedRequestAssembler>& gathering = gatheringFor(portSends, gatheringClock, interface, message.source);
         (void)gathering.assembler.start(request);
         gathering.partsInstructions = partInstructions(message);
@@ -1041,6 +1094,111 @@ Status acquireHeld(ObjectId id, uint32_t timeoutMs, ObjectId holder, const Serve
     return holdForRemote(id, holder);
 }
 
+// A word of a request's payload, big-endian.
+uint32_t payloadWord(const ServedEntry& entry, size_t at)
+{
+    return (uint32_t{entry.payload[at]} << 24) | (uint32_t{entry.payload[at + 1]} << 16) |
+           (uint32_t{entry.payload[at + 2]} << 8) | entry.payload[at + 3];
+}
+
+// An alarm set by a timer's owner on another node: refused unless the task
+// it names owns the timer (a worker's own privileges are not the owner's),
+// then set as the owner would set it locally; a routed one is passed on.
+Status serveAlarm(const RemoteRequest& request, const ServedEntry& entry, ObjectId id, bool routed)
+{
+    const ObjectId owner = ObjectId::fromRaw(payloadWord(entry, 0));
+    AlarmNotification notification;
+    notification.kind = (request.argument & 0x10) != 0 ? AlarmNotification::Kind::Signal : AlarmNotification::Kind::Event;
+    notification.value = payloadWord(entry, 4);
+    const uint64_t timeNs = (uint64_t{payloadWord(entry, 8)} << 32) | payloadWord(entry, 12);
+    const RemoteAlarmKind kind = static_cast<RemoteAlarmKind>(request.argument & 0x03);
+    if (routed) {
+        return callAlarm(id, kind, notification, timeNs, owner);
+    }
+    const Result<ObjectId> current = TimerManager::timerOwner(id);
+    if (!current.ok()) {
+        return current.status();
+    }
+    if (current.value() != owner) {
+        return Status::NotOwner;
+    }
+    switch (kind) {
+    case RemoteAlarmKind::WatchDog: return TimerManager::setWatchDogAlarm(id, owner, timeNs, notification);
+    case RemoteAlarmKind::Periodic: return TimerManager::setPeriodicAlarm(id, owner, timeNs, notification);
+    case RemoteAlarmKind::DayClock: break;
+    }
+    return TimerManager::setDayClockAlarm(id, owner, GregorianCalendar::fromNanoseconds(timeNs), notification);
+}
+
+// ---- alarms of this node's timers owned by tasks of other nodes --------------
+//
+// The tick's interrupt queues each notification here (RemoteForward.hpp's
+// alarm queue); the notifier task posts it to the owner as a remote
+// PostEvent or SendSignal. An owner that no longer exists, or whose node
+// does not answer, has its timer deleted, as a local owner's death does.
+
+struct AlarmNotice {
+    ObjectId timer;
+    ObjectId owner;
+    AlarmNotification notification;
+};
+
+constexpr size_t kAlarmNotices = 16;
+AlarmNotice alarmNotices[kAlarmNotices];
+size_t alarmHead = 0;  // The next notice to send.
+size_t alarmCount = 0;
+ObjectId notifierTask;
+constexpr uint32_t kAlarmEvent = 1;
+
+// From the tick's interrupt (interrupts disabled) or a task.
+void queueAlarm(ObjectId timer, ObjectId owner, const AlarmNotification& notification)
+{
+    Lock lock;
+    if (alarmCount == kAlarmNotices) {
+        ++statistics.alarmsDropped;
+        return;
+    }
+    alarmNotices[(alarmHead + alarmCount) % kAlarmNotices] = AlarmNotice{timer, owner, notification};
+    ++alarmCount;
+    const Result<Task*> notifier = TaskManager::resolve(notifierTask);
+    if (notifier.ok()) {
+        TaskManager::postEvent(*notifier.value(), kAlarmEvent);
+    }
+}
+
+void notifierEntry(uintptr_t)
+{
+    for (;;) {
+        AlarmNotice notice;
+        {
+            Lock lock;
+            if (alarmCount == 0) {
+                notice.timer = ObjectId::null();
+            } else {
+                notice = alarmNotices[alarmHead];
+                alarmHead = (alarmHead + 1) % kAlarmNotices;
+                --alarmCount;
+            }
+        }
+        if (notice.timer.isNull()) {
+            (void)TaskAgent::ReceiveEvent(kAlarmEvent, EventWait::Any, kWaitForever);
+            continue;
+        }
+        const Status status = notice.notification.kind == AlarmNotification::Kind::Signal
+                                  ? TaskAgent::SendSignal(notice.owner, notice.notification.value)
+                                  : TaskAgent::PostEvent(notice.owner, notice.notification.value);
+        Lock lock;
+        if (status == Status::Ok) {
+            ++statistics.alarmsNotified;
+        } else if (status == Status::InvalidId || status == Status::StaleId || status == Status::Unreachable) {
+            ++statistics.alarmOwnersLost;
+            TimerManager::dropTimerOfLostOwner(notice.timer, notice.owner);
+        } else {
+            ++statistics.alarmsDropped; // Not told (no call slot free, the node unmapped): lost, counted.
+        }
+    }
+}
+
 // A read service's result as the reply's status and value.
 uint32_t replyValueOf(uint32_t value) { return value; }
 uint32_t replyValueOf(uint8_t value) { return value; }
@@ -1094,6 +1252,19 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
             // here or on a routed request's node.
             reply.value = kAskHeld;
         }
+        break;
+    }
+    case RemoteService::TimerSetAlarm: reply.status = serveAlarm(request, entry, id, routed); break;
+    case RemoteService::TimerCancelAlarm: {
+        const ObjectId owner = ObjectId::fromRaw(request.argument);
+        if (routed) {
+            replyWith(reply, call(RemoteService::TimerCancelAlarm, id, request.argument, ObjectId::null()));
+            break;
+        }
+        const Result<ObjectId> current = TimerManager::timerOwner(id);
+        reply.status = !current.ok()              ? current.status()
+                       : current.value() != owner ? Status::NotOwner
+                                                  : TimerManager::cancelAlarm(id, owner);
         break;
     }
     case RemoteService::HeldAcquire:
@@ -1339,9 +1510,25 @@ Status startAgent()
             return workerId.status();
         }
     }
+    if (notifierTask.isNull()) {
+        // Alarms are urgent: the notifier asks at a high priority, on the
+        // bus too, below the receiver only.
+        TaskAttributes notifier;
+        notifier.name = "net-alarms";
+        notifier.priority = 1;
+        notifier.stackSize = kTaskStackBytes;
+        notifier.newProcess = true;
+        const Result<ObjectId> notifierId = TaskManager::create(notifier, notifierEntry, 0);
+        if (!notifierId.ok()) {
+            return notifierId.status();
+        }
+        notifierTask = notifierId.value();
+    }
     setRemoteForwarder(forward);
     setRemoteNameResolver(forwardName);
     setRemotePortSender(forwardPortSend);
+    setRemoteAlarmSetter(forwardAlarm);
+    setRemoteAlarmQueue(queueAlarm);
     started = true;
     return Status::Ok;
 }

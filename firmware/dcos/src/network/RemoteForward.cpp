@@ -19,6 +19,33 @@ void setRemoteNameResolver(RemoteNameResolver resolver) { remoteNameResolver = r
 
 void setRemotePortSender(RemotePortSender sender) { remotePortSender = sender; }
 
+namespace {
+RemoteAlarmSetter remoteAlarmSetter = nullptr;
+RemoteAlarmQueue remoteAlarmQueue = nullptr;
+} // namespace
+
+void setRemoteAlarmSetter(RemoteAlarmSetter setter) { remoteAlarmSetter = setter; }
+
+Status forwardRemoteAlarm(ObjectId timer, RemoteAlarmKind kind, const AlarmNotification& notification,
+                          uint64_t timeNs)
+{
+    RemoteAlarmSetter const setter = remoteAlarmSetter;
+    if (setter == nullptr) {
+        return Status::Remote;
+    }
+    return setter(timer, kind, notification, timeNs);
+}
+
+void setRemoteAlarmQueue(RemoteAlarmQueue queue) { remoteAlarmQueue = queue; }
+
+void queueRemoteAlarm(ObjectId timer, ObjectId owner, const AlarmNotification& notification)
+{
+    RemoteAlarmQueue const queue = remoteAlarmQueue;
+    if (queue != nullptr) {
+        queue(timer, owner, notification);
+    }
+}
+
 Status forwardRemotePortSend(ObjectId port, const Message& message, int priority)
 {
     RemotePortSender const sender = remotePortSender;

@@ -50,6 +50,8 @@ const char* remoteServiceName(RemoteService service)
     case RemoteService::PortSend: return "port-send";
     case RemoteService::HeldAcquire: return "held-acquire";
     case RemoteService::HeldRelease: return "held-release";
+    case RemoteService::TimerSetAlarm: return "set-alarm";
+    case RemoteService::TimerCancelAlarm: return "cancel-alarm";
     }
     return "?";
 }
@@ -236,6 +238,48 @@ static_assert(kPortSendBytes[0] + kPortSendBytes[1] + kPortSendBytes[2] == kPort
 
 } // namespace
 
+namespace {
+
+// A port send's layout with another service: an alarm's.
+void encodeSixteenBytes(RemoteService service, const PortSendRequest& request,
+                        uint8_t (&frames)[kPortSendFrames][kRemoteMessageBytes], uint8_t (&lengths)[kPortSendFrames])
+{
+    encodePortSend(request, frames, lengths);
+    frames[0][0] = static_cast<uint8_t>(service);
+}
+
+constexpr uint8_t kAlarmKindMask = 0x03;
+constexpr uint8_t kAlarmSignalFlag = 0x10;
+
+void putWord(uint8_t* to, uint32_t value)
+{
+    to[0] = static_cast<uint8_t>(value >> 24);
+    to[1] = static_cast<uint8_t>(value >> 16);
+    to[2] = static_cast<uint8_t>(value >> 8);
+    to[3] = static_cast<uint8_t>(value);
+}
+
+uint32_t word(const uint8_t* from)
+{
+    return (uint32_t{from[0]} << 24) | (uint32_t{from[1]} << 16) | (uint32_t{from[2]} << 8) | from[3];
+}
+
+} // namespace
+
+void encodeAlarm(const AlarmRequest& request, uint8_t (&frames)[kAlarmFrames][kRemoteMessageBytes],
+                 uint8_t (&lengths)[kAlarmFrames])
+{
+    PortSendRequest shaped;
+    shaped.transaction = request.transaction;
+    shaped.object = request.object;
+    shaped.priority = static_cast<int8_t>(static_cast<uint8_t>(request.kind) | (request.signal ? kAlarmSignalFlag : 0));
+    putWord(shaped.message, request.owner);
+    putWord(shaped.message + 4, request.value);
+    putWord(shaped.message + 8, static_cast<uint32_t>(request.timeNs >> 32));
+    putWord(shaped.message + 12, static_cast<uint32_t>(request.timeNs));
+    encodeSixteenBytes(RemoteService::TimerSetAlarm, shaped, frames, lengths);
+}
+
 void encodePortSend(const PortSendRequest& request, uint8_t (&frames)[kPortSendFrames][kRemoteMessageBytes],
                     uint8_t (&lengths)[kPortSendFrames])
 {
@@ -332,7 +376,8 @@ ContinuedRequestAssembler::Outcome ContinuedRequestAssembler::start(const Remote
 {
     next_ = 0;
     switch (first.service) {
-    case RemoteService::PortSend: next_ = 1; break;
+    case RemoteService::PortSend:
+    case RemoteService::TimerSetAlarm: next_ = 1; break;
     case RemoteService::HeldAcquire: next_ = kHeldPart; break;
     default: return Outcome::Dropped;
     }
@@ -368,6 +413,24 @@ PortSendRequest ContinuedRequestAssembler::portSend() const
     request.message[2] = static_cast<uint8_t>(first_.argument);
     __builtin_memcpy(request.message + kPortSendBytes[0], bytes_, kPortMessageBytes - kPortSendBytes[0]);
     return request;
+}
+
+bool ContinuedRequestAssembler::alarm(AlarmRequest& out) const
+{
+    const PortSendRequest shaped = portSend();
+    const uint8_t flags = static_cast<uint8_t>(shaped.priority);
+    const uint8_t kind = flags & kAlarmKindMask;
+    if ((flags & ~(kAlarmKindMask | kAlarmSignalFlag)) != 0 || kind == 0) {
+        return false;
+    }
+    out.transaction = shaped.transaction;
+    out.object = shaped.object;
+    out.kind = static_cast<RemoteAlarmKind>(kind);
+    out.signal = (flags & kAlarmSignalFlag) != 0;
+    out.owner = word(shaped.message);
+    out.value = word(shaped.message + 4);
+    out.timeNs = (uint64_t{word(shaped.message + 8)} << 32) | word(shaped.message + 12);
+    return true;
 }
 
 HeldAcquireRequest ContinuedRequestAssembler::heldAcquire() const

@@ -1,5 +1,6 @@
 // The timer agent's interface object (seed 7.5).
 #include <dcos/TimerAgent.hpp>
+#include <dcos/GregorianCalendar.hpp>
 #include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/TimerManager.hpp>
@@ -26,22 +27,40 @@ DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::Create(const char* name,
 
 DCOS_CONFIGURATION_SERVICE Status TimerAgent::Delete(ObjectId timer) { return TimerManager::deleteTimer(timer, internal::currentTaskId()); }
 
+// Each alarm primitive given another node's timer sets it there, for the
+// calling task, which must own it (docs/protocols/remote-transactions.md,
+// "Timers").
 Status TimerAgent::SetWatchDogAlarm(ObjectId timer, uint64_t intervalNs, AlarmNotification notification)
 {
-    return TimerManager::setWatchDogAlarm(timer, internal::currentTaskId(), intervalNs, notification);
+    const Status local = TimerManager::setWatchDogAlarm(timer, internal::currentTaskId(), intervalNs, notification);
+    return internal::orRemoteAlarm(local, timer, internal::RemoteAlarmKind::WatchDog, notification, intervalNs);
 }
 
 Status TimerAgent::SetDayClockAlarm(ObjectId timer, const DateTime& time, AlarmNotification notification)
 {
-    return TimerManager::setDayClockAlarm(timer, internal::currentTaskId(), time, notification);
+    const Status local = TimerManager::setDayClockAlarm(timer, internal::currentTaskId(), time, notification);
+    if (local != Status::Remote) [[likely]] {
+        return local;
+    }
+    // As the time of day in nanoseconds since 1970, which the timer's node
+    // turns back into its calendar.
+    const Result<uint64_t> ns = GregorianCalendar::toNanoseconds(time);
+    return ns.ok() ? internal::orRemoteAlarm(local, timer, internal::RemoteAlarmKind::DayClock, notification, ns.value())
+                   : ns.status();
 }
 
 Status TimerAgent::SetPeriodicAlarm(ObjectId timer, uint64_t periodNs, AlarmNotification notification)
 {
-    return TimerManager::setPeriodicAlarm(timer, internal::currentTaskId(), periodNs, notification);
+    const Status local = TimerManager::setPeriodicAlarm(timer, internal::currentTaskId(), periodNs, notification);
+    return internal::orRemoteAlarm(local, timer, internal::RemoteAlarmKind::Periodic, notification, periodNs);
 }
 
-Status TimerAgent::CancelAlarm(ObjectId timer) { return TimerManager::cancelAlarm(timer, internal::currentTaskId()); }
+Status TimerAgent::CancelAlarm(ObjectId timer)
+{
+    const ObjectId self = internal::currentTaskId();
+    return internal::orRemote(TimerManager::cancelAlarm(timer, self), internal::RemoteService::TimerCancelAlarm, timer,
+                              self.raw());
+}
 
 DCOS_CONFIGURATION_SERVICE Result<ObjectId> TimerAgent::NameToObject(const char* name)
 {

@@ -4,6 +4,8 @@
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
+#include <dcos/internal/RemoteForward.hpp>
+#include <dcos/TaskAgent.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/TaskManager.hpp>
@@ -69,6 +71,12 @@ void notifyOwner(TimerObject& timer)
 {
     const Result<ObjectId> owner = timerTable.ownerOf(timer.id);
     if (!owner.ok()) {
+        return;
+    }
+    if (owner.value().node() != timerTable.node()) [[unlikely]] {
+        // An owner on another node: the remote agent's notifier tells it
+        // from a task (docs/protocols/remote-transactions.md, "Timers").
+        queueRemoteAlarm(timer.id, owner.value(), timer.notification);
         return;
     }
     const Result<Task*> task = TaskManager::resolve(owner.value());
@@ -478,9 +486,22 @@ Result<ObjectId> TimerManager::timerNameToObject(const char* name, Visibility as
 
 DCOS_CONFIGURATION_SERVICE Status TimerManager::xferOwnership(ObjectId id, ObjectId caller, ObjectId newOwner)
 {
-    const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
-    if (newOwnerStatus != Status::Ok) {
-        return newOwnerStatus;
+    // A timer may be owned by a task of another node, which sets its alarms
+    // over the network and is notified so (seed 6.4, 7.5): that task is
+    // asked whether it exists.
+    if (!newOwner.isNull() && newOwner.type() == ObjectType::Task && newOwner.node() != timerTable.node()) {
+        const Result<TaskState> state = TaskAgent::GetState(newOwner);
+        if (!state.ok()) {
+            return state.status();
+        }
+        if (state.value() == TaskState::NonExistent || state.value() == TaskState::Terminating) {
+            return Status::InvalidId;
+        }
+    } else {
+        const Status newOwnerStatus = TaskManager::checkNewOwner(newOwner);
+        if (newOwnerStatus != Status::Ok) {
+            return newOwnerStatus;
+        }
     }
     arch_x86::InterruptGuard guard;
     const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
@@ -489,6 +510,26 @@ DCOS_CONFIGURATION_SERVICE Status TimerManager::xferOwnership(ObjectId id, Objec
     }
     const Result<ObjectId> owner = timerTable.ownerOf(id);
     return timerTable.XferOwnership(id, owner.value(), newOwner);
+}
+
+Result<ObjectId> TimerManager::timerOwner(ObjectId id)
+{
+    arch_x86::InterruptGuard guard;
+    return timerTable.ownerOf(id);
+}
+
+void TimerManager::dropTimerOfLostOwner(ObjectId id, ObjectId owner)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<ObjectId> current = timerTable.ownerOf(id);
+    const Result<TimerObject**> entry = timerTable.resolve(id);
+    if (!current.ok() || current.value() != owner || !entry.ok()) {
+        return; // Deleted or given to another owner meanwhile.
+    }
+    TimerObject& timer = **entry.value();
+    disarm(timer.entry);
+    timer.kind = AlarmKind::None;
+    (void)timerTable.Delete(id);
 }
 
 Status TimerManager::addTimerObjects(size_t count)

@@ -99,6 +99,10 @@ struct RemoteStatistics {
     uint32_t routedRequests = 0;   ///< Transactions begun with a node behind a gateway, through it.
     uint32_t forwarded = 0;        ///< Routed requests this node served for another node, as a gateway.
     uint32_t unrouted = 0;         ///< Routed request frames dropped: their route header was not heard.
+    // Timers owned by tasks of other nodes (docs/protocols/remote-transactions.md, "Timers").
+    uint32_t alarmsNotified = 0;   ///< Alarms told to their owner on another node.
+    uint32_t alarmOwnersLost = 0;  ///< Alarms whose owner was gone: the timer was deleted.
+    uint32_t alarmsDropped = 0;    ///< Alarms not told: the notifier's queue was full, or no call slot was free.
     // The instruction counts of the last transaction (the remote bench).
     RemoteInstructions instructions{};
 };

@@ -11,6 +11,7 @@
 
 #include <dcos/MessagePortAgent.hpp>
 #include <dcos/ObjectId.hpp>
+#include <dcos/TimerAgent.hpp>
 #include <dcos/Status.hpp>
 #include <dcos/internal/RemoteMessage.hpp>
 
@@ -45,6 +46,37 @@ void setRemotePortSender(RemotePortSender sender);
     }
     return forwardRemotePortSend(port, message, priority);
 }
+
+/// Sets an alarm of another node's timer, for the calling task, its owner.
+using RemoteAlarmSetter = Status (*)(ObjectId timer, RemoteAlarmKind kind, const AlarmNotification& notification,
+                                     uint64_t timeNs);
+
+/// Set by the remote agent when it starts; null until then.
+void setRemoteAlarmSetter(RemoteAlarmSetter setter);
+
+/// Sets the alarm on the timer's node (the interval, period or time of day
+/// in @p timeNs), or Status::Remote when no remote agent runs. Out of line:
+/// only a Set...Alarm's miss path calls it.
+[[gnu::noinline]] Status forwardRemoteAlarm(ObjectId timer, RemoteAlarmKind kind,
+                                            const AlarmNotification& notification, uint64_t timeNs);
+
+/// A Set...Alarm's status after its local attempt: @p local unless it is
+/// Remote, in which case the alarm is set on the timer's node.
+[[gnu::always_inline]] inline Status orRemoteAlarm(Status local, ObjectId timer, RemoteAlarmKind kind,
+                                                   const AlarmNotification& notification, uint64_t timeNs)
+{
+    if (local != Status::Remote) [[likely]] {
+        return local;
+    }
+    return forwardRemoteAlarm(timer, kind, notification, timeNs);
+}
+
+/// Tells @p owner, a task of another node, that @p timer's alarm went off:
+/// queued for the remote agent's notifier, from the tick's interrupt. Set
+/// by the remote agent; without one the notification is lost, counted.
+using RemoteAlarmQueue = void (*)(ObjectId timer, ObjectId owner, const AlarmNotification& notification);
+void setRemoteAlarmQueue(RemoteAlarmQueue queue);
+void queueRemoteAlarm(ObjectId timer, ObjectId owner, const AlarmNotification& notification);
 
 /// Asks the other nodes for an object of @p type named @p name.
 using RemoteNameResolver = Result<ObjectId> (*)(ObjectType type, const char* name);

@@ -56,10 +56,15 @@ enum class RemoteService : uint8_t {
     /// Release by the task that holds a binary semaphore; argument: that
     /// task's id.
     HeldRelease = 13,
+    /// A request of three frames (alarms, below): a timer's alarm set by
+    /// its owner, a task of the requesting node.
+    TimerSetAlarm = 14,
+    /// CancelAlarm by the timer's owner; argument: the owner's id.
+    TimerCancelAlarm = 15,
 };
 
 /// The last service value assigned.
-constexpr uint8_t kLastRemoteService = 13;
+constexpr uint8_t kLastRemoteService = 15;
 
 /// The value of a reply NotSupported to SemaphoreAcquire or
 /// SemaphoreRelease of a binary semaphore: ask again with HeldAcquire or
@@ -152,6 +157,8 @@ bool isStatusValue(uint8_t value);
 constexpr size_t kPortSendFrames = 3;
 /// Frames of one held acquire.
 constexpr size_t kHeldAcquireFrames = 2;
+/// Frames of one alarm: a port send's layout (below).
+constexpr size_t kAlarmFrames = kPortSendFrames;
 constexpr size_t kPortMessageBytes = 16;
 
 /// A port send, whole.
@@ -195,6 +202,33 @@ constexpr bool isContinuation(const uint8_t* bytes, size_t length) { return leng
 void encodePortSend(const PortSendRequest& request, uint8_t (&frames)[kPortSendFrames][kRemoteMessageBytes],
                     uint8_t (&lengths)[kPortSendFrames]);
 
+/// A timer's alarm set by its owner on another node
+/// (docs/protocols/remote-transactions.md, "Timers"): three frames laid
+/// out as a port send's, service TimerSetAlarm, whose byte 4 is the flags
+/// and whose sixteen message bytes are the record:
+///
+///     flags    bits 1-0 the alarm: 1 watch-dog, 2 day clock, 3 periodic;
+///              bit 4 the notification: 0 event, 1 signal; others zero
+///     record   bytes 0-3   the owner, the task that sets it (big-endian)
+///              bytes 4-7   the notification's event set or signal number
+///              bytes 8-15  the time: the interval or period in ns, or the
+///                          day clock's time of day in ns since 1970
+enum class RemoteAlarmKind : uint8_t { WatchDog = 1, DayClock = 2, Periodic = 3 };
+
+struct AlarmRequest {
+    uint8_t transaction = 0;
+    uint16_t object = 0;      ///< The timer id's low 16 bits.
+    RemoteAlarmKind kind = RemoteAlarmKind::WatchDog;
+    bool signal = false;      ///< The notification: a signal, else events.
+    uint32_t value = 0;       ///< The events, or the signal number.
+    uint32_t owner = 0;       ///< The owner's id, whole.
+    uint64_t timeNs = 0;
+};
+
+/// The three frames of @p request and their lengths (8, 8, 7).
+void encodeAlarm(const AlarmRequest& request, uint8_t (&frames)[kAlarmFrames][kRemoteMessageBytes],
+                 uint8_t (&lengths)[kAlarmFrames]);
+
 /// The two frames of @p request.
 void encodeHeldAcquire(const HeldAcquireRequest& request,
                        uint8_t (&frames)[kHeldAcquireFrames][kRemoteMessageBytes]);
@@ -216,7 +250,8 @@ public:
         Dropped,   ///< Out of turn, of another transaction or malformed: what was gathered is dropped.
     };
 
-    /// Part 0; Dropped for a service of one frame.
+    /// Part 0 (PortSend, TimerSetAlarm or HeldAcquire); Dropped for a
+    /// service of one frame.
     Outcome start(const RemoteRequest& first);
     Outcome take(const Continuation& part);
     /// The service of the request gathered.
@@ -224,6 +259,8 @@ public:
     /// The request, once Complete, as what its service is.
     PortSendRequest portSend() const;
     HeldAcquireRequest heldAcquire() const;
+    /// An alarm; false when its flags are not defined (ReservedBits).
+    bool alarm(AlarmRequest& out) const;
 
 private:
     uint8_t next_ = 0;        // The part expected; 0 when none.

@@ -89,6 +89,12 @@ public:
     static Status cancelAlarm(ObjectId timer, ObjectId caller);
     static Result<ObjectId> timerNameToObject(const char* name, Visibility askingScope = Visibility::Local);
     static Status xferOwnership(ObjectId timer, ObjectId caller, ObjectId newOwner);
+    /// The owner of @p timer, a task of this node or of another. O(1).
+    static Result<ObjectId> timerOwner(ObjectId timer);
+    /// Deletes @p timer if @p owner, a task of another node, still owns it:
+    /// that owner is gone (the remote agent learnt so notifying it), as a
+    /// local owner's death deletes its timers. O(1).
+    static void dropTimerOfLostOwner(ObjectId timer, ObjectId owner);
     static Status addTimerObjects(size_t count);
     static size_t timerCount();
 
