@@ -18,7 +18,8 @@ message to a port of the board (docs/protocols/remote-transactions.md,
 "Port sends"), and asks the board, as its gateway, for its own semaphore
 ("Gateways"): the board forwards the routed request back to the peer as
 its own request and relays the answer. Last, the peer's task holds a
-binary semaphore of the board ("Binary semaphores").
+binary semaphore of the board ("Binary semaphores") and owns a timer of
+the board, whose alarm the board posts to it ("Timers").
 
 Emulated time is paced at a fiftieth of wall time, so that the VM's
 answers, slow under an emulated CPU on a busy host, come well within the
@@ -348,6 +349,42 @@ await_reply("AGAIN")
 bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True,
                      data=struct.pack(">BBHI", HELD_RELEASE, 0x54, semaphore, HOLDER)))
 await_reply("LETGO")
+
+# Phase 8: a timer of the board owned by this node's task 0x00031005
+# (docs/protocols/remote-transactions.md, "Timers"). The board asks about
+# the task first (TaskGetState of object 0x1005): answer it is ready (2).
+# At the go frame ALARM, whose data is the timer's object, set a watch-dog
+# alarm of 20 ms whose events are 0x40: three frames laid out as a port
+# send's. Then answer the board's PostEvent of those events to the task.
+ALARM_GO, SET_ALARM, GET_STATE, POST_EVENT = 0x7FC, 14, 6, 4
+
+def serve_one(expected_service):
+    while True:
+        message = receive()
+        if not message.is_extended_id:
+            continue
+        priority, kind, destination, source = fields(message)
+        if kind != REQUEST or destination != ME or source != BOARD:
+            continue
+        service, transaction, obj, argument = struct.unpack(">BBHI", bytes(message.data))
+        if service != expected_service:
+            continue
+        print(f"@@PEER SERVED priority={priority} service={service} object={obj:04X} argument={argument}@@", flush=True)
+        value = 2 if service == GET_STATE else 0
+        bus.send(can.Message(arbitration_id=identifier(priority, REPLY, source, ME), is_extended_id=True,
+                             data=struct.pack(">BBBBI", service, transaction, OK, 0, value)))
+        return
+
+serve_one(GET_STATE)
+timer = struct.unpack(">H", go(ALARM_GO))[0]
+record = HOLDER.to_bytes(4, "big") + (0x40).to_bytes(4, "big") + (20_000_000).to_bytes(8, "big")
+transaction = 0x61
+for data in (struct.pack(">BBHB", SET_ALARM, transaction, timer, 0x01) + record[0:3],
+             bytes([0x80 | 1 << 4 | transaction & 0x0F]) + record[3:10],
+             bytes([0x80 | 2 << 4 | transaction & 0x0F]) + record[10:16]):
+    bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True, data=data))
+await_reply("ALARMSET")
+serve_one(POST_EVENT)
 bus.shutdown()
 """
 
@@ -534,6 +571,20 @@ def test_a_python_can_node_holds_a_binary_semaphore_of_the_board(world):
     world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7FB, b""))
     assert peer_line(world, "AGAIN") == "priority=9 service=12 transaction=53 status=17 flags=0 value=0"
     assert peer_line(world, "LETGO") == "priority=9 service=13 transaction=54 status=0 flags=0 value=0"
-    world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
     assert call(world, f"holder {binary}") == ("ok", 0)
     assert call(world, f"acquire {binary} 0") == ("ok", 0)
+
+
+def test_a_python_can_node_owns_a_timer_of_the_board_and_gets_its_alarm(world):
+    # docs/protocols/remote-transactions.md, "Timers": the board gives its
+    # timer to the peer's task, asking the peer about it first; the peer sets
+    # a watch-dog alarm of 20 ms, and the board's notifier posts its events
+    # to the peer's task at priority 1.
+    timer = created(world.board, "remote timer", "RTIMER")
+    assert call(world, f"give {timer} 0x00031005") == ("ok", 0)
+    assert peer_line(world, "SERVED") == "priority=24 service=6 object=1005 argument=0"
+    world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7FC, (int(timer, 16) & 0xFFFF).to_bytes(2, "big")))
+    assert peer_line(world, "ALARMSET") == "priority=9 service=14 transaction=61 status=0 flags=0 value=0"
+    assert peer_line(world, "SERVED") == "priority=1 service=4 object=1005 argument=64"
+    world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
+    assert remote.net_counters(world.board)["alarms-notified"] == 1
