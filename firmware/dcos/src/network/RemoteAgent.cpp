@@ -1481,6 +1481,17 @@ void receiverEntry(uintptr_t)
 // Creates the receiver and the workers on first use. A start that failed
 // part way (no task slot, no stack) resumes where it stopped on the next
 // attach, so no task is made twice.
+// One of the agent's own tasks, in a process of its own.
+Result<ObjectId> createAgentTask(const char* name, uint8_t priority, TaskEntry entry, uintptr_t argument)
+{
+    TaskAttributes attributes;
+    attributes.name = name;
+    attributes.priority = priority;
+    attributes.stackSize = kTaskStackBytes;
+    attributes.newProcess = true;
+    return TaskManager::create(attributes, entry, argument);
+}
+
 Status startAgent()
 {
     static size_t workersCreated = 0;
@@ -1488,24 +1499,14 @@ Status startAgent()
         return Status::Ok;
     }
     if (receiverTask.isNull()) {
-        TaskAttributes receiver;
-        receiver.name = "net-receiver";
-        receiver.priority = 0;
-        receiver.stackSize = kTaskStackBytes;
-        receiver.newProcess = true;
-        const Result<ObjectId> receiverId = TaskManager::create(receiver, receiverEntry, 0);
+        const Result<ObjectId> receiverId = createAgentTask("net-receiver", 0, receiverEntry, 0);
         if (!receiverId.ok()) {
             return receiverId.status();
         }
         receiverTask = receiverId.value();
     }
     for (; workersCreated < kRemoteWorkers; ++workersCreated) {
-        TaskAttributes worker;
-        worker.name = "net-worker";
-        worker.priority = kLowestPriority;
-        worker.stackSize = kTaskStackBytes;
-        worker.newProcess = true;
-        const Result<ObjectId> workerId = TaskManager::create(worker, workerEntry, workersCreated);
+        const Result<ObjectId> workerId = createAgentTask("net-worker", kLowestPriority, workerEntry, workersCreated);
         if (!workerId.ok()) {
             return workerId.status();
         }
@@ -1513,12 +1514,7 @@ Status startAgent()
     if (notifierTask.isNull()) {
         // Alarms are urgent: the notifier asks at a high priority, on the
         // bus too, below the receiver only.
-        TaskAttributes notifier;
-        notifier.name = "net-alarms";
-        notifier.priority = 1;
-        notifier.stackSize = kTaskStackBytes;
-        notifier.newProcess = true;
-        const Result<ObjectId> notifierId = TaskManager::create(notifier, notifierEntry, 0);
+        const Result<ObjectId> notifierId = createAgentTask("net-alarms", 1, notifierEntry, 0);
         if (!notifierId.ok()) {
             return notifierId.status();
         }
