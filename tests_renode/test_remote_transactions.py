@@ -687,3 +687,47 @@ def test_a_timer_whose_owner_on_another_node_is_gone_is_deleted(pair):
     sent = counters["alarms-notified"]
     lab.hub.wait_until(lab.hub.now_ns + 200_000_000, 120)
     assert net_counters(two)["alarms-notified"] == sent
+
+
+def test_a_held_acquire_and_an_alarm_torn_or_duplicated_on_the_bus_are_performed_once(pair):
+    lab, one, two = pair
+    binary = created(two, "remote sem binary", "RSEM")
+    timer = created(two, "remote timer", "RTIMER")
+    console = self_id(one)
+    assert call(two, f"give {timer} {console}")[0] == "ok"
+    before = net_counters(two)
+    identifier = (8 << 24) | (REQUEST << 16) | (2 << 8) | 1  # "from CAN node 1", priority 8
+    # A held acquire for node 1's console, transaction 0xE7: its holder part
+    # alone (part 0 lost), then whole, then whole again as a retransmission
+    # would be. Performed twice, the second would say "would deadlock".
+    semaphore = int(binary, 16) & 0xFFFF
+    held = [bytes([12, 0xE7, semaphore >> 8, semaphore & 0xFF, 0, 0, 0, 0]),
+            bytes([0xB7]) + int(console, 16).to_bytes(4, "big") + bytes(3)]
+    # An alarm for the same task, transaction 0xE8: a watch-dog of 100 ms,
+    # events 0x20; torn (part 1 lost), then whole twice.
+    index = int(timer, 16) & 0xFFFF
+    record = int(console, 16).to_bytes(4, "big") + (0x20).to_bytes(4, "big") + (100_000_000).to_bytes(8, "big")
+    alarm = [bytes([14, 0xE8, index >> 8, index & 0xFF, 0x01]) + record[0:3], bytes([0x98]) + record[3:10],
+             bytes([0xA8]) + record[10:16]]
+    def answers(records=None):
+        return [data for _, destination, _, data in dcos_frames(lab, REPLY, records)
+                if destination == 1 and data[1] in (0xE7, 0xE8)]
+
+    replies = 0
+    for frames, answered in (([held[1]], 0), (held, 1), (held, 1), ([alarm[0], alarm[2]], 0), (alarm, 1),
+                             (alarm, 1)):
+        for data in frames:
+            lab.hub.inject("can0", "injector", Frame.data_frame(identifier, data, extended=True))
+        replies += answered
+        # The frames' time on the bus, then the answer when one is due.
+        lab.hub.wait_until(lab.hub.now_ns + 5_000_000, 60)
+        lab.hub.wait_for_records(lambda records: len(answers(records)) >= replies, 60, "the reply")
+    ours = answers()
+    assert ours == [bytes([12, 0xE7, 0, 0, 0, 0, 0, 0])] * 2 + [bytes([14, 0xE8, 0, 0, 0, 0, 0, 0])] * 2, ours
+    status, holder, _ = call(two, f"holder {binary}")
+    assert (status, f"0x{holder:08x}") == ("ok", console)
+    served = net_counters(two)
+    assert served["served"] - before["served"] == 2 and served["duplicates"] - before["duplicates"] == 2, served
+    # The alarm went off once, to node 1's console.
+    assert call(one, "events 2000")[:2] == ("ok", 0x20)
+    assert call(one, "events 300")[0] == "timed out"
