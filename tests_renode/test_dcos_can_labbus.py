@@ -327,3 +327,26 @@ def test_dump_decodes_an_alarm_and_tells_its_parts_from_a_port_sends(hub):
     ], remote
     annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
     assert annotations[2] == "prio 24 remote request 1->2: set-alarm part 3/3 slot 7", lines
+
+
+def test_dump_decodes_a_relayed_publication(hub):
+    # docs/protocols/publications.md, "Across a gateway": gateway node 2
+    # relays node 3's publisher 0xA53 onto this bus, each frame behind a
+    # relay header naming node 3; a relayed frame without its header.
+    page = bytes(range(0x10, 0x20))
+    parts = [bytes([0x3A, 0x53, 0x56, 0x77]) + page[0:4], bytes([0x7A, 0x53]) + page[4:10],
+             bytes([0xBA, 0x53]) + page[10:16]]
+    header = bytes([0xFF, 0, 0, 3])
+    frames = []
+    for part in parts:
+        frames += [Frame(0x0A21FF02, extended=True, dlc=4, data=header),
+                   Frame(0x0A21FF02, extended=True, dlc=8, data=part)]
+    frames.append(Frame(0x0A21FF02, extended=True, dlc=8, data=parts[0]))
+    output, lines = decoded_dumps(hub, frames)
+    decoded = [json.loads(line)["dcos"]["publication"] for line in output.splitlines()]
+    assert decoded[0] == {"relay_node": 3}
+    assert decoded[1] == {"index": 0xA53, "part": 0, "sequence": 0x5677, "node": 3}
+    assert decoded[5]["page"] == page.hex().upper() and decoded[5]["node"] == 3, decoded[5]
+    assert decoded[6] == {"malformed": "relayed frame without its header"}
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations[0] == "prio 10 relayed publication 2->all: relay header: node 3", lines

@@ -21,7 +21,8 @@ import pytest
 
 from dcoslab import remote
 from dcoslab.canbus import Frame
-from dcoslab.remote import REPLY, REQUEST, created, net_counters
+from dcoslab.remote import REPLY, REQUEST, created, net_counters, wait_tally
+from dcoslab.remote import publish as remote_publish, subscribe as remote_subscribe
 
 BIT_RATE = 500_000
 ROUTED = 0x13
@@ -289,3 +290,40 @@ def test_a_timer_behind_the_gateway_is_set_by_its_owner_and_notifies_it_through_
     assert call(one, "events 2000")[:2] == ("ok", 4)
     assert call(one, f"cancel {timer}")[0] == "ok"
     assert net_counters(two)["forwarded"] >= 5
+
+
+RELAYED = 0x21
+
+
+def test_a_publisher_behind_the_gateway_is_read_through_it(triple):
+    lab, one, two, three = triple
+    publisher = remote_publish(three, "level", count=20)
+    assert publisher.startswith("0x00038")
+    # Node 1 opens node 3's publisher through node 2, which from then on
+    # relays its frames onto can0, each behind a header naming node 3.
+    remote_subscribe(one, publisher)
+    wait_tally(lab, one, lambda status, _: status != "busy", "the subscriber to open")
+    three.command("pubsub go")
+    status, counts = wait_tally(lab, one, lambda _, c: c["last"] == 20, "the 20th page")
+    assert status == "ok"
+    assert (counts["received"], counts["repeats"], counts["torn"], counts["gaps"]) == (20, 0, 0, 0), counts
+    lab.hub.wait_until(lab.hub.now_ns + 5_000_000, 60)
+    relayed = frames(lab, "can0", RELAYED)
+    headers, parts = relayed[0::2], relayed[1::2]
+    assert {data for *_, data in headers} == {bytes([0xFF, 0, 0, 3])}
+    # Every frame of node 3's on can1 after the Open, once, in order, from
+    # node 2 to all, at the writer's priority.
+    originals = [data for *_, data in frames(lab, "can1", 0x20)]
+    assert [data for *_, data in parts] == originals[-len(parts):]
+    assert len(parts) >= 3 * 20
+    assert {(priority, destination, source) for priority, destination, source, _ in relayed} == {(10, 255, 2)}
+    assert net_counters(two)["publications-relayed"] == len(parts)
+    # The publisher's deletion is relayed too: node 1's reader learns it.
+    three.command("pubsub delete")
+    status, counts = wait_tally(lab, one, lambda _, c: c["deleted"] == 1, "the withdrawal")
+    assert counts["received"] == 20
+    # A relayed frame without its header is dropped, never taken as node 2's.
+    lab.hub.inject("can0", "injector", Frame.data_frame((10 << 24) | (RELAYED << 16) | (255 << 8) | 2,
+                                                       parts[0][3], extended=True))
+    lab.hub.wait_until(lab.hub.now_ns + 2_000_000, 60)
+    assert net_counters(one)["unrouted"] == 1

@@ -24,6 +24,8 @@ static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RoutedRequest) ==
               static_cast<uint8_t>(can::MessageType::RoutedRequest));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::DsmPublication) ==
               static_cast<uint8_t>(can::MessageType::DsmPublication));
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RelayedPublication) ==
+              static_cast<uint8_t>(can::MessageType::RelayedPublication));
 
 namespace {
 
@@ -32,7 +34,7 @@ bool isSystemMessage(can::MessageType type)
 {
     return type == can::MessageType::RemoteRequest || type == can::MessageType::RemoteReply ||
            type == can::MessageType::NameQuery || type == can::MessageType::RoutedRequest ||
-           type == can::MessageType::DsmPublication ||
+           type == can::MessageType::DsmPublication || type == can::MessageType::RelayedPublication ||
            type == can::MessageType::TimeSync;
 }
 

@@ -243,3 +243,22 @@ TEST(PublicationMessageTest, TheFilterAgreesWithAModelOfTwoBusesWithLossesAndLag
 }
 
 } // namespace
+
+TEST(PublicationMessageTest, ARelayHeaderNamesTheNodeAndIsNoPublicationFrame)
+{
+    uint8_t header[kRelayHeaderBytes];
+    encodeRelayHeader(0x0103, header);
+    EXPECT_EQ(std::vector<uint8_t>(header, header + kRelayHeaderBytes), (std::vector<uint8_t>{0xFF, 0x00, 0x01, 0x03}));
+    uint16_t node = 0;
+    ASSERT_TRUE(decodeRelayHeader(header, kRelayHeaderBytes, node));
+    EXPECT_EQ(node, 0x0103);
+    PublicationPart part;
+    EXPECT_NE(decodePublicationPart(header, kRelayHeaderBytes, part), PublicationMessageError::None);
+    const uint8_t reserved[kRelayHeaderBytes] = {0xFF, 0x01, 0x00, 0x03};
+    EXPECT_FALSE(decodeRelayHeader(reserved, kRelayHeaderBytes, node));
+    const uint8_t other[kRelayHeaderBytes] = {0xFE, 0x00, 0x00, 0x03};
+    EXPECT_FALSE(decodeRelayHeader(other, kRelayHeaderBytes, node));
+    EXPECT_FALSE(decodeRelayHeader(header, 3, node));
+    const uint8_t longer[5] = {0xFF, 0x00, 0x00, 0x03, 0x00};
+    EXPECT_FALSE(decodeRelayHeader(longer, 5, node));
+}

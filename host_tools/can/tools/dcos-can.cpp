@@ -116,6 +116,43 @@ public:
 
     DataDecoding decode(const can::MessageIdentifier& id, const can::CanFrame& frame)
     {
+        return decodePart(uint32_t{id.source()}, frame);
+    }
+
+    /// A relayed publication's frame (docs/protocols/publications.md,
+    /// "Across a gateway"): a relay header, or the frame it names the node of.
+    DataDecoding decodeRelayed(const can::MessageIdentifier& id, const can::CanFrame& frame)
+    {
+        using namespace dcos::internal;
+        uint16_t node = 0;
+        if (decodeRelayHeader(frame.data(), frame.length(), node)) {
+            relayed_[id.source()] = node;
+            DataDecoding out;
+            out.key = "publication";
+            out.text = fmt::format("relay header: node {}", node);
+            out.json = {{"relay_node", node}};
+            return out;
+        }
+        const auto found = relayed_.find(id.source());
+        if (found == relayed_.end()) {
+            DataDecoding out;
+            out.key = "publication";
+            return malformed(out, "relayed frame without its header");
+        }
+        node = found->second;
+        relayed_.erase(found);
+        // Put together apart from the gateway's own publications: keyed by the node.
+        DataDecoding out = decodePart(0x10000u | node, frame);
+        if (!out.json.contains("malformed")) {
+            out.text = fmt::format("node {} ", node) + out.text;
+            out.json["node"] = node;
+        }
+        return out;
+    }
+
+private:
+    DataDecoding decodePart(uint32_t sender, const can::CanFrame& frame)
+    {
         using namespace dcos::internal;
         DataDecoding out;
         out.key = "publication";
@@ -137,7 +174,7 @@ public:
             out.text += fmt::format(" seq {}", part.sequence);
             out.json["sequence"] = part.sequence;
         }
-        PublicationAssembler& assembler = pages_[(uint32_t{id.source()} << 12) | part.index];
+        PublicationAssembler& assembler = pages_[(uint64_t{sender} << 12) | part.index];
         const PublicationAssembler::Outcome outcome = assembler.take(part);
         if (outcome == PublicationAssembler::Outcome::Complete) {
             std::string page;
@@ -154,9 +191,9 @@ public:
         return out;
     }
 
-private:
-    std::map<uint32_t, dcos::internal::PublicationAssembler> pages_;
+    std::map<uint64_t, dcos::internal::PublicationAssembler> pages_;
     std::map<uint32_t, dcos::internal::RemoteService> continued_;
+    std::map<uint8_t, uint16_t> relayed_; // The node a gateway's last relay header named.
 };
 
 // The name of an object type, as a name query carries it.
@@ -180,6 +217,9 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
     using namespace dcos::internal;
     if (id.type() == can::MessageType::DsmPublication) {
         return pages.decode(id, frame);
+    }
+    if (id.type() == can::MessageType::RelayedPublication) {
+        return pages.decodeRelayed(id, frame);
     }
     DataDecoding out;
     if (id.type() == can::MessageType::TimeSync) {

@@ -33,6 +33,10 @@ enum class MessageType : uint8_t {
     RoutedRequest = 0x13,
     /// A distributed shared memory publication (seed 7.10).
     DsmPublication = 0x20,
+    /// A publication of a node behind a gateway, relayed by the gateway: a
+    /// relay header naming the publisher's node before each frame
+    /// (docs/protocols/publications.md, "Across a gateway").
+    RelayedPublication = 0x21,
     /// A segmented transfer, ISO 15765-2 (IsoTpSender, IsoTpReceiver).
     Segmented = 0x30,
     /// Configuration by the system engineering interface agent (seed 7.14).
@@ -51,6 +55,7 @@ constexpr bool isAssignedMessageType(uint8_t raw)
     case MessageType::NameQuery:
     case MessageType::RoutedRequest:
     case MessageType::DsmPublication:
+    case MessageType::RelayedPublication:
     case MessageType::Segmented:
     case MessageType::Configuration:
     case MessageType::Flashing:
@@ -69,6 +74,7 @@ constexpr const char* messageTypeName(MessageType type)
     case MessageType::NameQuery: return "name query";
     case MessageType::RoutedRequest: return "routed request";
     case MessageType::DsmPublication: return "DSM publication";
+    case MessageType::RelayedPublication: return "relayed publication";
     case MessageType::Segmented: return "segmented";
     case MessageType::Configuration: return "configuration";
     case MessageType::Flashing: return "flashing";

@@ -33,6 +33,7 @@ enum class SystemMessageType : uint8_t {
     NameQuery = 0x12, ///< A part of a name query, to the broadcast address (docs/protocols/remote-transactions.md).
     RoutedRequest = 0x13, ///< A route header or a request's frame, to a gateway (docs/protocols/remote-transactions.md, "Gateways").
     DsmPublication = 0x20, ///< A part of a publication, to the broadcast address (docs/protocols/publications.md).
+    RelayedPublication = 0x21, ///< A relay header or a publication's frame, from a gateway (publications.md, "Across a gateway").
 };
 
 /// One system message as a link carries it.

@@ -146,6 +146,7 @@ void listRemote(shell::Shell& shell)
         {"publications-sent", s.publicationsSent}, {"publication-parts", s.publicationParts},
         {"unknown-senders", s.unknownSenders}, {"names-not-found", s.namesNotFound},
         {"routed-requests", s.routedRequests}, {"forwarded", s.forwarded}, {"unrouted", s.unrouted},
+        {"publications-relayed", s.publicationsRelayed},
         {"alarms-notified", s.alarmsNotified}, {"alarm-owners-lost", s.alarmOwnersLost},
         {"alarms-dropped", s.alarmsDropped},
     };

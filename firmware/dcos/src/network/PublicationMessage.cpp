@@ -142,4 +142,21 @@ bool PublicationFilter::take(uint16_t sequence, uint64_t nowNs)
     return true;
 }
 
+void encodeRelayHeader(uint16_t node, uint8_t (&bytes)[kRelayHeaderBytes])
+{
+    bytes[0] = 0xFF;
+    bytes[1] = 0;
+    bytes[2] = static_cast<uint8_t>(node >> 8);
+    bytes[3] = static_cast<uint8_t>(node);
+}
+
+bool decodeRelayHeader(const uint8_t* bytes, size_t length, uint16_t& node)
+{
+    if (length != kRelayHeaderBytes || bytes[0] != 0xFF || bytes[1] != 0) {
+        return false;
+    }
+    node = static_cast<uint16_t>((bytes[2] << 8) | bytes[3]);
+    return true;
+}
+
 } // namespace dcos::internal

@@ -659,6 +659,92 @@ void onReply(uint8_t interface, const SystemMessage& message)
     (void)TaskManager::wakeFirst(slot.waiter, Status::Ok);
 }
 
+// ---- publications relayed by this node as a gateway ------------------------
+//
+// A node behind a gateway opens a publisher on the gateway's other bus with
+// a routed DsmOpen; the gateway notes the publisher and the interface the
+// Open came from, and from then on passes each of the publisher's frames to
+// that interface, every frame behind a relay header naming the publisher's
+// node (PublicationMessage.hpp). An entry ends with the publisher's
+// withdrawal; with every entry in use, a routed Open answers Busy.
+
+struct Relay {
+    bool used = false;
+    ObjectId publisher;
+    uint8_t interface = 0;  // Where its frames go.
+};
+
+constexpr size_t kRelays = 8;
+Relay relays[kRelays];
+
+// Notes that @p publisher's frames go to @p interface; false when the table is full. Under the lock.
+bool addRelay(ObjectId publisher, uint8_t interface)
+{
+    Relay* free = nullptr;
+    for (Relay& relay : relays) {
+        if (relay.used && relay.publisher == publisher && relay.interface == interface) {
+            return true;
+        }
+        if (!relay.used && free == nullptr) {
+            free = &relay;
+        }
+    }
+    if (free == nullptr) {
+        return false;
+    }
+    *free = Relay{true, publisher, interface};
+    return true;
+}
+
+void removeRelay(ObjectId publisher, uint8_t interface)
+{
+    Lock lock;
+    for (Relay& relay : relays) {
+        if (relay.used && relay.publisher == publisher && relay.interface == interface) {
+            relay.used = false;
+        }
+    }
+}
+
+// Passes a frame of @p publisher, which arrived on @p from, to every
+// interface that asked for it, behind its relay header, at the frame's
+// priority. A withdrawal ends the relay.
+void relayPublication(uint8_t from, const SystemMessage& message, ObjectId publisher, bool withdrawal)
+{
+    uint8_t header[kRelayHeaderBytes];
+    encodeRelayHeader(publisher.node(), header);
+    for (Relay& relay : relays) {
+        uint8_t to;
+        {
+            Lock lock;
+            if (!relay.used || relay.publisher != publisher || relay.interface == from) {
+                continue;
+            }
+            to = relay.interface;
+            if (withdrawal) {
+                relay.used = false;
+            }
+        }
+        if (sendBytes(to, SystemMessageType::RelayedPublication, message.priority, NetworkLink::kBroadcast, header,
+                      kRelayHeaderBytes) &&
+            sendBytes(to, SystemMessageType::RelayedPublication, message.priority, NetworkLink::kBroadcast,
+                      message.data, message.length)) {
+            Lock lock;
+            ++statistics.publicationsRelayed;
+        }
+    }
+}
+
+// The node a relay header named, per sender, for the one frame after it.
+struct RelayHeard {
+    bool used = false;
+    uint8_t interface = 0;
+    uint32_t source = 0;
+    uint16_t node = 0;
+};
+
+RelayHeard relaysHeard[kRelays];
+
 // A publication frame arrived on @p interface.
 void onPublication(uint8_t interface, const SystemMessage& message)
 {
@@ -677,6 +763,50 @@ void onPublication(uint8_t interface, const SystemMessage& message)
         }
     }
     DsmManager::deliverPublication(interface, node.value(), part, TimerAgent::Uptime());
+    // As a gateway: to the buses that asked for this publisher.
+    const ObjectId publisher = publisherOn(node.value(), part.index);
+    relayPublication(interface, message, publisher, part.kind == PublicationPartKind::Withdrawal);
+}
+
+// A relayed publication frame arrived on @p interface: a relay header, or
+// the frame it names the node of. Relayed frames are not relayed again: a
+// publisher is read one gateway beyond its bus.
+void onRelayedPublication(uint8_t interface, const SystemMessage& message)
+{
+    uint16_t origin = 0;
+    RelayHeard* heard = nullptr;
+    {
+        Lock lock;
+        RelayHeard* free = nullptr;
+        for (RelayHeard& entry : relaysHeard) {
+            if (entry.used && entry.interface == interface && entry.source == message.source) {
+                heard = &entry;
+            } else if (!entry.used && free == nullptr) {
+                free = &entry;
+            }
+        }
+        if (decodeRelayHeader(message.data, message.length, origin)) {
+            RelayHeard* const slot = heard != nullptr ? heard : (free != nullptr ? free : &relaysHeard[0]);
+            *slot = RelayHeard{true, interface, message.source, origin};
+            return;
+        }
+        if (heard == nullptr) {
+            ++statistics.unrouted; // A relayed frame whose header was not heard.
+            return;
+        }
+        origin = heard->node;
+        heard->used = false; // A header names the one frame after it.
+    }
+    PublicationPart part;
+    if (decodePublicationPart(message.data, message.length, part) != PublicationMessageError::None) {
+        countMalformed();
+        return;
+    }
+    {
+        Lock lock;
+        ++statistics.publicationParts;
+    }
+    DsmManager::deliverPublication(interface, origin, part, TimerAgent::Uptime());
 }
 
 // ---- the serving side ---------------------------------------------------------
@@ -1321,8 +1451,27 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
     }
     case RemoteService::DsmOpen: {
         if (routed) {
-            // Publications are multicast on a bus and no gateway relays them.
-            reply.status = Status::NotSupported;
+            // As a gateway: the publisher's frames are relayed to the bus the
+            // Open came from from now on, and the gateway opens it itself,
+            // so its node sends its latest page again, relayed too. A
+            // publisher behind a further gateway is not: relayed frames are
+            // not relayed again.
+            const Result<NextHop> hop = NetworkInterfacesManager::Resolve(id.node());
+            if (hop.ok() && hop.value().via.raw() != hop.value().destination.raw()) {
+                reply.status = Status::NotSupported;
+                break;
+            }
+            {
+                Lock lock;
+                if (!addRelay(id, entry.interface)) {
+                    reply.status = Status::Busy;
+                    break;
+                }
+            }
+            replyWith(reply, call(RemoteService::DsmOpen, id, 0, ObjectId::null()));
+            if (reply.status != Status::Ok) {
+                removeRelay(id, entry.interface);
+            }
             break;
         }
         replyWith(reply, DsmManager::serveRemoteOpen(id, withinController(entry.interface)));
@@ -1471,6 +1620,7 @@ void receiverEntry(uintptr_t)
                     break;
                 case SystemMessageType::NameQuery: onNameQuery(interface, message); break;
                 case SystemMessageType::DsmPublication: onPublication(interface, message); break;
+                case SystemMessageType::RelayedPublication: onRelayedPublication(interface, message); break;
                 case SystemMessageType::TimeSync: onTimeSyncMessage(interface, message); break;
                 }
             }

@@ -44,6 +44,26 @@ constexpr size_t kPublicationFrames = 3;
 constexpr size_t kPublicationFrameBytes = 8;
 constexpr size_t kWithdrawalBytes = 2;
 
+// ---- relayed publications (docs/protocols/publications.md, "Across a gateway")
+//
+// A gateway passes a publisher's frames from the publisher's bus to another,
+// message type 0x21 (RelayedPublication), each frame right after a relay
+// header that names the publisher's node:
+//
+//     relay header   byte 0 0xFF, byte 1 zero, bytes 2-3 the logical node
+//
+// A receiver takes the frame that follows a header from the same sender as
+// that node's, and drops a frame that follows none: without its node the
+// publisher's index names nothing.
+
+/// Bytes of a relay header.
+constexpr size_t kRelayHeaderBytes = 4;
+
+/// The relay header naming @p node.
+void encodeRelayHeader(uint16_t node, uint8_t (&bytes)[kRelayHeaderBytes]);
+/// Whether a relayed frame of @p length bytes is a relay header; the node into @p node.
+bool decodeRelayHeader(const uint8_t* bytes, size_t length, uint16_t& node);
+
 /// What a frame is.
 enum class PublicationPartKind : uint8_t {
     First = 0,      ///< Sequence number and page bytes 0-3.

@@ -98,7 +98,8 @@ struct RemoteStatistics {
     // Gateways (docs/protocols/remote-transactions.md, "Gateways").
     uint32_t routedRequests = 0;   ///< Transactions begun with a node behind a gateway, through it.
     uint32_t forwarded = 0;        ///< Routed requests this node served for another node, as a gateway.
-    uint32_t unrouted = 0;         ///< Routed request frames dropped: their route header was not heard.
+    uint32_t unrouted = 0;         ///< Routed request or relayed publication frames dropped: their header was not heard.
+    uint32_t publicationsRelayed = 0; ///< Publication frames this node passed on to another bus, as a gateway.
     // Timers owned by tasks of other nodes (docs/protocols/remote-transactions.md, "Timers").
     uint32_t alarmsNotified = 0;   ///< Alarms told to their owner on another node.
     uint32_t alarmOwnersLost = 0;  ///< Alarms whose owner was gone: the timer was deleted.
