@@ -19,7 +19,9 @@ message to a port of the board (docs/protocols/remote-transactions.md,
 ("Gateways"): the board forwards the routed request back to the peer as
 its own request and relays the answer. Last, the peer's task holds a
 binary semaphore of the board ("Binary semaphores") and owns a timer of
-the board, whose alarm the board posts to it ("Timers").
+the board, whose alarm the board posts to it ("Timers"); and it is the
+board's gateway to a publisher a bus away, whose frames it relays
+(docs/protocols/publications.md, "Across a gateway").
 
 Emulated time is paced at a fiftieth of wall time, so that the VM's
 answers, slow under an emulated CPU on a busy host, come well within the
@@ -385,6 +387,39 @@ for data in (struct.pack(">BBHB", SET_ALARM, transaction, timer, 0x01) + record[
     bus.send(can.Message(arbitration_id=identifier(9, REQUEST, BOARD, ME), is_extended_id=True, data=data))
 await_reply("ALARMSET")
 serve_one(POST_EVENT)
+
+# Phase 9: this node as the board's gateway to node 5, a bus away
+# (docs/protocols/publications.md, "Across a gateway"). The board opens
+# node 5's publisher 0x00058007 with a routed DsmOpen to this node: a route
+# header naming node 5, then the request. Answer it, then relay pages 1 to
+# 3 of that publisher, each frame behind a relay header naming node 5; a
+# relayed frame without its header goes first, which the board must drop.
+RELAYED = 0x21
+while True:
+    message = receive()
+    if not message.is_extended_id:
+        continue
+    priority, kind, destination, source = fields(message)
+    if kind == ROUTED and destination == ME and len(message.data) == 4:
+        route = bytes(message.data)
+        print(f"@@PEER ROUTE hops={route[0] & 0x0F} node={route[2] << 8 | route[3]}@@", flush=True)
+    elif kind == ROUTED and destination == ME and bytes(message.data)[0] == DSM_OPEN:
+        break
+service, transaction, obj, argument = struct.unpack(">BBHI", bytes(message.data))
+print(f"@@PEER RELAYOPEN priority={priority} object={obj:04X}@@", flush=True)
+bus.send(can.Message(arbitration_id=identifier(priority, REPLY, source, ME), is_extended_id=True,
+                     data=struct.pack(">BBBBI", service, transaction, OK, 0, 0)))
+
+def relay(data):
+    for frame in (bytes([0xFF, 0, 0, 5]), data):
+        bus.send(can.Message(arbitration_id=identifier(12, RELAYED, 0xFF, ME), is_extended_id=True, data=frame))
+
+first = parts(0x007, 1, page_of(1))
+bus.send(can.Message(arbitration_id=identifier(12, RELAYED, 0xFF, ME), is_extended_id=True, data=first[0]))
+for n in (1, 2, 3):
+    for data in parts(0x007, n, page_of(n)):
+        relay(data)
+print("@@PEER RELAYED@@", flush=True)
 bus.shutdown()
 """
 
@@ -586,5 +621,27 @@ def test_a_python_can_node_owns_a_timer_of_the_board_and_gets_its_alarm(world):
     world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7FC, (int(timer, 16) & 0xFFFF).to_bytes(2, "big")))
     assert peer_line(world, "ALARMSET") == "priority=9 service=14 transaction=61 status=0 flags=0 value=0"
     assert peer_line(world, "SERVED") == "priority=1 service=4 object=1005 argument=64"
+    # The board counts it once the peer's reply is in.
+    end = world.lab.hub.now_ns + 2_000_000_000
+    while remote.net_counters(world.board)["alarms-notified"] != 1:
+        assert world.lab.hub.now_ns < end, "the notification was never answered"
+        world.lab.hub.wait_until(world.lab.hub.now_ns + 20_000_000, STEP)
+
+
+def test_the_board_reads_a_publisher_a_python_can_gateway_relays(world):
+    # docs/protocols/publications.md, "Across a gateway": the peer is the
+    # board's gateway to node 5; the board opens node 5's publisher through
+    # it and takes the pages it relays, dropping a relayed frame without its header.
+    for line in ("net map 5 130.2.0.5", "net route 130.2.0.0/16 130.1.0.3"):
+        assert "error" not in world.board.command(line, timeout=STEP)
+    before = remote.net_counters(world.board)
+    output = world.board.command("pubsub subscribe 0x00058007 5", timeout=STEP)
+    assert "PTASK" in output, output
+    assert peer_line(world, "ROUTE") == "hops=4 node=5"
+    assert peer_line(world, "RELAYOPEN") == "priority=5 object=8007"
+    world.vm.expect(r"@@PEER RELAYED@@", timeout=STEP)
+    status, counts = wait_tally(world.lab, world.board, lambda _, c: c["last"] == 3, "page 3", STEP)
+    assert status == "ok", status
+    assert (counts["received"], counts["repeats"], counts["torn"]) == (3, 0, 0), counts
+    assert remote.net_counters(world.board)["unrouted"] - before["unrouted"] == 1
     world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
-    assert remote.net_counters(world.board)["alarms-notified"] == 1
