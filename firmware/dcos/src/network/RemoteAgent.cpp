@@ -324,11 +324,18 @@ bool sendRequest(const CallSlot& slot, uint8_t priority, const uint8_t (*frames)
     return true;
 }
 
-// One transaction of @p service on @p id with @p argument: one request
-// frame, or for HeldAcquire the two frames naming @p holder; the reply's
-// status and value, a refusal's value in @p errorValue.
-Result<uint32_t> call(RemoteService service, ObjectId id, uint32_t argument, ObjectId holder,
-                      uint32_t* errorValue = nullptr)
+// The most frames one request takes (a port send's, an alarm's).
+constexpr size_t kMostRequestFrames = kPortSendFrames;
+static_assert(kAlarmFrames <= kMostRequestFrames && kHeldAcquireFrames <= kMostRequestFrames);
+
+// One transaction of @p service on another node's @p id: a call slot, then
+// the request that @p encode lays out for the slot's transaction number
+// (it fills the frames and their lengths, and says how many), sent again
+// after every silent watchdog period, at the caller's running priority, so
+// a task that inherited urgency asks with it; the reply's status and
+// value, a refusal's value in @p errorValue.
+template <typename Encode>
+Result<uint32_t> transact(RemoteService service, ObjectId id, Encode encode, uint32_t* errorValue = nullptr)
 {
     // The transaction's instructions count from here (RemoteInstructions).
     const uint64_t begun = readCounter();
@@ -338,29 +345,46 @@ Result<uint32_t> call(RemoteService service, ObjectId id, uint32_t argument, Obj
         return opened.status();
     }
     CallSlot* const slot = opened.value();
-
-    uint8_t frames[kHeldAcquireFrames][kRemoteMessageBytes];
-    const uint8_t lengths[kHeldAcquireFrames] = {kRemoteMessageBytes, kRemoteMessageBytes};
-    size_t count = 1;
-    if (service == RemoteService::HeldAcquire) {
-        HeldAcquireRequest request;
-        request.transaction = slot->transaction;
-        request.object = static_cast<uint16_t>(id.raw() & 0xFFFF);
-        request.timeoutMs = argument;
-        request.holder = holder.raw();
-        encodeHeldAcquire(request, frames);
-        count = kHeldAcquireFrames;
-    } else {
-        RemoteRequest request;
-        request.service = service;
-        request.transaction = slot->transaction;
-        request.object = static_cast<uint16_t>(id.raw() & 0xFFFF);
-        request.argument = argument;
-        encodeRequest(request, frames[0]);
-    }
-    // The running priority, so a task that inherited urgency asks with it.
+    uint8_t frames[kMostRequestFrames][kRemoteMessageBytes];
+    uint8_t lengths[kMostRequestFrames];
+    const size_t count = encode(slot->transaction, frames, lengths);
+    // The parts in a row: a part the link did not take leaves a request the
+    // server drops, so the rest is not sent; the watchdog sends all again.
     return awaitReply(
         *slot, begun, [&] { (void)sendRequest(*slot, self.priority, frames, lengths, count); }, errorValue);
+}
+
+// One transaction of @p service on @p id with @p argument: one request
+// frame, or for HeldAcquire the two frames naming @p holder.
+Result<uint32_t> call(RemoteService service, ObjectId id, uint32_t argument, ObjectId holder,
+                      uint32_t* errorValue = nullptr)
+{
+    const uint16_t object = static_cast<uint16_t>(id.raw() & 0xFFFF);
+    return transact(
+        service, id,
+        [&](uint8_t transaction, uint8_t (&frames)[kMostRequestFrames][kRemoteMessageBytes],
+            uint8_t (&lengths)[kMostRequestFrames]) -> size_t {
+            lengths[0] = lengths[1] = kRemoteMessageBytes;
+            if (service == RemoteService::HeldAcquire) {
+                HeldAcquireRequest request;
+                request.transaction = transaction;
+                request.object = object;
+                request.timeoutMs = argument;
+                request.holder = holder.raw();
+                uint8_t held[kHeldAcquireFrames][kRemoteMessageBytes];
+                encodeHeldAcquire(request, held);
+                __builtin_memcpy(frames, held, sizeof held);
+                return kHeldAcquireFrames;
+            }
+            RemoteRequest request;
+            request.service = service;
+            request.transaction = transaction;
+            request.object = object;
+            request.argument = argument;
+            encodeRequest(request, frames[0]);
+            return 1;
+        },
+        errorValue);
 }
 
 // Ids of other nodes' semaphores that answered kAskHeld: binary ones,
@@ -427,26 +451,18 @@ Result<uint32_t> forward(RemoteService service, ObjectId id, uint32_t argument)
 // watchdog period, and the reply's status.
 Status forwardPortSend(ObjectId port, const Message& message, int priority)
 {
-    const uint64_t begun = readCounter();
-    Task& self = Scheduler::current();
-    const Result<CallSlot*> opened = openRemoteCall(self, RemoteService::PortSend, port);
-    if (!opened.ok()) {
-        return opened.status();
-    }
-    CallSlot* const slot = opened.value();
-    PortSendRequest request;
-    request.transaction = slot->transaction;
-    request.object = static_cast<uint16_t>(port.raw() & 0xFFFF);
-    request.priority = static_cast<int8_t>(priority);
-    __builtin_memcpy(request.message, message.bytes, kPortMessageBytes);
-    uint8_t frames[kPortSendFrames][kRemoteMessageBytes];
-    uint8_t lengths[kPortSendFrames];
-    encodePortSend(request, frames, lengths);
-    // The parts in a row: a part the link did not take leaves a request the
-    // server drops, so the rest is not sent; the watchdog sends all three again.
-    return awaitReply(*slot, begun, [&] {
-        (void)sendRequest(*slot, self.priority, frames, lengths, kPortSendFrames);
-    }).status();
+    return transact(RemoteService::PortSend, port,
+                    [&](uint8_t transaction, uint8_t (&frames)[kMostRequestFrames][kRemoteMessageBytes],
+                        uint8_t (&lengths)[kMostRequestFrames]) -> size_t {
+                        PortSendRequest request;
+                        request.transaction = transaction;
+                        request.object = static_cast<uint16_t>(port.raw() & 0xFFFF);
+                        request.priority = static_cast<int8_t>(priority);
+                        __builtin_memcpy(request.message, message.bytes, kPortMessageBytes);
+                        encodePortSend(request, frames, lengths);
+                        return kPortSendFrames;
+                    })
+        .status();
 }
 
 // An alarm of another node's timer, set for @p owner (RemoteForward.hpp's
@@ -456,27 +472,21 @@ Status forwardPortSend(ObjectId port, const Message& message, int priority)
 Status callAlarm(ObjectId timer, RemoteAlarmKind kind, const AlarmNotification& notification, uint64_t timeNs,
                  ObjectId owner)
 {
-    const uint64_t begun = readCounter();
-    Task& self = Scheduler::current();
-    const Result<CallSlot*> opened = openRemoteCall(self, RemoteService::TimerSetAlarm, timer);
-    if (!opened.ok()) {
-        return opened.status();
-    }
-    CallSlot* const slot = opened.value();
-    AlarmRequest request;
-    request.transaction = slot->transaction;
-    request.object = static_cast<uint16_t>(timer.raw() & 0xFFFF);
-    request.kind = kind;
-    request.signal = notification.kind == AlarmNotification::Kind::Signal;
-    request.value = notification.value;
-    request.owner = owner.raw();
-    request.timeNs = timeNs;
-    uint8_t frames[kAlarmFrames][kRemoteMessageBytes];
-    uint8_t lengths[kAlarmFrames];
-    encodeAlarm(request, frames, lengths);
-    return awaitReply(*slot, begun, [&] {
-        (void)sendRequest(*slot, self.priority, frames, lengths, kAlarmFrames);
-    }).status();
+    return transact(RemoteService::TimerSetAlarm, timer,
+                    [&](uint8_t transaction, uint8_t (&frames)[kMostRequestFrames][kRemoteMessageBytes],
+                        uint8_t (&lengths)[kMostRequestFrames]) -> size_t {
+                        AlarmRequest request;
+                        request.transaction = transaction;
+                        request.object = static_cast<uint16_t>(timer.raw() & 0xFFFF);
+                        request.kind = kind;
+                        request.signal = notification.kind == AlarmNotification::Kind::Signal;
+                        request.value = notification.value;
+                        request.owner = owner.raw();
+                        request.timeNs = timeNs;
+                        encodeAlarm(request, frames, lengths);
+                        return kAlarmFrames;
+                    })
+        .status();
 }
 
 Status forwardAlarm(ObjectId timer, RemoteAlarmKind kind, const AlarmNotification& notification, uint64_t timeNs)
