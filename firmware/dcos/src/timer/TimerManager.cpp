@@ -488,8 +488,15 @@ DCOS_CONFIGURATION_SERVICE Status TimerManager::xferOwnership(ObjectId id, Objec
 {
     // A timer may be owned by a task of another node, which sets its alarms
     // over the network and is notified so (seed 6.4, 7.5): that task is
-    // asked whether it exists.
+    // asked whether it exists, once the caller is known to be allowed to give it.
     if (!newOwner.isNull() && newOwner.type() == ObjectType::Task && newOwner.node() != timerTable.node()) {
+        {
+            arch_x86::InterruptGuard guard;
+            const Result<TimerObject*> timer = resolveOwnedTimer(id, caller);
+            if (!timer.ok()) {
+                return timer.status();
+            }
+        }
         const Result<TaskState> state = TaskAgent::GetState(newOwner);
         if (!state.ok()) {
             return state.status();
