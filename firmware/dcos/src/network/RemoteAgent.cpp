@@ -686,6 +686,7 @@ struct Relay {
 
 constexpr size_t kRelays = 8;
 Relay relays[kRelays];
+size_t relaysInUse = 0; // So a node that relays nothing pays one test per frame.
 
 // Notes that @p publisher's frames go to @p interface; false when the table is full. Under the lock.
 bool addRelay(ObjectId publisher, uint8_t interface)
@@ -703,7 +704,15 @@ bool addRelay(ObjectId publisher, uint8_t interface)
         return false;
     }
     *free = Relay{true, publisher, interface};
+    ++relaysInUse;
     return true;
+}
+
+// Ends @p relay. Under the lock.
+void endRelay(Relay& relay)
+{
+    relay.used = false;
+    --relaysInUse;
 }
 
 void removeRelay(ObjectId publisher, uint8_t interface)
@@ -711,7 +720,7 @@ void removeRelay(ObjectId publisher, uint8_t interface)
     Lock lock;
     for (Relay& relay : relays) {
         if (relay.used && relay.publisher == publisher && relay.interface == interface) {
-            relay.used = false;
+            endRelay(relay);
         }
     }
 }
@@ -721,6 +730,12 @@ void removeRelay(ObjectId publisher, uint8_t interface)
 // priority. A withdrawal ends the relay.
 void relayPublication(uint8_t from, const SystemMessage& message, ObjectId publisher, bool withdrawal)
 {
+    {
+        Lock lock;
+        if (relaysInUse == 0) [[likely]] {
+            return;
+        }
+    }
     uint8_t header[kRelayHeaderBytes];
     encodeRelayHeader(publisher.node(), header);
     for (Relay& relay : relays) {
@@ -732,7 +747,7 @@ void relayPublication(uint8_t from, const SystemMessage& message, ObjectId publi
             }
             to = relay.interface;
             if (withdrawal) {
-                relay.used = false;
+                endRelay(relay);
             }
         }
         if (sendBytes(to, SystemMessageType::RelayedPublication, message.priority, NetworkLink::kBroadcast, header,
