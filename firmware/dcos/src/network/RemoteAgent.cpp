@@ -1030,21 +1030,6 @@ void onRequest(uint8_t interface, const SystemMessage& message, bool routed)
             gathering.partsInstructions += partInstructions(message);
             return; // In turn and not the last, or out of turn and dropped: the requester sends it again.
         }
-        if (gathering.assembler.service() == RemoteService::TimerSetAlarm) {
-            AlarmRequest alarm;
-            if (!gathering.assembler.alarm(alarm)) {
-                countMalformed();
-                return;
-            }
-            const PortSendRequest whole = gathering.assembler.portSend();
-            RemoteRequest request;
-            request.service = RemoteService::TimerSetAlarm;
-            request.transaction = whole.transaction;
-            request.object = whole.object;
-            request.argument = static_cast<uint8_t>(whole.priority); // The flags; the record rides as the payload.
-            admitFor(interface, message, request, routed, whole.message, gathering.partsInstructions);
-            return;
-        }
         if (gathering.assembler.service() == RemoteService::HeldAcquire) {
             const HeldAcquireRequest held = gathering.assembler.heldAcquire();
             RemoteRequest request;
@@ -1061,9 +1046,17 @@ void onRequest(uint8_t interface, const SystemMessage& message, bool routed)
             admitFor(interface, message, request, routed, payload, gathering.partsInstructions);
             return;
         }
+        // A port send or an alarm, laid out alike: byte 4 (the message's
+        // priority, an alarm's flags) as the argument, the sixteen bytes as
+        // the payload. An alarm whose flags are not defined is malformed.
+        AlarmRequest alarm;
+        if (gathering.assembler.service() == RemoteService::TimerSetAlarm && !gathering.assembler.alarm(alarm)) {
+            countMalformed();
+            return;
+        }
         const PortSendRequest whole = gathering.assembler.portSend();
         RemoteRequest request;
-        request.service = RemoteService::PortSend;
+        request.service = gathering.assembler.service();
         request.transaction = whole.transaction;
         request.object = whole.object;
         request.argument = static_cast<uint8_t>(whole.priority);
@@ -1249,24 +1242,21 @@ Status acquireHeld(ObjectId id, uint32_t timeoutMs, ObjectId holder, const Serve
     return holdForRemote(id, holder);
 }
 
-// A word of a request's payload, big-endian.
-uint32_t payloadWord(const ServedEntry& entry, size_t at)
-{
-    return (uint32_t{entry.payload[at]} << 24) | (uint32_t{entry.payload[at + 1]} << 16) |
-           (uint32_t{entry.payload[at + 2]} << 8) | entry.payload[at + 3];
-}
-
 // An alarm set by a timer's owner on another node: refused unless the task
 // it names owns the timer (a worker's own privileges are not the owner's),
 // then set as the owner would set it locally; a routed one is passed on.
 Status serveAlarm(const RemoteRequest& request, const ServedEntry& entry, ObjectId id, bool routed)
 {
-    const ObjectId owner = ObjectId::fromRaw(payloadWord(entry, 0));
-    AlarmNotification notification;
-    notification.kind = (request.argument & 0x10) != 0 ? AlarmNotification::Kind::Signal : AlarmNotification::Kind::Event;
-    notification.value = payloadWord(entry, 4);
-    const uint64_t timeNs = (uint64_t{payloadWord(entry, 8)} << 32) | payloadWord(entry, 12);
-    const RemoteAlarmKind kind = static_cast<RemoteAlarmKind>(request.argument & 0x03);
+    // The flags were checked as the alarm came in (onRequest).
+    AlarmRequest alarm;
+    if (!decodeAlarmRecord(static_cast<uint8_t>(request.argument), entry.payload, alarm)) {
+        return Status::InvalidArgument;
+    }
+    const ObjectId owner = ObjectId::fromRaw(alarm.owner);
+    const AlarmNotification notification{
+        alarm.signal ? AlarmNotification::Kind::Signal : AlarmNotification::Kind::Event, alarm.value};
+    const uint64_t timeNs = alarm.timeNs;
+    const RemoteAlarmKind kind = alarm.kind;
     if (routed) {
         return callAlarm(id, kind, notification, timeNs, owner);
     }

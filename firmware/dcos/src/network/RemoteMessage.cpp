@@ -415,22 +415,26 @@ PortSendRequest ContinuedRequestAssembler::portSend() const
     return request;
 }
 
-bool ContinuedRequestAssembler::alarm(AlarmRequest& out) const
+bool decodeAlarmRecord(uint8_t flags, const uint8_t (&record)[kPortMessageBytes], AlarmRequest& out)
 {
-    const PortSendRequest shaped = portSend();
-    const uint8_t flags = static_cast<uint8_t>(shaped.priority);
     const uint8_t kind = flags & kAlarmKindMask;
     if ((flags & ~(kAlarmKindMask | kAlarmSignalFlag)) != 0 || kind == 0) {
         return false;
     }
-    out.transaction = shaped.transaction;
-    out.object = shaped.object;
     out.kind = static_cast<RemoteAlarmKind>(kind);
     out.signal = (flags & kAlarmSignalFlag) != 0;
-    out.owner = word(shaped.message);
-    out.value = word(shaped.message + 4);
-    out.timeNs = (uint64_t{word(shaped.message + 8)} << 32) | word(shaped.message + 12);
+    out.owner = word(record);
+    out.value = word(record + 4);
+    out.timeNs = (uint64_t{word(record + 8)} << 32) | word(record + 12);
     return true;
+}
+
+bool ContinuedRequestAssembler::alarm(AlarmRequest& out) const
+{
+    const PortSendRequest shaped = portSend();
+    out.transaction = shaped.transaction;
+    out.object = shaped.object;
+    return decodeAlarmRecord(static_cast<uint8_t>(shaped.priority), shaped.message, out);
 }
 
 HeldAcquireRequest ContinuedRequestAssembler::heldAcquire() const

@@ -225,6 +225,11 @@ struct AlarmRequest {
     uint64_t timeNs = 0;
 };
 
+/// An alarm's @p flags and sixteen-byte @p record (the layout above) into
+/// @p out's fields but its transaction and object; false when the flags
+/// are not defined.
+bool decodeAlarmRecord(uint8_t flags, const uint8_t (&record)[kPortMessageBytes], AlarmRequest& out);
+
 /// The three frames of @p request and their lengths (8, 8, 7).
 void encodeAlarm(const AlarmRequest& request, uint8_t (&frames)[kAlarmFrames][kRemoteMessageBytes],
                  uint8_t (&lengths)[kAlarmFrames]);
