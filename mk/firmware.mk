@@ -33,11 +33,19 @@ FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
 # functions, loops or jump targets: -mtune=i486 pads each to 16 bytes, a
 # tenth of the kernel's code, for a prefetch gain the 486's 8 KiB cache
 # gives back as misses; padding in a hot path is also executed as no-ops.
-FW_CODE_FLAGS := -std=c++20 $(FW_ARCH_FLAGS) -mregparm=3 -freg-struct-return -O2 \
+# No frame pointer (-fomit-frame-pointer): EBP is a seventh register, and
+# every call saves its push, move and pop; the panic report's back trace
+# scans the stack for return addresses instead of following EBP
+# (boot/src/Panic.cpp), and debuggers unwind from the DWARF frame tables -g
+# writes. A 4-byte stack (-mpreferred-stack-boundary=2): nothing here uses
+# SSE (-mgeneral-regs-only), so no frame needs 16-byte alignment, and the
+# SUB and ADD that kept it are gone from every call that makes one.
+# Applications get the same flags (mk/sdk.mk), so both sides agree.
+FW_CODE_FLAGS := -std=c++20 $(FW_ARCH_FLAGS) -mregparm=3 -freg-struct-return -mpreferred-stack-boundary=2 -O2 \
 	-falign-functions=1 -falign-jumps=1 -falign-loops=1 -falign-labels=1 -g \
 	-ffreestanding -fno-pic -fno-pie -fno-exceptions -fno-rtti -fno-threadsafe-statics \
 	-fno-stack-protector -fstack-clash-protection -fno-asynchronous-unwind-tables -fno-unwind-tables \
-	-fno-omit-frame-pointer -fno-tree-loop-distribute-patterns -mgeneral-regs-only \
+	-fomit-frame-pointer -fno-tree-loop-distribute-patterns -mgeneral-regs-only \
 	-fno-isolate-erroneous-paths-dereference -fno-isolate-erroneous-paths-attribute \
 	-ffunction-sections -fdata-sections
 # An ignored Status or Result is an error in applications too, whose build

@@ -3,6 +3,7 @@
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/CpuException.hpp>
 #include <arch_x86/FaultTasks.hpp>
+#include <arch_x86/Paging.hpp>
 
 #include <stdarg.h>
 
@@ -19,18 +20,87 @@ void printControlRegisters(runtime::CharacterSink& out)
                     static_cast<unsigned long>(arch_x86::readCr3()));
 }
 
-// Walks the saved frame pointers (the firmware keeps them) up to a bounded
-// depth; the boot stub pushes a zero frame pointer that ends the walk.
-void printBackTrace(runtime::CharacterSink& out, uint32_t ebp)
+// The firmware's code, from the linker script: a return address lies in it.
+extern "C" const uint8_t __text_start[];
+extern "C" const uint8_t __text_end[];
+
+// The length of an indirect CALL (FF /2, Intel SDM Vol. 2A, "CALL") whose
+// ModR/M byte is @p modrm and whose next byte, a SIB byte where the ModR/M
+// calls for one, is @p sib: 2 to 7 bytes.
+constexpr unsigned indirectCallLength(uint8_t modrm, uint8_t sib)
 {
-    runtime::format(out, "back trace:");
-    for (unsigned depth = 0; depth < 12 && ebp != 0 && (ebp & 3) == 0 && ebp >= 0x100000; ++depth) {
-        const uint32_t* frame = reinterpret_cast<const uint32_t*>(ebp);
-        runtime::format(out, " %08lx", static_cast<unsigned long>(frame[1]));
-        if (frame[0] <= ebp) {
-            break; // Frames must move up the stack; anything else is corrupt.
+    const unsigned mod = modrm >> 6;
+    const unsigned rm = modrm & 7u;
+    const bool hasSib = mod != 3 && rm == 4;
+    switch (mod) {
+    case 0:
+        if (hasSib) {
+            return (sib & 7u) == 5 ? 7 : 3; // A SIB with no base register takes a 32-bit displacement.
         }
-        ebp = frame[0];
+        return rm == 5 ? 6 : 2; // rm 5 without a register is a 32-bit absolute address.
+    case 1:
+        return hasSib ? 4 : 3;
+    case 2:
+        return hasSib ? 7 : 6;
+    default:
+        return 2;
+    }
+}
+static_assert(indirectCallLength(0xD0, 0) == 2 && indirectCallLength(0x15, 0) == 6 &&
+              indirectCallLength(0x14, 0x85) == 7 && indirectCallLength(0x54, 0x24) == 4);
+
+// Whether @p address, in the firmware's code, follows a CALL instruction,
+// direct (E8 and a 32-bit offset) or indirect, so that it can be a return
+// address rather than a code address some other value happens to equal.
+bool followsCall(uintptr_t address)
+{
+    if (address < reinterpret_cast<uintptr_t>(__text_start) + 7 || address >= reinterpret_cast<uintptr_t>(__text_end)) {
+        return false;
+    }
+    const uint8_t* const end = reinterpret_cast<const uint8_t*>(address);
+    if (end[-5] == 0xE8) {
+        return true;
+    }
+    for (unsigned length = 2; length <= 7; ++length) {
+        const uint8_t* const call = end - length;
+        if (call[0] == 0xFF && ((call[1] >> 3) & 7u) == 2 && indirectCallLength(call[1], call[2]) == length) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Lists the return addresses on the stack above @p stackPointer, innermost
+// first, up to a bounded number. The firmware is compiled without frame
+// pointers (mk/firmware.mk: EBP is one more register on the real-time
+// paths), so there is no chain of frames to follow; the stack is scanned
+// instead, as the Linux kernel does without frame pointers, for words that
+// lie in the code and follow a CALL. A stale return address left in a
+// frame's unused slots can appear too: the list is for reading beside the
+// code, which the lab does (tests_renode/dcoslab/symbolize.py). The scan
+// reads at most 4 KiB and stops at the first page that is not present, so
+// it never faults at a stack's guard page or beyond its top.
+void printBackTrace(runtime::CharacterSink& out, uint32_t stackPointer)
+{
+    constexpr unsigned kMostAddresses = 12;
+    constexpr unsigned kMostWords = 1024;
+    runtime::format(out, "back trace:");
+    unsigned found = 0;
+    uintptr_t at = stackPointer & ~uintptr_t{3};
+    uintptr_t checkedPage = 1; // No page starts here: the first word's page is checked.
+    for (unsigned word = 0; word < kMostWords && found < kMostAddresses && at != 0; ++word, at += 4) {
+        const uintptr_t page = arch_x86::Paging::pageBase(at);
+        if (page != checkedPage) {
+            if (arch_x86::Paging::enabled() && !arch_x86::Paging::isPresent(at)) {
+                break;
+            }
+            checkedPage = page;
+        }
+        const uint32_t value = *reinterpret_cast<const volatile uint32_t*>(at);
+        if (followsCall(value)) {
+            runtime::format(out, " %08lx", static_cast<unsigned long>(value));
+            ++found;
+        }
     }
     runtime::format(out, "\r\n");
 }
@@ -73,7 +143,7 @@ extern "C" [[noreturn]] void dcosPanic(const char* format, ...)
                         static_cast<unsigned long>(caller), static_cast<unsigned long>(esp),
                         static_cast<unsigned long>(ebp), static_cast<unsigned long>(arch_x86::readEflags()));
         printControlRegisters(out);
-        printBackTrace(out, ebp);
+        printBackTrace(out, esp);
         runtime::format(out, "*** system halted\r\n");
     }
     dcosPanicHalt();
@@ -106,7 +176,7 @@ extern "C" [[noreturn]] void dcosPanicWithFrame(const arch_x86::InterruptFrame* 
                         static_cast<unsigned long>(frame->es), static_cast<unsigned long>(frame->fs),
                         static_cast<unsigned long>(frame->gs));
         printControlRegisters(out);
-        printBackTrace(out, frame->ebp);
+        printBackTrace(out, esp);
         runtime::format(out, "*** system halted\r\n");
     }
     dcosPanicHalt();

@@ -49,7 +49,7 @@ _start:
     subl %edi, %ecx
     rep stosb
 
-    xorl %ebp, %ebp             /* A zero frame pointer ends stack walks. */
+    xorl %ebp, %ebp             /* Every register starts defined, EBP too. */
     pushl %ebx                  /* Multiboot information structure */
     pushl %esi                  /* Multiboot magic */
     call bootFromMultiboot

@@ -11,8 +11,8 @@
 
 extern "C" {
 
-/// Prints "DCOS PANIC: <message>", the registers of the caller, a frame
-/// pointer back trace, and halts.
+/// Prints "DCOS PANIC: <message>", the registers of the caller, the return
+/// addresses found on its stack (the back trace), and halts.
 [[noreturn]] void dcosPanic(const char* format, ...) __attribute__((format(printf, 1, 2)));
 
 /// Prints a panic report for a trapped CPU state: the vector, its name, the

@@ -381,14 +381,15 @@ bool probeRemoteHolder(ObjectId id)
     }
 }
 
-[[gnu::noinline]] Status acquireFull(ObjectId id, const uint64_t* timeoutIn)
+[[gnu::noinline]] Status acquireFull(ObjectId id, const SpilledTimeout* spilled)
 {
+    const uint64_t timeout = spilled->value();
     bool heldRemotely = false;
-    const Status status = acquireLocal(id, timeoutIn, heldRemotely);
+    const Status status = acquireLocal(id, &timeout, heldRemotely);
     if (heldRemotely) [[unlikely]] {
-        return acquireFromRemoteHolder(id, *timeoutIn, status);
+        return acquireFromRemoteHolder(id, timeout, status);
     }
-    return orRemote(status, RemoteService::SemaphoreAcquire, id, remoteTimeoutMs(*timeoutIn));
+    return orRemote(status, RemoteService::SemaphoreAcquire, id, remoteTimeoutMs(timeout));
 }
 
 [[gnu::noinline]] Status releaseFull(ObjectId id) { return orRemote(releaseLocal(id), RemoteService::SemaphoreRelease, id, 0); }
@@ -483,7 +484,8 @@ Status SemaphoreAgent::Acquire(ObjectId id, uint64_t timeout)
             }
         }
     }
-    return internal::callSlowPath(internal::acquireFull, id, &timeout);
+    const internal::SpilledTimeout spilled(timeout);
+    return internal::callSlowPath(internal::acquireFull, id, &spilled);
 }
 
 Status SemaphoreAgent::Release(ObjectId id)
