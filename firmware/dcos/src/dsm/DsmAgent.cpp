@@ -591,9 +591,13 @@ Result<uint32_t> DsmAgent::Write(ObjectId id, const DsmPage& page)
         PublisherObject* const* found = publisherTable.find(id, owner);
         if (found != nullptr) [[likely]] {
             PublisherObject& publisher = **found;
+            // The owner's test comes before the interrupt context's: a
+            // handler may write whoever owns the publisher, so the order
+            // changes no outcome, and the common writer, the owner, skips
+            // the nesting depth's load and test.
             if (publisher.slowWrite == 0 && publisher.readers.isEmpty()
-                && (internal::inInterruptContext()
-                    || (internal::Scheduler::started() && owner == internal::Scheduler::current().id))) [[likely]] {
+                && ((internal::Scheduler::started() && owner == internal::Scheduler::current().id)
+                    || internal::inInterruptContext())) [[likely]] {
                 internal::copySixteenBytes(publisher.page.bytes, page.bytes);
                 const uint32_t written = internal::nextDataId(publisher.dataId);
                 publisher.dataId = written;

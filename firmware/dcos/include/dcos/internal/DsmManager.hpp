@@ -60,6 +60,21 @@ public:
 };
 
 /// The next data identifier after @p dataId; kNoDsmData is skipped.
-constexpr uint32_t nextDataId(uint32_t dataId) { return dataId + 1 == kNoDsmData ? dataId + 2 : dataId + 1; }
+/// kNoDsmData is 0, which only the wrap from 0xFFFFFFFF reaches, so the
+/// carry of the increment is the skip: an ADD and an ADC on Write's fast
+/// path, where GCC spells the same arithmetic in C++ as a compare and a
+/// branch or a SETE and a mask.
+constexpr uint32_t nextDataId(uint32_t dataId)
+{
+    static_assert(kNoDsmData == 0, "the carry of the increment skips kNoDsmData only if it is 0");
+#if defined(__i386__) || defined(__x86_64__)
+    if (!__builtin_is_constant_evaluated()) {
+        asm("addl $1, %0\n\tadcl $0, %0" : "+r"(dataId) : : "cc");
+        return dataId;
+    }
+#endif
+    return dataId == 0xFFFFFFFFu ? 1u : dataId + 1;
+}
+static_assert(nextDataId(0xFFFFFFFFu) == 1 && nextDataId(0) == 1 && nextDataId(41) == 42);
 
 } // namespace dcos::internal
