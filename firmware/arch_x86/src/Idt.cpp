@@ -43,7 +43,7 @@ Idt::Handler trapHandler = unhandled;
 Idt::Handler outermostExitHook = unchanged;
 } // namespace
 
-volatile unsigned Idt::depth_ = 0;
+unsigned Idt::depth_ = Idt::kBeforeTaskContext;
 
 void Idt::install()
 {
@@ -93,6 +93,8 @@ DCOS_ASM_REGISTER_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::Int
     } else {
         resume = interruptHandler(frame);
     }
+    // The whole word: before the kernel enters task context the top bit is
+    // set, and no task can be switched to, so the hook is not called then.
     if (Idt::depth_ == 1) {
         resume = outermostExitHook(resume);
     }

@@ -53,14 +53,35 @@ public:
     static void setOutermostExitHook(Handler hook);
 
     /// The current nesting depth of interrupt handlers (0 in task context).
-    /// Inline: every blocking service asks, on its fast path.
-    static unsigned nestingDepth() { return depth_; }
+    /// Inline: every blocking service asks, on its fast path, and the
+    /// masked read is one TEST of memory against an immediate.
+    static unsigned nestingDepth() { return depth_ & kDepthMask; }
+
+    /// True when no task is the caller: inside an interrupt handler, or at
+    /// boot before the kernel enters task context. One word answers both,
+    /// so the memory agents' fast paths, which record the calling task as
+    /// a holder, pay one test for them instead of two.
+    static bool outsideTaskContext() { return depth_ != 0; }
+
+    /// Called once, with interrupts disabled, when the first task is about
+    /// to run: from then on outsideTaskContext() means an interrupt handler.
+    static void enterTaskContext() { depth_ &= kDepthMask; }
 
 private:
     friend arch_x86::InterruptFrame* (::interruptEntry)(arch_x86::InterruptFrame* frame);
 
-    // Raised and lowered by interruptEntry around each handler.
-    static volatile unsigned depth_;
+    // The nesting depth in the low bits; the top bit is set from boot until
+    // enterTaskContext(). The depth never reaches the top bit (each level
+    // takes a stack frame), so INC and DEC never touch it.
+    static constexpr unsigned kBeforeTaskContext = 0x80000000u;
+    static constexpr unsigned kDepthMask = ~kBeforeTaskContext;
+
+    // Raised and lowered by interruptEntry around each handler; read by the
+    // scheduler's assembly too (TaskContextSwitch.S), hence the plain symbol
+    // name. Not volatile: an interrupt always restores it before the code it
+    // interrupted runs again, so that code never sees it change, and
+    // interruptEntry tells the compiler through its asm operands.
+    static unsigned depth_ asm("dcosInterruptDepth");
 };
 
 } // namespace arch_x86

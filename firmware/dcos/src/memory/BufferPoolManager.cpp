@@ -113,26 +113,6 @@ static_assert(kPoolCapacity <= 0x1000, "a pool's slot takes 12 bits of a handle,
     HeldList::give(head, handle, links, heldLinks);
 }
 
-// Records a buffer just handed out (its index) as held by its holder,
-// given as callerHolderWord() gave it: the running task's id, or the
-// system's tag, whose buffers are on no list.
-[[gnu::always_inline]] inline void listTaken(const PoolObject* object, uint32_t index, uint32_t holderWord)
-{
-    if (holderWord != BufferPool::kSystemHolder) [[likely]] {
-        HeldList::take(Scheduler::current().heldBuffers, heldHandle(object, index), heldLinks);
-    }
-}
-
-// Takes a buffer its holder (as for listTaken()) is giving back off the
-// holder's list.
-[[gnu::always_inline]] inline void listGiven(const PoolObject* object, uint32_t index, uint8_t* links,
-                                             uint32_t holderWord)
-{
-    if (holderWord != BufferPool::kSystemHolder) [[likely]] {
-        HeldList::give(Scheduler::current().heldBuffers, heldHandle(object, index), links, heldLinks);
-    }
-}
-
 constinit uint32_t recoveryWalkCount = 0;
 
 // Gives back every buffer the dead task held, from its list; when the list
@@ -437,7 +417,8 @@ using internal::BufferPoolManager;
 // (BufferPool::tryAllocate, tryRelease). Every other
 // case, errors included, goes to the manager's complete service, which
 // resolves the id again under its own guard and gives the precise status.
-// callerHolderWord() never gives kFreeMark, as tryAllocate requires.
+// A task's id never has kFreeMark in its low half (its type is the task's),
+// as tryAllocate requires of the holder.
 
 Result<void*> BufferPoolAgent::Allocate(ObjectId id)
 {
@@ -445,12 +426,20 @@ Result<void*> BufferPoolAgent::Allocate(ObjectId id)
         const arch_x86::InterruptGuard guard;
         internal::PoolObject* const object = internal::fastObjectOf(id);
         if (object->id == id) [[likely]] {
-            if (void* buffer = object->pool.tryAllocate(
-                    [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); },
-                    [object](uint32_t index, uint8_t*, uint32_t holder) {
-                        internal::listTaken(object, index, holder);
-                    }))
-                [[likely]] {
+            // A task's allocation and the system's are two inline paths, as
+            // in Return below.
+            internal::Task* const task = internal::memory_area::callerTask();
+            if (task != nullptr) [[likely]] {
+                if (void* buffer = object->pool.tryAllocate(
+                        [task] { return task->id.raw(); },
+                        [object, task](uint32_t index, uint8_t*, uint32_t) {
+                            internal::HeldList::take(task->heldBuffers, internal::heldHandle(object, index),
+                                                     internal::heldLinks);
+                        }))
+                    [[likely]] {
+                    return buffer;
+                }
+            } else if (void* buffer = object->pool.tryAllocate([] { return uint32_t{BufferPool::kSystemHolder}; })) {
                 return buffer;
             }
         }
@@ -464,12 +453,23 @@ Status BufferPoolAgent::Return(ObjectId id, void* buffer)
         const arch_x86::InterruptGuard guard;
         internal::PoolObject* const object = internal::fastObjectOf(id);
         if (object->id == id) [[likely]] {
-            if (object->pool.tryRelease(
-                    buffer, [] { return internal::memory_area::callerHolderWord(BufferPool::kSystemHolder); },
-                    [object](uint32_t index, uint8_t* links, uint32_t holder) {
-                        internal::listGiven(object, index, links, holder);
-                    }))
-                [[likely]] {
+            // A task's return and the system's are two inline paths: the
+            // task's knows its holder and its list from the one test of the
+            // caller, instead of keeping the holder word in a register to
+            // test it again for the list, which made GCC spill the words it
+            // had loaded.
+            internal::Task* const task = internal::memory_area::callerTask();
+            if (task != nullptr) [[likely]] {
+                if (object->pool.tryRelease(
+                        buffer, [task] { return task->id.raw(); },
+                        [object, task](uint32_t index, uint8_t* links, uint32_t) {
+                            internal::HeldList::give(task->heldBuffers, internal::heldHandle(object, index), links,
+                                                     internal::heldLinks);
+                        }))
+                    [[likely]] {
+                    return Status::Ok;
+                }
+            } else if (object->pool.tryRelease(buffer, [] { return uint32_t{BufferPool::kSystemHolder}; })) {
                 return Status::Ok;
             }
         }

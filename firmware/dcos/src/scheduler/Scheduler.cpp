@@ -295,6 +295,7 @@ void Scheduler::start()
     arch_x86::disableInterrupts();
     Task* first = pickNext();
     current_ = first;
+    arch_x86::Idt::enterTaskContext(); // Interrupts are off: no handler sees the change half made.
     dispatchPending_ = false;
     TaskManager::switchContext(*first, *first);
     resumeInterruptFrame(first->savedFrame);

@@ -35,6 +35,16 @@ bool inInterruptContext();
 inline bool inInterruptContext() { return arch_x86::Idt::nestingDepth() != 0; }
 #endif
 
+/// True when the caller is the system rather than a task: inside an
+/// interrupt handler, or at boot before the scheduler runs its first task.
+/// On the board it is one test of one word (Idt::outsideTaskContext), for
+/// the fast paths that record the calling task as a holder.
+#ifdef DCOS_HOST_BUILD
+bool outsideTaskContext();
+#else
+inline bool outsideTaskContext() { return arch_x86::Idt::outsideTaskContext(); }
+#endif
+
 /// The node id of this controller, stamped into every object id it issues.
 uint16_t localNode();
 

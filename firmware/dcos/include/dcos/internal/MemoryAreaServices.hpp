@@ -40,27 +40,25 @@ static_assert(static_cast<uint16_t>(ObjectId(0xFFFF, ObjectType::Task, ObjectId:
 [[gnu::always_inline]] inline Task* callerTask()
 {
     // Unlikely: the task's case then runs straight through, without the jump
-    // over the system's that GCC would otherwise place on it.
-    if (inInterruptContext() || !Scheduler::started()) [[unlikely]] {
+    // over the system's that GCC would otherwise place on it. Outside task
+    // context covers both of the system's cases, an interrupt handler and
+    // the boot before the scheduler starts, in one test.
+    if (outsideTaskContext()) [[unlikely]] {
         return nullptr;
     }
-    return &Scheduler::current();
+    // In task context the scheduler has started, so a task runs: telling
+    // the compiler spares the callers' test of the result for null.
+    Task* const task = &Scheduler::current();
+    if (task == nullptr) {
+        __builtin_unreachable();
+    }
+    return task;
 }
 
 /// The holder tag of memory held by @p task, or @p systemHolder for null (the system).
 [[gnu::always_inline]] inline uint16_t holderOf(const Task* task, uint16_t systemHolder)
 {
     return task != nullptr ? holderOfTask(task->id) : systemHolder;
-}
-
-/// The caller's holder (callerTask()) in the low half of a word whose high
-/// half is left as it comes (the running task's node), for the pool's fast
-/// paths, which shift the holder into place: a 16-bit value would cost them
-/// a store and a reload, or a mask.
-[[gnu::always_inline]] inline uint32_t callerHolderWord(uint16_t systemHolder)
-{
-    const Task* const task = callerTask();
-    return task != nullptr ? task->id.raw() : systemHolder;
 }
 
 /// The holder for a new owner given as a task id; the null id is the system.

@@ -26,7 +26,7 @@
 #define SCHEDULER_DISPATCH_HOLDS _ZN4dcos8internal9Scheduler14dispatchHolds_E
 #define SCHEDULER_SWITCH_COUNT _ZN4dcos8internal9Scheduler12switchCount_E
 #define SCHEDULER_READY_QUEUES _ZN4dcos8internal9Scheduler12readyQueues_E
-#define IDT_NESTING_DEPTH _ZN8arch_x863Idt6depth_E
+#define IDT_NESTING_DEPTH dcosInterruptDepth /* Idt::depth_; non-zero outside task context too */
 
 /* dcos::SchedulerAgent::Yield(), a static member, and the C++ general path it falls back to. */
 #define SCHEDULER_AGENT_YIELD _ZN4dcos14SchedulerAgent5YieldEv
