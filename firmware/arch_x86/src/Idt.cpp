@@ -4,6 +4,7 @@
 
 extern "C" const uint32_t interruptStubTable[256];
 extern "C" [[noreturn]] void dcosPanicWithFrame(const arch_x86::InterruptFrame* frame, const char* reason);
+extern "C" [[noreturn]] void dcosPanic(const char* format, ...) __attribute__((format(printf, 1, 2)));
 
 namespace arch_x86 {
 
@@ -37,11 +38,20 @@ InterruptFrame* unhandled(InterruptFrame* frame)
 
 InterruptFrame* unchanged(InterruptFrame* frame) { return frame; }
 
+// Until the board sets its handler, a line's interrupt is as unexpected as
+// any vector without one; the frame is not at hand, so the report names the line.
+void unhandledLine(unsigned line) { dcosPanic("interrupt on line %u before the board set its handler", line); }
+
 Idt::Handler exceptionHandler = unhandled;
-Idt::Handler interruptHandler = unhandled;
 Idt::Handler trapHandler = unhandled;
-Idt::Handler outermostExitHook = unchanged;
 } // namespace
+
+// Read by interrupt_common (InterruptStubs.S), which dispatches the lines
+// itself: hence plain names and external linkage.
+extern "C" {
+constinit Idt::LineHandler dcosInterruptLineHandler = unhandledLine;
+constinit Idt::Handler dcosOutermostExitHook = unchanged;
+}
 
 unsigned Idt::depth_ = Idt::kBeforeTaskContext;
 
@@ -64,13 +74,13 @@ void Idt::setGate(unsigned vector, uint16_t selector, uint32_t offset, uint8_t t
 
 void Idt::setExceptionHandler(Handler handler) { exceptionHandler = handler; }
 
-void Idt::setInterruptHandler(Handler handler) { interruptHandler = handler; }
+void Idt::setInterruptHandler(LineHandler handler) { dcosInterruptLineHandler = handler; }
 
 void Idt::setTrapHandler(Handler handler) { trapHandler = handler; }
 
-InterruptFrame* Idt::dispatchInterrupt(InterruptFrame* frame) { return interruptHandler(frame); }
+void Idt::dispatchInterrupt(unsigned line) { dcosInterruptLineHandler(line); }
 
-void Idt::setOutermostExitHook(Handler hook) { outermostExitHook = hook; }
+void Idt::setOutermostExitHook(Handler hook) { dcosOutermostExitHook = hook; }
 
 } // namespace arch_x86
 
@@ -82,22 +92,26 @@ DCOS_ASM_REGISTER_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::Int
     asm volatile("incl %0" : "+m"(Idt::depth_));
     const uint32_t vector = frame->vector;
     InterruptFrame* resume;
-    // Device requests first: they are the frequent ones and the ones whose
-    // latency counts.
-    if (vector - firstIrqVector < Idt::firstTrapVector - firstIrqVector) {
-        resume = interruptHandler(frame);
-    } else if (vector < exceptionVectorCount) {
+    // The interrupt controller's lines never come here: interrupt_common
+    // hands them to the line handler itself, for their latency's sake.
+    if (vector < exceptionVectorCount) {
         resume = exceptionHandler(frame);
     } else if (vector >= Idt::firstTrapVector && vector <= Idt::lastTrapVector) {
         resume = trapHandler(frame);
     } else {
-        resume = interruptHandler(frame);
+        // Above the traps: no interrupt controller line raises these.
+        resume = unhandled(frame);
     }
     // The whole word: before the kernel enters task context the top bit is
     // set, and no task can be switched to, so the hook is not called then.
+    // interrupt_common makes the same test for the lines.
     if (Idt::depth_ == 1) {
-        resume = outermostExitHook(resume);
+        resume = dcosOutermostExitHook(resume);
     }
     asm volatile("decl %0" : "+m"(Idt::depth_));
     return resume;
 }
+
+// The constants interrupt_common spells as numbers.
+static_assert(arch_x86::firstIrqVector == 32 && arch_x86::Idt::firstTrapVector == 48,
+              "InterruptStubs.S: the lines are vectors 32 to 47");

@@ -6,9 +6,10 @@
  * place, then the vector number is pushed (Intel SDM Vol. 3, 6.13 lists the
  * vectors that push an error code: 8, 10-14 and 17). The common path saves
  * the general and segment registers into an InterruptFrame, loads the kernel
- * data segments, and calls interruptEntry(frame). That function returns the
- * frame to resume, which lets the scheduler switch to another task's saved
- * frame at the exit of the outermost interrupt.
+ * data segments, and calls the board's line handler for an interrupt
+ * controller line, interruptEntry(frame) for any other vector. At the exit
+ * of the outermost interrupt the scheduler's hook returns the frame to
+ * resume, which lets it switch to another task's saved frame.
  */
     .section .text
     .code32
@@ -45,7 +46,29 @@ interrupt_common:
     movl %eax, %fs
     movl %eax, %gs
 1:  cld                         /* The C++ ABI expects DF clear. */
-    movl %esp, %eax             /* InterruptFrame* argument, in EAX (regparm) */
+    /*
+     * The interrupt controller's lines, vectors 32 to 47 (Idt.cpp checks the
+     * numbers), go straight to the board's line handler with the line in
+     * EAX (regparm): their latency is the one that counts, and a line
+     * handler neither needs the frame nor returns one. The rest is what
+     * interruptEntry does for every other vector: the nesting depth around
+     * the handler, and at the outermost level's exit the hook that may
+     * switch to another task's frame.
+     */
+    movl 48(%esp), %eax         /* InterruptFrame::vector */
+    subl $32, %eax              /* the line: vector - firstIrqVector */
+    cmpl $16, %eax
+    jae 3f
+    incl dcosInterruptDepth
+    call *dcosInterruptLineHandler
+    cmpl $1, dcosInterruptDepth /* The whole word: never 1 before task context. */
+    jne 4f
+    movl %esp, %eax             /* The frame to resume, for the hook to replace. */
+    call *dcosOutermostExitHook
+    movl %eax, %esp
+4:  decl dcosInterruptDepth
+    jmp interrupt_return
+3:  movl %esp, %eax             /* InterruptFrame* argument, in EAX (regparm) */
     call interruptEntry
     movl %eax, %esp             /* Resume the frame the dispatcher chose. */
     .globl interrupt_return     /* Also the way into a frame for the scheduler's switch. */

@@ -42,6 +42,21 @@ struct Attachment {
 };
 
 Attachment attachments[interruptLineCount];
+// What the dispatch calls straight away: a line's attachment, except on the
+// lines that can be spurious (7 and 15, whose in-service bit must be read
+// first) and on lines nobody owns, which keep a null handler here. So one
+// test of the handler sends every uncommon case to dispatchUncommon(), and
+// the common one pays no test of its line number.
+Attachment directAttachments[interruptLineCount];
+
+// Whether an interrupt on @p line can be spurious (Pic8259::isGenuine).
+constexpr bool canBeSpurious(unsigned line) { return (line & 7u) == 7u; }
+
+void setAttachment(unsigned line, Attachment attachment)
+{
+    attachments[line] = attachment;
+    directAttachments[line] = canBeSpurious(line) ? Attachment{nullptr, nullptr} : attachment;
+}
 uint32_t unexpected[interruptLineCount];
 uint32_t spurious;
 uint16_t node = 1;
@@ -64,34 +79,52 @@ PolledConsole polledConsole;
 
 void consoleInterrupt(void*) { uart.handleInterrupt(); }
 
-arch_x86::InterruptFrame* dispatchInterrupt(arch_x86::InterruptFrame* frame)
+// The interrupt controller's vectors are exactly the board's lines, so the
+// dispatch needs no range check: Idt calls it for no other vector.
+static_assert(arch_x86::Idt::firstTrapVector - arch_x86::firstIrqVector == interruptLineCount,
+              "the vectors below the traps are the 8259A pair's lines");
+
+// The attached routine of @p line with interrupts enabled, then the EOI.
+[[gnu::always_inline]] inline void runAttachment(const Attachment& attachment, unsigned line)
 {
-    const unsigned line = frame->vector - arch_x86::firstIrqVector;
-    if (line >= interruptLineCount) {
-        dcosPanicWithFrame(frame, "interrupt on a vector no device uses");
-    }
+    // The 8259A holds back this line and every less urgent one until the
+    // EOI below, so enabling interrupts lets only more urgent lines nest.
+    arch_x86::enableInterrupts();
+    attachment.handler(attachment.context);
+    arch_x86::disableInterrupts();
+    pic.endOfInterrupt(line);
+}
+
+// Lines 7 and 15, which can be spurious, and lines nobody owns.
+[[gnu::noinline]] void dispatchUncommon(unsigned line)
+{
     if (!pic.isGenuine(line)) {
         // A spurious IRQ 15 still occupied the master's cascade input.
         if (line == 15) {
             pic.endOfInterrupt(Pic8259::cascadeLine);
         }
         ++spurious;
-        return frame;
+        return;
     }
     const Attachment& attachment = attachments[line];
     if (attachment.handler != nullptr) {
-        // The 8259A holds back this line and every less urgent one until the
-        // EOI below, so enabling interrupts lets only more urgent lines nest.
-        arch_x86::enableInterrupts();
-        attachment.handler(attachment.context);
-        arch_x86::disableInterrupts();
+        runAttachment(attachment, line);
     } else {
         // Nobody owns this line: mask it so it cannot storm, and count it.
         ++unexpected[line];
         pic.mask(line);
+        pic.endOfInterrupt(line);
     }
-    pic.endOfInterrupt(line);
-    return frame;
+}
+
+void dispatchInterrupt(unsigned line)
+{
+    const Attachment& direct = directAttachments[line];
+    if (direct.handler == nullptr) [[unlikely]] {
+        dispatchUncommon(line);
+        return;
+    }
+    runAttachment(direct, line);
 }
 
 } // namespace
@@ -211,7 +244,7 @@ dcos::Status attachInterrupt(unsigned line, InterruptHandler handler, void* cont
     if (attachments[line].handler != nullptr) {
         return dcos::Status::Busy;
     }
-    attachments[line] = {handler, context};
+    setAttachment(line, {handler, context});
     pic.unmask(line);
     return dcos::Status::Ok;
 }
@@ -223,7 +256,7 @@ dcos::Status detachInterrupt(unsigned line)
     }
     arch_x86::InterruptGuard guard;
     pic.mask(line);
-    attachments[line] = {nullptr, nullptr};
+    setAttachment(line, {nullptr, nullptr});
     return dcos::Status::Ok;
 }
 

@@ -10,7 +10,9 @@
 #include <arch_x86/AssemblyLinkage.hpp>
 #include <arch_x86/InterruptFrame.hpp>
 
-/// The single C++ entry for every vector, called from interrupt_common.
+/// The C++ entry for every vector but the interrupt controller's lines,
+/// which interrupt_common hands to the line handler itself; called from
+/// interrupt_common and from the fault tasks' stubs.
 DCOS_ASM_REGISTER_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame);
 
 namespace arch_x86 {
@@ -31,17 +33,26 @@ public:
     /// Sets the handler for the CPU exception vectors 0-31.
     static void setExceptionHandler(Handler handler);
 
-    /// Sets the handler for vectors 32-255 (hardware and software interrupts)
-    /// outside the kernel trap range.
-    static void setInterruptHandler(Handler handler);
+    /// Handles one interrupt controller line (its vector less
+    /// firstIrqVector). The interrupted code resumes from its own frame: a
+    /// switch of tasks happens in the outermost exit hook, not here, so the
+    /// line handler needs neither the frame nor to return one.
+    using LineHandler = void (*)(unsigned line);
+
+    /// Sets the handler for the interrupt controller's lines, vectors 32 up
+    /// to the kernel trap range (hardware interrupts, and software ones
+    /// raised on their vectors). It is given the line, never a vector
+    /// outside that range, so it need not check one; a vector above the
+    /// traps panics.
+    static void setInterruptHandler(LineHandler handler);
 
     /// The vectors software traps into the kernel use (int 0x30-0x3F).
     static constexpr unsigned firstTrapVector = 0x30;
     static constexpr unsigned lastTrapVector = 0x3F;
 
-    /// Runs the interrupt handler for frame's vector, as its arrival would
-    /// (for an interrupt whose delivery a fault cut short).
-    static InterruptFrame* dispatchInterrupt(InterruptFrame* frame);
+    /// Runs the interrupt handler for @p line, as its arrival would (for an
+    /// interrupt whose delivery a fault cut short).
+    static void dispatchInterrupt(unsigned line);
 
     /// Sets the handler for the kernel trap vectors.
     static void setTrapHandler(Handler handler);
@@ -76,11 +87,13 @@ private:
     static constexpr unsigned kBeforeTaskContext = 0x80000000u;
     static constexpr unsigned kDepthMask = ~kBeforeTaskContext;
 
-    // Raised and lowered by interruptEntry around each handler; read by the
-    // scheduler's assembly too (TaskContextSwitch.S), hence the plain symbol
-    // name. Not volatile: an interrupt always restores it before the code it
-    // interrupted runs again, so that code never sees it change, and
-    // interruptEntry tells the compiler through its asm operands.
+    // Raised and lowered around each handler, by interrupt_common for the
+    // lines (InterruptStubs.S) and by interruptEntry for every other vector;
+    // read by the scheduler's assembly too (TaskContextSwitch.S): hence the
+    // plain symbol name. Not volatile: an interrupt
+    // always restores it before the code it interrupted runs again, so that
+    // code never sees it change, and interruptEntry tells the compiler
+    // through its asm operands.
     static unsigned depth_ asm("dcosInterruptDepth");
 };
 

@@ -797,10 +797,7 @@ arch_x86::InterruptFrame* TaskManager::prepareReturnWithWork(Task& task, arch_x8
         // recovery stack, or its line would stay in service for good.
         unsigned line = 0;
         if (bsp::interruptCutShort(line)) {
-            arch_x86::InterruptFrame delivery = *frame;
-            delivery.vector = arch_x86::firstIrqVector + line;
-            delivery.errorCode = 0;
-            (void)arch_x86::Idt::dispatchInterrupt(&delivery);
+            arch_x86::Idt::dispatchInterrupt(line);
         }
         return frame;
     }
