@@ -65,3 +65,24 @@ TEST(ReadyBitmapTest, AllPrioritiesDescendInOrder)
     }
     EXPECT_TRUE(bitmap.isEmpty());
 }
+
+TEST(ReadyBitmapTest, ClearHighestIsClearOfTheHighestOverEveryPattern)
+{
+    // Random patterns with their highest priority cleared both ways.
+    uint32_t state = 0x9E3779B9u;
+    for (int round = 0; round < 10000; ++round) {
+        state = state * 1664525u + 1013904223u;
+        const uint32_t pattern = state | 1u << (state >> 27); // Never empty.
+        ReadyBitmap byNumber;
+        ReadyBitmap byBits;
+        for (uint8_t priority = 0; priority < ReadyBitmap::kLevels; ++priority) {
+            if ((pattern >> priority) & 1u) {
+                byNumber.set(priority);
+                byBits.set(priority);
+            }
+        }
+        byNumber.clear(byNumber.highest());
+        byBits.clearHighest();
+        ASSERT_EQ(byBits.bits(), byNumber.bits()) << std::hex << pattern;
+    }
+}

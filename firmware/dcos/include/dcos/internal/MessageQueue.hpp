@@ -105,7 +105,7 @@ public:
         level.head = buffer->next;
         if (level.head == nullptr) {
             level.tail = nullptr;
-            levels_.clear(first);
+            levels_.clearHighest(); // first is the highest level.
         }
         --count_;
         return buffer;

@@ -22,6 +22,10 @@ public:
     constexpr void set(uint8_t priority) { bits_ |= bit(priority); }
     /// Marks @p priority (0..31) as having no ready task. Cost O(1).
     constexpr void clear(uint8_t priority) { bits_ &= ~bit(priority); }
+    /// clear(highest()) for a non-empty bitmap: the highest priority is the
+    /// lowest set bit, which bits & (bits - 1) clears without the bit's
+    /// number, so a caller need not keep it in a register. Cost O(1).
+    constexpr void clearHighest() { bits_ &= bits_ - 1; }
     /// Whether @p priority (0..31) has ready tasks. Cost O(1).
     constexpr bool test(uint8_t priority) const { return (bits_ & bit(priority)) != 0; }
     /// Whether no priority has ready tasks, i.e. only the idle path can run. Cost O(1).
