@@ -72,7 +72,15 @@ public:
     /// boot before the kernel enters task context. One word answers both,
     /// so the memory agents' fast paths, which record the calling task as
     /// a holder, pay one test for them instead of two.
-    static bool outsideTaskContext() { return depth_ != 0; }
+    static bool outsideTaskContext()
+    {
+        // A CMP of the word in memory with 0, its flag the result: for
+        // "!= 0" GCC loads the word and tests the register, one instruction
+        // more on every memory agent's fast path.
+        bool outside;
+        asm("cmpl $0, %1" : "=@ccne"(outside) : "m"(depth_));
+        return outside;
+    }
 
     /// Called once, with interrupts disabled, when the first task is about
     /// to run: from then on outsideTaskContext() means an interrupt handler.

@@ -432,7 +432,7 @@ Result<void*> BufferPoolAgent::Allocate(ObjectId id)
             if (task != nullptr) [[likely]] {
                 if (void* buffer = object->pool.tryAllocate(
                         [task] { return task->id.raw(); },
-                        [object, task](uint32_t index, uint8_t*, uint32_t) {
+                        [object, task](uint32_t index, uint8_t*) {
                             internal::HeldList::take(task->heldBuffers, internal::heldHandle(object, index),
                                                      internal::heldLinks);
                         }))
@@ -462,7 +462,7 @@ Status BufferPoolAgent::Return(ObjectId id, void* buffer)
             if (task != nullptr) [[likely]] {
                 if (object->pool.tryRelease(
                         buffer, [task] { return task->id.raw(); },
-                        [object, task](uint32_t index, uint8_t* links, uint32_t) {
+                        [object, task](uint32_t index, uint8_t* links) {
                             internal::HeldList::give(task->heldBuffers, internal::heldHandle(object, index), links,
                                                      internal::heldLinks);
                         }))

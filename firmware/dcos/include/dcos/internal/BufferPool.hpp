@@ -71,7 +71,7 @@ public:
 
     /// The functor of tryAllocate() and tryRelease() for callers that keep no lists.
     struct IgnoreLinks {
-        void operator()(uint32_t, uint8_t*, uint32_t) const {}
+        void operator()(uint32_t, uint8_t*) const {}
     };
 
     /// Creates an unused pool; initialise() puts it in service.
@@ -96,9 +96,10 @@ public:
     /// The holder is asked for only once the head passed its checks: while
     /// they run, the kernel's fast path has no register to spare for it.
     ///
-    /// @p taken(index, links, holderWord) is called with the buffer's index,
-    /// its link words and what @p holderWord() gave, once it is the
-    /// holder's, before it is returned.
+    /// @p taken(index, links) is called with the buffer's index and its
+    /// link words once it is the holder's, before it is returned. (The
+    /// caller knows its holder; handing the word back made GCC keep a dead
+    /// copy of it on the stack.)
     template <typename HolderWord, typename Taken = IgnoreLinks>
     [[gnu::always_inline]] void* tryAllocate(HolderWord holderWord, Taken taken = {})
     {
@@ -116,15 +117,16 @@ public:
         head_ = word >> 16; // Checked when it is the head: below limit_, or the end.
         const uint32_t holder = static_cast<uint32_t>(holderWord());
         storeState(index, ((holder << 16) | index) ^ allocatedKey_);
-        taken(index, linksOf(index), holder);
-        // One subtraction in memory keeps both counts: the free buffers are
-        // the low-water mark plus those above it, and only when none is
-        // above it does the mark move (the borrow says so).
-        uint32_t above;
-        if (__builtin_sub_overflow(aboveLowWater_, 1u, &above)) [[unlikely]] {
+        taken(index, linksOf(index));
+        // The free buffers are the low-water mark plus those above it, and
+        // only when none is above it does the mark move. The test is a CMP
+        // of the count in memory with 0 (isZero), the common case a DEC in
+        // memory: three instructions where GCC's load, subtract, branch on
+        // the borrow and store were four.
+        if (isZero(aboveLowWater_)) [[unlikely]] {
             --lowWater_;
         } else {
-            aboveLowWater_ = above;
+            --aboveLowWater_;
         }
         ++allocations_;
         void* const buffer = reinterpret_cast<void*>(base_ + index * stride_);
@@ -143,9 +145,9 @@ public:
     /// The holder is asked for once the address is known to be a buffer's,
     /// for the reason tryAllocate() gives. O(1).
     ///
-    /// @p given(index, links, holderWord) is called with the buffer's index,
-    /// its link words and what @p holderWord() gave, once it is known to be
-    /// the holder's, before it is freed.
+    /// @p given(index, links) is called with the buffer's index and its link
+    /// words once it is known to be the holder's, just after it is freed
+    /// (its links are not touched by the freeing).
     template <typename HolderWord, typename Given = IgnoreLinks>
     [[gnu::always_inline]] bool tryRelease(void* buffer, HolderWord holderWord, Given given = {})
     {
@@ -160,8 +162,11 @@ public:
         if (loadState(static_cast<uint32_t>(index)) != expected) {
             return false; // Free already, another holder's, the system's, or overwritten.
         }
-        given(static_cast<uint32_t>(index), linksOf(static_cast<uint32_t>(index)), holder);
+        // Freed first: the state word's address then need not live on, in a
+        // register or spilled, across the holder's list work, which reads
+        // only the links.
         pushFree(static_cast<uint32_t>(index));
+        given(static_cast<uint32_t>(index), linksOf(static_cast<uint32_t>(index)));
         return true;
     }
 
@@ -290,6 +295,20 @@ private:
     uintptr_t indexOf(const void* buffer) const
     {
         return std::rotr((reinterpret_cast<uintptr_t>(buffer) - base_) * inverse_, int{shift_});
+    }
+
+    // Whether @p count is 0, as a CMP of it in memory with 0 and the zero
+    // flag as the result: for a comparison with 0 GCC loads the word and
+    // tests the register instead, one instruction more.
+    [[gnu::always_inline]] static bool isZero(const uint32_t& count)
+    {
+#if defined(__i386__) || defined(__x86_64__)
+        bool zero;
+        asm("cmpl $0, %1" : "=@cce"(zero) : "m"(count));
+        return zero;
+#else
+        return count == 0;
+#endif
     }
 
     void pushFree(uint32_t index)
