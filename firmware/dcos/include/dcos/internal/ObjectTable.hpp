@@ -182,7 +182,7 @@ public:
         // task agent's real-time services resolve through this after find(),
         // and a call, even one never taken, costs them two instructions of
         // stack alignment on every hit.
-        Entry& entry = entries_[indexSlot_[id.index()]];
+        Entry& entry = entries_[slotOfIndex(id.index())];
         if (entry.header.key != id.raw() || id.isNull()) {
             return core_.missReasonInline(id);
         }
@@ -207,7 +207,7 @@ public:
     /// ownership on the same lookup. @p owner is unchanged on a miss.
     T* find(ObjectId id, ObjectId& owner)
     {
-        Entry& entry = entries_[indexSlot_[id.index()]];
+        Entry& entry = entries_[slotOfIndex(id.index())];
         if (entry.header.key != id.raw() || id.isNull()) {
             return nullptr;
         }
@@ -358,6 +358,25 @@ private:
     // The null owner has a list of its own, so that a walk for it finds the
     // system's objects as the slot-by-slot walk did.
     static size_t ownerKey(ObjectId owner) { return owner.isNull() ? kSystemOwnerKey : OwnerKeys::keyOf(owner); }
+
+    // The slot an index last named, widened by one MOVZX: for a widening
+    // load -mtune=i486 writes an XOR and a MOV into the low part, and the
+    // fast paths then copy the register before scaling it, three
+    // instructions for the one that takes the same three clocks on an i486.
+    [[gnu::always_inline]] uint32_t slotOfIndex(uint32_t index) const
+    {
+#if defined(__i386__)
+        uint32_t slot;
+        if constexpr (sizeof(SlotNumber) == 1) {
+            asm("movzbl %1, %0" : "=r"(slot) : "m"(indexSlot_[index]));
+        } else {
+            asm("movzwl %1, %0" : "=r"(slot) : "m"(indexSlot_[index]));
+        }
+        return slot;
+#else
+        return indexSlot_[index];
+#endif
+    }
 
     // Every accessor funnels through here. A hit is find()'s two compares:
     // the slot the id's index last named keeps its live object's whole id,
