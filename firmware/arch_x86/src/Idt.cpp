@@ -87,8 +87,8 @@ void Idt::setOutermostExitHook(Handler hook) { dcosOutermostExitHook = hook; }
 DCOS_ASM_REGISTER_LINKAGE arch_x86::InterruptFrame* interruptEntry(arch_x86::InterruptFrame* frame)
 {
     using namespace arch_x86;
-    // One read-modify-write instruction each way (interrupts are off): the
-    // volatile's load, add and store would be three.
+    // One read-modify-write instruction each way (interrupts are off): a
+    // load, add and store would be three.
     asm volatile("incl %0" : "+m"(Idt::depth_));
     const uint32_t vector = frame->vector;
     InterruptFrame* resume;

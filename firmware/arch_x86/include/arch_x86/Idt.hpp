@@ -98,10 +98,10 @@ private:
     // Raised and lowered around each handler, by interrupt_common for the
     // lines (InterruptStubs.S) and by interruptEntry for every other vector;
     // read by the scheduler's assembly too (TaskContextSwitch.S): hence the
-    // plain symbol name. Not volatile: an interrupt
-    // always restores it before the code it interrupted runs again, so that
-    // code never sees it change, and interruptEntry tells the compiler
-    // through its asm operands.
+    // plain symbol name. Not volatile: an interrupt always restores it
+    // before the code it interrupted runs again, so that code never sees it
+    // change, and interruptEntry tells the compiler through its asm
+    // operands.
     static unsigned depth_ asm("dcosInterruptDepth");
 };
 
