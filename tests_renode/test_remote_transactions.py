@@ -191,6 +191,43 @@ def test_a_duplicated_request_is_answered_but_not_executed_again(pair):
     assert net_counters(one)["stray-replies"] == 2
 
 
+def test_a_transaction_number_met_again_in_a_new_request_is_performed(pair):
+    """A node that restarts numbers its first transactions as it did after
+    its last boot, so node 2 may still hold a finished entry of the same
+    caller slot and number. Only an exact repetition heard while its
+    requester can still be waiting for the reply is a retransmission; the
+    same number in another request, or in the same request later than that,
+    is a new transaction and is performed."""
+    lab, one, two = pair
+    first = created(two, "remote sem 0", "RSEM")
+    second = created(two, "remote sem 0", "RSEM")
+    identifier = (8 << 24) | (REQUEST << 16) | (2 << 8) | 1
+
+    def release(semaphore):
+        index = int(semaphore, 16) & 0xFFFF
+        return bytes([2, 0xF7, index >> 8, index & 0xFF, 0, 0, 0, 0])
+
+    def inject(request):
+        replies = len(dcos_frames(lab, REPLY))
+        lab.hub.inject("can0", "injector", Frame.data_frame(identifier, request, extended=True))
+        lab.hub.wait_for_records(lambda records: len(dcos_frames(lab, REPLY, records)) > replies, 60, "the reply")
+
+    inject(release(first))
+    inject(release(second))  # Transaction 0xF7 again, another semaphore: a new request.
+    inject(release(second))  # At once, exactly as before: a retransmission.
+    assert call(two, f"count {first}")[:2] == ("ok", 1)
+    assert call(two, f"count {second}")[:2] == ("ok", 1)
+    served = net_counters(two)
+    assert served["served"] == 2 and served["duplicates"] == 1
+    # The same request once its requester would long have given up on the
+    # reply (twice its silence of 4 watchdog periods): a new transaction.
+    lab.hub.wait_until(lab.hub.now_ns + 2 * (SILENT_PERIODS + 1) * WATCHDOG_MS * 1_000_000, 60)
+    inject(release(second))
+    assert call(two, f"count {second}")[:2] == ("ok", 2)
+    served = net_counters(two)
+    assert served["served"] == 3 and served["duplicates"] == 1
+
+
 def test_a_request_runs_at_the_requesters_priority_on_the_serving_node(pair):
     lab, one, two = pair
     semaphore = created(two, "remote sem 1", "RSEM")

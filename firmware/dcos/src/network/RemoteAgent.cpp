@@ -132,6 +132,13 @@ struct ServedEntry {
 // given up, or died: the serving node stops waiting for it.
 constexpr uint64_t kRequesterSilenceNs = kWatchdogNs * kRemoteSilentPeriods;
 
+// How long a finished entry's reply answers retransmissions after the last
+// one was heard. A requester whose reply was lost sends its request again
+// every watchdog period, and gives up when it has heard nothing for
+// kRequesterSilenceNs; twice that is past any retransmission it can still
+// send. A request with the entry's number that comes later is a new one.
+constexpr uint64_t kServedReplyLifetimeNs = 2 * kRequesterSilenceNs;
+
 ServedEntry served[kRemoteServed];
 uint32_t arrivals = 0;
 uint32_t completions = 0;
@@ -851,6 +858,28 @@ bool sameCallSlot(const ServedEntry& entry, uint8_t interface, uint32_t source, 
            entry.relay == relay;
 }
 
+// Whether @p request (with @p payload, null for none) is a retransmission
+// of @p entry's, heard at @p nowNs. A retransmission repeats its request
+// exactly, and a finished entry's comes within its reply's lifetime. The
+// transaction number alone does not say so: a node that restarts begins
+// its call slots' generations anew, so its first transactions can carry the
+// numbers of its last ones before, and a number met again in another
+// request, or long after the requester must have given up on its reply, is
+// that requester's new transaction, to be performed, not answered from the
+// table.
+bool isRetransmission(const ServedEntry& entry, const RemoteRequest& request, const uint8_t* payload,
+                      uint64_t nowNs)
+{
+    static constexpr uint8_t kNoPayload[sizeof entry.payload]{};
+    const RemoteRequest& stored = entry.request;
+    if (stored.transaction != request.transaction || stored.service != request.service ||
+        stored.object != request.object || stored.argument != request.argument ||
+        __builtin_memcmp(entry.payload, payload != nullptr ? payload : kNoPayload, sizeof entry.payload) != 0) {
+        return false;
+    }
+    return entry.state != ServedState::Done || nowNs - entry.heardNs < kServedReplyLifetimeNs;
+}
+
 // Where a new request goes: the finished entry of the same caller slot,
 // else a free entry, else the request completed longest ago. Null when
 // every entry is queued or running. O(kRemoteServed), under the lock.
@@ -1124,11 +1153,12 @@ void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteR
                 break;
             }
         }
+        const uint64_t nowNs = TimerAgent::Uptime();
         ServedEntry* const known =
-            sameSlot != nullptr && sameSlot->request.transaction == request.transaction ? sameSlot : nullptr;
+            sameSlot != nullptr && isRetransmission(*sameSlot, request, payload, nowNs) ? sameSlot : nullptr;
         if (known != nullptr) {
             ++statistics.duplicates;
-            known->heardNs = TimerAgent::Uptime();
+            known->heardNs = nowNs;
             if (known->state == ServedState::Done) {
                 __builtin_memcpy(stored, known->reply, kRemoteMessageBytes);
                 action = known->silent ? Action::None : Action::Stored;
@@ -1154,7 +1184,7 @@ void admitRequest(uint8_t interface, const SystemMessage& message, const RemoteR
                 entry->source = message.source;
                 entry->request = request;
                 entry->order = arrivals++;
-                entry->heardNs = TimerAgent::Uptime();
+                entry->heardNs = nowNs;
                 entry->arrivalStamp = message.instructionStamp;
                 entry->partsBefore = partsBefore;
                 entry->node = node;
