@@ -350,3 +350,21 @@ def test_dump_decodes_a_relayed_publication(hub):
     assert decoded[6] == {"malformed": "relayed frame without its header"}
     annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
     assert annotations[0] == "prio 10 relayed publication 2->all: relay header: node 3", lines
+
+
+def test_dump_decodes_a_nodes_announcement_that_it_started(hub):
+    # docs/protocols/remote-transactions.md, "A node that starts again":
+    # node 2's announcement to every node, then one with a byte past the id
+    # set and one naming no node, which no node sends.
+    output, lines = decoded_dumps(hub, [
+        Frame(0x1F14FF02, extended=True, dlc=8, data=bytes([0, 2, 0, 0, 0, 0, 0, 0])),
+        Frame(0x1F14FF02, extended=True, dlc=8, data=bytes([0, 2, 0, 0, 0, 0, 0, 9])),
+        Frame(0x1F14FF02, extended=True, dlc=8, data=bytes(8))])
+    decoded = [json.loads(line)["dcos"]["node_started"] for line in output.splitlines()]
+    assert decoded == [{"node": 2}, {"malformed": "reserved bits set"}, {"malformed": "unknown node"}]
+    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+    assert annotations == [
+        "prio 31 node started 2->all: node 2 started",
+        "prio 31 node started 2->all: malformed: reserved bits set",
+        "prio 31 node started 2->all: malformed: unknown node",
+    ], lines

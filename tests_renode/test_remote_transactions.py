@@ -23,7 +23,7 @@ import pytest
 
 from dcoslab import remote
 from dcoslab.canbus import Frame
-from dcoslab.remote import REPLY, REQUEST, attach_node, created, dcos_frames, net_counters
+from dcoslab.remote import NODE_STARTED, REPLY, REQUEST, attach_node, created, dcos_frames, net_counters
 
 BIT_RATE = 500_000
 WATCHDOG_MS = 50       # DCOS_CONFIG_REMOTE_WATCHDOG_MS
@@ -387,9 +387,11 @@ def test_a_remote_request_overtakes_a_bulk_transfer_of_lower_priority(pair):
         assert record.frame.id >> 24 == 2
         assert record.lost == (("hub.bulk", 0),), lab.hub.log_text()
     # Node 1's link passed its one reply to the remote agent and dropped the
-    # bulk frames, which are no remote transaction.
+    # bulk frames, which are no remote transaction. Besides, each node
+    # announced at attach that it had started: node 1 sent its announcement
+    # and the request, and received node 2's announcement and the reply.
     link = re.search(r"can0 link interface=0 sent=(\d+) received=(\d+) foreign=(\d+)", one.command("can stats can0"))
-    assert link and (int(link.group(1)), int(link.group(2))) == (1, 1) and int(link.group(3)) >= 3, link
+    assert link and (int(link.group(1)), int(link.group(2))) == (2, 2) and int(link.group(3)) >= 3, link
 
 
 def test_a_corrupted_request_and_reply_change_no_result(pair):
@@ -724,6 +726,56 @@ def test_a_timer_whose_owner_on_another_node_is_gone_is_deleted(pair):
     sent = counters["alarms-notified"]
     lab.hub.wait_until(lab.hub.now_ns + 200_000_000, 120)
     assert net_counters(two)["alarms-notified"] == sent
+
+
+def test_a_node_that_starts_again_leaves_no_hold_or_timer_to_its_tasks_of_before(pair):
+    """A node that restarts gives its boot tasks the ids they had, so a hold
+    or a timer another node keeps for such a task would outlive it. Each
+    node therefore announces, at its first attach of an interface since it
+    started, that it started; the others give up what they keep for its
+    tasks of before, as when those tasks are found gone."""
+    lab, one, two = pair
+    # Both announced at attach: 8 bytes to every node, the node's id in front.
+    # Node 2's may still be on its way when its attach command returns.
+    lab.hub.wait_for_records(lambda records: len(dcos_frames(lab, NODE_STARTED, records)) >= 2, 60,
+                             "both nodes' announcements")
+    announcements = sorted((source, destination, priority, data)
+                           for priority, destination, source, data in dcos_frames(lab, NODE_STARTED))
+    assert announcements == [(1, 255, 31, bytes([0, 1, 0, 0, 0, 0, 0, 0])),
+                             (2, 255, 31, bytes([0, 2, 0, 0, 0, 0, 0, 0]))], lab.hub.log_text()
+    # Node 1's console holds node 2's binary semaphore; a listener of node 1
+    # owns a timer of node 2 with a periodic alarm.
+    binary = created(two, "remote sem binary", "RSEM")
+    assert call(one, f"acquire {binary} 0")[0] == "ok"
+    listener = created(one, "remote listener", "RTASK")
+    timer = created(two, "remote timer", "RTIMER")
+    assert call(two, f"alarm {timer} periodic 50 1")[0] == "ok"
+    assert call(two, f"give {timer} {listener}")[0] == "ok"
+    identifier = (31 << 24) | (NODE_STARTED << 16) | (255 << 8) | 1
+    # Announcements node 2 must refuse: its own id, and a byte past the id set.
+    for data in (bytes([0, 2, 0, 0, 0, 0, 0, 0]), bytes([0, 1, 0, 0, 0, 0, 0, 1])):
+        lab.hub.inject("can0", "injector", Frame.data_frame(identifier, data, extended=True))
+    lab.hub.wait_until(lab.hub.now_ns + 20_000_000, 60)
+    counters = net_counters(two)
+    assert counters["malformed"] == 2 and counters["nodes-started"] == 0, counters
+    assert call(two, f"acquire {binary} 0")[0] == "would block"
+    # "Node 1 started" while node 2's console waits for the semaphore: the
+    # wait ends "holder ended" when the announcement comes, 100 ms in, not a
+    # probe slice (200 ms) later, and the timer is deleted.
+    lab.hub.inject("can0", "injector", Frame.data_frame(identifier, bytes([0, 1, 0, 0, 0, 0, 0, 0]), extended=True),
+                   at_ns=lab.hub.now_ns + 100_000_000)
+    status, _, ms = call(two, f"acquire {binary} 5000")
+    assert status == "holder ended"
+    assert ms < SILENT_PERIODS * WATCHDOG_MS, ms
+    assert call(two, f"acquire {binary} 0")[0] == "ok"
+    assert call(two, f"cancel {timer}")[0] in ("invalid id", "stale id")
+    counters = net_counters(two)
+    assert (counters["nodes-started"], counters["holds-freed"], counters["timers-of-restarted"]) == (1, 1, 1), counters
+    # A link attached again is no restart: node 1 says nothing more.
+    assert "error:" not in one.command("can detach can0")
+    assert "carries interface 0" in one.command("can attach can0")
+    lab.hub.wait_until(lab.hub.now_ns + 20_000_000, 60)
+    assert len(dcos_frames(lab, NODE_STARTED)) == 2 + 3
 
 
 def test_a_held_acquire_and_an_alarm_torn_or_duplicated_on_the_bus_are_performed_once(pair):

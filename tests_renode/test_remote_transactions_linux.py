@@ -21,7 +21,10 @@ its own request and relays the answer. Last, the peer's task holds a
 binary semaphore of the board ("Binary semaphores") and owns a timer of
 the board, whose alarm the board posts to it ("Timers"); and it is the
 board's gateway to a publisher a bus away, whose frames it relays
-(docs/protocols/publications.md, "Across a gateway").
+(docs/protocols/publications.md, "Across a gateway"). Last, the peer's task
+holds a binary semaphore of the board again, and the peer announces that
+it started ("A node that starts again"): the board frees the semaphore. The
+peer also checks the board's own announcement, sent when it attached.
 
 Emulated time is paced at a fiftieth of wall time, so that the VM's
 answers, slow under an emulated CPU on a busy host, come well within the
@@ -71,12 +74,23 @@ def fields(message):
     raw = message.arbitration_id
     return raw >> 24, (raw >> 16) & 0xFF, (raw >> 8) & 0xFF, raw & 0xFF
 
+NODE_STARTED = 0x14
+
 def receive(seconds=120):
-    message = bus.recv(timeout=seconds)
-    if message is None:
-        print("@@PEER silence@@", flush=True)
-        sys.exit(1)
-    return message
+    # A node's announcement that it started (docs/protocols/remote-
+    # transactions.md, "A node that starts again") is printed, not returned:
+    # no phase waits for one.
+    while True:
+        message = bus.recv(timeout=seconds)
+        if message is None:
+            print("@@PEER silence@@", flush=True)
+            sys.exit(1)
+        if message.is_extended_id and fields(message)[1] == NODE_STARTED:
+            priority, kind, destination, source = fields(message)
+            print(f"@@PEER ANNOUNCED priority={priority} destination={destination} source={source} "
+                  f"data={bytes(message.data).hex()}@@", flush=True)
+            continue
+        return message
 
 def await_reply(tag):
     # The board's reply to this node's request, printed field by field.
@@ -420,6 +434,19 @@ for n in (1, 2, 3):
     for data in parts(0x007, n, page_of(n)):
         relay(data)
 print("@@PEER RELAYED@@", flush=True)
+
+# Phase 10: this node starts again ("A node that starts again"). At the go
+# frame RESTART, whose data is a binary semaphore's object, its task
+# 0x00031005 takes it in the held form; then the node announces that it
+# started, as it would on its first attach after a restart, and its task
+# of before holds nothing any more.
+RESTART_GO = 0x7FD
+semaphore = struct.unpack(">H", go(RESTART_GO))[0]
+held_acquire(0x61, semaphore)
+await_reply("HELDAGAIN")
+bus.send(can.Message(arbitration_id=identifier(31, NODE_STARTED, 0xFF, ME), is_extended_id=True,
+                     data=ME.to_bytes(2, "big") + bytes(6)))
+print("@@PEER RESTARTED@@", flush=True)
 bus.shutdown()
 """
 
@@ -442,6 +469,9 @@ def world():
         world.vm.start()
         world.bridge = SlcanBridge(world.vm.slcan_socket_path, world.lab.socket_path, "can0").start()
         world.bridge.wait_for(lambda b: b.is_open, BOOT_TIMEOUT, "slcand to open the channel")
+        # The peer listens before the board attaches, so that it hears the
+        # board's announcement that it started.
+        world.vm.expect(r"@@READY peer@@", timeout=BOOT_TIMEOUT)
         attach_node(world.board, 1, [3], BITRATE, timeout=STEP)
 
     yield from hold_world(BridgedWorld(), build)
@@ -462,7 +492,9 @@ def peer_line(world, tag):
 
 
 def test_the_board_uses_a_semaphore_of_a_python_can_node(world):
-    world.vm.expect(r"@@READY peer@@", timeout=BOOT_TIMEOUT)
+    # The board announced at its attach that it had started: to every node,
+    # its id in the first two bytes.
+    assert peer_line(world, "ANNOUNCED") == "priority=31 destination=255 source=1 data=0001000000000000"
     assert call(world, "count 0x0003a001") == ("ok", 5)
     assert call(world, "acquire 0x0003a001 0") == ("ok", 0)
     assert call(world, "count 0x0003a001") == ("ok", 4)
@@ -644,4 +676,21 @@ def test_the_board_reads_a_publisher_a_python_can_gateway_relays(world):
     assert status == "ok", status
     assert (counts["received"], counts["repeats"], counts["torn"]) == (3, 0, 0), counts
     assert remote.net_counters(world.board)["unrouted"] - before["unrouted"] == 1
+
+
+def test_a_python_can_node_that_starts_again_holds_nothing_of_before(world):
+    # docs/protocols/remote-transactions.md, "A node that starts again": the
+    # peer's task holds a binary semaphore of the board, then the peer
+    # announces that node 3 started; the board frees the semaphore.
+    binary = created(world.board, "remote sem binary", "RSEM")
+    world.lab.hub.inject("can0", "lab", Frame.data_frame(0x7FD, (int(binary, 16) & 0xFFFF).to_bytes(2, "big")))
+    assert peer_line(world, "HELDAGAIN") == "priority=9 service=12 transaction=61 status=0 flags=0 value=0"
+    world.vm.expect(r"@@PEER RESTARTED@@", timeout=STEP)
     world.vm.expect(r"@@PEER status=0@@", timeout=STEP)
+    # The announcement crossed the bridge before the peer's script ended; a
+    # few emulated milliseconds later the board has taken it.
+    world.lab.hub.wait_until(world.lab.hub.now_ns + 20_000_000, STEP)
+    assert call(world, f"holder {binary}") == ("ok", 0)
+    assert call(world, f"acquire {binary} 0") == ("ok", 0)
+    counters = remote.net_counters(world.board)
+    assert (counters["nodes-started"], counters["holds-freed"]) == (1, 1), counters

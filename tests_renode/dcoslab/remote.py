@@ -16,6 +16,8 @@ _RESULT = re.compile(r"RRES (.+) (\d+) (\d+)\r?$", re.M)
 
 # The CAN message types of remote transactions and publications (docs/protocols/can.md).
 REQUEST, REPLY, PUBLICATION = 0x11, 0x10, 0x20
+# A node's announcement that it started (docs/protocols/remote-transactions.md, "A node that starts again").
+NODE_STARTED = 0x14
 
 
 def attach_node(board, node, peers, bitrate, timeout=120):

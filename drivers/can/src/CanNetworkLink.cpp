@@ -22,6 +22,8 @@ static_assert(static_cast<uint8_t>(dcos::SystemMessageType::NameQuery) ==
               static_cast<uint8_t>(can::MessageType::NameQuery));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RoutedRequest) ==
               static_cast<uint8_t>(can::MessageType::RoutedRequest));
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::NodeStarted) ==
+              static_cast<uint8_t>(can::MessageType::NodeStarted));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::DsmPublication) ==
               static_cast<uint8_t>(can::MessageType::DsmPublication));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RelayedPublication) ==
@@ -34,6 +36,7 @@ bool isSystemMessage(can::MessageType type)
 {
     return type == can::MessageType::RemoteRequest || type == can::MessageType::RemoteReply ||
            type == can::MessageType::NameQuery || type == can::MessageType::RoutedRequest ||
+           type == can::MessageType::NodeStarted ||
            type == can::MessageType::DsmPublication || type == can::MessageType::RelayedPublication ||
            type == can::MessageType::TimeSync;
 }

@@ -116,8 +116,8 @@ TEST(MessageIdentifier, OnlyTheListedTypesAreAssigned)
 {
     int assigned = 0;
     for (unsigned raw = 0; raw <= 0xFF; ++raw) {
-        const bool expected = raw == 0x01 || raw == 0x10 || raw == 0x11 || raw == 0x12 || raw == 0x13 || raw == 0x20
-                              || raw == 0x21 || raw == 0x30 || raw == 0x40 || raw == 0x50;
+        const bool expected = raw == 0x01 || raw == 0x10 || raw == 0x11 || raw == 0x12 || raw == 0x13 || raw == 0x14
+                              || raw == 0x20 || raw == 0x21 || raw == 0x30 || raw == 0x40 || raw == 0x50;
         EXPECT_EQ(can::isAssignedMessageType(static_cast<uint8_t>(raw)), expected) << raw;
         const uint32_t id = (raw << MessageIdentifier::kTypeShift) | (1u << MessageIdentifier::kDestinationShift) | 2u;
         EXPECT_EQ(MessageIdentifier::decode(id).ok(), expected) << raw;
@@ -127,7 +127,7 @@ TEST(MessageIdentifier, OnlyTheListedTypesAreAssigned)
         }
         assigned += expected ? 1 : 0;
     }
-    EXPECT_EQ(assigned, 10);
+    EXPECT_EQ(assigned, 11);
     EXPECT_STREQ(can::messageTypeName(MessageType::RemoteRequest), "remote request");
     EXPECT_STREQ(can::messageTypeName(MessageType::RelayedPublication), "relayed publication");
 }

@@ -47,6 +47,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         FUZZ_CHECK(replyError == RemoteMessageError::WrongLength || replyError == RemoteMessageError::UnknownService ||
                    replyError == RemoteMessageError::UnknownStatus || replyError == RemoteMessageError::ReservedBits);
     }
+    NodeStarted announcement;
+    const RemoteMessageError announcementError = decodeNodeStarted(data, size, announcement);
+    if (announcementError == RemoteMessageError::None) {
+        uint8_t again[kRemoteMessageBytes];
+        encodeNodeStarted(announcement, again);
+        FUZZ_CHECK(size == kRemoteMessageBytes && std::memcmp(again, data, size) == 0);
+        FUZZ_CHECK(announcement.node != 0 && announcement.node != 0xFFFF);
+    } else {
+        FUZZ_CHECK(announcementError == RemoteMessageError::WrongLength ||
+                   announcementError == RemoteMessageError::ReservedBits ||
+                   announcementError == RemoteMessageError::UnknownNode);
+    }
     RouteHeader header;
     const RemoteMessageError headerError = decodeRouteHeader(data, size, header);
     if (headerError == RemoteMessageError::None) {

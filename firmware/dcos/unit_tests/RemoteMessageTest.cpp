@@ -121,6 +121,35 @@ TEST(RemoteMessageTest, TheDecodersRefuseWhatNoNodeSends)
     EXPECT_STREQ(remoteMessageErrorName(RemoteMessageError::ReservedBits), "reserved bits set");
 }
 
+TEST(RemoteMessageTest, ANodesAnnouncementIsItsIdBigEndianThenZeros)
+{
+    // docs/protocols/remote-transactions.md, "A node that starts again".
+    uint8_t bytes[kRemoteMessageBytes];
+    encodeNodeStarted(NodeStarted{0x1234}, bytes);
+    const Bytes expected{0x12, 0x34, 0, 0, 0, 0, 0, 0};
+    EXPECT_TRUE(std::equal(expected.begin(), expected.end(), bytes));
+    NodeStarted decoded;
+    ASSERT_EQ(decodeNodeStarted(bytes, sizeof bytes, decoded), RemoteMessageError::None);
+    EXPECT_EQ(decoded.node, 0x1234);
+}
+
+TEST(RemoteMessageTest, AnAnnouncementOfNoNodeOrWithMoreThanTheIdIsRefused)
+{
+    NodeStarted decoded;
+    const uint8_t good[kRemoteMessageBytes] = {0, 7, 0, 0, 0, 0, 0, 0};
+    EXPECT_EQ(decodeNodeStarted(good, 7, decoded), RemoteMessageError::WrongLength);
+    for (size_t byte = 2; byte < kRemoteMessageBytes; ++byte) {
+        uint8_t bytes[kRemoteMessageBytes];
+        std::memcpy(bytes, good, sizeof bytes);
+        bytes[byte] = 1;
+        EXPECT_EQ(decodeNodeStarted(bytes, sizeof bytes, decoded), RemoteMessageError::ReservedBits) << byte;
+    }
+    const uint8_t none[kRemoteMessageBytes] = {};
+    EXPECT_EQ(decodeNodeStarted(none, sizeof none, decoded), RemoteMessageError::UnknownNode);
+    const uint8_t broadcast[kRemoteMessageBytes] = {0xFF, 0xFF, 0, 0, 0, 0, 0, 0};
+    EXPECT_EQ(decodeNodeStarted(broadcast, sizeof broadcast, decoded), RemoteMessageError::UnknownNode);
+}
+
 TEST(RemoteMessageTest, TimeOutsTravelAsWholeMillisecondsNeverShorter)
 {
     EXPECT_EQ(remoteTimeoutMs(dcos::kPoll), kRemotePoll);

@@ -251,6 +251,17 @@ DataDecoding decodedData(const can::MessageIdentifier& id, const can::CanFrame& 
         }
         return out;
     }
+    if (id.type() == can::MessageType::NodeStarted) {
+        out.key = "node_started";
+        NodeStarted announcement;
+        const RemoteMessageError error = decodeNodeStarted(frame.data(), frame.length(), announcement);
+        if (error != RemoteMessageError::None) {
+            return malformed(out, remoteMessageErrorName(error));
+        }
+        out.text = fmt::format("node {} started", announcement.node);
+        out.json = {{"node", announcement.node}};
+        return out;
+    }
     if (id.type() == can::MessageType::NameQuery) {
         out.key = "name_query";
         NameQueryPart part;

@@ -31,6 +31,11 @@ enum class MessageType : uint8_t {
     /// route header naming the logical destination, then the request's
     /// frames (docs/protocols/remote-transactions.md, "Gateways").
     RoutedRequest = 0x13,
+    /// A node's first message on a bus since it started, to every node:
+    /// what they keep for its tasks of before (a semaphore a task of it
+    /// held, a timer one owned) belongs to tasks that no longer run
+    /// (docs/protocols/remote-transactions.md, "A node that starts again").
+    NodeStarted = 0x14,
     /// A distributed shared memory publication (seed 7.10).
     DsmPublication = 0x20,
     /// A publication of a node behind a gateway, relayed by the gateway: a
@@ -54,6 +59,7 @@ constexpr bool isAssignedMessageType(uint8_t raw)
     case MessageType::RemoteRequest:
     case MessageType::NameQuery:
     case MessageType::RoutedRequest:
+    case MessageType::NodeStarted:
     case MessageType::DsmPublication:
     case MessageType::RelayedPublication:
     case MessageType::Segmented:
@@ -73,6 +79,7 @@ constexpr const char* messageTypeName(MessageType type)
     case MessageType::RemoteRequest: return "remote request";
     case MessageType::NameQuery: return "name query";
     case MessageType::RoutedRequest: return "routed request";
+    case MessageType::NodeStarted: return "node started";
     case MessageType::DsmPublication: return "DSM publication";
     case MessageType::RelayedPublication: return "relayed publication";
     case MessageType::Segmented: return "segmented";

@@ -32,6 +32,7 @@ enum class SystemMessageType : uint8_t {
     RemoteRequest = 0x11,
     NameQuery = 0x12, ///< A part of a name query, to the broadcast address (docs/protocols/remote-transactions.md).
     RoutedRequest = 0x13, ///< A route header or a request's frame, to a gateway (docs/protocols/remote-transactions.md, "Gateways").
+    NodeStarted = 0x14, ///< A node's first message on an interface since it started, to the broadcast address (remote-transactions.md, "A node that starts again").
     DsmPublication = 0x20, ///< A part of a publication, to the broadcast address (docs/protocols/publications.md).
     RelayedPublication = 0x21, ///< A relay header or a publication's frame, from a gateway (publications.md, "Across a gateway").
 };

@@ -149,6 +149,8 @@ void listRemote(shell::Shell& shell)
         {"publications-relayed", s.publicationsRelayed},
         {"alarms-notified", s.alarmsNotified}, {"alarm-owners-lost", s.alarmOwnersLost},
         {"alarms-dropped", s.alarmsDropped},
+        {"nodes-started", s.nodesStarted}, {"holds-freed", s.holdsFreed},
+        {"timers-of-restarted", s.timersOfRestarted},
     };
     printCounters(shell, counters);
     // The last transaction's instructions on each side, in an image with an

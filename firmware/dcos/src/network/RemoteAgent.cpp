@@ -803,6 +803,55 @@ void onPublication(uint8_t interface, const SystemMessage& message)
 // A relayed publication frame arrived on @p interface: a relay header, or
 // the frame it names the node of. Relayed frames are not relayed again: a
 // publisher is read one gateway beyond its bus.
+// ---- a node that starts again ---------------------------------------------------
+
+// Whether this node has announced itself on each interface since it
+// started: once per boot, so a link taken down and attached again (the
+// node did not restart) says nothing.
+bool announced[kNetworkInterfaces] = {};
+
+// The announcement (docs/protocols/remote-transactions.md, "A node that
+// starts again"): 8 bytes to the broadcast address, the node's logical id
+// big-endian in bytes 0-1, bytes 2-7 zero. At the least urgent priority:
+// it is sent once, before the node has asked anybody anything.
+constexpr uint8_t kAnnouncementPriority = 31;
+
+// Called by AttachLink, which attaches one interface at a time. A send
+// that fails (counted by sendOnLink) leaves the announcement to the next
+// attach.
+void announceStart(uint8_t interface)
+{
+    if (announced[interface]) {
+        return;
+    }
+    uint8_t data[kRemoteMessageBytes];
+    encodeNodeStarted(NodeStarted{localNode()}, data);
+    announced[interface] =
+        sendMessage(interface, SystemMessageType::NodeStarted, kAnnouncementPriority, NetworkLink::kBroadcast, data);
+}
+
+// Another node started: what this node keeps for its tasks of before is
+// given up, as when those tasks are found gone (a held semaphore freed and
+// its waiters told the holder ended; a timer it owned deleted). Its node
+// id comes in the message, not from the physical address, which a gateway
+// or the tables could map differently; a malformed announcement, or one of
+// this node's own id, is counted malformed and changes nothing.
+void onNodeStarted(const SystemMessage& message)
+{
+    NodeStarted announcement;
+    if (decodeNodeStarted(message.data, message.length, announcement) != RemoteMessageError::None ||
+        announcement.node == localNode()) {
+        countMalformed();
+        return;
+    }
+    const size_t holds = freeHoldsOfNode(announcement.node);
+    const size_t timers = TimerManager::dropTimersOwnedOnNode(announcement.node);
+    Lock lock;
+    ++statistics.nodesStarted;
+    statistics.holdsFreed += static_cast<uint32_t>(holds);
+    statistics.timersOfRestarted += static_cast<uint32_t>(timers);
+}
+
 void onRelayedPublication(uint8_t interface, const SystemMessage& message)
 {
     uint16_t origin = 0;
@@ -1666,6 +1715,7 @@ void receiverEntry(uintptr_t)
                 case SystemMessageType::NameQuery: onNameQuery(interface, message); break;
                 case SystemMessageType::DsmPublication: onPublication(interface, message); break;
                 case SystemMessageType::RelayedPublication: onRelayedPublication(interface, message); break;
+                case SystemMessageType::NodeStarted: onNodeStarted(message); break;
                 case SystemMessageType::TimeSync: onTimeSyncMessage(interface, message); break;
                 }
             }
@@ -1865,8 +1915,10 @@ Status NetworkInterfacesManager::AttachLink(uint8_t interface, NetworkLink& link
     if (start != Status::Ok) {
         internal::Lock lock;
         internal::links[interface] = nullptr;
+        return start;
     }
-    return start;
+    internal::announceStart(interface);
+    return Status::Ok;
 }
 
 Status NetworkInterfacesManager::DetachLink(uint8_t interface)

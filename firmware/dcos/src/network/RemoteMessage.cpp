@@ -65,8 +65,34 @@ const char* remoteMessageErrorName(RemoteMessageError error)
     case RemoteMessageError::NullObject: return "null object";
     case RemoteMessageError::UnknownStatus: return "unknown status";
     case RemoteMessageError::ReservedBits: return "reserved bits set";
+    case RemoteMessageError::UnknownNode: return "unknown node";
     }
     return "?";
+}
+
+void encodeNodeStarted(const NodeStarted& announcement, uint8_t (&bytes)[kRemoteMessageBytes])
+{
+    __builtin_memset(bytes, 0, kRemoteMessageBytes);
+    bytes[0] = static_cast<uint8_t>(announcement.node >> 8);
+    bytes[1] = static_cast<uint8_t>(announcement.node);
+}
+
+RemoteMessageError decodeNodeStarted(const uint8_t* bytes, size_t length, NodeStarted& announcement)
+{
+    if (length != kRemoteMessageBytes) {
+        return RemoteMessageError::WrongLength;
+    }
+    for (size_t i = 2; i < kRemoteMessageBytes; ++i) {
+        if (bytes[i] != 0) {
+            return RemoteMessageError::ReservedBits;
+        }
+    }
+    const uint16_t node = static_cast<uint16_t>((bytes[0] << 8) | bytes[1]);
+    if (node == 0 || node == 0xFFFF) {
+        return RemoteMessageError::UnknownNode;
+    }
+    announcement.node = node;
+    return RemoteMessageError::None;
 }
 
 uint32_t remoteTimeoutMs(uint64_t timeoutNs)

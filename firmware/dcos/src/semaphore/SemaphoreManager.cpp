@@ -256,6 +256,24 @@ bool probeRemoteHolder(ObjectId id)
     return true;
 }
 
+size_t freeHoldsOfNode(uint16_t node)
+{
+    ensureTable();
+    size_t freed = 0;
+    for (size_t slot = 0; slot < table.activeCount(); ++slot) {
+        arch_x86::InterruptGuard guard;
+        Semaphore& semaphore = semaphores[slot];
+        if (semaphore.id.isNull() || semaphore.remoteHolder.isNull() || semaphore.remoteHolder.node() != node) {
+            continue;
+        }
+        semaphore.remoteHolder = ObjectId::null();
+        semaphore.count = 1;
+        TaskManager::wakeAll(semaphore.waiters, Status::Abandoned);
+        ++freed;
+    }
+    return freed;
+}
+
 // The complete Acquire and Release: every case, from a resolved id.
 // The agent's fast paths (below) come here for all they do not handle.
 // @p heldRemotely is set when the semaphore is held by another node's task:

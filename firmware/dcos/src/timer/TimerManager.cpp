@@ -539,6 +539,27 @@ void TimerManager::dropTimerOfLostOwner(ObjectId id, ObjectId owner)
     (void)timerTable.Delete(id);
 }
 
+size_t TimerManager::dropTimersOwnedOnNode(uint16_t node)
+{
+    size_t dropped = 0;
+    for (size_t slot = 0; slot < timerTable.activeCount(); ++slot) {
+        ObjectId id;
+        ObjectId owner;
+        {
+            arch_x86::InterruptGuard guard;
+            id = timers[slot].id;
+            const Result<ObjectId> current = id.isNull() ? Result<ObjectId>(Status::InvalidId) : timerTable.ownerOf(id);
+            if (!current.ok() || current.value().isNull() || current.value().node() != node) {
+                continue;
+            }
+            owner = current.value();
+        }
+        dropTimerOfLostOwner(id, owner);
+        ++dropped;
+    }
+    return dropped;
+}
+
 Status TimerManager::addTimerObjects(size_t count)
 {
     arch_x86::InterruptGuard guard;

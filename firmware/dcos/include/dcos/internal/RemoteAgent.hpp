@@ -104,6 +104,10 @@ struct RemoteStatistics {
     uint32_t alarmsNotified = 0;   ///< Alarms told to their owner on another node.
     uint32_t alarmOwnersLost = 0;  ///< Alarms whose owner was gone: the timer was deleted.
     uint32_t alarmsDropped = 0;    ///< Alarms not told: the notifier's queue was full, or no call slot was free.
+    // Nodes that started again (docs/protocols/remote-transactions.md, "A node that starts again").
+    uint32_t nodesStarted = 0;     ///< Other nodes' announcements that they started, heard on any interface.
+    uint32_t holdsFreed = 0;       ///< Binary semaphores freed because their holder's node started again.
+    uint32_t timersOfRestarted = 0; ///< Timers deleted because their owner's node started again.
     // The instruction counts of the last transaction (the remote bench).
     RemoteInstructions instructions{};
 };

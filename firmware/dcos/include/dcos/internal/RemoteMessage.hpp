@@ -118,6 +118,7 @@ enum class RemoteMessageError : uint8_t {
     NullObject,      ///< A request for object 0 (no type, no index).
     UnknownStatus,   ///< A reply's status that no node sends.
     ReservedBits,    ///< A reply flag that is not defined.
+    UnknownNode,     ///< A node's announcement naming node 0 or the broadcast node 0xFFFF.
 };
 
 const char* remoteMessageErrorName(RemoteMessageError error);
@@ -129,6 +130,20 @@ void encodeReply(const RemoteReply& reply, uint8_t (&bytes)[kRemoteMessageBytes]
 RemoteMessageError decodeRequest(const uint8_t* bytes, size_t length, RemoteRequest& request);
 /// Decodes a reply of @p length bytes; None and @p reply filled in, or why not.
 RemoteMessageError decodeReply(const uint8_t* bytes, size_t length, RemoteReply& reply);
+
+/// A node's announcement that it started, its first message on a bus since
+/// then (docs/protocols/remote-transactions.md, "A node that starts
+/// again"): message type NodeStarted, to the broadcast address, bytes 0-1
+/// the node's logical id big-endian, bytes 2-7 zero.
+struct NodeStarted {
+    uint16_t node = 0;
+};
+
+void encodeNodeStarted(const NodeStarted& announcement, uint8_t (&bytes)[kRemoteMessageBytes]);
+/// Decodes an announcement of @p length bytes; None and @p announcement
+/// filled in, or why not: WrongLength, ReservedBits for a byte 2-7 that is
+/// not zero, UnknownNode for node 0 or 0xFFFF.
+RemoteMessageError decodeNodeStarted(const uint8_t* bytes, size_t length, NodeStarted& announcement);
 
 /// Whether @p value is a status some node may send (every Status value).
 bool isStatusValue(uint8_t value);

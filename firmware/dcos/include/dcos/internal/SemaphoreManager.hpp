@@ -57,6 +57,13 @@ Status releaseForRemote(ObjectId id, ObjectId holder);
 /// Abandoned. True when it freed it. Called by waiters between slices.
 bool probeRemoteHolder(ObjectId id);
 
+/// Frees every binary semaphore held by a task of @p node, which has
+/// started again: its tasks of before no longer run, so their holds are
+/// given up as the probe gives up a gone holder's, waiters woken with
+/// Abandoned. Returns how many it freed. O(active semaphores), each under
+/// its own interrupt guard; called by the remote agent's receiver.
+size_t freeHoldsOfNode(uint16_t node);
+
 /// A semaphore named @p name visible from @p askingScope.
 Result<ObjectId> semaphoreNameToObject(const char* name, Visibility askingScope);
 

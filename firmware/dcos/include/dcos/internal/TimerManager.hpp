@@ -95,6 +95,10 @@ public:
     /// that owner is gone (the remote agent learnt so notifying it), as a
     /// local owner's death deletes its timers. O(1).
     static void dropTimerOfLostOwner(ObjectId timer, ObjectId owner);
+    /// Deletes every timer owned by a task of @p node, which has started
+    /// again, as dropTimerOfLostOwner() deletes one. Returns how many.
+    /// O(active timers), each under its own interrupt guard.
+    static size_t dropTimersOwnedOnNode(uint16_t node);
     static Status addTimerObjects(size_t count);
     static size_t timerCount();
 
