@@ -800,9 +800,6 @@ void onPublication(uint8_t interface, const SystemMessage& message)
     relayPublication(interface, message, publisher, part.kind == PublicationPartKind::Withdrawal);
 }
 
-// A relayed publication frame arrived on @p interface: a relay header, or
-// the frame it names the node of. Relayed frames are not relayed again: a
-// publisher is read one gateway beyond its bus.
 // ---- a node that starts again ---------------------------------------------------
 
 // Whether this node has announced itself on each interface since it
@@ -852,6 +849,9 @@ void onNodeStarted(const SystemMessage& message)
     statistics.timersOfRestarted += static_cast<uint32_t>(timers);
 }
 
+// A relayed publication frame arrived on @p interface: a relay header, or
+// the frame it names the node of. Relayed frames are not relayed again: a
+// publisher is read one gateway beyond its bus.
 void onRelayedPublication(uint8_t interface, const SystemMessage& message)
 {
     uint16_t origin = 0;
