@@ -42,6 +42,11 @@ def wait_for_participants(hub, count, bus="can0"):
                  f"{count} participants on {bus}")
 
 
+def annotations(lines):
+    """The annotation after "  ; " on each line of a `dcos-can dump --decode` text."""
+    return [line.split("  ; ", 1)[1] for line in lines.splitlines()]
+
+
 def decoded_dumps(hub, frames):
     """Another node sends frames; what `dcos-can dump --decode` prints of them, in JSON and in text."""
     count = str(len(frames))
@@ -99,8 +104,7 @@ def test_dump_puts_publications_back_together(hub):
         {"index": 0xA53, "part": 2, "out_of_turn": True},
         {"index": 0xA53, "withdrawn": True},
     ]
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations == [
+    assert annotations(lines) == [
         "prio 10 DSM publication 2->all: publisher 0xa53 part 1/3 seq 22135",
         "prio 10 DSM publication 2->all: publisher 0xa53 part 2/3",
         "prio 10 DSM publication 2->all: publisher 0xa53 part 3/3 page 101112131415161718191A1B1C1D1E1F (seq 22135)",
@@ -124,8 +128,7 @@ def test_dump_decodes_remote_transactions(hub):
         {"service": "acquire", "transaction": 0x13, "status": "timed out", "pending": False, "value": 0},
         {"malformed": "wrong length"},
     ]
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations == [
+    assert annotations(lines) == [
         "prio 20 remote request 1->2: acquire txn 0x13 object 0xa005 argument 200",
         "prio 20 remote reply 2->1: acquire txn 0x13 ok pending value 0",
         "prio 20 remote reply 2->1: acquire txn 0x13 timed out value 0",
@@ -220,8 +223,8 @@ def test_dump_decodes_name_queries(hub):
     assert decoded[3]["remote"] == {"service": "name", "transaction": 0x10, "status": "ok", "pending": False,
                                     "value": 0x0002A001}
     assert decoded[4]["name_query"] == {"malformed": "no such object type"}
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations[:2] == ['prio 24 name query 1->all: semaphore part 1/3 txn 0x10 "pump"',
+    notes = annotations(lines)
+    assert notes[:2] == ['prio 24 name query 1->all: semaphore part 1/3 txn 0x10 "pump"',
                                'prio 24 name query 1->all: semaphore part 2/3 txn 0x10 ""'], lines
 
 
@@ -240,8 +243,8 @@ def test_dump_decodes_a_port_send(hub):
         {"service": "port-send", "part": 2, "slot": 0xB},
         {"malformed": "unknown service"},
     ]
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations[1:3] == ["prio 20 remote request 1->2: port-send part 2/3 slot 11",
+    notes = annotations(lines)
+    assert notes[1:3] == ["prio 20 remote request 1->2: port-send part 2/3 slot 11",
                                 "prio 20 remote request 1->2: port-send part 3/3 slot 11"], lines
 
 
@@ -258,8 +261,8 @@ def test_dump_decodes_a_routed_request(hub):
         {"service": "count", "transaction": 0x21, "object": 0xA001, "argument": 0},
         {"malformed": "reserved bits set"},
     ]
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations[0] == "prio 20 routed request 1->2: route to node 3 hops 4 txn 0x21", lines
+    notes = annotations(lines)
+    assert notes[0] == "prio 20 routed request 1->2: route to node 3 hops 4 txn 0x21", lines
 
 
 def test_dump_decodes_the_global_time_base(hub):
@@ -277,8 +280,7 @@ def test_dump_decodes_the_global_time_base(hub):
         {"kind": "probe", "sequence": 9},
         {"malformed": "bad rank"},
     ]
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations == [
+    assert annotations(lines) == [
         "prio 0 time sync 1->all: sync seq 5 second 78187493530 rank 3 every 2500 ms",
         "prio 0 time sync 1->all: follow-up seq 5 ns-low56 4822678189205111",
         "prio 0 time sync 100->all: probe seq 9",
@@ -303,8 +305,8 @@ def test_dump_decodes_a_held_acquire(hub):
         {"service": "held-release", "transaction": 0x36, "object": 0xA004, "argument": 0x00011002},
         {"malformed": "reserved bits set"},
     ], remote
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations[1] == "prio 24 remote request 1->2: held-acquire holder 0x00011002 slot 5", lines
+    notes = annotations(lines)
+    assert notes[1] == "prio 24 remote request 1->2: held-acquire holder 0x00011002 slot 5", lines
 
 
 def test_dump_decodes_an_alarm_and_tells_its_parts_from_a_port_sends(hub):
@@ -325,8 +327,8 @@ def test_dump_decodes_an_alarm_and_tells_its_parts_from_a_port_sends(hub):
         {"service": "set-alarm", "part": 2, "slot": 7},
         {"service": "cancel-alarm", "transaction": 0x28, "object": 0x3001, "argument": 0x00011002},
     ], remote
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations[2] == "prio 24 remote request 1->2: set-alarm part 3/3 slot 7", lines
+    notes = annotations(lines)
+    assert notes[2] == "prio 24 remote request 1->2: set-alarm part 3/3 slot 7", lines
 
 
 def test_dump_decodes_a_relayed_publication(hub):
@@ -348,8 +350,8 @@ def test_dump_decodes_a_relayed_publication(hub):
     assert decoded[1] == {"index": 0xA53, "part": 0, "sequence": 0x5677, "node": 3}
     assert decoded[5]["page"] == page.hex().upper() and decoded[5]["node"] == 3, decoded[5]
     assert decoded[6] == {"malformed": "relayed frame without its header"}
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations[0] == "prio 10 relayed publication 2->all: relay header: node 3", lines
+    notes = annotations(lines)
+    assert notes[0] == "prio 10 relayed publication 2->all: relay header: node 3", lines
 
 
 def test_dump_decodes_a_nodes_announcement_that_it_started(hub):
@@ -362,8 +364,7 @@ def test_dump_decodes_a_nodes_announcement_that_it_started(hub):
         Frame(0x1F14FF02, extended=True, dlc=8, data=bytes(8))])
     decoded = [json.loads(line)["dcos"]["node_started"] for line in output.splitlines()]
     assert decoded == [{"node": 2}, {"malformed": "reserved bits set"}, {"malformed": "unknown node"}]
-    annotations = [line.split("  ; ", 1)[1] for line in lines.splitlines()]
-    assert annotations == [
+    assert annotations(lines) == [
         "prio 31 node started 2->all: node 2 started",
         "prio 31 node started 2->all: malformed: reserved bits set",
         "prio 31 node started 2->all: malformed: unknown node",

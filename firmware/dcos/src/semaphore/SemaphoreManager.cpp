@@ -120,6 +120,16 @@ void destroy(Semaphore& semaphore, Status why)
     (void)table.Delete(semaphore.id); // Cannot fail: the callers resolved the id under the same lock.
 }
 
+// Gives up a remote holder's hold that will never be released (the holder
+// ended, or its node started again): the semaphore is free, and its
+// waiters learn the holder ended, as when a local holder dies.
+void abandonRemoteHold(Semaphore& semaphore)
+{
+    semaphore.remoteHolder = ObjectId::null();
+    semaphore.count = 1;
+    TaskManager::wakeAll(semaphore.waiters, Status::Abandoned);
+}
+
 unsigned recoverSemaphores(ObjectId deadTask)
 {
     arch_x86::InterruptGuard guard;
@@ -249,10 +259,7 @@ bool probeRemoteHolder(ObjectId id)
     if (!resolved.ok() || resolved.value()->remoteHolder != holder) {
         return false;
     }
-    Semaphore& semaphore = *resolved.value();
-    semaphore.remoteHolder = ObjectId::null();
-    semaphore.count = 1;
-    TaskManager::wakeAll(semaphore.waiters, Status::Abandoned);
+    abandonRemoteHold(*resolved.value());
     return true;
 }
 
@@ -263,12 +270,11 @@ size_t freeHoldsOfNode(uint16_t node)
     for (size_t slot = 0; slot < table.activeCount(); ++slot) {
         arch_x86::InterruptGuard guard;
         Semaphore& semaphore = semaphores[slot];
-        if (semaphore.id.isNull() || semaphore.remoteHolder.isNull() || semaphore.remoteHolder.node() != node) {
+        // A deleted semaphore's remote holder is null (destroy()).
+        if (semaphore.remoteHolder.isNull() || semaphore.remoteHolder.node() != node) {
             continue;
         }
-        semaphore.remoteHolder = ObjectId::null();
-        semaphore.count = 1;
-        TaskManager::wakeAll(semaphore.waiters, Status::Abandoned);
+        abandonRemoteHold(semaphore);
         ++freed;
     }
     return freed;

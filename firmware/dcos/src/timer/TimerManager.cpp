@@ -548,7 +548,8 @@ size_t TimerManager::dropTimersOwnedOnNode(uint16_t node)
         {
             arch_x86::InterruptGuard guard;
             id = timers[slot].id;
-            const Result<ObjectId> current = id.isNull() ? Result<ObjectId>(Status::InvalidId) : timerTable.ownerOf(id);
+            // A free or deleted slot's id (null, or stale) has no owner.
+            const Result<ObjectId> current = timerTable.ownerOf(id);
             if (!current.ok() || current.value().isNull() || current.value().node() != node) {
                 continue;
             }
