@@ -25,6 +25,7 @@
 #include "Benchmark.hpp"
 
 #include <arch_x86/Cpu.hpp>
+#include <bsp/Board.hpp>
 #include <shell/Shell.hpp>
 #include <shell/ShellCommand.hpp>
 
@@ -165,12 +166,52 @@ inline uint64_t readTimeStampCounter()
     asm volatile("" ::: "memory");
 }
 
-// One measured call, with interrupts disabled unless the benchmark needs them.
+// How far from either end of the tick's period a measured call with
+// interrupts disabled starts. A path that reads the clock (Uptime,
+// GetSystemClock, the CAN routines' frame stamps) takes one more branch in
+// bsp::nanosecondsIntoTick during the 8254's first count after its reload
+// (838 ns) and while the tick is pending; without this margin that fell
+// inside one call in a few thousand, at a moment set by when the command was
+// typed, and a fixed path once counted 9 more (Can.TransmitInterrupt, 251
+// against 242). The end margin is ten times the longest fixed path the bench
+// has (Modbus.WriteMultipleRegisters, about 7,300 instructions, one a
+// nanosecond under exact counting).
+constexpr uint32_t clearAfterTickNs = 5000;
+constexpr uint32_t clearBeforeTickNs = 100000;
+// More than a whole period of attempts (one is some 40 instructions): the
+// margin is then found unless the tick has stopped, and the call is
+// measured anyway.
+constexpr unsigned clearOfTickAttempts = 100000;
+
+// Disables interrupts at a moment clear of the tick (above). Between
+// attempts interrupts are enabled, so a pending tick is taken there: STI
+// lets one more instruction run before an interrupt is recognised (Intel
+// SDM, STI), hence the NOP before CLI.
+void disableInterruptsClearOfTick()
+{
+    const uint64_t period = bsp::tickPeriodNanoseconds();
+    for (unsigned attempt = 0;; ++attempt) {
+        arch_x86::disableInterrupts();
+        const uint32_t into = bsp::nanosecondsIntoTick();
+        if (period == 0 || attempt == clearOfTickAttempts ||
+            (into >= clearAfterTickNs && into + uint64_t{clearBeforeTickNs} <= period)) {
+            return;
+        }
+        asm volatile("sti\n\tnop" ::: "memory");
+    }
+}
+
+// One measured call, with interrupts disabled unless the benchmark needs
+// them; when they are, at a moment clear of the tick if they were enabled.
 uint64_t measureOnce(void (*function)(), bool interruptsEnabled)
 {
     const uint32_t flags = arch_x86::readEflags();
     if (!interruptsEnabled) {
-        arch_x86::disableInterrupts();
+        if ((flags & arch_x86::eflagsInterruptEnable) != 0) {
+            disableInterruptsClearOfTick();
+        } else {
+            arch_x86::disableInterrupts();
+        }
     }
     const uint64_t count = timeOneCall(function);
     if ((flags & arch_x86::eflagsInterruptEnable) != 0) {

@@ -145,9 +145,12 @@ Status populateWithTargetArmed(uint32_t count)
 // (the timer agent's calendar cache). Setting the clock used to move every
 // day-clock alarm with it; they are keyed by time of day now and stay where
 // they are, and the other timers carry day-clock alarms, an hour and more
-// after 2024-01-01 00:00, to show that. Every measured call sets
-// 2024-01-01 00:00 again, which moves the clock back by the few
-// microseconds since the previous call.
+// after 2024-01-01 00:00, to show that. Every measured call sets the clock
+// a second ahead, to 2024-01-01 00:00:01, and the unmeasured restore sets
+// it back to 00:00. Setting it back by less than a tick, as the same
+// setting made again would, moves the day-clock wheel's cursor back a tick
+// or not depending on where in the tick the call falls (14 instructions
+// once in a few hundred calls); a second ahead is the same path every time.
 
 Status populateWithDayClockAlarms(uint32_t count) { return populateArmed(count, Armed::DayClock); }
 
@@ -158,7 +161,10 @@ void getSystemClock()
     lastValue = now.ok() ? now.value().nanosecond : 0;
 }
 
-void setSystemClock() { check(timerAgent.SetSystemClock(clockSetting)); }
+constexpr dcos::DateTime clockSettingPlusOne{2024, 1, 1, 0, 0, 1, 0, dcos::Weekday::Monday};
+
+void setSystemClock() { check(timerAgent.SetSystemClock(clockSettingPlusOne)); }
+void setSystemClockBack() { check(timerAgent.SetSystemClock(clockSetting)); }
 
 // --- Timer.XferOwnership of the target from the shell to the shell.
 
@@ -192,7 +198,7 @@ DCOS_BENCHMARK(timerCancelAlarmBench, "Timer.CancelAlarm", populateWithTargetArm
 DCOS_BENCHMARK(timerGetSystemClockBench, "Timer.GetSystemClock", populate, getSystemClock, Cost::Constant,
                .teardown = clearAll);
 DCOS_BENCHMARK(timerSetSystemClockBench, "Timer.SetSystemClock", populateWithDayClockAlarms, setSystemClock,
-               Cost::Constant, .teardown = clearAll);
+               Cost::Constant, .restore = setSystemClockBack, .teardown = clearAll);
 DCOS_BENCHMARK(timerXferOwnershipBench, "Timer.XferOwnership", populate, transferOwnership, Cost::Constant,
                .teardown = clearAll);
 DCOS_BENCHMARK(timerNameToObjectBench, "Timer.NameToObject", populate, nameToObject, Cost::Variable,
