@@ -13,7 +13,7 @@
 # caused it is kept in $(FUZZ_BUILD)/artifacts/<target>/.
 
 FUZZ_BUILD := $(BUILD)/fuzz
-# Fuzzing time per target; eleven targets, so 'make test' spends about 165 s here.
+# Fuzzing time per target; sixteen targets, so 'make test' spends about 240 s here.
 FUZZ_SECONDS ?= 15
 FUZZ_TARGETS := frame isotp slcan frametext
 FUZZ_CORPUS := fieldbus/can/fuzz/corpus
@@ -35,6 +35,15 @@ HOST_MODBUS_FUZZ_REPORT := $(BUILD)/reports/fuzz-host-modbus-tests.xml
 DCOS_FUZZ_TARGETS := network_tables remote_message publication_message time_sync
 DCOS_FUZZ_CORPUS := firmware/dcos/fuzz/corpus
 DCOS_FUZZ_REPORT := $(BUILD)/reports/fuzz-dcos-tests.xml
+# Controller images: the verifier every image a controller is sent passes
+# through (firmware/image/fuzz) and dcos-image's ELF reader
+# (host_tools/image/fuzz), on Debian's mbedTLS (not instrumented).
+IMAGE_FUZZ_TARGETS := image
+IMAGE_FUZZ_CORPUS := firmware/image/fuzz/corpus
+IMAGE_FUZZ_REPORT := $(BUILD)/reports/fuzz-image-tests.xml
+HOST_IMAGE_FUZZ_TARGETS := elf_payload
+HOST_IMAGE_FUZZ_CORPUS := host_tools/image/fuzz/corpus
+HOST_IMAGE_FUZZ_REPORT := $(BUILD)/reports/fuzz-host-image-tests.xml
 
 FUZZ_CXX := clang++
 # toml++ is compiled into the fuzz targets as Debian's shared library, which
@@ -48,7 +57,8 @@ FUZZ_SANITIZERS := address,undefined
 FUZZ_CXXFLAGS := -std=c++20 -O1 -g -fno-omit-frame-pointer -fno-sanitize-recover=all \
 	-Wall -Wextra -Wno-missing-field-initializers -Werror -MMD -MP \
 	-Ifieldbus/can/include -Ifieldbus/modbus/include -Ifirmware/dcos/include \
-	-Ihost_tools/modbus/include -I/usr/include/modbus $(TOML_RELEASE_ASSERT)
+	-Ihost_tools/modbus/include -I/usr/include/modbus -Ifirmware/image/include -Ihost_tools/image/include \
+	$(TOML_RELEASE_ASSERT)
 # Objects are instrumented for coverage without libFuzzer's main; the
 # targets are linked with it.
 FUZZ_COMPILE_FLAGS := $(FUZZ_CXXFLAGS) -fsanitize=fuzzer-no-link,$(FUZZ_SANITIZERS)
@@ -70,17 +80,25 @@ DCOS_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/dcos/src/network/NetworkAddress
 	$(FUZZ_BUILD)/firmware/dcos/src/network/ClockServo.cpp.o
 DCOS_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/dcos/fuzz/fuzz_%.cpp.o,$(DCOS_FUZZ_TARGETS))
 DCOS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(DCOS_FUZZ_TARGETS))
+IMAGE_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(IMAGE_SRCS))
+IMAGE_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/image/fuzz/fuzz_%.cpp.o,$(IMAGE_FUZZ_TARGETS))
+IMAGE_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(IMAGE_FUZZ_TARGETS))
+HOST_IMAGE_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,host_tools/image/src/ElfPayload.cpp $(IMAGE_SRCS))
+HOST_IMAGE_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/image/fuzz/fuzz_%.cpp.o,$(HOST_IMAGE_FUZZ_TARGETS))
+HOST_IMAGE_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOST_IMAGE_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as
 # intermediate files and be deleted after every build.
 .SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS) $(MODBUS_FUZZ_LIBRARY_OBJS) $(MODBUS_FUZZ_TARGET_OBJS) \
-	$(HOST_MODBUS_FUZZ_LIBRARY_OBJS) $(HOST_MODBUS_FUZZ_TARGET_OBJS) $(DCOS_FUZZ_LIBRARY_OBJS) $(DCOS_FUZZ_TARGET_OBJS)
+	$(HOST_MODBUS_FUZZ_LIBRARY_OBJS) $(HOST_MODBUS_FUZZ_TARGET_OBJS) $(DCOS_FUZZ_LIBRARY_OBJS) $(DCOS_FUZZ_TARGET_OBJS) \
+	$(IMAGE_FUZZ_LIBRARY_OBJS) $(IMAGE_FUZZ_TARGET_OBJS) $(HOST_IMAGE_FUZZ_LIBRARY_OBJS) $(HOST_IMAGE_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
 fuzz: deps
 	@$(MAKE) --no-print-directory test-fuzz
 
-fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARIES) $(DCOS_FUZZ_BINARIES)
+fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARIES) $(DCOS_FUZZ_BINARIES) \
+	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite.
@@ -95,6 +113,10 @@ test-fuzz:
 		--seconds $(FUZZ_SECONDS) --report $(HOST_MODBUS_FUZZ_REPORT) $(HOST_MODBUS_FUZZ_TARGETS) || status=1; \
 	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(DCOS_FUZZ_CORPUS) \
 		--seconds $(FUZZ_SECONDS) --report $(DCOS_FUZZ_REPORT) $(DCOS_FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(IMAGE_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(IMAGE_FUZZ_REPORT) $(IMAGE_FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(HOST_IMAGE_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(HOST_IMAGE_FUZZ_REPORT) $(HOST_IMAGE_FUZZ_TARGETS) || status=1; \
 	exit $${status:-0}
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
@@ -118,6 +140,17 @@ $(DCOS_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/dcos/fuzz/fu
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^
+
+$(IMAGE_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/image/fuzz/fuzz_%.cpp.o $(IMAGE_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lmbedcrypto
+
+$(HOST_IMAGE_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/image/fuzz/fuzz_%.cpp.o \
+		$(HOST_IMAGE_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lmbedcrypto
 
 FUZZ_FLAGS_STAMP := $(FUZZ_BUILD)/flags.stamp
 $(FUZZ_FLAGS_STAMP): FORCE

@@ -3,7 +3,7 @@
 
 HOST_BUILD := $(BUILD)/host
 HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Wno-missing-field-initializers -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES) \
-	-Ihost_tools/can/include $(HOSTMODBUS_CXXFLAGS)
+	-Ihost_tools/can/include $(HOSTMODBUS_CXXFLAGS) -Ifirmware/image/include -Ihost_tools/image/include
 
 # Firmware sources with no hardware access of their own (chip drivers go
 # through the mocked port I/O).
@@ -24,7 +24,9 @@ HOST_PORTABLE_SRCS := \
 	$(CAN_DRIVER_PORTABLE_SRCS) \
 	$(MODBUS_DRIVER_PORTABLE_SRCS) \
 	$(HOSTCAN_SRCS) \
-	$(HOSTMODBUS_SRCS)
+	$(HOSTMODBUS_SRCS) \
+	$(IMAGE_SRCS) \
+	$(HOSTIMAGE_SRCS)
 
 HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp drivers/*/unit_tests/*.cpp fieldbus/*/unit_tests/*.cpp \
 	host_tools/*/unit_tests/*.cpp)
@@ -46,6 +48,12 @@ $(HOST_FLAGS_STAMP): FORCE
 $(HOST_BUILD)/%.cpp.o: %.cpp $(HOST_FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
-	$(Q)g++ $(HOST_CXXFLAGS) -c $< -o $@
+	$(Q)g++ $(HOST_CXXFLAGS) $(HOST_FILE_FLAGS) -c $< -o $@
 
 -include $(shell find $(HOST_BUILD) -name '*.d' 2>/dev/null)
+
+# Flags of one file (outside the flags stamp, which would otherwise take
+# them from whichever file's build first reached it). The image verifier's
+# tests read Wycheproof's vectors from the tree.
+$(HOST_BUILD)/firmware/image/unit_tests/EcdsaP256WycheproofTest.cpp.o: \
+	HOST_FILE_FLAGS := -DDCOS_IMAGE_TEST_DATA='"$(CURDIR)/firmware/image/unit_tests"'

@@ -13,12 +13,18 @@ HOSTCAN_TEST_SRCS := $(wildcard host_tools/can/unit_tests/*.cpp)
 # Debian's libmodbus and toml++ (the shared library, hence the defines).
 HOSTMODBUS_SRCS := $(wildcard host_tools/modbus/src/*.cpp)
 HOSTMODBUS_CXXFLAGS := -Ihost_tools/modbus/include -I/usr/include/modbus -DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1
-HOST_TOOLS_LIBS := -lfmt -lmodbus -ltomlplusplus
+# Controller images (docs/boot.md): the format and the verifier the stage
+# loader uses (firmware/image), and the host's ELF reader and signer
+# (host_tools/image), on Debian's mbedTLS.
+IMAGE_SRCS := $(wildcard firmware/image/src/*.cpp)
+HOSTIMAGE_SRCS := $(wildcard host_tools/image/src/*.cpp)
+HOST_TOOLS_LIBS := -lfmt -lmodbus -ltomlplusplus -lmbedcrypto
 
 DCOS_CAN := $(HOST_TOOLS_BIN)/dcos-can
 DCOS_MODBUS := $(HOST_TOOLS_BIN)/dcos-modbus
 DCOS_MODBUS_SIM := $(HOST_TOOLS_BIN)/dcos-modbus-sim
-HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM)
+DCOS_IMAGE := $(HOST_TOOLS_BIN)/dcos-image
+HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE)
 
 host-tools: $(HOST_TOOLS)
 
@@ -43,3 +49,9 @@ $(DCOS_MODBUS_SIM): $(BUILD)/host/host_tools/modbus/tools/dcos-modbus-sim.cpp.o 
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS)
+
+$(DCOS_IMAGE): $(BUILD)/host/host_tools/image/tools/dcos-image.cpp.o \
+	$(patsubst %,$(BUILD)/host/%.o,$(IMAGE_SRCS) $(HOSTIMAGE_SRCS))
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto

@@ -16,6 +16,8 @@ libfmt-dev:formats the host tools' output
 nlohmann-json3-dev:writes the host tools' --json output
 libmodbus-dev:the Modbus RTU master and slave of dcos-modbus and dcos-modbus-sim (host_tools/modbus)
 libtomlplusplus-dev:toml++, which parses dcos-modbus-sim's configuration files
+openssl:an ECDSA implementation we did not write, which checks dcos-image's signatures and makes keys it signs with (tests_renode/test_host_tools_image.py)
+libmbedtls-dev:mbedTLS, the vetted SHA-256 and ECDSA P-256 with which dcos-image signs controller images and the image verifier checks them
 clang:compiles the CAN link layer's fuzz targets (make fuzz, run by make test)
 libclang-rt-14-dev:libFuzzer and the address and undefined-behaviour sanitizer runtimes those fuzz targets link (clang only recommends it)
 qemu-system-data:option ROMs the emulator loads (multiboot, linuxboot), from the -L path /usr/share/qemu

@@ -24,6 +24,7 @@
 #   bin/dcos-can                 dump, send and measure CAN traffic (docs/guide/host-can.md)
 #   bin/dcos-modbus              read and write a Modbus RTU slave (docs/guide/modbus-host.md)
 #   bin/dcos-modbus-sim          a simulated Modbus RTU slave declared in a TOML file (likewise)
+#   bin/dcos-image               signing keys, signed controller images (docs/guide/signing-images.md)
 #   share/dcos/modbus/           dcos-modbus-sim's example files: a drive, a sensor
 #   libexec/dcos/                the emulator built with the DCOS board models
 #
