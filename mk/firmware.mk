@@ -134,6 +134,9 @@ FW_COLD_SRCS := \
 FW_COLD_FLAGS := -Os
 
 fw_objects = $(patsubst %,$(FW_BUILD)/%.o,$(1))
+# mbedTLS and the controller image verifier (FW_IMAGE_OBJS), before the
+# images that link them.
+include mk/mbedtls.mk
 FW_OBJS := $(call fw_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
 FW_TARGET_TEST_OBJS := $(call fw_objects,$(FW_TARGET_TEST_SRCS))
 FW_MINIMAL_OBJS := $(call fw_objects,$(FW_MINIMAL_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
@@ -157,10 +160,13 @@ $(IMAGE_486): $(FW_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	@echo "  LD      $@"
 	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS)
 
-$(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
+# The test image also checks controller images with mbedTLS built for the
+# i486 (mk/mbedtls.mk), which its on-target test "image" runs.
+$(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_IMAGE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld \
+		$(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS)
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_IMAGE_OBJS) $(MBEDTLS_FW_LIBRARY)
 
 $(IMAGE_486_MINIMAL): $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
@@ -182,7 +188,7 @@ update_if_changed = { new='$@.new.'$$$$; cat > "$$new" && { cmp -s "$$new" '$@' 
 # an object taken out of an image relinks it.
 $(FW_IMAGES_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(FW_LDFLAGS) $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) $(FW_MINIMAL_TARGET_TEST_OBJS)' | $(update_if_changed)
+	@echo '$(FW_LDFLAGS) $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) $(FW_MINIMAL_TARGET_TEST_OBJS) $(FW_IMAGE_OBJS)' | $(update_if_changed)
 
 # Objects depend on the flags they were compiled with: a change of flags
 # rebuilds everything instead of linking stale objects.

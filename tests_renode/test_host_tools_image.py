@@ -13,6 +13,11 @@ import subprocess
 
 import pytest
 
+from dcoslab.board import EXIT_PASS
+
+# On-target tests this module runs (see test_kernel_core.test_every_target_test_is_run).
+IMAGE_TARGET_TESTS = ["image"]
+
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TOOL = os.path.join(REPOSITORY, "build", "host_tools", "bin", "dcos-image")
 FIRMWARE = os.path.join(REPOSITORY, "build", "486", "dcos486.elf")
@@ -179,3 +184,18 @@ def test_sign_refuses_what_is_not_firmware_and_bad_arguments(workspace):
     assert "cannot read" in run("sign", "-k", str(tmp_path / "none.pem"), "--board", "isa486", "--version",
                                 "1.0.0", "-o", str(out), FIRMWARE, check_code=3).stderr
     assert not out.exists(), "a refused sign writes nothing"
+
+
+def test_the_controller_verifies_images_with_mbedtls_built_for_the_i486(boot, isa486):
+    # The test image links firmware/image with mbedTLS compiled from Debian's
+    # source for the i486 (mk/mbedtls.mk; the i486 check covers it). It
+    # verifies a real signed image and refuses it with one bit changed in the
+    # header, the payload or the signature.
+    emulator = boot(isa486, "test")
+    emulator.expect(r"dcos> ")
+    emulator.send("test image --exit\r")
+    emulator.expect(r"the signed image: a valid image")
+    emulator.expect(r"one header bit changed: the signature does not verify")
+    emulator.expect(r"one payload bit changed: the payload is not the one its signed header describes")
+    emulator.expect(r"one signature bit changed: the signature does not verify")
+    emulator.expect_exit(EXIT_PASS)

@@ -1,10 +1,66 @@
 #include <image/EcdsaP256.hpp>
 
 #include <mbedtls/ecdsa.h>
+#if defined(MBEDTLS_MEMORY_BUFFER_ALLOC_C)
+#include <mbedtls/memory_buffer_alloc.h>
+
+#include <boot/Panic.hpp>
+
+// The arena's bookkeeping was found corrupted: memory the verifier owns was
+// written by someone else, which no error code can undo.
+extern "C" void dcos_mbedtls_exit(int status)
+{
+    dcosPanic("mbedTLS found its memory arena corrupted (status %d)", status);
+}
+#endif
 
 namespace image {
 
 namespace {
+
+#if defined(MBEDTLS_MEMORY_BUFFER_ALLOC_C)
+// On the controller (mk/mbedtls.mk), mbedTLS computes in a static arena:
+// there is no heap to take from, and a verification must not fail for lack
+// of memory the kernel's tasks use. 8 KiB holds a P-256 verification with
+// the configuration's window of 2 several times over (the on-target test
+// "image" verifies real signatures in it). Not reentrant: a second
+// verification while one runs (another task) is refused, never allowed to
+// share the arena.
+constexpr size_t kArenaSize = 8192;
+alignas(8) unsigned char arena[kArenaSize];
+bool arenaReady = false;
+int busy = 0;
+
+class ArenaUse {
+public:
+    ArenaUse() : owned_(__atomic_exchange_n(&busy, 1, __ATOMIC_ACQUIRE) == 0)
+    {
+        if (owned_ && !arenaReady) {
+            mbedtls_memory_buffer_alloc_init(arena, sizeof arena);
+            arenaReady = true;
+        }
+    }
+    ~ArenaUse()
+    {
+        if (owned_) {
+            __atomic_store_n(&busy, 0, __ATOMIC_RELEASE);
+        }
+    }
+    ArenaUse(const ArenaUse&) = delete;
+    ArenaUse& operator=(const ArenaUse&) = delete;
+
+    bool owned() const { return owned_; }
+
+private:
+    bool owned_;
+};
+#else
+// On the host, Debian's mbedTLS takes its memory from the C library.
+class ArenaUse {
+public:
+    bool owned() const { return true; }
+};
+#endif
 
 // The curve and a point read into mbedTLS's types, freed on every path.
 class Curve {
@@ -64,6 +120,10 @@ private:
 bool EcdsaP256::verify(const uint8_t (&publicKey)[kPublicKeySize], const uint8_t (&digest)[kDigestSize],
                        const uint8_t (&signature)[kSignatureSize])
 {
+    const ArenaUse arena;
+    if (!arena.owned()) {
+        return false;
+    }
     Curve curve;
     if (!curve.readPoint(publicKey)) {
         return false;
@@ -77,6 +137,10 @@ bool EcdsaP256::verify(const uint8_t (&publicKey)[kPublicKeySize], const uint8_t
 
 bool EcdsaP256::validPublicKey(const uint8_t (&publicKey)[kPublicKeySize])
 {
+    const ArenaUse arena;
+    if (!arena.owned()) {
+        return false;
+    }
     Curve curve;
     return curve.readPoint(publicKey);
 }

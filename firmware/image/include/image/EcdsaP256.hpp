@@ -18,7 +18,9 @@ public:
     /// True when @p signature is a valid signature of @p digest under
     /// @p publicKey. False for a point not on the curve, r or s outside
     /// [1, n - 1], or any other failure: a verifier that cannot decide
-    /// refuses.
+    /// refuses. On the controller a second verification while one runs
+    /// (in another task) is refused too: mbedTLS computes in one static
+    /// arena there.
     static bool verify(const uint8_t (&publicKey)[kPublicKeySize], const uint8_t (&digest)[kDigestSize],
                        const uint8_t (&signature)[kSignatureSize]);
 

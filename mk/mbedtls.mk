@@ -1,0 +1,54 @@
+# mbedTLS for the firmware: Debian's own source (apt-get source mbedtls,
+# 2.28, by mk/fetch-debian-source.sh into build/mbedtls-src/tree), compiled
+# for the i486 with the firmware's code flags and DCOS's configuration
+# (firmware/image/mbedtls/dcos_mbedtls_config.h): SHA-256 and ECDSA P-256
+# verification, which check controller images (docs/boot.md). The host
+# tools link Debian's packaged library instead (libmbedtls-dev).
+
+MBEDTLS_SOURCE_ROOT := $(BUILD)/mbedtls-src
+MBEDTLS_TREE := $(MBEDTLS_SOURCE_ROOT)/tree
+MBEDTLS_FETCHED := $(MBEDTLS_SOURCE_ROOT)/fetched.stamp
+MBEDTLS_FW_BUILD := $(FW_BUILD)/mbedtls
+# The library's files the configuration needs; nothing else is compiled.
+MBEDTLS_FW_MODULES := asn1parse asn1write bignum constant_time ecdsa ecp ecp_curves memory_buffer_alloc platform \
+	platform_util sha256
+MBEDTLS_FW_OBJS := $(patsubst %,$(MBEDTLS_FW_BUILD)/%.c.o,$(MBEDTLS_FW_MODULES))
+MBEDTLS_FW_LIBRARY := $(MBEDTLS_FW_BUILD)/libmbedcrypto.a
+# The firmware's code flags for C (FW_CODE_FLAGS less the C++ ones), -Os:
+# image checks run at boot and on an engineer's request, never on a path
+# make bench measures. mbedTLS is not ours, so its warnings are not errors.
+MBEDTLS_FW_CFLAGS := -std=c99 $(FW_ARCH_FLAGS) -mregparm=3 -freg-struct-return -mpreferred-stack-boundary=2 -Os \
+	-falign-functions=1 -falign-jumps=1 -falign-loops=1 -falign-labels=1 -g -ffreestanding -fno-pic -fno-pie \
+	-fno-stack-protector -fno-asynchronous-unwind-tables -fno-unwind-tables -fomit-frame-pointer \
+	-fno-tree-loop-distribute-patterns -mgeneral-regs-only -ffunction-sections -fdata-sections \
+	-DMBEDTLS_CONFIG_FILE='"dcos_mbedtls_config.h"' -Ifirmware/image/mbedtls -I$(MBEDTLS_TREE)/include -MMD -MP
+# What firmware code that uses firmware/image (and so mbedTLS's headers)
+# compiles with.
+FW_IMAGE_INCLUDES := -Ifirmware/image/include -DMBEDTLS_CONFIG_FILE='"dcos_mbedtls_config.h"' \
+	-Ifirmware/image/mbedtls -I$(MBEDTLS_TREE)/include
+
+$(MBEDTLS_FETCHED):
+	@mk/fetch-debian-source.sh mbedtls $(MBEDTLS_SOURCE_ROOT)
+	@touch $@
+
+# Named .c.o, as the firmware's objects are named .cpp.o: a plain %.o rule
+# would also match make's attempt to remake the dependency files (x.d from
+# x.d.o, by its built-in rule %: %.o).
+$(MBEDTLS_FW_BUILD)/%.c.o: $(MBEDTLS_FETCHED) firmware/image/mbedtls/dcos_mbedtls_config.h
+	@mkdir -p $(dir $@)
+	@echo "  CC      $@"
+	$(Q)gcc $(MBEDTLS_FW_CFLAGS) -c $(MBEDTLS_TREE)/library/$*.c -o $@
+
+$(MBEDTLS_FW_LIBRARY): $(MBEDTLS_FW_OBJS)
+	@echo "  AR      $@"
+	$(Q)rm -f $@ && ar rcs $@ $^
+
+
+# Controller images' format and verifier (firmware/image), compiled for the
+# firmware against this library's headers: cold code, like mbedTLS itself.
+FW_IMAGE_SRCS := $(wildcard firmware/image/src/*.cpp)
+FW_IMAGE_OBJS := $(call fw_objects,$(FW_IMAGE_SRCS))
+# The on-target test of the verifier, in the test image.
+FW_IMAGE_USER_OBJS := $(FW_IMAGE_OBJS) $(FW_BUILD)/tests_renode/target/ImageVerifierTest.cpp.o
+$(FW_IMAGE_USER_OBJS): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS) $(FW_IMAGE_INCLUDES)
+$(FW_IMAGE_USER_OBJS): | $(MBEDTLS_FETCHED)
