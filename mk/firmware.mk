@@ -17,7 +17,8 @@ FW_INCLUDES := \
 	-Ifieldbus/can/include \
 	-Ifieldbus/modbus/include \
 	-Idrivers/can/include \
-	-Idrivers/modbus/include
+	-Idrivers/modbus/include \
+	-Idrivers/ata/include
 
 FW_ARCH_FLAGS := -m32 -march=i486 -mtune=i486
 # How every firmware object is compiled, the kernel's and an application's
@@ -64,6 +65,7 @@ include fieldbus/can/can.mk
 include fieldbus/modbus/modbus.mk
 include drivers/can/can.mk
 include drivers/modbus/modbus.mk
+include drivers/ata/ata.mk
 
 # Sources every image contains, whatever its kernel configuration: the
 # runtime, the CPU, the loader's entry and the board.

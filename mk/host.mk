@@ -12,6 +12,8 @@ HOST_PORTABLE_SRCS := \
 	firmware/runtime/src/Int64Division.cpp \
 	firmware/runtime/src/Format.cpp \
 	firmware/boot/src/CommandLine.cpp \
+	firmware/boot/src/BootState.cpp \
+	firmware/boot/src/Crc32.cpp \
 	$(wildcard firmware/shell/src/*.cpp) \
 	$(DCOS_PORTABLE_SRCS) \
 	firmware/bsp_486/src/Pic8259.cpp \
@@ -22,6 +24,7 @@ HOST_PORTABLE_SRCS := \
 	$(CAN_PORTABLE_SRCS) \
 	$(MODBUS_PORTABLE_SRCS) \
 	$(CAN_DRIVER_PORTABLE_SRCS) \
+	$(ATA_DRIVER_PORTABLE_SRCS) \
 	$(MODBUS_DRIVER_PORTABLE_SRCS) \
 	$(HOSTCAN_SRCS) \
 	$(HOSTMODBUS_SRCS) \
