@@ -28,13 +28,14 @@ JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 
 include mk/firmware.mk
 include mk/host_tools.mk
+include mk/card.mk
 include mk/host.mk
 include mk/bench.mk
 include mk/qemu.mk
 include mk/sdk.mk
 include mk/fuzz.mk
 
-all: firmware host-tests host-tools
+all: firmware host-tests host-tools loader card
 
 deps:
 	@mk/install-deps.sh

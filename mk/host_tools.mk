@@ -18,13 +18,17 @@ HOSTMODBUS_CXXFLAGS := -Ihost_tools/modbus/include -I/usr/include/modbus -DTOML_
 # (host_tools/image), on Debian's mbedTLS.
 IMAGE_SRCS := $(wildcard firmware/image/src/*.cpp)
 HOSTIMAGE_SRCS := $(wildcard host_tools/image/src/*.cpp)
+# The card's records, the firmware's own code (firmware/boot), which the
+# host's card tool writes and reads.
+BOOT_RECORD_SRCS := firmware/boot/src/BootState.cpp firmware/boot/src/ConfigurationBlock.cpp firmware/boot/src/Crc32.cpp
 HOST_TOOLS_LIBS := -lfmt -lmodbus -ltomlplusplus -lmbedcrypto
 
 DCOS_CAN := $(HOST_TOOLS_BIN)/dcos-can
 DCOS_MODBUS := $(HOST_TOOLS_BIN)/dcos-modbus
 DCOS_MODBUS_SIM := $(HOST_TOOLS_BIN)/dcos-modbus-sim
 DCOS_IMAGE := $(HOST_TOOLS_BIN)/dcos-image
-HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE)
+DCOS_CARD := $(HOST_TOOLS_BIN)/dcos-card
+HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE) $(DCOS_CARD)
 
 host-tools: $(HOST_TOOLS)
 
@@ -50,8 +54,8 @@ $(DCOS_MODBUS_SIM): $(BUILD)/host/host_tools/modbus/tools/dcos-modbus-sim.cpp.o 
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS)
 
-$(DCOS_IMAGE): $(BUILD)/host/host_tools/image/tools/dcos-image.cpp.o \
-	$(patsubst %,$(BUILD)/host/%.o,$(IMAGE_SRCS) $(HOSTIMAGE_SRCS))
+$(DCOS_IMAGE) $(DCOS_CARD): $(HOST_TOOLS_BIN)/%: $(BUILD)/host/host_tools/image/tools/%.cpp.o \
+	$(patsubst %,$(BUILD)/host/%.o,$(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto

@@ -32,6 +32,14 @@ def test_486_images_hold_only_i486_instructions(kind):
     assert "i486 clean" in result.stdout
 
 
+def test_the_stage_loader_holds_only_i486_instructions():
+    # The card's stage loader (docs/boot.md) runs on the same processor
+    # before any kernel, with mbedTLS compiled in.
+    result = run_checker(os.path.join(REPOSITORY, "build", "486", "stage-loader.elf"))
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "i486 clean" in result.stdout
+
+
 def test_clean_object_passes(tmp_path):
     obj = assemble(tmp_path, "clean", "    movl %eax, %ebx\n    bswap %ecx\n    cmpxchg %edx, (%esi)\n    xadd %eax, (%edi)\n    invlpg (%eax)\n    nop\n    fsqrt")
     result = run_checker(obj)

@@ -62,7 +62,8 @@ class Board:
         return [device["driver"] for device in self.devices]
 
     def emulator_command(self, image, serial_backends, append="", icount=False, cpu=None, memory_mib=None,
-                         accel=None, device_properties=None, without_devices=(), extra_args=(), line_ports=None):
+                         accel=None, device_properties=None, without_devices=(), extra_args=(), line_ports=None,
+                         card=False):
         """The emulator argv for image, with one chardev argument per serial port.
 
         serial_backends maps names in serial_ports to a QEMU -serial value
@@ -83,6 +84,13 @@ class Board:
         {"isa-mfio": {"no-irq": "on"}}); without_devices names drivers to
         leave out (a board that is absent); extra_args go to the emulator as
         they are (e.g. the -chardev a device property refers to).
+
+        card=True boots image as the board's CompactFlash card (docs/boot.md):
+        a raw disk on the primary IDE channel that the BIOS boots, with the
+        board's IB700 watchdog fitted; the kernel's command line is the
+        card's own (append must be empty). The emulator then restarts the
+        board on a reset (a watchdog's, say) as a real board does, where a
+        -kernel boot stops (-no-reboot).
 
         line_ports maps serial ports named in the board's line_ports to the
         properties that join them to a lab line (hub, hub-name, line): such a
@@ -107,11 +115,16 @@ class Board:
             command += ["-accel", accel]
         if cpu or not accel:
             command += ["-cpu", cpu or self.cpu]
+        command += ["-m", str(memory_mib or self.memory_mib)]
+        if card:
+            if append:
+                raise ValueError("a card carries its own command line (dcos-card create --append), not -append")
+            command += ["-drive", f"file={image},if=ide,format=raw,index=0", "-boot", "c",
+                        "-device", "ib700", "-watchdog-action", "reset"]
+        else:
+            command += ["-kernel", image, "-no-reboot"]
         command += [
-            "-m", str(memory_mib or self.memory_mib),
-            "-kernel", image,
             "-display", "none",
-            "-no-reboot",
             "-monitor", "none",
         ]
         command += list(self.emulator_args)

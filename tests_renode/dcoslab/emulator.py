@@ -27,7 +27,7 @@ class EmulatorError(AssertionError):
 class Emulator:
     def __init__(self, board, image, append="", icount=False, cpu=None, memory_mib=None, accel=None,
                  device_properties=None, without_devices=(), extra_args=(), name=None, serial_sockets=(),
-                 line_ports=None):
+                 line_ports=None, card=False):
         self.board = board
         # What failures call this emulator, e.g. "board2" among several boards.
         self.name = name or board.name
@@ -47,6 +47,8 @@ class Emulator:
         self.serial_sockets = tuple(serial_sockets)
         # Serial ports joined to a lab line instead (Board.emulator_command).
         self.line_ports = dict(line_ports or {})
+        # image is a CompactFlash card the board boots from (Board.emulator_command).
+        self.card = card
         self._workdir = tempfile.TemporaryDirectory(prefix="dcos-emulator-")
         self._socket_path = os.path.join(self._workdir.name, "console.sock")
         self._stderr_path = os.path.join(self._workdir.name, "emulator.stderr")
@@ -79,6 +81,7 @@ class Emulator:
             self.image, backends, append=self.append, icount=self.icount, cpu=self.cpu,
             memory_mib=self.memory_mib, accel=self.accel, device_properties=self.device_properties,
             without_devices=self.without_devices, extra_args=self.extra_args, line_ports=self.line_ports,
+            card=self.card,
         )
         command[1:1] = ["-chardev", backend] + chardevs
         self.argv = command

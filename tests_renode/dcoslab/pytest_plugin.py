@@ -79,17 +79,19 @@ def boot(request):
     they are, serial_sockets=["rs485"] joins serial ports to Unix sockets
     (Emulator.serial_socket_path), line_ports={"rs485": {"hub": ..., "hub-name":
     ..., "line": ...}} puts serial ports on a lab line (dcoslab/rs485.py),
-    cpu="pentium" replaces the board's CPU model.
+    cpu="pentium" replaces the board's CPU model, card="path/to/card.img"
+    boots the board from that CompactFlash card image instead of an image
+    kind (docs/boot.md).
     """
     started = []
     request.node.dcos_emulators = started
 
     def start(board, kind="production", append="", icount=False, device_properties=None, without_devices=(),
-              extra_args=(), name=None, serial_sockets=(), line_ports=None, cpu=None):
-        image = kind if os.path.sep in kind else board.image(kind)
+              extra_args=(), name=None, serial_sockets=(), line_ports=None, cpu=None, card=None):
+        image = card or (kind if os.path.sep in kind else board.image(kind))
         emulator = Emulator(board, image, append=append, icount=icount, cpu=cpu, device_properties=device_properties,
                             without_devices=without_devices, extra_args=extra_args, name=name,
-                            serial_sockets=serial_sockets, line_ports=line_ports)
+                            serial_sockets=serial_sockets, line_ports=line_ports, card=card is not None)
         started.append(emulator)
         return emulator.start()
 

@@ -71,22 +71,4 @@ bool BootState::decode(const uint8_t (&sector)[kSize], BootState& out)
     return true;
 }
 
-bool BootState::newest(const uint8_t (&first)[kSize], const uint8_t (&second)[kSize], BootState& out,
-                       unsigned& copy)
-{
-    BootState a;
-    BootState b;
-    const bool aValid = decode(first, a);
-    const bool bValid = decode(second, b);
-    if (!aValid && !bValid) {
-        return false;
-    }
-    // Sequences only grow; a copy written after the other has the higher
-    // one, also across the wrap at 2^32 (compared as a signed distance).
-    const bool secondNewer = bValid && (!aValid || static_cast<int32_t>(b.sequence - a.sequence) > 0);
-    out = secondNewer ? b : a;
-    copy = secondNewer ? 1 : 0;
-    return true;
-}
-
 } // namespace boot

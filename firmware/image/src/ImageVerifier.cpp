@@ -42,7 +42,9 @@ ImagePolicy ImagePolicy::forBoard(BoardType board)
 {
     ImagePolicy policy;
     policy.board = board;
-    policy.slotCapacity = 2u << 20;
+    // A slot is 2 MiB of card; the card keeps the 256-byte header in a
+    // sector of its own (docs/boot.md, "The card"), which costs 256 bytes.
+    policy.slotCapacity = (2u << 20) - 256;
     policy.memoryStart = 1u << 20;
     policy.memoryEnd = 16u << 20;
     return policy;

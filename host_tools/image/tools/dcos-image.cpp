@@ -15,6 +15,7 @@
 #include <hostimage/ElfPayload.hpp>
 #include <hostimage/ImageSigner.hpp>
 #include <hostimage/SigningKey.hpp>
+#include <hostimage/ToolFiles.hpp>
 
 #include <image/ImageHeader.hpp>
 #include <image/ImageVerifier.hpp>
@@ -26,17 +27,9 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
-#include <fcntl.h>
-#include <fstream>
-#include <iterator>
 #include <optional>
 #include <string>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <vector>
 
 namespace {
@@ -47,126 +40,41 @@ constexpr int kExitUsage = 2;
 constexpr int kExitFile = 3;
 constexpr int kExitKey = 4;
 
-// Read no file larger than this: an image or a firmware ELF file is far
-// smaller, and a wrong path (a disk image, /dev/zero) is refused at once.
-constexpr std::streamoff kLargestFile = 64 << 20;
-
 int fail(int code, const std::string& message)
 {
     fmt::print(stderr, "dcos-image: {}\n", message);
     return code;
 }
 
-std::optional<std::vector<uint8_t>> readFile(const std::string& path, std::string& error)
-{
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        error = fmt::format("cannot read {}: {}", path, std::strerror(errno));
-        return std::nullopt;
-    }
-    in.seekg(0, std::ios::end);
-    const std::streamoff size = in.tellg();
-    if (size < 0 || size > kLargestFile) {
-        error = fmt::format("{} is not a regular file of at most 64 MiB", path);
-        return std::nullopt;
-    }
-    in.seekg(0);
-    std::vector<uint8_t> bytes(static_cast<size_t>(size));
-    if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) {
-        error = fmt::format("cannot read {}", path);
-        return std::nullopt;
-    }
-    return bytes;
-}
-
-// Writes a file whole, through a temporary name renamed over the target, so
-// that a failure leaves no half-written image or key. A private key's file
-// is created readable by its owner only (mode 0600), and an existing one is
-// not replaced unless @p replace.
-bool writeFile(const std::string& path, const void* data, size_t size, bool secret, bool replace, std::string& error)
-{
-    if (!replace && access(path.c_str(), F_OK) == 0) {
-        error = fmt::format("{} exists already (--force replaces it)", path);
-        return false;
-    }
-    const std::string temporary = path + ".tmp";
-    const int descriptor = open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC, secret ? 0600 : 0644);
-    if (descriptor < 0) {
-        error = fmt::format("cannot write {}: {}", temporary, std::strerror(errno));
-        return false;
-    }
-    bool written = fchmod(descriptor, secret ? 0600 : 0644) == 0;
-    const auto* bytes = static_cast<const uint8_t*>(data);
-    for (size_t done = 0; written && done < size;) {
-        const ssize_t count = write(descriptor, bytes + done, size - done);
-        if (count <= 0) {
-            written = false;
-            break;
-        }
-        done += static_cast<size_t>(count);
-    }
-    written = fsync(descriptor) == 0 && written;
-    written = close(descriptor) == 0 && written;
-    if (!written || rename(temporary.c_str(), path.c_str()) != 0) {
-        error = fmt::format("cannot write {}: {}", path, std::strerror(errno));
-        unlink(temporary.c_str());
-        return false;
-    }
-    return true;
-}
-
-std::string hex(const uint8_t* data, size_t size)
-{
-    std::string text;
-    for (size_t i = 0; i < size; ++i) {
-        text += fmt::format("{:02x}", data[i]);
-    }
-    return text;
-}
-
-std::string versionText(const image::ImageVersion& version)
-{
-    char text[32];
-    version.format(text, sizeof text);
-    return text;
-}
-
 std::string keyIdOf(const hostimage::SigningKey::PublicPoint& point)
 {
     uint8_t id[image::ImageHeader::kDigestSize];
     image::Sha256::digest(point.data(), point.size(), id);
-    return hex(id, sizeof id);
-}
-
-image::TrustedKey trustedKeyOf(const hostimage::SigningKey::PublicPoint& point)
-{
-    uint8_t bytes[image::EcdsaP256::kPublicKeySize];
-    std::copy(point.begin(), point.end(), bytes);
-    return image::TrustedKey::fromPoint(bytes);
+    return hostimage::hexText(id, sizeof id);
 }
 
 nlohmann::json headerJson(const image::ImageHeader& header)
 {
     return {{"board", image::boardName(header.board)},
-            {"version", versionText(header.version)},
+            {"version", hostimage::versionText(header.version)},
             {"payload_size", header.payloadSize},
             {"memory_size", header.memorySize},
             {"load_address", header.loadAddress},
             {"entry", header.entry},
-            {"payload_sha256", hex(header.payloadDigest, sizeof header.payloadDigest)},
-            {"key_id", hex(header.keyId, sizeof header.keyId)}};
+            {"payload_sha256", hostimage::hexText(header.payloadDigest, sizeof header.payloadDigest)},
+            {"key_id", hostimage::hexText(header.keyId, sizeof header.keyId)}};
 }
 
 void printHeader(const image::ImageHeader& header)
 {
     fmt::print("board         {}\n", image::boardName(header.board));
-    fmt::print("version       {}\n", versionText(header.version));
+    fmt::print("version       {}\n", hostimage::versionText(header.version));
     fmt::print("payload       {} bytes\n", header.payloadSize);
     fmt::print("memory        {} bytes (0x{:08x} to 0x{:08x})\n", header.memorySize, header.loadAddress,
                uint64_t{header.loadAddress} + header.memorySize);
     fmt::print("entry         0x{:08x}\n", header.entry);
-    fmt::print("payload hash  {}\n", hex(header.payloadDigest, sizeof header.payloadDigest));
-    fmt::print("key id        {}\n", hex(header.keyId, sizeof header.keyId));
+    fmt::print("payload hash  {}\n", hostimage::hexText(header.payloadDigest, sizeof header.payloadDigest));
+    fmt::print("key id        {}\n", hostimage::hexText(header.keyId, sizeof header.keyId));
 }
 
 int keygen(const std::string& keyPath, std::string publicPath, bool force, bool json)
@@ -184,8 +92,8 @@ int keygen(const std::string& keyPath, std::string publicPath, bool force, bool 
     if (privatePem.empty() || publicPem.empty()) {
         return fail(kExitKey, "cannot write the new key as PEM");
     }
-    if (!writeFile(keyPath, privatePem.data(), privatePem.size(), true, force, error) ||
-        !writeFile(publicPath, publicPem.data(), publicPem.size(), false, force, error)) {
+    if (!hostimage::writeWholeFile(keyPath, privatePem.data(), privatePem.size(), true, force, error) ||
+        !hostimage::writeWholeFile(publicPath, publicPem.data(), publicPem.size(), false, force, error)) {
         return fail(kExitFile, error);
     }
     const std::string id = keyIdOf(key->publicPoint());
@@ -202,7 +110,7 @@ int keygen(const std::string& keyPath, std::string publicPath, bool force, bool 
 
 std::optional<std::string> readText(const std::string& path, std::string& error)
 {
-    const std::optional<std::vector<uint8_t>> bytes = readFile(path, error);
+    const std::optional<std::vector<uint8_t>> bytes = hostimage::readWholeFile(path, error);
     if (!bytes) {
         return std::nullopt;
     }
@@ -238,7 +146,7 @@ int sign(const SignOptions& options, bool json)
     if (!key) {
         return fail(kExitKey, fmt::format("{}: {}", options.key, error));
     }
-    const std::optional<std::vector<uint8_t>> elf = readFile(options.input, error);
+    const std::optional<std::vector<uint8_t>> elf = hostimage::readWholeFile(options.input, error);
     if (!elf) {
         return fail(kExitFile, error);
     }
@@ -253,13 +161,13 @@ int sign(const SignOptions& options, bool json)
     }
     // The policy the board's controllers apply, so that an image they would
     // refuse for its size or addresses is refused here, not after a transfer.
-    const image::TrustedKey trusted = trustedKeyOf(key->publicPoint());
+    const image::TrustedKey trusted = hostimage::trustedKeyOf(key->publicPoint());
     const image::ImageResult<image::ImageHeader> check = image::ImageVerifier::verify(
         signedImage->data(), signedImage->size(), &trusted, 1, image::ImagePolicy::forBoard(board));
     if (!check.ok()) {
         return fail(kExitRefused, fmt::format("{}: {}", options.input, image::imageErrorText(check.error())));
     }
-    if (!writeFile(options.output, signedImage->data(), signedImage->size(), false, true, error)) {
+    if (!hostimage::writeWholeFile(options.output, signedImage->data(), signedImage->size(), false, true, error)) {
         return fail(kExitFile, error);
     }
     if (json) {
@@ -291,18 +199,14 @@ int verify(const VerifyOptions& options, bool json)
     std::string error;
     std::vector<image::TrustedKey> keys;
     for (const std::string& path : options.keys) {
-        const std::optional<std::string> pem = readText(path, error);
-        if (!pem) {
-            return fail(kExitFile, error);
-        }
-        const std::optional<hostimage::SigningKey::PublicPoint> point =
-            hostimage::SigningKey::publicPointFromPem(*pem, error);
+        bool unreadable = false;
+        const std::optional<hostimage::SigningKey::PublicPoint> point = hostimage::readPublicKey(path, error, unreadable);
         if (!point) {
-            return fail(kExitKey, fmt::format("{}: {}", path, error));
+            return fail(unreadable ? kExitFile : kExitKey, error);
         }
-        keys.push_back(trustedKeyOf(*point));
+        keys.push_back(hostimage::trustedKeyOf(*point));
     }
-    const std::optional<std::vector<uint8_t>> bytes = readFile(options.input, error);
+    const std::optional<std::vector<uint8_t>> bytes = hostimage::readWholeFile(options.input, error);
     if (!bytes) {
         return fail(kExitFile, error);
     }
@@ -325,8 +229,8 @@ int verify(const VerifyOptions& options, bool json)
         fmt::print("{}\n", out.dump());
     } else if (result.ok()) {
         fmt::print("{}: valid, {} {} signed by key {}\n", options.input, image::boardName(result.value().board),
-                   versionText(result.value().version),
-                   hex(result.value().keyId, sizeof result.value().keyId));
+                   hostimage::versionText(result.value().version),
+                   hostimage::hexText(result.value().keyId, sizeof result.value().keyId));
     } else {
         fmt::print(stderr, "dcos-image: {}: refused: {}\n", options.input, image::imageErrorText(result.error()));
     }
@@ -336,7 +240,7 @@ int verify(const VerifyOptions& options, bool json)
 int info(const std::string& path, bool json)
 {
     std::string error;
-    const std::optional<std::vector<uint8_t>> bytes = readFile(path, error);
+    const std::optional<std::vector<uint8_t>> bytes = hostimage::readWholeFile(path, error);
     if (!bytes) {
         return fail(kExitFile, error);
     }

@@ -185,6 +185,10 @@ TEST(ImageSignerTest, AnImageLargerThanTheSlotIsRefused)
     EXPECT_EQ(verdict(bytes, policy), ImageError::Oversized);
     const std::vector<uint8_t> large = signedImage(payloadOf(2u << 20));
     EXPECT_EQ(verdict(large), ImageError::Oversized) << "2 MiB of payload and a header in a 2 MiB slot";
+    const std::vector<uint8_t> fits = signedImage(payloadOf((2u << 20) - 512));
+    EXPECT_EQ(verdict(fits), ImageError::Ok) << "a payload of 4095 sectors fills the slot after the header's sector";
+    const std::vector<uint8_t> over = signedImage(payloadOf((2u << 20) - 511));
+    EXPECT_EQ(verdict(over), ImageError::Oversized);
 }
 
 TEST(ImageSignerTest, AnImageForAnotherBoardIsRefused)

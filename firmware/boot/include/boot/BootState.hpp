@@ -19,6 +19,7 @@
 #pragma once
 
 #include <boot/CardLayout.hpp>
+#include <boot/RecordCopies.hpp>
 
 #include <stddef.h>
 #include <stdint.h>
@@ -47,10 +48,12 @@ struct BootState {
     /// confirmed slot.
     static bool decode(const uint8_t (&sector)[kSize], BootState& out);
 
-    /// The state two copies hold: the valid one with the higher sequence.
-    /// @p copy is its index (0 or 1). False when neither is valid.
+    /// The state two copies hold (RecordCopies.hpp).
     static bool newest(const uint8_t (&first)[kSize], const uint8_t (&second)[kSize], BootState& out,
-                       unsigned& copy);
+                       unsigned& copy)
+    {
+        return newestCopy(first, second, out, copy);
+    }
 };
 
 } // namespace boot

@@ -44,7 +44,8 @@ struct ImagePolicy {
     bool allowDowngrade = false;
 
     /// The board's slot and memory (docs/boot.md): an application slot of
-    /// 2 MiB; on the 486 board the image lives between 1 MiB, where
+    /// 2 MiB of card, which holds an image of 2 MiB less 256 bytes (the
+    /// card pads the header to a sector); on the 486 board the image lives between 1 MiB, where
     /// conventional memory and the BIOS end, and 16 MiB, what the ISA bus
     /// addresses. Nothing installed, no downgrade.
     static ImagePolicy forBoard(BoardType board);

@@ -1,0 +1,367 @@
+// The stage loader (docs/boot.md, "How a controller starts"): the program
+// the card's boot sector starts, before any kernel. It reads the card's
+// configuration and boot state, decides with BootPlanner which slot's image
+// boots, checks that image's signature and digest with the same verifier the
+// host tools use (firmware/image, mbedTLS), loads it, and starts it as a
+// Multiboot loader would, so the kernel starts the same way from the card
+// as from QEMU's -kernel. A new image boots as a trial with the board's
+// watchdog armed: if it does not confirm, the watchdog resets the board and
+// the next boot reverts.
+//
+// Everything runs with interrupts off and polls: the console on COM1, the
+// card by ATA PIO (drivers/ata). Every message starts with "stage: ", so a
+// test or an engineer tells it from the kernel's.
+#include <ata/AtaPioDisk.hpp>
+#include <boot/BootPlanner.hpp>
+#include <boot/BootState.hpp>
+#include <boot/CardLayout.hpp>
+#include <boot/ConfigurationBlock.hpp>
+#include <image/ImageVerifier.hpp>
+
+#include <arch_x86/PortIo.hpp>
+#include <dcos/Version.hpp>
+#include <runtime/Format.hpp>
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+namespace {
+
+using arch_x86::portRead8;
+using arch_x86::portWrite8;
+namespace card = boot::card;
+
+// -- the console: COM1, polled ------------------------------------------------
+
+// The 16550's ports (PC/AT COM1) and the line status bit that says the
+// transmitter holds no character (16550D data sheet, LSR bit 5, THRE).
+constexpr uint16_t kCom1 = 0x3F8;
+constexpr uint16_t kCom1LineStatus = kCom1 + 5;
+constexpr uint8_t kTransmitterEmpty = 0x20;
+
+class StageConsole final : public runtime::CharacterSink {
+public:
+    void put(char character) override
+    {
+        // Bounded: a UART that never empties (none fitted) does not hang the boot.
+        for (unsigned poll = 0; poll < 100000 && (portRead8(kCom1LineStatus) & kTransmitterEmpty) == 0; ++poll) {
+        }
+        portWrite8(kCom1, static_cast<uint8_t>(character));
+    }
+};
+
+StageConsole console;
+
+__attribute__((format(printf, 1, 2))) void say(const char* format, ...)
+{
+    runtime::format(console, "stage: ");
+    va_list arguments;
+    va_start(arguments, format);
+    runtime::formatTo(console, format, arguments);
+    va_end(arguments);
+    runtime::format(console, "\r\n");
+}
+
+[[noreturn]] void halt()
+{
+    for (;;) {
+        asm volatile("cli; hlt");
+    }
+}
+
+// -- the machine ----------------------------------------------------------------
+
+// The MC146818's CMOS RAM (ports 0x70/0x71): bytes 0x30 and 0x31 hold the
+// memory above 1 MiB in KiB, as the BIOS counted it (IBM PC/AT Technical
+// Reference, "CMOS RAM address map"). Bit 7 of the index port is the NMI
+// mask, left set here.
+uint32_t extendedMemoryKib()
+{
+    portWrite8(0x70, 0x80 | 0x30);
+    const uint32_t low = portRead8(0x71);
+    portWrite8(0x70, 0x80 | 0x31);
+    const uint32_t high = portRead8(0x71);
+    return low | (high << 8);
+}
+
+// True when addresses above 1 MiB are not folded onto the first megabyte.
+bool a20Enabled()
+{
+    volatile uint32_t* low = reinterpret_cast<volatile uint32_t*>(0x7E00);
+    volatile uint32_t* high = reinterpret_cast<volatile uint32_t*>(0x107E00);
+    const uint32_t saved = *low;
+    *low = 0x0D0C05A2u;
+    *high = ~0x0D0C05A2u;
+    const bool enabled = *low == 0x0D0C05A2u;
+    *low = saved;
+    return enabled;
+}
+
+// The boot sector asked the BIOS; if that did not work, the "fast A20"
+// bit of system control port A (0x92, bit 1), which PC/AT-compatible
+// chipsets have.
+bool enableA20()
+{
+    if (a20Enabled()) {
+        return true;
+    }
+    portWrite8(0x92, static_cast<uint8_t>((portRead8(0x92) | 0x02) & ~0x01));
+    return a20Enabled();
+}
+
+// The board's watchdog: an iBASE IB700-compatible timer (QEMU's ib700),
+// ports 0x441 (a write stops it) and 0x443 (a write starts it; the value's
+// low four bits pick the time, 30 s less 2 s per step). The stage loader
+// arms it for a trial boot only; the new image stops it when it confirms.
+constexpr uint16_t kWatchdogStop = 0x441;
+constexpr uint16_t kWatchdogStart = 0x443;
+constexpr uint8_t kWatchdogTrialSetting = 0; // 30 s
+
+// -- the card ---------------------------------------------------------------------
+
+alignas(4) uint8_t sectorA[card::kSectorSize];
+alignas(4) uint8_t sectorB[card::kSectorSize];
+
+bool readRecordCopies(ata::AtaPioDisk& disk, uint32_t lba)
+{
+    const ata::AtaError first = disk.read(lba, 1, sectorA);
+    const ata::AtaError second = disk.read(lba + 1, 1, sectorB);
+    if (first != ata::AtaError::Ok || second != ata::AtaError::Ok) {
+        say("cannot read sectors %lu and %lu: %s", static_cast<unsigned long>(lba),
+            static_cast<unsigned long>(lba + 1),
+            ata::ataErrorText(first != ata::AtaError::Ok ? first : second));
+        return false;
+    }
+    return true;
+}
+
+boot::ConfigurationBlock configuration;
+image::TrustedKey trustedKeys[boot::ConfigurationBlock::kMaximumKeys];
+size_t trustedKeyCount = 0;
+
+// The verdict of the last slot loaded into memory, whose image is then in
+// place at its load address.
+uint8_t loadedSlot = boot::BootState::kNoSlot;
+image::ImageHeader loadedHeader;
+
+// Reads a slot's image into its place in memory and checks it: the header
+// (signature, board, memory window) first, then the payload's digest. The
+// card keeps the 256-byte header in the slot's first sector and the
+// payload from its second, so that the payload's sectors are read straight
+// to where the image runs.
+bool loadAndVerify(ata::AtaPioDisk& disk, uint8_t slot, uint32_t memoryEnd)
+{
+    loadedSlot = boot::BootState::kNoSlot;
+    const uint32_t lba = card::kSlotLba[slot];
+    const ata::AtaError header = disk.read(lba, 1, sectorA);
+    if (header != ata::AtaError::Ok) {
+        say("slot %s: cannot read: %s", card::slotName(slot), ata::ataErrorText(header));
+        return false;
+    }
+    const image::ImageResult<image::ImageHeader> decoded = image::ImageHeader::decode(sectorA, sizeof sectorA);
+    if (!decoded.ok()) {
+        say("slot %s: %s", card::slotName(slot), image::imageErrorText(decoded.error()));
+        return false;
+    }
+    image::ImagePolicy policy = image::ImagePolicy::forBoard(image::BoardType::Isa486);
+    if (memoryEnd < policy.memoryEnd) {
+        policy.memoryEnd = memoryEnd;
+    }
+    const image::ImageResult<image::ImageHeader> checked = image::ImageVerifier::checkHeader(
+        sectorA, image::ImageHeader::kSize, uint64_t{image::ImageHeader::kSize} + decoded.value().payloadSize,
+        trustedKeys, trustedKeyCount, policy);
+    if (!checked.ok()) {
+        say("slot %s: %s", card::slotName(slot), image::imageErrorText(checked.error()));
+        return false;
+    }
+    const image::ImageHeader& image = checked.value();
+    auto* place = reinterpret_cast<uint8_t*>(static_cast<uintptr_t>(image.loadAddress));
+    const uint32_t whole = image.payloadSize / card::kSectorSize;
+    const uint32_t tail = image.payloadSize % card::kSectorSize;
+    ata::AtaError read = whole != 0 ? disk.read(lba + 1, whole, place) : ata::AtaError::Ok;
+    if (read == ata::AtaError::Ok && tail != 0) {
+        // The last part sector through a buffer: no byte past the payload is written.
+        read = disk.read(lba + 1 + whole, 1, sectorB);
+        for (uint32_t i = 0; read == ata::AtaError::Ok && i < tail; ++i) {
+            place[whole * card::kSectorSize + i] = sectorB[i];
+        }
+    }
+    if (read != ata::AtaError::Ok) {
+        say("slot %s: cannot read the payload: %s", card::slotName(slot), ata::ataErrorText(read));
+        return false;
+    }
+    const image::ImageError payload = image::ImageVerifier::checkPayload(image, place, image.payloadSize);
+    char version[32];
+    image.version.format(version, sizeof version);
+    if (payload != image::ImageError::Ok) {
+        say("slot %s: %s %s: %s", card::slotName(slot), image::boardName(image.board), version,
+            image::imageErrorText(payload));
+        return false;
+    }
+    say("slot %s: %s %s, signature and digest valid", card::slotName(slot), image::boardName(image.board), version);
+    loadedSlot = slot;
+    loadedHeader = image;
+    return true;
+}
+
+bool writeState(ata::AtaPioDisk& disk, const boot::BootState& state, unsigned copy)
+{
+    state.encode(sectorA);
+    const ata::AtaError written = disk.write(card::kBootStateLba + copy, 1, sectorA);
+    if (written != ata::AtaError::Ok) {
+        say("cannot write the boot state: %s", ata::ataErrorText(written));
+        return false;
+    }
+    return true;
+}
+
+// -- the hand-over ------------------------------------------------------------------
+
+// Multiboot Specification 0.6.96, 3.3: what the kernel's entry reads.
+struct MultibootInfo {
+    uint32_t flags;
+    uint32_t memLower;
+    uint32_t memUpper;
+    uint32_t bootDevice;
+    uint32_t cmdline;
+    uint32_t modsCount;
+    uint32_t modsAddr;
+    uint32_t syms[4];
+    uint32_t mmapLength;
+    uint32_t mmapAddr;
+    uint32_t drivesLength;
+    uint32_t drivesAddr;
+    uint32_t configTable;
+    uint32_t bootLoaderName;
+};
+constexpr uint32_t kMultibootMemory = 1u << 0;
+constexpr uint32_t kMultibootCommandLine = 1u << 2;
+constexpr uint32_t kMultibootLoaderName = 1u << 9;
+constexpr uint32_t kMultibootLoaderMagic = 0x2BADB002;
+
+MultibootInfo handover;
+char commandLine[boot::ConfigurationBlock::kCommandLineSize + 96];
+const char loaderName[] = "DCOS stage loader";
+
+[[noreturn]] void start(const image::ImageHeader& image, uint8_t slot, bool trial, bool reverted, uint32_t upperKib)
+{
+    // The memory after the payload that the image's .bss needs zeroed.
+    auto* place = reinterpret_cast<uint8_t*>(static_cast<uintptr_t>(image.loadAddress));
+    for (uint32_t i = image.payloadSize; i < image.memorySize; ++i) {
+        place[i] = 0;
+    }
+    char version[32];
+    image.version.format(version, sizeof version);
+    // The kernel learns where it came from on its command line: the
+    // configuration's own line, then the boot's facts (docs/boot.md).
+    runtime::formatToBuffer(commandLine, sizeof commandLine, "%s%sboot.slot=%s boot.version=%s%s%s",
+                            configuration.commandLine, configuration.commandLine[0] != '\0' ? " " : "",
+                            card::slotName(slot), version, trial ? " boot.trial=1" : "",
+                            reverted ? " boot.reverted=1" : "");
+    handover.flags = kMultibootMemory | kMultibootCommandLine | kMultibootLoaderName;
+    handover.memLower = 640;
+    handover.memUpper = upperKib;
+    handover.cmdline = reinterpret_cast<uintptr_t>(commandLine);
+    handover.bootLoaderName = reinterpret_cast<uintptr_t>(loaderName);
+    if (trial) {
+        portWrite8(kWatchdogStart, kWatchdogTrialSetting);
+        say("watchdog armed: the new image must confirm within 30 s");
+    } else {
+        portWrite8(kWatchdogStop, 0);
+    }
+    say("starting slot %s at 0x%08lx", card::slotName(slot), static_cast<unsigned long>(image.entry));
+    asm volatile("jmp *%2" : : "a"(kMultibootLoaderMagic), "b"(&handover), "r"(image.entry) : "memory");
+    __builtin_unreachable();
+}
+
+[[noreturn]] void recovery(const char* why)
+{
+    say("recovery: %s", why);
+    say("recovery: no image can be received here yet; write one to the card with dcos-card");
+    halt();
+}
+
+} // namespace
+
+// The verifier's mbedTLS and the I/O windows report what cannot go on here.
+extern "C" [[noreturn]] void dcosPanic(const char* format, ...)
+{
+    runtime::format(console, "stage: panic: ");
+    va_list arguments;
+    va_start(arguments, format);
+    runtime::formatTo(console, format, arguments);
+    va_end(arguments);
+    runtime::format(console, "\r\n");
+    halt();
+}
+
+extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
+{
+    say("DCOS stage loader %s, from BIOS drive 0x%02lx", dcos::versionString, static_cast<unsigned long>(bootDrive));
+    if (!enableA20()) {
+        recovery("the A20 gate cannot be enabled: no memory above 1 MiB");
+    }
+    const uint32_t upperKib = extendedMemoryKib();
+    const uint32_t memoryEnd = (1u << 20) + upperKib * 1024u;
+
+    ata::AtaPioDisk disk = ata::AtaPioDisk::primary();
+    const ata::AtaError identified = disk.identify();
+    if (identified != ata::AtaError::Ok) {
+        recovery(ata::ataErrorText(identified));
+    }
+    say("card: %s, %lu sectors", disk.model(), static_cast<unsigned long>(disk.sectorCount()));
+    if (disk.sectorCount() < card::kMinimumCardSectors) {
+        recovery("the card is smaller than the layout needs");
+    }
+
+    unsigned copy = 0;
+    if (!readRecordCopies(disk, card::kConfigurationLba) ||
+        !boot::newestCopy(sectorA, sectorB, configuration, copy)) {
+        recovery("no valid configuration on the card");
+    }
+    for (size_t i = 0; i < configuration.keyCount; ++i) {
+        trustedKeys[trustedKeyCount++] = image::TrustedKey::fromPoint(configuration.keys[i]);
+    }
+    say("configuration %lu: %u trusted key%s", static_cast<unsigned long>(configuration.sequence),
+        static_cast<unsigned>(trustedKeyCount), trustedKeyCount == 1 ? "" : "s");
+    if (trustedKeyCount == 0) {
+        recovery("the configuration trusts no key, so no image can be verified");
+    }
+
+    boot::BootState stored;
+    unsigned stateCopy = 0;
+    const bool haveState = readRecordCopies(disk, card::kBootStateLba) &&
+                           boot::BootState::newest(sectorA, sectorB, stored, stateCopy);
+    if (haveState) {
+        say("boot state %lu: confirmed slot %s, trial %s%s", static_cast<unsigned long>(stored.sequence),
+            card::slotName(stored.confirmedSlot),
+            stored.trial == boot::TrialState::None      ? "none"
+            : stored.trial == boot::TrialState::Pending ? "pending in slot "
+                                                        : "booting in slot ",
+            stored.trial == boot::TrialState::None ? "" : card::slotName(stored.trialSlot));
+    } else {
+        say("no boot state on the card: a new card");
+    }
+
+    boot::BootPlan plan = boot::BootPlanner::plan(haveState ? &stored : nullptr, [&](uint8_t slot) {
+        return loadAndVerify(disk, slot, memoryEnd);
+    });
+    say("%s", plan.reason);
+    if (plan.write) {
+        // The next sequence, into the copy that does not hold the state read:
+        // a power cut during this write leaves that state standing.
+        plan.state.sequence = haveState ? stored.sequence + 1 : 1;
+        const unsigned target = haveState ? stateCopy ^ 1u : 0u;
+        if (!writeState(disk, plan.state, target)) {
+            recovery("the boot state cannot be written, so a trial could not be reverted");
+        }
+    }
+    if (plan.action == boot::BootPlan::Action::Recovery) {
+        recovery(plan.reason);
+    }
+    if (loadedSlot != plan.slot && !loadAndVerify(disk, plan.slot, memoryEnd)) {
+        recovery("the chosen image did not verify when loaded again");
+    }
+    start(loadedHeader, plan.slot, plan.trial, plan.reverted, upperKib);
+}
