@@ -95,7 +95,8 @@ FW_SRCS := \
 	$(CAN_DRIVER_PORTABLE_SRCS) \
 	$(CAN_DRIVER_TARGET_SRCS) \
 	$(MODBUS_DRIVER_PORTABLE_SRCS) \
-	$(MODBUS_DRIVER_TARGET_SRCS)
+	$(MODBUS_DRIVER_TARGET_SRCS) \
+	$(ATA_DRIVER_PORTABLE_SRCS)
 
 # The minimal kernel configuration: the system, scheduler, task and timer
 # agents and what boot needs; no shell, no console commands, no other agent,

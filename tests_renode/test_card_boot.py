@@ -6,7 +6,9 @@ dcos-card from the built boot sector, stage loader and development key
 """
 import json
 import os
+import re
 import subprocess
+import time
 
 from dcoslab.board import REPOSITORY
 
@@ -170,3 +172,50 @@ def test_dcos_card_keeps_the_confirmed_slot_and_refuses_a_downgrade(boot, isa486
     assert result.returncode == 1 and "older than the installed image" in result.stderr, result.stderr
     tool("dcos-card", "write", card, "--slot", "B", signed(tmp_path, "1.1.9"), "--allow-downgrade")
     assert card_state(card)["slots"]["B"]["version"] == "1.1.9"
+
+
+def emulated_seconds(emulator):
+    """The node's uptime in whole seconds, from the uptime command."""
+    output = emulator.command("uptime")
+    match = re.search(r"up (\d+) d (\d+):(\d+):(\d+)", output)
+    assert match, output
+    days, hours, minutes, seconds = (int(group) for group in match.groups())
+    return ((days * 24 + hours) * 60 + minutes) * 60 + seconds
+
+
+def test_a_trial_that_confirms_stays_and_boots_from_then_on(boot, isa486, tmp_path):
+    card = new_card(tmp_path, ("A", signed(tmp_path, "1.0.0"), False))
+    first = boot(isa486, card=card)
+    first.expect(r"dcos> ")
+    assert "this image is confirmed already" in first.command("boot confirm")
+    first.close()
+    tool("dcos-card", "write", card, "--slot", "B", signed(tmp_path, "1.1.0"), "--pending")
+    emulator = boot(isa486, card=card, icount=True)
+    emulator.expect(r"boot\.trial=1")
+    emulator.expect(r"dcos> ")
+    status = emulator.command("boot")
+    assert "boot: slot B, version 1.1.0, on trial" in status, status
+    assert "confirmed slot A, trial booting in slot B" in status, status
+    assert "confirmed: this image boots from now on, and the watchdog is stopped" in emulator.command("boot confirm")
+    assert "confirmed slot B, trial none" in emulator.command("boot")
+    # Well past the watchdog's 30 s of emulated time: no reset comes.
+    deadline = time.monotonic() + 120
+    while emulated_seconds(emulator) < 45:
+        assert time.monotonic() < deadline, "the emulated clock did not reach 45 s"
+        time.sleep(0.2)
+    assert emulator.transcript.count("stage: DCOS stage loader") == 1, "the board was reset"
+    emulator.close()
+    state = card_state(card)["boot_state"]
+    assert state["confirmed"] == "B" and state["trial"] == "none" and state["reverts"] == 0, state
+    again = boot(isa486, card=card)
+    again.expect(r"stage: the confirmed image")
+    again.expect(r"command line: node=3 boot\.slot=B boot\.version=1\.1\.0\r")
+    again.expect(r"dcos> ")
+
+
+def test_a_node_started_without_its_card_has_nothing_to_confirm(boot, isa486):
+    emulator = boot(isa486)
+    emulator.expect(r"dcos> ")
+    assert "not from the card" in emulator.command("boot")
+    emulator.send("boot confirm\r")
+    emulator.expect(r"boot: this node was not started from its card: there is nothing to confirm")

@@ -32,6 +32,7 @@ DCOS_TARGET_SRCS := \
 	firmware/dcos/src/kernel/Kernel.cpp \
 	firmware/dcos/src/kernel/ConsoleRoot.cpp \
 	firmware/dcos/src/kernel/KernelCommands.cpp \
+	firmware/dcos/src/kernel/BootCommands.cpp \
 	$(wildcard firmware/dcos/src/task/*.cpp firmware/dcos/src/task/*.S) \
 	$(wildcard firmware/dcos/src/scheduler/*.cpp firmware/dcos/src/scheduler/*.S) \
 	$(wildcard firmware/dcos/src/timer/*.cpp) \

@@ -159,8 +159,9 @@ void FakeAtaDisk::execute(uint8_t command)
         transferLba_ = lba;
         remaining_ = count;
         position_ = 0;
-        if (failing_.count(lba) != 0) {
-            error_ = failing_[lba];
+        if (failing_.count(lba) != 0 ||
+            (command == reg::kCommandWriteSectors && failingWrites_.count(lba) != 0)) {
+            error_ = failing_.count(lba) != 0 ? failing_[lba] : failingWrites_[lba];
             errorBit_ = true;
             transfer_ = Transfer::None;
             return;

@@ -29,6 +29,8 @@ public:
     // -- what the test plays --------------------------------------------------
     /// Reads and writes of this sector fail with ERR and this error register.
     void failSector(uint32_t lba, uint8_t error = 0x40) { failing_[lba] = error; }
+    /// Writes to this sector fail with ERR (write fault); reads succeed.
+    void failWritesTo(uint32_t lba, uint8_t error = 0x40) { failingWrites_[lba] = error; }
     /// The device never clears BSY again.
     void hang() { hung_ = true; }
     /// IDENTIFY reports no LBA support.
@@ -64,6 +66,7 @@ private:
     bool hung_ = false;
     std::map<uint32_t, std::vector<uint8_t>> data_;
     std::map<uint32_t, uint8_t> failing_;
+    std::map<uint32_t, uint8_t> failingWrites_;
 
     uint8_t registers_[8] = {};
     uint8_t error_ = 0;
