@@ -66,6 +66,7 @@ include fieldbus/modbus/modbus.mk
 include drivers/can/can.mk
 include drivers/modbus/modbus.mk
 include drivers/ata/ata.mk
+include firmware/flash/flash.mk
 
 # Sources every image contains, whatever its kernel configuration: the
 # runtime, the CPU, the loader's entry and the board.

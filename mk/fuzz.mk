@@ -13,7 +13,7 @@
 # caused it is kept in $(FUZZ_BUILD)/artifacts/<target>/.
 
 FUZZ_BUILD := $(BUILD)/fuzz
-# Fuzzing time per target; sixteen targets, so 'make test' spends about 240 s here.
+# Fuzzing time per target; seventeen targets, so 'make test' spends about 255 s here.
 FUZZ_SECONDS ?= 15
 FUZZ_TARGETS := frame isotp slcan frametext
 FUZZ_CORPUS := fieldbus/can/fuzz/corpus
@@ -44,6 +44,10 @@ IMAGE_FUZZ_REPORT := $(BUILD)/reports/fuzz-image-tests.xml
 HOST_IMAGE_FUZZ_TARGETS := elf_payload
 HOST_IMAGE_FUZZ_CORPUS := host_tools/image/fuzz/corpus
 HOST_IMAGE_FUZZ_REPORT := $(BUILD)/reports/fuzz-host-image-tests.xml
+# The flash protocol's node side (firmware/flash/fuzz): framing and session.
+FLASH_FUZZ_TARGETS := flash_session
+FLASH_FUZZ_CORPUS := firmware/flash/fuzz/corpus
+FLASH_FUZZ_REPORT := $(BUILD)/reports/fuzz-flash-tests.xml
 
 FUZZ_CXX := clang++
 # toml++ is compiled into the fuzz targets as Debian's shared library, which
@@ -58,7 +62,7 @@ FUZZ_CXXFLAGS := -std=c++20 -O1 -g -fno-omit-frame-pointer -fno-sanitize-recover
 	-Wall -Wextra -Wno-missing-field-initializers -Werror -MMD -MP \
 	-Ifieldbus/can/include -Ifieldbus/modbus/include -Ifirmware/dcos/include \
 	-Ihost_tools/modbus/include -I/usr/include/modbus -Ifirmware/image/include -Ihost_tools/image/include \
-	$(TOML_RELEASE_ASSERT)
+	-Ifirmware/flash/include -Ifirmware/boot/include -Ifirmware/runtime/include $(TOML_RELEASE_ASSERT)
 # Objects are instrumented for coverage without libFuzzer's main; the
 # targets are linked with it.
 FUZZ_COMPILE_FLAGS := $(FUZZ_CXXFLAGS) -fsanitize=fuzzer-no-link,$(FUZZ_SANITIZERS)
@@ -86,11 +90,16 @@ IMAGE_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(IMAGE_FUZZ_TARGETS))
 HOST_IMAGE_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,host_tools/image/src/ElfPayload.cpp $(IMAGE_SRCS))
 HOST_IMAGE_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/image/fuzz/fuzz_%.cpp.o,$(HOST_IMAGE_FUZZ_TARGETS))
 HOST_IMAGE_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOST_IMAGE_FUZZ_TARGETS))
+FLASH_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) \
+	firmware/boot/src/BootState.cpp firmware/boot/src/Crc32.cpp)
+FLASH_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/flash/fuzz/fuzz_%.cpp.o,$(FLASH_FUZZ_TARGETS))
+FLASH_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(FLASH_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as
 # intermediate files and be deleted after every build.
 .SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS) $(MODBUS_FUZZ_LIBRARY_OBJS) $(MODBUS_FUZZ_TARGET_OBJS) \
 	$(HOST_MODBUS_FUZZ_LIBRARY_OBJS) $(HOST_MODBUS_FUZZ_TARGET_OBJS) $(DCOS_FUZZ_LIBRARY_OBJS) $(DCOS_FUZZ_TARGET_OBJS) \
-	$(IMAGE_FUZZ_LIBRARY_OBJS) $(IMAGE_FUZZ_TARGET_OBJS) $(HOST_IMAGE_FUZZ_LIBRARY_OBJS) $(HOST_IMAGE_FUZZ_TARGET_OBJS)
+	$(IMAGE_FUZZ_LIBRARY_OBJS) $(IMAGE_FUZZ_TARGET_OBJS) $(HOST_IMAGE_FUZZ_LIBRARY_OBJS) $(HOST_IMAGE_FUZZ_TARGET_OBJS) \
+	$(FLASH_FUZZ_LIBRARY_OBJS) $(FLASH_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
@@ -98,7 +107,7 @@ fuzz: deps
 	@$(MAKE) --no-print-directory test-fuzz
 
 fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARIES) $(DCOS_FUZZ_BINARIES) \
-	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES)
+	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES) $(FLASH_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite.
@@ -117,6 +126,8 @@ test-fuzz:
 		--seconds $(FUZZ_SECONDS) --report $(IMAGE_FUZZ_REPORT) $(IMAGE_FUZZ_TARGETS) || status=1; \
 	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(HOST_IMAGE_FUZZ_CORPUS) \
 		--seconds $(FUZZ_SECONDS) --report $(HOST_IMAGE_FUZZ_REPORT) $(HOST_IMAGE_FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(FLASH_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(FLASH_FUZZ_REPORT) $(FLASH_FUZZ_TARGETS) || status=1; \
 	exit $${status:-0}
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
@@ -148,6 +159,11 @@ $(IMAGE_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/image/fuzz/
 
 $(HOST_IMAGE_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/image/fuzz/fuzz_%.cpp.o \
 		$(HOST_IMAGE_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lmbedcrypto
+
+$(FLASH_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/flash/fuzz/fuzz_%.cpp.o $(FLASH_FUZZ_LIBRARY_OBJS)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lmbedcrypto

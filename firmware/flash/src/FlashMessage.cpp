@@ -1,0 +1,317 @@
+#include <flash/FlashMessage.hpp>
+
+#include <image/Sha256.hpp>
+
+namespace flash {
+
+namespace {
+
+// Bounds-checked little-endian writing and reading of one message.
+class Writer {
+public:
+    Writer(uint8_t* out, size_t capacity) : out_(out), capacity_(capacity) {}
+
+    void u8(uint8_t value)
+    {
+        if (at_ < capacity_) {
+            out_[at_] = value;
+        }
+        ++at_;
+    }
+    void u16(uint16_t value)
+    {
+        u8(static_cast<uint8_t>(value));
+        u8(static_cast<uint8_t>(value >> 8));
+    }
+    void u32(uint32_t value)
+    {
+        u16(static_cast<uint16_t>(value));
+        u16(static_cast<uint16_t>(value >> 16));
+    }
+    void bytes(const uint8_t* data, size_t count)
+    {
+        for (size_t i = 0; i < count; ++i) {
+            u8(data != nullptr ? data[i] : 0);
+        }
+    }
+    void version(const image::ImageVersion& v)
+    {
+        u8(v.major);
+        u8(v.minor);
+        u16(v.patch);
+        u32(v.build);
+    }
+    size_t finish() const { return at_ <= capacity_ ? at_ : 0; }
+
+private:
+    uint8_t* out_;
+    size_t capacity_;
+    size_t at_ = 0;
+};
+
+class Reader {
+public:
+    Reader(const uint8_t* data, size_t length) : data_(data), length_(length) {}
+
+    uint8_t u8() { return at_ < length_ ? data_[at_++] : (++at_, 0); }
+    uint16_t u16()
+    {
+        const uint16_t low = u8();
+        return static_cast<uint16_t>(low | (u8() << 8));
+    }
+    uint32_t u32()
+    {
+        const uint32_t low = u16();
+        return low | (static_cast<uint32_t>(u16()) << 16);
+    }
+    void bytes(uint8_t* out, size_t count)
+    {
+        for (size_t i = 0; i < count; ++i) {
+            out[i] = u8();
+        }
+    }
+    const uint8_t* here() const { return at_ <= length_ ? data_ + at_ : nullptr; }
+    void skip(size_t count) { at_ += count; }
+    image::ImageVersion version()
+    {
+        image::ImageVersion v;
+        v.major = u8();
+        v.minor = u8();
+        v.patch = u16();
+        v.build = u32();
+        return v;
+    }
+    /// Every byte read, and none missing.
+    bool exact() const { return at_ == length_; }
+
+private:
+    const uint8_t* data_;
+    size_t length_;
+    size_t at_ = 0;
+};
+
+bool knownStatus(uint8_t value) { return value <= static_cast<uint8_t>(FlashStatus::Unsupported); }
+bool knownImageError(uint8_t value) { return value <= static_cast<uint8_t>(image::ImageError::Downgrade); }
+bool slotOrNone(uint8_t value) { return value < 2 || value == 0xFF; }
+
+} // namespace
+
+const char* flashStatusText(FlashStatus status)
+{
+    switch (status) {
+    case FlashStatus::Ok: return "done";
+    case FlashStatus::NotAuthenticated: return "the session is not authenticated";
+    case FlashStatus::AuthenticationFailed: return "authentication failed: the key is not trusted or the signature is wrong";
+    case FlashStatus::ImageRefused: return "the image is refused";
+    case FlashStatus::OutOfOrder: return "a block out of order";
+    case FlashStatus::BadBlockCrc: return "a block's CRC does not match its bytes";
+    case FlashStatus::CardError: return "the node's card cannot be read or written";
+    case FlashStatus::NoTransfer: return "no transfer in progress, or not every byte has arrived";
+    case FlashStatus::Malformed: return "a malformed request";
+    case FlashStatus::Unsupported: return "a request the node does not serve here";
+    }
+    return "unknown status";
+}
+
+size_t FlashMessage::encode(uint8_t* out, size_t capacity) const
+{
+    Writer w(out, capacity);
+    w.u8(static_cast<uint8_t>(type));
+    w.u8(tag);
+    switch (type) {
+    case MessageType::Hello:
+    case MessageType::End:
+        break;
+    case MessageType::Authenticate:
+        w.bytes(keyId, sizeof keyId);
+        w.bytes(signature, sizeof signature);
+        break;
+    case MessageType::Begin:
+        w.bytes(header, sizeof header);
+        break;
+    case MessageType::Data:
+        if (length > kMaxBlock) {
+            return 0;
+        }
+        w.u32(sequence);
+        w.u32(offset);
+        w.u16(length);
+        w.u32(crc);
+        w.bytes(bytes, length);
+        break;
+    case MessageType::Restart:
+        w.u8(static_cast<uint8_t>(target));
+        break;
+    case MessageType::HelloReply:
+        w.u8(protocol);
+        w.u8(static_cast<uint8_t>(mode));
+        w.u16(node);
+        w.u16(board);
+        w.bytes(challenge, sizeof challenge);
+        w.u8(confirmedSlot);
+        w.u8(trial);
+        w.u8(trialSlot);
+        for (int slotIndex = 0; slotIndex < 2; ++slotIndex) {
+            w.u8(slotHolds[slotIndex] ? 1 : 0);
+            w.version(slotVersion[slotIndex]);
+        }
+        w.u16(maxBlock);
+        break;
+    case MessageType::AuthenticateReply:
+    case MessageType::RestartReply:
+    case MessageType::ErrorReply:
+        w.u8(static_cast<uint8_t>(status));
+        break;
+    case MessageType::BeginReply:
+        w.u8(static_cast<uint8_t>(status));
+        w.u8(static_cast<uint8_t>(imageError));
+        w.u8(slot);
+        w.u32(offset);
+        break;
+    case MessageType::DataReply:
+        w.u8(static_cast<uint8_t>(status));
+        w.u32(offset);
+        break;
+    case MessageType::EndReply:
+        w.u8(static_cast<uint8_t>(status));
+        w.u8(static_cast<uint8_t>(imageError));
+        break;
+    }
+    return w.finish();
+}
+
+bool FlashMessage::decode(const uint8_t* data, size_t length, FlashMessage& out)
+{
+    if (data == nullptr || length < 2) {
+        return false;
+    }
+    Reader r(data, length);
+    FlashMessage m;
+    const uint8_t type = r.u8();
+    m.tag = r.u8();
+    uint8_t value = 0;
+    switch (type) {
+    case static_cast<uint8_t>(MessageType::Hello):
+    case static_cast<uint8_t>(MessageType::End):
+        break;
+    case static_cast<uint8_t>(MessageType::Authenticate):
+        r.bytes(m.keyId, sizeof m.keyId);
+        r.bytes(m.signature, sizeof m.signature);
+        break;
+    case static_cast<uint8_t>(MessageType::Begin):
+        r.bytes(m.header, sizeof m.header);
+        break;
+    case static_cast<uint8_t>(MessageType::Data):
+        m.sequence = r.u32();
+        m.offset = r.u32();
+        m.length = r.u16();
+        m.crc = r.u32();
+        if (m.length > kMaxBlock) {
+            return false;
+        }
+        m.bytes = r.here();
+        r.skip(m.length);
+        break;
+    case static_cast<uint8_t>(MessageType::Restart):
+        value = r.u8();
+        if (value > static_cast<uint8_t>(RestartTarget::Recovery)) {
+            return false;
+        }
+        m.target = static_cast<RestartTarget>(value);
+        break;
+    case static_cast<uint8_t>(MessageType::HelloReply):
+        m.protocol = r.u8();
+        value = r.u8();
+        if (value > static_cast<uint8_t>(NodeMode::Recovery)) {
+            return false;
+        }
+        m.mode = static_cast<NodeMode>(value);
+        m.node = r.u16();
+        m.board = r.u16();
+        r.bytes(m.challenge, sizeof m.challenge);
+        m.confirmedSlot = r.u8();
+        m.trial = r.u8();
+        m.trialSlot = r.u8();
+        for (int slotIndex = 0; slotIndex < 2; ++slotIndex) {
+            const uint8_t holds = r.u8();
+            if (holds > 1) {
+                return false;
+            }
+            m.slotHolds[slotIndex] = holds == 1;
+            m.slotVersion[slotIndex] = r.version();
+        }
+        m.maxBlock = r.u16();
+        if (!slotOrNone(m.confirmedSlot) || !slotOrNone(m.trialSlot) || m.trial > 2 || m.maxBlock == 0 ||
+            m.maxBlock > kMaxBlock) {
+            return false;
+        }
+        break;
+    case static_cast<uint8_t>(MessageType::AuthenticateReply):
+    case static_cast<uint8_t>(MessageType::RestartReply):
+    case static_cast<uint8_t>(MessageType::ErrorReply):
+        value = r.u8();
+        if (!knownStatus(value)) {
+            return false;
+        }
+        m.status = static_cast<FlashStatus>(value);
+        break;
+    case static_cast<uint8_t>(MessageType::BeginReply):
+        value = r.u8();
+        if (!knownStatus(value)) {
+            return false;
+        }
+        m.status = static_cast<FlashStatus>(value);
+        value = r.u8();
+        if (!knownImageError(value)) {
+            return false;
+        }
+        m.imageError = static_cast<image::ImageError>(value);
+        m.slot = r.u8();
+        m.offset = r.u32();
+        if (!slotOrNone(m.slot)) {
+            return false;
+        }
+        break;
+    case static_cast<uint8_t>(MessageType::DataReply):
+        value = r.u8();
+        if (!knownStatus(value)) {
+            return false;
+        }
+        m.status = static_cast<FlashStatus>(value);
+        m.offset = r.u32();
+        break;
+    case static_cast<uint8_t>(MessageType::EndReply):
+        value = r.u8();
+        if (!knownStatus(value)) {
+            return false;
+        }
+        m.status = static_cast<FlashStatus>(value);
+        value = r.u8();
+        if (!knownImageError(value)) {
+            return false;
+        }
+        m.imageError = static_cast<image::ImageError>(value);
+        break;
+    default:
+        return false;
+    }
+    if (!r.exact()) {
+        return false;
+    }
+    m.type = static_cast<MessageType>(type);
+    out = m;
+    return true;
+}
+
+void authenticationDigest(uint16_t node, const uint8_t (&challenge)[kChallengeSize], uint8_t (&digest)[32])
+{
+    static const uint8_t kDomain[] = {'D', 'C', 'O', 'S', '-', 'F', 'L', 'A', 'S', 'H', '-', '1'};
+    const uint8_t nodeBytes[2] = {static_cast<uint8_t>(node), static_cast<uint8_t>(node >> 8)};
+    image::Sha256 hash;
+    hash.update(kDomain, sizeof kDomain);
+    hash.update(nodeBytes, sizeof nodeBytes);
+    hash.update(challenge, kChallengeSize);
+    hash.finish(digest);
+}
+
+} // namespace flash
