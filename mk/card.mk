@@ -23,9 +23,11 @@ STAGE_SRCS := \
 	firmware/boot/loader/stage_entry.S \
 	firmware/boot/loader/StageLoader.cpp \
 	firmware/boot/src/BootState.cpp \
+	firmware/boot/src/CommandLine.cpp \
 	firmware/boot/src/ConfigurationBlock.cpp \
 	firmware/boot/src/Crc32.cpp \
 	$(ATA_DRIVER_PORTABLE_SRCS) \
+	$(FLASH_PORTABLE_SRCS) \
 	firmware/runtime/src/CxxRuntime.cpp \
 	firmware/runtime/src/Format.cpp \
 	firmware/runtime/src/Int64Division.cpp \
@@ -34,8 +36,10 @@ STAGE_SRCS := \
 STAGE_OBJS := $(call fw_objects,$(STAGE_SRCS)) $(FW_IMAGE_OBJS)
 STAGE_ELF := $(BUILD)/486/stage-loader.elf
 STAGE_BIN := $(BUILD)/486/stage-loader.bin
-$(call fw_objects,firmware/boot/loader/StageLoader.cpp): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS) $(FW_IMAGE_INCLUDES)
-$(call fw_objects,firmware/boot/loader/StageLoader.cpp): | $(MBEDTLS_FETCHED)
+# They include the image verifier's headers, and so mbedTLS's.
+STAGE_IMAGE_USER_OBJS := $(call fw_objects,firmware/boot/loader/StageLoader.cpp $(FLASH_PORTABLE_SRCS))
+$(STAGE_IMAGE_USER_OBJS): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS) $(FW_IMAGE_INCLUDES) -Ifirmware/flash/include
+$(STAGE_IMAGE_USER_OBJS): | $(MBEDTLS_FETCHED)
 
 DEVELOPMENT_KEY := $(BUILD)/keys/development.pem
 CARD_486 := $(BUILD)/486/card-486.img

@@ -18,6 +18,8 @@ HOSTMODBUS_CXXFLAGS := -Ihost_tools/modbus/include -I/usr/include/modbus -DTOML_
 # (host_tools/image), on Debian's mbedTLS.
 IMAGE_SRCS := $(wildcard firmware/image/src/*.cpp)
 HOSTIMAGE_SRCS := $(wildcard host_tools/image/src/*.cpp)
+# dcos-flash's link to a node (host_tools/flash), on the protocol's own code (firmware/flash).
+HOSTFLASH_SRCS := $(wildcard host_tools/flash/src/*.cpp)
 # The card's records, the firmware's own code (firmware/boot), which the
 # host's card tool writes and reads.
 BOOT_RECORD_SRCS := firmware/boot/src/BootState.cpp firmware/boot/src/ConfigurationBlock.cpp firmware/boot/src/Crc32.cpp
@@ -28,7 +30,8 @@ DCOS_MODBUS := $(HOST_TOOLS_BIN)/dcos-modbus
 DCOS_MODBUS_SIM := $(HOST_TOOLS_BIN)/dcos-modbus-sim
 DCOS_IMAGE := $(HOST_TOOLS_BIN)/dcos-image
 DCOS_CARD := $(HOST_TOOLS_BIN)/dcos-card
-HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE) $(DCOS_CARD)
+DCOS_FLASH := $(HOST_TOOLS_BIN)/dcos-flash
+HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE) $(DCOS_CARD) $(DCOS_FLASH)
 
 host-tools: $(HOST_TOOLS)
 
@@ -56,6 +59,12 @@ $(DCOS_MODBUS_SIM): $(BUILD)/host/host_tools/modbus/tools/dcos-modbus-sim.cpp.o 
 
 $(DCOS_IMAGE) $(DCOS_CARD): $(HOST_TOOLS_BIN)/%: $(BUILD)/host/host_tools/image/tools/%.cpp.o \
 	$(patsubst %,$(BUILD)/host/%.o,$(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS))
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto
+
+$(DCOS_FLASH): $(BUILD)/host/host_tools/flash/tools/dcos-flash.cpp.o \
+	$(patsubst %,$(BUILD)/host/%.o,$(HOSTFLASH_SRCS) $(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto

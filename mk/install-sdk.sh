@@ -25,6 +25,8 @@
 #   bin/dcos-modbus              read and write a Modbus RTU slave (docs/guide/modbus-host.md)
 #   bin/dcos-modbus-sim          a simulated Modbus RTU slave declared in a TOML file (likewise)
 #   bin/dcos-image               signing keys, signed controller images (docs/guide/signing-images.md)
+#   bin/dcos-card                controller cards: create, write a slot, show (likewise)
+#   bin/dcos-flash               flash a controller over its serial line (docs/guide/flashing.md)
 #   share/dcos/modbus/           dcos-modbus-sim's example files: a drive, a sensor
 #   libexec/dcos/                the emulator built with the DCOS board models
 #

@@ -87,10 +87,14 @@ class Emulator:
         self.argv = command
         with open(self._stderr_path, "wb") as stderr:
             self._process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=stderr, stderr=stderr)
+        self._connect_console(timeout)
+        return self
+
+    def _connect_console(self, timeout):
         deadline = time.monotonic() + timeout
         while True:
             if self._process.poll() is not None:
-                raise EmulatorError(f"emulator exited at start with status {self._process.returncode}:\n"
+                raise EmulatorError(f"emulator exited with status {self._process.returncode}:\n"
                                     + self.emulator_messages())
             try:
                 sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
@@ -101,10 +105,33 @@ class Emulator:
                 if time.monotonic() > deadline:
                     raise EmulatorError("emulator console socket never appeared") from None
                 time.sleep(0.02)
+        with self._condition:
+            self._closed = False
         self._socket = sock
         self._reader = threading.Thread(target=self._read_console, daemon=True)
         self._reader.start()
-        return self
+
+    @property
+    def console_socket_path(self):
+        """The Unix socket the board's console (COM1) is served on."""
+        return self._socket_path
+
+    def release_console(self):
+        """Lets another program have the console: the harness disconnects.
+
+        The emulator serves the console socket again for the next client (a
+        host tool such as dcos-flash, then reattach_console()); what the
+        board prints while nobody is connected is lost.
+        """
+        self._socket.shutdown(socket.SHUT_RDWR)
+        self._socket.close()
+        self._reader.join(timeout=5)
+        self._socket = None
+        self._reader = None
+
+    def reattach_console(self, timeout=DEFAULT_TIMEOUT):
+        """Connects the harness to the console again after release_console()."""
+        self._connect_console(timeout)
 
     def serial_socket_path(self, port):
         """The Unix socket the emulator serves serial port @p port on (see serial_sockets)."""

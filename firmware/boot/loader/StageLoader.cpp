@@ -12,10 +12,13 @@
 // card by ATA PIO (drivers/ata). Every message starts with "stage: ", so a
 // test or an engineer tells it from the kernel's.
 #include <ata/AtaPioDisk.hpp>
+#include <boot/BootInfo.hpp>
 #include <boot/BootPlanner.hpp>
 #include <boot/BootState.hpp>
 #include <boot/CardLayout.hpp>
 #include <boot/ConfigurationBlock.hpp>
+#include <flash/FlashSession.hpp>
+#include <flash/SerialFramer.hpp>
 #include <image/ImageVerifier.hpp>
 
 #include <arch_x86/PortIo.hpp>
@@ -37,8 +40,27 @@ namespace card = boot::card;
 // The 16550's ports (PC/AT COM1) and the line status bit that says the
 // transmitter holds no character (16550D data sheet, LSR bit 5, THRE).
 constexpr uint16_t kCom1 = 0x3F8;
+constexpr uint16_t kCom1InterruptEnable = kCom1 + 1;
+constexpr uint16_t kCom1FifoControl = kCom1 + 2;
+constexpr uint16_t kCom1LineControl = kCom1 + 3;
+constexpr uint16_t kCom1ModemControl = kCom1 + 4;
 constexpr uint16_t kCom1LineStatus = kCom1 + 5;
-constexpr uint8_t kTransmitterEmpty = 0x20;
+constexpr uint8_t kDataReady = 0x01;        // LSR bit 0, DR
+constexpr uint8_t kTransmitterEmpty = 0x20; // LSR bit 5, THRE
+constexpr uint8_t kTransmitterIdle = 0x40;  // LSR bit 6, TEMT: the last stop bit has left
+
+// 115200 bit/s 8N1, FIFOs on, no interrupts: what the kernel's console
+// uses too, so one terminal sees both (16550D data sheet, Tables 2 to 4).
+void setUpConsole()
+{
+    portWrite8(kCom1InterruptEnable, 0x00);
+    portWrite8(kCom1LineControl, 0x80); // DLAB
+    portWrite8(kCom1 + 0, 0x01);        // divisor 1: 115200 bit/s from 1.8432 MHz
+    portWrite8(kCom1 + 1, 0x00);
+    portWrite8(kCom1LineControl, 0x03); // 8 data bits, no parity, 1 stop bit
+    portWrite8(kCom1FifoControl, 0x07); // FIFOs on and cleared
+    portWrite8(kCom1ModemControl, 0x03); // DTR, RTS
+}
 
 class StageConsole final : public runtime::CharacterSink {
 public:
@@ -255,7 +277,15 @@ const char loaderName[] = "DCOS stage loader";
     image.version.format(version, sizeof version);
     // The kernel learns where it came from on its command line: the
     // configuration's own line, then the boot's facts (docs/boot.md).
-    runtime::formatToBuffer(commandLine, sizeof commandLine, "%s%sboot.slot=%s boot.version=%s%s%s",
+    // The configuration's node id reaches the kernel as "node=" unless its
+    // command line names one itself.
+    char nodeText[16] = {};
+    char ignored[8];
+    if (configuration.nodeId != 0 &&
+        !boot::findCommandLineOption(configuration.commandLine, "node", ignored, sizeof ignored)) {
+        runtime::formatToBuffer(nodeText, sizeof nodeText, "node=%u ", static_cast<unsigned>(configuration.nodeId));
+    }
+    runtime::formatToBuffer(commandLine, sizeof commandLine, "%s%s%sboot.slot=%s boot.version=%s%s%s", nodeText,
                             configuration.commandLine, configuration.commandLine[0] != '\0' ? " " : "",
                             card::slotName(slot), version, trial ? " boot.trial=1" : "",
                             reverted ? " boot.reverted=1" : "");
@@ -275,11 +305,138 @@ const char loaderName[] = "DCOS stage loader";
     __builtin_unreachable();
 }
 
+// The node id, as the kernel will take it: the configuration's, else
+// "node=" on the configuration's command line, else 1 (the kernel's default).
+uint16_t nodeId()
+{
+    if (configuration.nodeId != 0) {
+        return configuration.nodeId;
+    }
+    char text[8];
+    unsigned long value = 0;
+    if (boot::findCommandLineOption(configuration.commandLine, "node", text, sizeof text)) {
+        for (const char* digit = text; *digit >= '0' && *digit <= '9'; ++digit) {
+            value = value * 10 + static_cast<unsigned long>(*digit - '0');
+        }
+    }
+    return value != 0 && value < 0xFFFF ? static_cast<uint16_t>(value) : 1;
+}
+
+// The card as the flash session writes it, through the ATA driver.
+class CardStore final : public flash::FlashStore {
+public:
+    explicit CardStore(ata::AtaPioDisk& disk) : disk_(disk) {}
+    bool read(uint32_t lba, uint32_t count, void* buffer) override
+    {
+        return disk_.read(lba, count, buffer) == ata::AtaError::Ok;
+    }
+    bool write(uint32_t lba, uint32_t count, const void* buffer) override
+    {
+        return disk_.write(lba, count, buffer) == ata::AtaError::Ok;
+    }
+
+private:
+    ata::AtaPioDisk& disk_;
+};
+
+// What makes this start's challenges its own: the real-time clock's time
+// and date, the 8254's count, and the boot state's sequence. Not secret:
+// the flash protocol's challenge only has to be new (docs/protocols/flash.md).
+void challengeSeed(uint8_t (&seed)[12], uint32_t sequence)
+{
+    static constexpr uint8_t kClockRegisters[] = {0x00, 0x02, 0x04, 0x07, 0x08, 0x09};
+    for (size_t i = 0; i < sizeof kClockRegisters; ++i) {
+        portWrite8(0x70, static_cast<uint8_t>(0x80 | kClockRegisters[i]));
+        seed[i] = portRead8(0x71);
+    }
+    portWrite8(0x43, 0x00); // latch counter 0
+    seed[6] = portRead8(0x40);
+    seed[7] = portRead8(0x40);
+    for (int i = 0; i < 4; ++i) {
+        seed[8 + i] = static_cast<uint8_t>(sequence >> (8 * i));
+    }
+}
+
+// The real-time clock's seconds register (MC146818, register 0): it moves
+// once a second, which is all the recovery loop needs of a clock.
+uint8_t clockSecond()
+{
+    portWrite8(0x70, 0x80 | 0x00);
+    return portRead8(0x71);
+}
+
+// Restarts the board: the keyboard controller pulses the processor's reset
+// line (8042 command 0xFE, IBM PC/AT Technical Reference).
+[[noreturn]] void resetBoard()
+{
+    for (unsigned poll = 0; poll < 100000 && (portRead8(kCom1LineStatus) & kTransmitterIdle) == 0; ++poll) {
+    }
+    for (unsigned poll = 0; poll < 100000 && (portRead8(0x64) & 0x02) != 0; ++poll) {
+    }
+    portWrite8(0x64, 0xFE);
+    halt();
+}
+
+ata::AtaPioDisk* recoveryDisk = nullptr;
+uint32_t recoveryMemoryEnd = 16u << 20;
+uint32_t recoverySequence = 0;
+
+// Recovery: the stage loader serves the flash protocol on COM1 (framed,
+// so the console's text around it does not matter) until a host has put
+// a verified image on the card and asks for a restart, which boots it as a
+// trial. Without a card or a trusted key there is nothing to serve.
 [[noreturn]] void recovery(const char* why)
 {
     say("recovery: %s", why);
-    say("recovery: no image can be received here yet; write one to the card with dcos-card");
-    halt();
+    if (recoveryDisk == nullptr || trustedKeyCount == 0) {
+        say("recovery: no card or no trusted key: halted");
+        halt();
+    }
+    say("recovery: waiting for an image on this serial line (dcos-flash)");
+    CardStore store(*recoveryDisk);
+    flash::SessionIdentity identity;
+    identity.node = nodeId();
+    identity.board = image::BoardType::Isa486;
+    identity.mode = flash::NodeMode::Recovery;
+    identity.memoryEnd = recoveryMemoryEnd;
+    uint8_t seed[12];
+    challengeSeed(seed, recoverySequence);
+    // On the stack: this function never returns, and the boot sector's
+    // stack below 0x90000 has room above the stage loader's memory.
+    flash::FlashSession session(store, trustedKeys, trustedKeyCount, identity, seed, sizeof seed);
+    flash::SerialFramer receiver;
+    uint8_t reply[flash::kMaxMessage];
+    uint8_t framed[flash::kMaxMessage + flash::SerialFramer::kOverhead];
+    // A frame left unfinished for two ticks of the real-time clock's
+    // seconds (one to two seconds) is abandoned: its sender went away.
+    uint8_t lastSecond = clockSecond();
+    unsigned silentSeconds = 0;
+    for (;;) {
+        if ((portRead8(kCom1LineStatus) & kDataReady) == 0) {
+            const uint8_t second = clockSecond();
+            if (second != lastSecond) {
+                lastSecond = second;
+                if (receiver.inFrame() && ++silentSeconds >= 2) {
+                    receiver.reset();
+                    silentSeconds = 0;
+                }
+            }
+            continue;
+        }
+        silentSeconds = 0;
+        if (!receiver.receive(portRead8(kCom1))) {
+            continue;
+        }
+        const size_t length = session.handle(receiver.payload(), receiver.payloadLength(), reply, sizeof reply);
+        const size_t frameLength = flash::SerialFramer::frame(reply, length, framed, sizeof framed);
+        for (size_t i = 0; i < frameLength; ++i) {
+            console.put(static_cast<char>(framed[i]));
+        }
+        flash::RestartTarget target{};
+        if (session.restartRequested(target)) {
+            resetBoard();
+        }
+    }
 }
 
 } // namespace
@@ -298,12 +455,14 @@ extern "C" [[noreturn]] void dcosPanic(const char* format, ...)
 
 extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
 {
+    setUpConsole();
     say("DCOS stage loader %s, from BIOS drive 0x%02lx", dcos::versionString, static_cast<unsigned long>(bootDrive));
     if (!enableA20()) {
         recovery("the A20 gate cannot be enabled: no memory above 1 MiB");
     }
     const uint32_t upperKib = extendedMemoryKib();
     const uint32_t memoryEnd = (1u << 20) + upperKib * 1024u;
+    recoveryMemoryEnd = memoryEnd;
 
     ata::AtaPioDisk disk = ata::AtaPioDisk::primary();
     const ata::AtaError identified = disk.identify();
@@ -311,6 +470,7 @@ extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
         recovery(ata::ataErrorText(identified));
     }
     say("card: %s, %lu sectors", disk.model(), static_cast<unsigned long>(disk.sectorCount()));
+    recoveryDisk = &disk;
     if (disk.sectorCount() < card::kMinimumCardSectors) {
         recovery("the card is smaller than the layout needs");
     }
@@ -333,6 +493,7 @@ extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
     unsigned stateCopy = 0;
     const bool haveState = readRecordCopies(disk, card::kBootStateLba) &&
                            boot::BootState::newest(sectorA, sectorB, stored, stateCopy);
+    recoverySequence = haveState ? stored.sequence : 0;
     if (haveState) {
         say("boot state %lu: confirmed slot %s, trial %s%s", static_cast<unsigned long>(stored.sequence),
             card::slotName(stored.confirmedSlot),

@@ -240,6 +240,9 @@ FlashStatus FlashSession::data(const FlashMessage& request, FlashMessage& reply)
 
 FlashStatus FlashSession::end(FlashMessage& reply)
 {
+    if (!transferring_ && transferComplete_) {
+        return FlashStatus::Ok; // A repeated End: its reply was lost.
+    }
     if (!transferring_ || progress_ != header_.payloadSize) {
         return FlashStatus::NoTransfer;
     }

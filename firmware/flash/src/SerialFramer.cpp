@@ -40,6 +40,15 @@ size_t SerialFramer::frame(const uint8_t* payload, size_t length, uint8_t* out, 
     return length + kOverhead;
 }
 
+void SerialFramer::reset()
+{
+    if (state_ != State::Sync0) {
+        ++dropped_;
+    }
+    state_ = State::Sync0;
+    at_ = 0;
+}
+
 bool SerialFramer::receive(uint8_t byte)
 {
     switch (state_) {

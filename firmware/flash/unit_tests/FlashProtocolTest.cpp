@@ -117,6 +117,26 @@ TEST(SerialFramerTest, FindsFramesInNoiseAndDropsDamagedOnes)
     EXPECT_EQ(flash::SerialFramer::frame(payload, 0, frame, sizeof frame), 0u);
 }
 
+TEST(SerialFramerTest, AResetAbandonsAFrameASenderLeftUnfinished)
+{
+    const uint8_t payload[5] = {1, 2, 3, 4, 5};
+    uint8_t frame[64];
+    const size_t length = flash::SerialFramer::frame(payload, sizeof payload, frame, sizeof frame);
+    flash::SerialFramer receiver;
+    for (size_t i = 0; i < 6; ++i) {
+        EXPECT_FALSE(receiver.receive(frame[i]));
+    }
+    EXPECT_TRUE(receiver.inFrame());
+    receiver.reset();
+    EXPECT_FALSE(receiver.inFrame());
+    EXPECT_EQ(receiver.dropped(), 1u);
+    bool completed = false;
+    for (size_t i = 0; i < length; ++i) {
+        completed = receiver.receive(frame[i]);
+    }
+    EXPECT_TRUE(completed) << "the next frame whole";
+}
+
 // -- a session against a card in memory --------------------------------------
 
 class MemoryCard final : public flash::FlashStore {
@@ -309,6 +329,9 @@ TEST_F(FlashSessionTest, AWholeSessionLeavesAVerifiedImagePendingInTheSlot)
     EXPECT_EQ(started.offset, 0u);
     EXPECT_EQ(sendAll(image).offset, 5000u);
     ASSERT_EQ(simple(MessageType::End).status, FlashStatus::Ok);
+    const unsigned writes = store.writes;
+    EXPECT_EQ(simple(MessageType::End).status, FlashStatus::Ok) << "a repeated End, its reply lost";
+    EXPECT_EQ(store.writes, writes) << "and nothing written twice";
     const std::optional<boot::BootState> state = store.state();
     ASSERT_TRUE(state.has_value());
     EXPECT_EQ(state->trial, boot::TrialState::Pending);

@@ -29,6 +29,13 @@ public:
     /// payload is then payload()/payloadLength() until the next byte.
     bool receive(uint8_t byte);
 
+    /// Abandons a frame begun but not finished (counted as dropped): the
+    /// receiver's owner calls it when the line has been silent too long,
+    /// so that a sender that died mid-frame does not swallow the next one.
+    void reset();
+    /// True while a frame is begun but not finished.
+    bool inFrame() const { return state_ != State::Sync0; }
+
     const uint8_t* payload() const { return buffer_; }
     size_t payloadLength() const { return length_; }
     /// Frames dropped for a bad length or CRC since construction.

@@ -1,0 +1,374 @@
+// dcos-flash: put a signed image on a controller over its serial line
+// (docs/guide/flashing.md, docs/protocols/flash.md).
+//
+//     dcos-flash -d DEVICE -k KEY.pem [-n NODE] IMAGE.dcos [--no-restart]
+//     dcos-flash -d DEVICE info
+//
+// DEVICE is a serial device (/dev/ttyUSB0, 115200 bit/s 8N1) or a Unix
+// socket (unix:/path, the emulated board's console). The session is
+// authenticated with KEY.pem, a signing key the node's card trusts. The
+// transfer resumes by itself where an interrupted one stopped, if the node
+// still holds it. After the image is verified on the node and marked
+// pending, the node restarts into it as a trial (unless --no-restart); the
+// image must then confirm (boot confirm), or the node reverts.
+//
+// Every command takes --json. Exit status: 0 done; 1 refused by the node
+// (authentication, the image, the node id), with the reason; 2 bad
+// arguments; 3 the device or a file is not available; 4 the link failed (no
+// answer, the line closed) or the key is not P-256.
+#include <hostflash/FlashLink.hpp>
+
+#include <hostimage/SigningKey.hpp>
+#include <hostimage/ToolFiles.hpp>
+
+#include <boot/Crc32.hpp>
+#include <flash/FlashMessage.hpp>
+#include <image/ImageHeader.hpp>
+
+#include <dcos/Version.hpp>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace {
+
+using flash::FlashMessage;
+using flash::FlashStatus;
+using flash::MessageType;
+using hostflash::LinkError;
+
+constexpr int kExitOk = 0;
+constexpr int kExitRefused = 1;
+constexpr int kExitUsage = 2;
+constexpr int kExitNotAvailable = 3;
+constexpr int kExitFailed = 4;
+
+int fail(int code, const std::string& message)
+{
+    fmt::print(stderr, "dcos-flash: {}\n", message);
+    return code;
+}
+
+struct Options {
+    std::string device;
+    std::string key;
+    std::string image;
+    int node = -1;
+    bool noRestart = false;
+    long timeoutMs = 2000;
+    int retries = 3;
+    bool json = false;
+};
+
+// One request and its reply, sent again on silence up to the retry count.
+class Conversation {
+public:
+    Conversation(hostflash::FlashLink& link, const Options& options) : link_(link), options_(options) {}
+
+    std::optional<FlashMessage> ask(FlashMessage request, std::string& why)
+    {
+        request.tag = ++tag_;
+        for (int attempt = 0; attempt <= options_.retries; ++attempt) {
+            FlashMessage reply;
+            const LinkError error = link_.exchange(request, reply, std::chrono::milliseconds(options_.timeoutMs), why);
+            if (error == LinkError::None) {
+                if (reply.type == MessageType::ErrorReply) {
+                    why = fmt::format("the node could not read a request: {}", flash::flashStatusText(reply.status));
+                    return std::nullopt;
+                }
+                return reply;
+            }
+            if (error != LinkError::Timeout) {
+                return std::nullopt;
+            }
+            ++retransmissions_;
+        }
+        why = fmt::format("no answer from the node after {} attempts", options_.retries + 1);
+        return std::nullopt;
+    }
+
+    unsigned retransmissions() const { return retransmissions_; }
+
+private:
+    hostflash::FlashLink& link_;
+    const Options& options_;
+    uint8_t tag_ = 0;
+    unsigned retransmissions_ = 0;
+};
+
+std::string versionOf(const FlashMessage& hello, int slot)
+{
+    return hello.slotHolds[slot] ? hostimage::versionText(hello.slotVersion[slot]) : std::string("empty");
+}
+
+const char* slotText(uint8_t slot) { return slot == 0 ? "A" : slot == 1 ? "B" : "none"; }
+
+nlohmann::json helloJson(const FlashMessage& hello)
+{
+    static const char* trials[] = {"none", "pending", "booting"};
+    return {{"node", hello.node},
+            {"mode", hello.mode == flash::NodeMode::Recovery ? "recovery" : "application"},
+            {"protocol", hello.protocol},
+            {"confirmed", slotText(hello.confirmedSlot)},
+            {"trial", hello.trial <= 2 ? trials[hello.trial] : "?"},
+            {"trial_slot", slotText(hello.trialSlot)},
+            {"slot_a", versionOf(hello, 0)},
+            {"slot_b", versionOf(hello, 1)}};
+}
+
+std::optional<FlashMessage> sayHello(Conversation& conversation, int& code)
+{
+    FlashMessage request;
+    request.type = MessageType::Hello;
+    std::string why;
+    std::optional<FlashMessage> reply = conversation.ask(request, why);
+    if (!reply || reply->type != MessageType::HelloReply) {
+        code = fail(kExitFailed, reply ? "the node answered Hello with something else" : why);
+        return std::nullopt;
+    }
+    if (reply->protocol != flash::kProtocolVersion) {
+        code = fail(kExitRefused, fmt::format("the node speaks flash protocol {}, this tool {}", reply->protocol,
+                                              flash::kProtocolVersion));
+        return std::nullopt;
+    }
+    return reply;
+}
+
+int info(Conversation& conversation, const Options& options)
+{
+    int code = kExitOk;
+    const std::optional<FlashMessage> hello = sayHello(conversation, code);
+    if (!hello) {
+        return code;
+    }
+    const nlohmann::json out = helloJson(*hello);
+    if (options.json) {
+        fmt::print("{}\n", out.dump());
+        return kExitOk;
+    }
+    fmt::print("node          {} ({})\n", hello->node, out["mode"].get<std::string>());
+    fmt::print("slot A        {}\n", out["slot_a"].get<std::string>());
+    fmt::print("slot B        {}\n", out["slot_b"].get<std::string>());
+    fmt::print("confirmed     {}\n", out["confirmed"].get<std::string>());
+    fmt::print("trial         {}{}\n", out["trial"].get<std::string>(),
+               hello->trialSlot <= 1 ? fmt::format(" in slot {}", slotText(hello->trialSlot)) : "");
+    return kExitOk;
+}
+
+void showProgress(uint32_t done, uint32_t total, double seconds)
+{
+    const double rate = seconds > 0 ? done / seconds : 0;
+    const double left = rate > 0 ? (total - done) / rate : 0;
+    const int width = 30;
+    const int filled = total != 0 ? static_cast<int>(width * static_cast<double>(done) / total) : width;
+    fmt::print(stderr, "\r[{}{}] {:3}% {} of {} KiB, {:.1f} KiB/s, {}:{:02} left ", std::string(filled, '#'),
+               std::string(width - filled, '.'), total != 0 ? done * 100 / total : 100, done / 1024, total / 1024,
+               rate / 1024, static_cast<int>(left) / 60, static_cast<int>(left) % 60);
+}
+
+int flashImage(Conversation& conversation, const Options& options)
+{
+    std::string error;
+    const std::optional<std::vector<uint8_t>> image = hostimage::readWholeFile(options.image, error);
+    if (!image) {
+        return fail(kExitNotAvailable, error);
+    }
+    const image::ImageResult<image::ImageHeader> header = image::ImageHeader::decode(image->data(), image->size());
+    if (!header.ok() || image->size() != image::ImageHeader::kSize + header.value().payloadSize) {
+        return fail(kExitRefused, fmt::format("{}: {}", options.image,
+                                              image::imageErrorText(header.ok() ? image::ImageError::Truncated
+                                                                                : header.error())));
+    }
+    const std::optional<std::vector<uint8_t>> pem = hostimage::readWholeFile(options.key, error);
+    if (!pem) {
+        return fail(kExitNotAvailable, error);
+    }
+    const std::optional<hostimage::SigningKey> key =
+        hostimage::SigningKey::fromPem(std::string(pem->begin(), pem->end()), error);
+    if (!key) {
+        return fail(kExitFailed, fmt::format("{}: {}", options.key, error));
+    }
+
+    int code = kExitOk;
+    const std::optional<FlashMessage> hello = sayHello(conversation, code);
+    if (!hello) {
+        return code;
+    }
+    if (options.node >= 0 && hello->node != options.node) {
+        return fail(kExitRefused, fmt::format("the device reaches node {}, not node {}", hello->node, options.node));
+    }
+
+    // The challenge, signed: the node's proof that this session may write its card.
+    FlashMessage authenticate;
+    authenticate.type = MessageType::Authenticate;
+    uint8_t digest[32];
+    flash::authenticationDigest(hello->node, hello->challenge, digest);
+    const image::TrustedKey keyId = hostimage::trustedKeyOf(key->publicPoint());
+    std::copy(std::begin(keyId.id), std::end(keyId.id), authenticate.keyId);
+    if (!key->sign(digest, authenticate.signature, error)) {
+        return fail(kExitFailed, error);
+    }
+    std::optional<FlashMessage> reply = conversation.ask(authenticate, error);
+    if (!reply) {
+        return fail(kExitFailed, error);
+    }
+    if (reply->status != FlashStatus::Ok) {
+        return fail(kExitRefused, fmt::format("node {}: {}", hello->node, flash::flashStatusText(reply->status)));
+    }
+
+    FlashMessage begin;
+    begin.type = MessageType::Begin;
+    std::copy(image->begin(), image->begin() + image::ImageHeader::kSize, begin.header);
+    reply = conversation.ask(begin, error);
+    if (!reply) {
+        return fail(kExitFailed, error);
+    }
+    if (reply->status != FlashStatus::Ok) {
+        return fail(kExitRefused, fmt::format("node {}: {}{}", hello->node, flash::flashStatusText(reply->status),
+                                              reply->status == FlashStatus::ImageRefused
+                                                  ? fmt::format(": {}", image::imageErrorText(reply->imageError))
+                                                  : ""));
+    }
+    const uint8_t slot = reply->slot;
+    const uint32_t total = header.value().payloadSize;
+    const uint32_t resumedFrom = reply->offset;
+    const uint32_t block = hello->maxBlock;
+    if (resumedFrom > total || resumedFrom % block != 0) {
+        return fail(kExitFailed, fmt::format("the node resumes at {}, which is no block of this image", resumedFrom));
+    }
+    const bool progress = !options.json && isatty(STDERR_FILENO) != 0;
+    const auto started = std::chrono::steady_clock::now();
+    for (uint32_t offset = resumedFrom; offset < total;) {
+        const uint32_t length = total - offset < block ? total - offset : block;
+        FlashMessage data;
+        data.type = MessageType::Data;
+        data.sequence = offset / block;
+        data.offset = offset;
+        data.length = static_cast<uint16_t>(length);
+        data.bytes = image->data() + image::ImageHeader::kSize + offset;
+        data.crc = boot::crc32(data.bytes, length);
+        reply = conversation.ask(data, error);
+        if (!reply) {
+            if (progress) {
+                fmt::print(stderr, "\n");
+            }
+            return fail(kExitFailed, fmt::format("{} after {} of {} bytes (run again to resume)", error, offset, total));
+        }
+        if (reply->status == FlashStatus::OutOfOrder && reply->offset == offset + length) {
+            reply->status = FlashStatus::Ok; // Our retransmission of a block the node had taken.
+        }
+        if (reply->status != FlashStatus::Ok) {
+            if (progress) {
+                fmt::print(stderr, "\n");
+            }
+            return fail(kExitRefused, fmt::format("node {} at byte {}: {}", hello->node, offset,
+                                                  flash::flashStatusText(reply->status)));
+        }
+        offset = reply->offset;
+        if (progress) {
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+            showProgress(offset - resumedFrom, total - resumedFrom, seconds);
+        }
+    }
+    if (progress) {
+        fmt::print(stderr, "\n");
+    }
+    FlashMessage end;
+    end.type = MessageType::End;
+    reply = conversation.ask(end, error);
+    if (!reply) {
+        return fail(kExitFailed, error);
+    }
+    if (reply->status != FlashStatus::Ok) {
+        return fail(kExitRefused, fmt::format("node {}: {}{}", hello->node, flash::flashStatusText(reply->status),
+                                              reply->status == FlashStatus::ImageRefused
+                                                  ? fmt::format(": {}", image::imageErrorText(reply->imageError))
+                                                  : ""));
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    bool restarted = false;
+    if (!options.noRestart) {
+        FlashMessage restart;
+        restart.type = MessageType::Restart;
+        reply = conversation.ask(restart, error);
+        if (!reply) {
+            return fail(kExitFailed, error);
+        }
+        if (reply->status != FlashStatus::Ok) {
+            return fail(kExitRefused, fmt::format("node {}: {}", hello->node, flash::flashStatusText(reply->status)));
+        }
+        restarted = true;
+    }
+    const std::string version = hostimage::versionText(header.value().version);
+    if (options.json) {
+        fmt::print("{}\n", nlohmann::json{{"node", hello->node},
+                                          {"slot", slotText(slot)},
+                                          {"version", version},
+                                          {"bytes", total},
+                                          {"resumed_from", resumedFrom},
+                                          {"seconds", seconds},
+                                          {"retransmissions", conversation.retransmissions()},
+                                          {"pending", true},
+                                          {"restarted", restarted}}
+                               .dump());
+    } else {
+        fmt::print("node {}: {} written to slot {}{}, verified, pending\n", hello->node, version, slotText(slot),
+                   resumedFrom != 0 ? fmt::format(" (resumed at byte {})", resumedFrom) : "");
+        fmt::print("{}\n", restarted ? "restarted into the trial: confirm it on the node ('boot confirm') within "
+                                       "the watchdog's 30 s, or it reverts"
+                                     : "not restarted (--no-restart): the next start tries it");
+    }
+    return kExitOk;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"dcos-flash: put a signed image on a controller over its serial line", "dcos-flash"};
+    app.set_version_flag("--version", std::string("dcos-flash ") + dcos::versionString);
+    app.footer("exit status: 0 done, 1 refused by the node, 2 bad arguments, 3 device or file not available, "
+               "4 link failed or key not P-256\n"
+               "devices: /dev/ttyUSB0 (115200 bit/s 8N1), unix:/path (the emulated board's console)");
+    Options options;
+    app.add_option("-d,--device", options.device, "the node's serial line")->required();
+    app.add_option("-k,--key", options.key, "a signing key the node's card trusts (PEM)");
+    app.add_option("-n,--node", options.node, "the node id expected at the other end")->check(CLI::Range(0, 0xFFFE));
+    app.add_option("--timeout-ms", options.timeoutMs, "how long to wait for each answer")
+        ->check(CLI::Range(10L, 600000L));
+    app.add_option("--retries", options.retries, "how often to send a request again on silence")
+        ->check(CLI::Range(0, 100));
+    app.add_flag("--no-restart", options.noRestart, "leave the image pending without restarting the node");
+    app.add_flag("--json", options.json, "machine-readable output: one JSON object");
+    app.add_option("image", options.image, "the signed image to flash (dcos-image sign)");
+    CLI::App* infoCommand = app.add_subcommand("info", "show the node's slots, versions and boot state");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& error) {
+        const int code = app.exit(error);
+        return code == 0 ? kExitOk : kExitUsage;
+    }
+    if (!*infoCommand && (options.image.empty() || options.key.empty())) {
+        return fail(kExitUsage, "flashing needs an image and -k KEY.pem (or the 'info' command)");
+    }
+    LinkError error = LinkError::None;
+    std::string why;
+    const std::unique_ptr<hostflash::FlashLink> link = hostflash::FlashLink::open(options.device, error, why);
+    if (!link) {
+        return fail(error == LinkError::BadArgument ? kExitUsage
+                    : error == LinkError::NotAvailable ? kExitNotAvailable
+                                                       : kExitFailed,
+                    why);
+    }
+    Conversation conversation(*link, options);
+    return *infoCommand ? info(conversation, options) : flashImage(conversation, options);
+}
