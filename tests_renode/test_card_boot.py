@@ -4,47 +4,14 @@ the slots' signed images and starts one. Each test makes its own card with
 dcos-card from the built boot sector, stage loader and development key
 (mk/card.mk), so what is on the card is what the test says.
 """
-import json
 import os
 import re
 import subprocess
 import time
 
-from dcoslab.board import REPOSITORY
+from dcoslab.cards import BIN, BUILT, DEVELOPMENT_KEY, SECTOR, SLOT_LBA, card_state, new_card, signed, tool
 
-BIN = os.path.join(REPOSITORY, "build", "host_tools", "bin")
-BUILT = os.path.join(REPOSITORY, "build", "486")
-DEVELOPMENT_KEY = os.path.join(REPOSITORY, "build", "keys", "development.pem")
 FIRMWARE = os.path.join(BUILT, "dcos486.elf")
-
-SLOT_LBA = {"A": 2048, "B": 6144}
-SECTOR = 512
-
-
-def tool(name, *arguments):
-    result = subprocess.run([os.path.join(BIN, name), *arguments], capture_output=True, text=True, timeout=60)
-    assert result.returncode == 0, f"{name} {' '.join(arguments)}: exit {result.returncode}\n{result.stdout}{result.stderr}"
-    return result.stdout
-
-
-def signed(tmp_path, version, key=DEVELOPMENT_KEY):
-    path = tmp_path / f"dcos486-{version}.dcos"
-    tool("dcos-image", "sign", "-k", key, "--board", "isa486", "--version", version, "-o", str(path), FIRMWARE)
-    return str(path)
-
-
-def new_card(tmp_path, *slots, append="node=3"):
-    """A card trusting the development key, with (slot, image, pending) written in order."""
-    path = tmp_path / "card.img"
-    tool("dcos-card", "create", "-o", str(path), "--boot-sector", os.path.join(BUILT, "boot-sector.bin"),
-         "--stage", os.path.join(BUILT, "stage-loader.bin"), "-p", DEVELOPMENT_KEY + ".pub", "--append", append)
-    for slot, image, pending in slots:
-        tool("dcos-card", "write", str(path), "--slot", slot, image, *(["--pending"] if pending else []))
-    return str(path)
-
-
-def card_state(path):
-    return json.loads(tool("dcos-card", "--json", "show", path))
 
 
 def flip_payload_byte(path, slot, offset):
@@ -57,13 +24,14 @@ def flip_payload_byte(path, slot, offset):
 
 def test_the_board_boots_its_card_through_the_bios_and_the_stage_loader(boot, isa486, tmp_path):
     card = new_card(tmp_path, ("A", signed(tmp_path, "1.0.0+1"), False))
-    assert card_state(card)["boot_state"] is None
+    # dcos-card confirms the image it writes to a card that confirms nothing yet.
+    assert card_state(card)["boot_state"]["confirmed"] == "A"
     emulator = boot(isa486, card=card)
     emulator.expect(r"stage: DCOS stage loader")
     emulator.expect(r"stage: configuration 1: 1 trusted key")
-    emulator.expect(r"stage: no boot state on the card: a new card")
+    emulator.expect(r"stage: boot state 1: confirmed slot A, trial none")
     emulator.expect(r"stage: slot A: isa486 1\.0\.0\+1, signature and digest valid")
-    emulator.expect(r"stage: no image confirmed yet: the first valid one, now confirmed")
+    emulator.expect(r"stage: the confirmed image")
     emulator.expect(r"stage: starting slot A")
     emulator.expect(r"board isa486 \(i486DX\), node 3,")
     emulator.expect(r"command line: node=3 boot\.slot=A boot\.version=1\.0\.0\+1")
@@ -72,6 +40,25 @@ def test_the_board_boots_its_card_through_the_bios_and_the_stage_loader(boot, is
     emulator.close()
     state = card_state(card)["boot_state"]
     assert state["confirmed"] == "A" and state["trial"] == "none" and state["sequence"] == 1, state
+
+
+def test_an_image_nothing_confirmed_boots_only_as_a_trial(boot, isa486, tmp_path):
+    # A valid image on a card that confirms nothing (written by a card
+    # reader, or a download cut before it was marked pending) must prove
+    # itself like any new image.
+    card = new_card(tmp_path)
+    image = open(signed(tmp_path, "1.0.0"), "rb").read()
+    with open(card, "r+b") as handle:
+        handle.seek(SLOT_LBA["A"] * SECTOR)
+        handle.write(image[:256] + bytes(256) + image[256:])
+    emulator = boot(isa486, card=card)
+    emulator.expect(r"stage: no boot state on the card: a new card")
+    emulator.expect(r"stage: no confirmed image: a valid one on trial")
+    emulator.expect(r"command line: node=3 boot\.slot=A boot\.version=1\.0\.0 boot\.trial=1")
+    emulator.expect(r"dcos> ")
+    assert "confirmed:" in emulator.command("boot confirm")
+    emulator.close()
+    assert card_state(card)["boot_state"]["confirmed"] == "A"
 
 
 def test_an_altered_confirmed_image_is_refused_and_the_other_slot_boots(boot, isa486, tmp_path):
@@ -137,8 +124,6 @@ def test_dcos_card_refuses_what_the_stage_loader_would_not_boot(tmp_path):
     assert shown["slots"]["A"]["valid"] is True and shown["slots"]["B"] is None
     assert shown["configuration"]["command_line"] == "node=3"
     tool("dcos-card", "write", card, "--slot", "B", signed(tmp_path, "1.1.0"), "--pending")
-    # A boot state exists now (pending B), but nothing is confirmed yet: the
-    # first boot's stage loader decides. Confirm A by hand for the checks.
     card_tool = os.path.join(BIN, "dcos-card")
 
     def refused(*arguments, code=1):

@@ -15,25 +15,13 @@ import signal
 import subprocess
 import time
 
-from dcoslab.board import REPOSITORY
-
-BIN = os.path.join(REPOSITORY, "build", "host_tools", "bin")
-BUILT = os.path.join(REPOSITORY, "build", "486")
-DEVELOPMENT_KEY = os.path.join(REPOSITORY, "build", "keys", "development.pem")
+from dcoslab import cards
+from dcoslab.cards import BIN, BUILT, DEVELOPMENT_KEY, tool
 
 
-def tool(name, *arguments, code=0, timeout=120):
-    result = subprocess.run([os.path.join(BIN, name), *arguments], capture_output=True, text=True, timeout=timeout)
-    assert result.returncode == code, (
-        f"{name} {' '.join(arguments)}: exit {result.returncode}, expected {code}\n{result.stdout}{result.stderr}")
-    return result
 
-
-def signed(tmp_path, version, firmware="dcos486-minimal.elf", key=DEVELOPMENT_KEY):
-    path = tmp_path / f"{version}.dcos"
-    tool("dcos-image", "sign", "-k", key, "--board", "isa486", "--version", version, "-o", str(path),
-         os.path.join(BUILT, firmware))
-    return str(path)
+def signed(directory, version, key=DEVELOPMENT_KEY):
+    return cards.signed(directory, version, firmware="dcos486-minimal.elf", key=key)
 
 
 def empty_card(tmp_path):

@@ -63,7 +63,7 @@ class Board:
 
     def emulator_command(self, image, serial_backends, append="", icount=False, cpu=None, memory_mib=None,
                          accel=None, device_properties=None, without_devices=(), extra_args=(), line_ports=None,
-                         card=False):
+                         card=False, card_drive=None):
         """The emulator argv for image, with one chardev argument per serial port.
 
         serial_backends maps names in serial_ports to a QEMU -serial value
@@ -90,7 +90,8 @@ class Board:
         board's IB700 watchdog fitted; the kernel's command line is the
         card's own (append must be empty). The emulator then restarts the
         board on a reset (a watchdog's, say) as a real board does, where a
-        -kernel boot stops (-no-reboot).
+        -kernel boot stops (-no-reboot). card_drive replaces the card's
+        -drive value (a block filter over the same file, dcoslab/powercut.py).
 
         line_ports maps serial ports named in the board's line_ports to the
         properties that join them to a lab line (hub, hub-name, line): such a
@@ -119,7 +120,7 @@ class Board:
         if card:
             if append:
                 raise ValueError("a card carries its own command line (dcos-card create --append), not -append")
-            command += ["-drive", f"file={image},if=ide,format=raw,index=0", "-boot", "c",
+            command += ["-drive", card_drive or f"file={image},if=ide,format=raw,index=0", "-boot", "c",
                         "-device", "ib700", "-watchdog-action", "reset"]
         else:
             command += ["-kernel", image, "-no-reboot"]

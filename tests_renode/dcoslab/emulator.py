@@ -13,6 +13,7 @@ import tempfile
 import threading
 import time
 
+from . import powercut
 from .board import EXIT_PANIC, EXIT_FAIL, EXIT_PASS
 from .symbolize import explain
 
@@ -27,7 +28,7 @@ class EmulatorError(AssertionError):
 class Emulator:
     def __init__(self, board, image, append="", icount=False, cpu=None, memory_mib=None, accel=None,
                  device_properties=None, without_devices=(), extra_args=(), name=None, serial_sockets=(),
-                 line_ports=None, card=False):
+                 line_ports=None, card=False, power_cut_after=None):
         self.board = board
         # What failures call this emulator, e.g. "board2" among several boards.
         self.name = name or board.name
@@ -49,9 +50,12 @@ class Emulator:
         self.line_ports = dict(line_ports or {})
         # image is a CompactFlash card the board boots from (Board.emulator_command).
         self.card = card
+        # The card loses its power after this many writes (dcoslab/powercut.py).
+        self.power_cut_after = power_cut_after
         self._workdir = tempfile.TemporaryDirectory(prefix="dcos-emulator-")
         self._socket_path = os.path.join(self._workdir.name, "console.sock")
         self._stderr_path = os.path.join(self._workdir.name, "emulator.stderr")
+        self._qmp_path = os.path.join(self._workdir.name, "qmp.sock") if power_cut_after is not None else None
         self._buffer = bytearray()
         self._cursor = 0
         self._condition = threading.Condition()
@@ -77,11 +81,16 @@ class Emulator:
             # until then is lost, as on an unconnected line.
             chardevs += ["-chardev", f"socket,id={port},path={self.serial_socket_path(port)},server=on,wait=off"]
             backends[port] = f"chardev:{port}"
+        card_drive = None
+        extra_args = self.extra_args
+        if self.power_cut_after is not None:
+            card_drive = powercut.drive(self.image, self.power_cut_after, self._workdir.name)
+            extra_args = tuple(extra_args) + ("-qmp", f"unix:{self._qmp_path},server=on,wait=off")
         command = self.board.emulator_command(
             self.image, backends, append=self.append, icount=self.icount, cpu=self.cpu,
             memory_mib=self.memory_mib, accel=self.accel, device_properties=self.device_properties,
-            without_devices=self.without_devices, extra_args=self.extra_args, line_ports=self.line_ports,
-            card=self.card,
+            without_devices=self.without_devices, extra_args=extra_args, line_ports=self.line_ports,
+            card=self.card, card_drive=card_drive,
         )
         command[1:1] = ["-chardev", backend] + chardevs
         self.argv = command
@@ -128,6 +137,14 @@ class Emulator:
         self._reader.join(timeout=5)
         self._socket = None
         self._reader = None
+
+    def wait_power_cut(self, timeout=DEFAULT_TIMEOUT):
+        """Waits until the card's power cut stopped the board (power_cut_after)."""
+        if self._qmp_path is None:
+            raise EmulatorError("this emulator's card has no power cut")
+        if not powercut.wait_stopped(self._qmp_path, timeout):
+            raise self._failure(f"the board did not stop at the card's write {self.power_cut_after + 1} "
+                                f"within {timeout} s")
 
     def reattach_console(self, timeout=DEFAULT_TIMEOUT):
         """Connects the harness to the console again after release_console()."""

@@ -81,17 +81,20 @@ def boot(request):
     ..., "line": ...}} puts serial ports on a lab line (dcoslab/rs485.py),
     cpu="pentium" replaces the board's CPU model, card="path/to/card.img"
     boots the board from that CompactFlash card image instead of an image
-    kind (docs/boot.md).
+    kind (docs/boot.md), and power_cut_after=N cuts that card's power after
+    its Nth write (dcoslab/powercut.py).
     """
     started = []
     request.node.dcos_emulators = started
 
     def start(board, kind="production", append="", icount=False, device_properties=None, without_devices=(),
-              extra_args=(), name=None, serial_sockets=(), line_ports=None, cpu=None, card=None):
+              extra_args=(), name=None, serial_sockets=(), line_ports=None, cpu=None, card=None,
+              power_cut_after=None):
         image = card or (kind if os.path.sep in kind else board.image(kind))
         emulator = Emulator(board, image, append=append, icount=icount, cpu=cpu, device_properties=device_properties,
                             without_devices=without_devices, extra_args=extra_args, name=name,
-                            serial_sockets=serial_sockets, line_ports=line_ports, card=card is not None)
+                            serial_sockets=serial_sockets, line_ports=line_ports, card=card is not None,
+                            power_cut_after=power_cut_after)
         started.append(emulator)
         return emulator.start()
 

@@ -12,8 +12,9 @@
 // card by ATA PIO (drivers/ata). Every message starts with "stage: ", so a
 // test or an engineer tells it from the kernel's.
 #include <ata/AtaPioDisk.hpp>
+#include <boot/AtaSectorStore.hpp>
 #include <boot/BootInfo.hpp>
-#include <boot/BootPlanner.hpp>
+#include <boot/BootSequence.hpp>
 #include <boot/BootState.hpp>
 #include <boot/CardLayout.hpp>
 #include <boot/ConfigurationBlock.hpp>
@@ -227,17 +228,6 @@ bool loadAndVerify(ata::AtaPioDisk& disk, uint8_t slot, uint32_t memoryEnd)
     return true;
 }
 
-bool writeState(ata::AtaPioDisk& disk, const boot::BootState& state, unsigned copy)
-{
-    state.encode(sectorA);
-    const ata::AtaError written = disk.write(card::kBootStateLba + copy, 1, sectorA);
-    if (written != ata::AtaError::Ok) {
-        say("cannot write the boot state: %s", ata::ataErrorText(written));
-        return false;
-    }
-    return true;
-}
-
 // -- the hand-over ------------------------------------------------------------------
 
 // Multiboot Specification 0.6.96, 3.3: what the kernel's entry reads.
@@ -322,23 +312,6 @@ uint16_t nodeId()
     return value != 0 && value < 0xFFFF ? static_cast<uint16_t>(value) : 1;
 }
 
-// The card as the flash session writes it, through the ATA driver.
-class CardStore final : public flash::FlashStore {
-public:
-    explicit CardStore(ata::AtaPioDisk& disk) : disk_(disk) {}
-    bool read(uint32_t lba, uint32_t count, void* buffer) override
-    {
-        return disk_.read(lba, count, buffer) == ata::AtaError::Ok;
-    }
-    bool write(uint32_t lba, uint32_t count, const void* buffer) override
-    {
-        return disk_.write(lba, count, buffer) == ata::AtaError::Ok;
-    }
-
-private:
-    ata::AtaPioDisk& disk_;
-};
-
 // What makes this start's challenges its own: the real-time clock's time
 // and date, the 8254's count, and the boot state's sequence. Not secret:
 // the flash protocol's challenge only has to be new (docs/protocols/flash.md).
@@ -393,7 +366,7 @@ uint32_t recoverySequence = 0;
         halt();
     }
     say("recovery: waiting for an image on this serial line (dcos-flash)");
-    CardStore store(*recoveryDisk);
+    boot::AtaSectorStore store(*recoveryDisk);
     flash::SessionIdentity identity;
     identity.node = nodeId();
     identity.board = image::BoardType::Isa486;
@@ -489,12 +462,10 @@ extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
         recovery("the configuration trusts no key, so no image can be verified");
     }
 
+    // What the card says, for the console; BootSequence reads it again to decide.
     boot::BootState stored;
     unsigned stateCopy = 0;
-    const bool haveState = readRecordCopies(disk, card::kBootStateLba) &&
-                           boot::BootState::newest(sectorA, sectorB, stored, stateCopy);
-    recoverySequence = haveState ? stored.sequence : 0;
-    if (haveState) {
+    if (readRecordCopies(disk, card::kBootStateLba) && boot::BootState::newest(sectorA, sectorB, stored, stateCopy)) {
         say("boot state %lu: confirmed slot %s, trial %s%s", static_cast<unsigned long>(stored.sequence),
             card::slotName(stored.confirmedSlot),
             stored.trial == boot::TrialState::None      ? "none"
@@ -504,19 +475,14 @@ extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
     } else {
         say("no boot state on the card: a new card");
     }
-
-    boot::BootPlan plan = boot::BootPlanner::plan(haveState ? &stored : nullptr, [&](uint8_t slot) {
-        return loadAndVerify(disk, slot, memoryEnd);
-    });
+    boot::AtaSectorStore store(disk);
+    const boot::BootDecision decision =
+        boot::BootSequence::decide(store, [&](uint8_t slot) { return loadAndVerify(disk, slot, memoryEnd); });
+    const boot::BootPlan& plan = decision.plan;
+    recoverySequence = decision.hadState ? decision.stored.sequence : 0;
     say("%s", plan.reason);
-    if (plan.write) {
-        // The next sequence, into the copy that does not hold the state read:
-        // a power cut during this write leaves that state standing.
-        plan.state.sequence = haveState ? stored.sequence + 1 : 1;
-        const unsigned target = haveState ? stateCopy ^ 1u : 0u;
-        if (!writeState(disk, plan.state, target)) {
-            recovery("the boot state cannot be written, so a trial could not be reverted");
-        }
+    if (decision.cardFailed) {
+        recovery(plan.reason);
     }
     if (plan.action == boot::BootPlan::Action::Recovery) {
         recovery(plan.reason);

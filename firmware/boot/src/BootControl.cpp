@@ -72,13 +72,9 @@ const char* confirmOutcomeText(ConfirmOutcome outcome)
 
 bool BootControl::readState(BootState& state, unsigned& copy)
 {
-    if (disk_.sectorCount() == 0 && disk_.identify() != ata::AtaError::Ok) {
-        return false;
-    }
     uint8_t first[card::kSectorSize];
     uint8_t second[card::kSectorSize];
-    return disk_.read(card::kBootStateLba, 1, first) == ata::AtaError::Ok &&
-           disk_.read(card::kBootStateLba + 1, 1, second) == ata::AtaError::Ok &&
+    return store_.read(card::kBootStateLba, 1, first) && store_.read(card::kBootStateLba + 1, 1, second) &&
            BootState::newest(first, second, state, copy);
 }
 
@@ -104,7 +100,7 @@ ConfirmOutcome BootControl::confirm(const RunningImage& running)
     ++state.sequence;
     uint8_t record[card::kSectorSize];
     state.encode(record);
-    if (disk_.write(card::kBootStateLba + (copy ^ 1u), 1, record) != ata::AtaError::Ok) {
+    if (!store_.write(card::kBootStateLba + (copy ^ 1u), 1, record)) {
         return ConfirmOutcome::CardError;
     }
     stopWatchdog();

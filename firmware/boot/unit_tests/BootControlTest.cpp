@@ -1,3 +1,4 @@
+#include <boot/AtaSectorStore.hpp>
 #include <boot/BootControl.hpp>
 
 #include "../../../drivers/ata/unit_tests/FakeAtaDisk.hpp"
@@ -74,7 +75,8 @@ TEST_F(BootControlTest, ConfirmingTheTrialWritesTheOlderCopyThenStopsTheWatchdog
     putState(card, 0, 7, 0, BootState::kNoSlot, TrialState::None);
     putState(card, 1, 8, 0, 1, TrialState::Booting);
     ata::AtaPioDisk driver = disk();
-    BootControl control(driver);
+    boot::AtaSectorStore driverStore(driver);
+    BootControl control(driverStore);
     (void)port_io_mock::takeLog();
     EXPECT_EQ(control.confirm(RunningImage::fromCommandLine("boot.slot=B boot.trial=1")), ConfirmOutcome::Confirmed);
     EXPECT_TRUE(stoppedWatchdog(port_io_mock::takeLog()));
@@ -93,7 +95,8 @@ TEST_F(BootControlTest, RefusesWhatIsNotTheCardsTrial)
     ata_test::FakeAtaDisk card(16384);
     putState(card, 0, 3, 0, 1, TrialState::Pending);
     ata::AtaPioDisk driver = disk();
-    BootControl control(driver);
+    boot::AtaSectorStore driverStore(driver);
+    BootControl control(driverStore);
     EXPECT_EQ(control.confirm(RunningImage::fromCommandLine("node=1")), ConfirmOutcome::NotFromCard);
     EXPECT_EQ(control.confirm(RunningImage::fromCommandLine("boot.slot=B boot.trial=1")), ConfirmOutcome::NotOnTrial)
         << "pending, not booting: the stage loader did not start it";
@@ -110,7 +113,8 @@ TEST_F(BootControlTest, ACardThatFailsLeavesTheTrialAndTheWatchdogRunning)
     putState(card, 0, 4, 0, 1, TrialState::Booting);
     card.failWritesTo(boot::card::kBootStateLba + 1);
     ata::AtaPioDisk driver = disk();
-    BootControl control(driver);
+    boot::AtaSectorStore driverStore(driver);
+    BootControl control(driverStore);
     (void)port_io_mock::takeLog();
     EXPECT_EQ(control.confirm(RunningImage::fromCommandLine("boot.slot=B boot.trial=1")), ConfirmOutcome::CardError);
     EXPECT_FALSE(stoppedWatchdog(port_io_mock::takeLog()));
@@ -121,7 +125,8 @@ TEST_F(BootControlTest, ACardThatFailsLeavesTheTrialAndTheWatchdogRunning)
     port_io_mock::reset();
     ata_test::FakeAtaDisk blank(16384);
     ata::AtaPioDisk other = disk();
-    BootControl none(other);
+    boot::AtaSectorStore otherStore(other);
+    BootControl none(otherStore);
     EXPECT_EQ(none.confirm(RunningImage::fromCommandLine("boot.slot=A")), ConfirmOutcome::CardError)
         << "a card without a boot state";
 }

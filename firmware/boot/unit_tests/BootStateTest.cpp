@@ -117,19 +117,26 @@ struct Slots {
     }
 };
 
-TEST(BootPlannerTest, ANewCardBootsTheFirstValidSlotAndConfirmsIt)
+TEST(BootPlannerTest, AnImageNothingConfirmedBootsOnlyAsATrial)
 {
     Slots slots;
     BootPlan plan = slots.plan(nullptr);
     EXPECT_EQ(plan.action, BootPlan::Action::Boot);
     EXPECT_EQ(plan.slot, 0);
-    EXPECT_FALSE(plan.trial);
+    EXPECT_TRUE(plan.trial);
     EXPECT_TRUE(plan.write);
-    EXPECT_EQ(plan.state.confirmedSlot, 0);
+    EXPECT_EQ(plan.state.confirmedSlot, BootState::kNoSlot);
+    EXPECT_EQ(plan.state.trial, TrialState::Booting);
+    EXPECT_EQ(plan.state.trialSlot, 0);
     slots.valid[0] = false;
     plan = slots.plan(nullptr);
     EXPECT_EQ(plan.slot, 1);
-    EXPECT_EQ(plan.state.confirmedSlot, 1);
+    EXPECT_TRUE(plan.trial);
+    // It never confirmed: dropped, and with nothing else valid, recovery.
+    const BootState after = plan.state;
+    plan = slots.plan(&after);
+    EXPECT_EQ(plan.action, BootPlan::Action::Recovery);
+    EXPECT_TRUE(plan.reverted);
 }
 
 TEST(BootPlannerTest, TheConfirmedImageBootsWithoutAWriteOrALookAtTheOtherSlot)

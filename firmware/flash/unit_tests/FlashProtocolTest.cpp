@@ -11,6 +11,8 @@
 #include <hostimage/SigningKey.hpp>
 #include <image/ImageVerifier.hpp>
 
+#include "FlashTestHost.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -20,21 +22,9 @@
 
 namespace {
 
-using flash::FlashMessage;
-using flash::FlashStatus;
-using flash::MessageType;
-namespace card = boot::card;
+using namespace flash_test;
 
 // -- messages and frames ----------------------------------------------------
-
-std::vector<uint8_t> encoded(const FlashMessage& message)
-{
-    std::vector<uint8_t> bytes(flash::kMaxMessage);
-    const size_t length = message.encode(bytes.data(), bytes.size());
-    EXPECT_NE(length, 0u);
-    bytes.resize(length);
-    return bytes;
-}
 
 TEST(FlashMessageTest, EveryTypeRoundTripsAndRefusesAByteMoreOrLess)
 {
@@ -139,84 +129,11 @@ TEST(SerialFramerTest, AResetAbandonsAFrameASenderLeftUnfinished)
 
 // -- a session against a card in memory --------------------------------------
 
-class MemoryCard final : public flash::FlashStore {
-public:
-    MemoryCard() : bytes(size_t{card::kBuiltCardSectors} * card::kSectorSize, 0) {}
-
-    bool read(uint32_t lba, uint32_t count, void* buffer) override
-    {
-        if (failing) {
-            return false;
-        }
-        std::copy_n(bytes.begin() + size_t{lba} * 512, size_t{count} * 512, static_cast<uint8_t*>(buffer));
-        return true;
-    }
-    bool write(uint32_t lba, uint32_t count, const void* buffer) override
-    {
-        if (failing) {
-            return false;
-        }
-        ++writes;
-        const auto* from = static_cast<const uint8_t*>(buffer);
-        std::copy(from, from + size_t{count} * 512, bytes.begin() + size_t{lba} * 512);
-        return true;
-    }
-
-    std::optional<boot::BootState> state() const
-    {
-        boot::BootState out;
-        unsigned copy = 0;
-        uint8_t a[512];
-        uint8_t b[512];
-        std::copy_n(bytes.begin() + card::kBootStateLba * 512, 512, a);
-        std::copy_n(bytes.begin() + (card::kBootStateLba + 1) * 512, 512, b);
-        if (!boot::BootState::newest(a, b, out, copy)) {
-            return std::nullopt;
-        }
-        return out;
-    }
-
-    std::vector<uint8_t> bytes;
-    bool failing = false;
-    unsigned writes = 0;
-};
-
-const hostimage::SigningKey& signingKey(int which)
-{
-    static std::vector<hostimage::SigningKey> keys = [] {
-        std::vector<hostimage::SigningKey> made;
-        for (int i = 0; i < 2; ++i) {
-            std::string error;
-            made.push_back(*hostimage::SigningKey::generate(error));
-        }
-        return made;
-    }();
-    return keys[static_cast<size_t>(which)];
-}
-
-image::TrustedKey trusted(const hostimage::SigningKey& key)
-{
-    uint8_t point[65];
-    std::copy(key.publicPoint().begin(), key.publicPoint().end(), point);
-    return image::TrustedKey::fromPoint(point);
-}
-
-std::vector<uint8_t> imageOf(size_t size, const image::ImageVersion& version, int key = 0)
-{
-    std::vector<uint8_t> payload(size);
-    for (size_t i = 0; i < size; ++i) {
-        payload[i] = static_cast<uint8_t>(i * 31 + 7);
-    }
-    std::string error;
-    return *hostimage::ImageSigner::sign(hostimage::ElfPayload(payload, 0x100000, static_cast<uint32_t>(size), 0x100000),
-                                         image::BoardType::Isa486, version, signingKey(key), error);
-}
-
 class FlashSessionTest : public ::testing::Test {
 protected:
     FlashSessionTest()
         : keys{trusted(signingKey(0))},
-          session(store, keys, 1, identity(), reinterpret_cast<const uint8_t*>("seed"), 4)
+          session(store, keys, 1, identity(), reinterpret_cast<const uint8_t*>("seed"), 4), host(session, 5)
     {
     }
 
@@ -227,92 +144,26 @@ protected:
         return id;
     }
 
-    FlashMessage ask(const FlashMessage& request)
-    {
-        const std::vector<uint8_t> bytes = encoded(request);
-        uint8_t reply[flash::kMaxMessage];
-        const size_t length = session.handle(bytes.data(), bytes.size(), reply, sizeof reply);
-        FlashMessage decoded;
-        EXPECT_TRUE(FlashMessage::decode(reply, length, decoded));
-        EXPECT_EQ(decoded.tag, request.tag);
-        return decoded;
-    }
-
-    FlashMessage hello()
-    {
-        FlashMessage m;
-        m.type = MessageType::Hello;
-        m.tag = ++tag;
-        return ask(m);
-    }
-
-    FlashStatus authenticate(int key = 0, bool freshHello = true)
-    {
-        FlashMessage challenge = freshHello ? hello() : lastHello;
-        lastHello = challenge;
-        uint8_t digest[32];
-        flash::authenticationDigest(5, challenge.challenge, digest);
-        FlashMessage m;
-        m.type = MessageType::Authenticate;
-        m.tag = ++tag;
-        const image::TrustedKey id = trusted(signingKey(key));
-        std::copy(std::begin(id.id), std::end(id.id), m.keyId);
-        std::string error;
-        EXPECT_TRUE(signingKey(key).sign(digest, m.signature, error));
-        return ask(m).status;
-    }
-
-    FlashMessage begin(const std::vector<uint8_t>& image)
-    {
-        FlashMessage m;
-        m.type = MessageType::Begin;
-        m.tag = ++tag;
-        std::copy_n(image.begin(), 256, m.header);
-        return ask(m);
-    }
-
+    FlashMessage hello() { return host.hello(); }
+    FlashStatus authenticate(int key = 0, bool freshHello = true) { return host.authenticate(key, freshHello); }
+    FlashMessage begin(const std::vector<uint8_t>& image) { return host.begin(image); }
     FlashMessage block(const std::vector<uint8_t>& image, uint32_t offset, uint32_t sequence, size_t length,
                        bool damage = false)
     {
-        std::vector<uint8_t> bytes(image.begin() + 256 + offset, image.begin() + 256 + offset + length);
-        FlashMessage m;
-        m.type = MessageType::Data;
-        m.tag = ++tag;
-        m.offset = offset;
-        m.sequence = sequence;
-        m.length = static_cast<uint16_t>(length);
-        m.crc = boot::crc32(bytes.data(), bytes.size());
-        if (damage) {
-            bytes[0] ^= 1;
-        }
-        m.bytes = bytes.data();
-        return ask(m);
+        return host.block(image, offset, sequence, length, damage);
     }
-
     FlashMessage sendAll(const std::vector<uint8_t>& image, uint32_t from = 0)
     {
-        FlashMessage reply;
-        const uint32_t size = static_cast<uint32_t>(image.size() - 256);
-        for (uint32_t offset = from; offset < size; offset += flash::kMaxBlock) {
-            reply = block(image, offset, offset / flash::kMaxBlock, std::min<size_t>(flash::kMaxBlock, size - offset));
-            EXPECT_EQ(reply.status, FlashStatus::Ok) << "offset " << offset;
-        }
+        const FlashMessage reply = host.sendAll(image, from);
+        EXPECT_EQ(reply.status, FlashStatus::Ok);
         return reply;
     }
-
-    FlashMessage simple(MessageType type)
-    {
-        FlashMessage m;
-        m.type = type;
-        m.tag = ++tag;
-        return ask(m);
-    }
+    FlashMessage simple(MessageType type) { return host.simple(type); }
 
     MemoryCard store;
     image::TrustedKey keys[1];
     flash::FlashSession session;
-    uint8_t tag = 0;
-    FlashMessage lastHello;
+    FlashHost host;
 };
 
 TEST_F(FlashSessionTest, AWholeSessionLeavesAVerifiedImagePendingInTheSlot)
@@ -366,7 +217,7 @@ TEST_F(FlashSessionTest, AChallengeServesOneAttemptAndAHelloEndsTheSession)
     ASSERT_EQ(authenticate(), FlashStatus::Ok);
     EXPECT_EQ(authenticate(0, false), FlashStatus::AuthenticationFailed) << "the same signature again";
     ASSERT_EQ(authenticate(), FlashStatus::Ok);
-    const FlashMessage first = lastHello;
+    const FlashMessage first = host.lastHello;
     const FlashMessage second = hello();
     EXPECT_EQ(begin(imageOf(600, {1, 0, 0, 0})).status, FlashStatus::NotAuthenticated);
     EXPECT_FALSE(std::equal(std::begin(first.challenge), std::end(first.challenge), std::begin(second.challenge)))

@@ -14,6 +14,8 @@
 // refuses to overwrite the confirmed slot, and an image older than the
 // confirmed one unless --allow-downgrade. With --pending the next boot
 // tries the image as a trial (it must confirm, or the boot after reverts).
+// Without it, on a card that confirms nothing yet (a new card), the image
+// is confirmed: the card's maker vouches for it.
 //
 // Exit status: 0 done; 1 the card or the image is refused (the reason is
 // printed); 2 bad arguments; 3 a file cannot be read or written; 4 a key is
@@ -222,11 +224,24 @@ int writeImage(const WriteOptions& options, bool json)
     if (!cardFile->writeSlot(slot, *imageBytes, error)) {
         return fail(kExitRefused, error);
     }
+    bool confirmedNow = false;
     if (options.pending) {
         boot::BootState next = state.value_or(boot::BootState{});
         next.trialSlot = static_cast<uint8_t>(slot);
         next.trial = boot::TrialState::Pending;
         cardFile->writeBootState(next);
+    } else if (confirmed == boot::BootState::kNoSlot) {
+        // A card that confirms nothing yet (a new one): whoever makes it
+        // vouches for the image, which is confirmed. The stage loader would
+        // otherwise boot it only as a trial, which must confirm.
+        boot::BootState next = state.value_or(boot::BootState{});
+        next.confirmedSlot = static_cast<uint8_t>(slot);
+        if (next.trialSlot == slot) {
+            next.trialSlot = boot::BootState::kNoSlot;
+            next.trial = boot::TrialState::None;
+        }
+        cardFile->writeBootState(next);
+        confirmedNow = true;
     }
     if (!hostimage::writeWholeFile(options.card, cardFile->bytes().data(), cardFile->bytes().size(), false, true,
                                    error)) {
@@ -237,11 +252,14 @@ int writeImage(const WriteOptions& options, bool json)
         fmt::print("{}\n", nlohmann::json{{"card", options.card},
                                           {"slot", card::slotName(slot)},
                                           {"version", version},
-                                          {"pending", options.pending}}
+                                          {"pending", options.pending},
+                                          {"confirmed", confirmedNow}}
                                .dump());
     } else {
         fmt::print("slot {}: {} written{}\n", card::slotName(slot), version,
-                   options.pending ? ", pending: the next boot tries it" : "");
+                   options.pending ? ", pending: the next boot tries it"
+                   : confirmedNow  ? ", confirmed (the card confirmed nothing yet)"
+                                   : "");
     }
     return kExitOk;
 }

@@ -7,8 +7,7 @@
 #pragma once
 
 #include <boot/BootState.hpp>
-
-#include <ata/AtaPioDisk.hpp>
+#include <boot/SectorStore.hpp>
 
 #include <stdint.h>
 
@@ -39,7 +38,7 @@ const char* confirmOutcomeText(ConfirmOutcome outcome);
 
 class BootControl {
 public:
-    explicit BootControl(ata::AtaPioDisk& disk) : disk_(disk) {}
+    explicit BootControl(SectorStore& store) : store_(store) {}
 
     /// The card's boot state; false when the card cannot be read or holds none.
     bool readState(BootState& state, unsigned& copy);
@@ -53,7 +52,7 @@ public:
     static void stopWatchdog();
 
 private:
-    ata::AtaPioDisk& disk_;
+    SectorStore& store_;
 };
 
 } // namespace boot

@@ -12,6 +12,7 @@
 //  - Otherwise the confirmed image boots. If it is invalid (the card
 //    decayed), the other slot's valid image boots and becomes confirmed,
 //    unless it is a trial dropped on this boot.
+//  - With no confirmed image at all, the first valid one boots as a trial.
 //  - With no valid image at all, the stage loader stays in recovery.
 //
 // Slots are verified only when the decision needs them, in that order.
@@ -110,18 +111,28 @@ BootPlan BootPlanner::decide(const BootState* stored, Valid&& valid)
         return plan;
     }
     // No confirmed image, or it no longer verifies: the first valid slot,
-    // the other one first when a confirmed slot failed.
-    const uint8_t first = state.confirmedSlot == BootState::kNoSlot ? 0 : static_cast<uint8_t>(state.confirmedSlot ^ 1);
+    // the other one first when a confirmed slot failed. An image nothing
+    // ever confirmed (a download cut short before it was marked pending,
+    // say) boots only as a trial: it must confirm, or it is dropped. The
+    // other slot of a confirmed image that decayed held the image confirmed
+    // before it, and boots confirmed.
+    const bool noneConfirmed = state.confirmedSlot == BootState::kNoSlot;
+    const uint8_t first = noneConfirmed ? 0 : static_cast<uint8_t>(state.confirmedSlot ^ 1);
     for (uint8_t i = 0; i < card::kSlotCount; ++i) {
         const uint8_t slot = static_cast<uint8_t>((first + i) % card::kSlotCount);
         if (slot != state.confirmedSlot && slot != dropped && valid(slot)) {
             plan.action = BootPlan::Action::Boot;
             plan.slot = slot;
-            plan.reason = state.confirmedSlot == BootState::kNoSlot
-                              ? "no image confirmed yet: the first valid one, now confirmed"
-                              : "the confirmed image is no longer valid: the other slot's, now confirmed";
-            state.confirmedSlot = slot;
             plan.write = true;
+            if (noneConfirmed) {
+                plan.trial = true;
+                state.trial = TrialState::Booting;
+                state.trialSlot = slot;
+                plan.reason = "no confirmed image: a valid one on trial: it must confirm before the watchdog expires";
+            } else {
+                state.confirmedSlot = slot;
+                plan.reason = "the confirmed image is no longer valid: the other slot's, now confirmed";
+            }
             return plan;
         }
     }

@@ -4,6 +4,7 @@
 //
 //   boot            the running image, and the card's boot state
 //   boot confirm    make the running trial image the confirmed one
+#include <boot/AtaSectorStore.hpp>
 #include <boot/BootControl.hpp>
 #include <boot/BootInfo.hpp>
 #include <boot/CardLayout.hpp>
@@ -31,7 +32,8 @@ shell::CommandResult bootCommand(shell::Shell& shell, int argc, char** argv)
 {
     const boot::RunningImage running = boot::RunningImage::fromCommandLine(bootInfo().commandLine);
     ata::AtaPioDisk disk = ata::AtaPioDisk::primary();
-    boot::BootControl control(disk);
+    boot::AtaSectorStore store(disk);
+    boot::BootControl control(store);
     if (argc == 2 && runtime::textEquals(argv[1], "confirm")) {
         const boot::ConfirmOutcome outcome = control.confirm(running);
         shell.print("boot: %s\r\n", boot::confirmOutcomeText(outcome));

@@ -19,6 +19,7 @@
 #include <flash/FlashMessage.hpp>
 
 #include <boot/BootState.hpp>
+#include <boot/SectorStore.hpp>
 #include <image/ImageVerifier.hpp>
 
 #include <stddef.h>
@@ -26,15 +27,8 @@
 
 namespace flash {
 
-/// The card, as the session reads and writes it: whole 512-byte sectors.
-class FlashStore {
-public:
-    virtual bool read(uint32_t lba, uint32_t count, void* buffer) = 0;
-    virtual bool write(uint32_t lba, uint32_t count, const void* buffer) = 0;
-
-protected:
-    ~FlashStore() = default;
-};
+/// The card, as the session reads and writes it (boot/SectorStore.hpp).
+using FlashStore = boot::SectorStore;
 
 struct SessionIdentity {
     uint16_t node = 0;

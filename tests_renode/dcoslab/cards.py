@@ -1,0 +1,46 @@
+"""Controllers' cards for the lab's tests (docs/boot.md): signed images and
+cards made with the built host tools (dcos-image, dcos-card), the boot
+sector, the stage loader and the development key (mk/card.mk)."""
+import json
+import os
+import subprocess
+
+from .board import REPOSITORY
+
+BIN = os.path.join(REPOSITORY, "build", "host_tools", "bin")
+BUILT = os.path.join(REPOSITORY, "build", "486")
+DEVELOPMENT_KEY = os.path.join(REPOSITORY, "build", "keys", "development.pem")
+
+SLOT_LBA = {"A": 2048, "B": 6144}
+SECTOR = 512
+
+
+def tool(name, *arguments, code=0, timeout=120):
+    """Runs a built host tool; fails the test unless it exits with @p code."""
+    result = subprocess.run([os.path.join(BIN, name), *arguments], capture_output=True, text=True, timeout=timeout)
+    assert result.returncode == code, (
+        f"{name} {' '.join(arguments)}: exit {result.returncode}, expected {code}\n{result.stdout}{result.stderr}")
+    return result
+
+
+def signed(directory, version, firmware="dcos486.elf", key=DEVELOPMENT_KEY):
+    """The firmware build/486/@p firmware signed as @p version, in @p directory."""
+    path = os.path.join(str(directory), f"{os.path.splitext(firmware)[0]}-{version}.dcos")
+    tool("dcos-image", "sign", "-k", key, "--board", "isa486", "--version", version, "-o", path,
+         os.path.join(BUILT, firmware))
+    return path
+
+
+def new_card(directory, *slots, append="node=3"):
+    """A card trusting the development key, with (slot, image, pending) written in order."""
+    path = os.path.join(str(directory), "card.img")
+    tool("dcos-card", "create", "-o", path, "--boot-sector", os.path.join(BUILT, "boot-sector.bin"),
+         "--stage", os.path.join(BUILT, "stage-loader.bin"), "-p", DEVELOPMENT_KEY + ".pub", "--append", append)
+    for slot, image, pending in slots:
+        tool("dcos-card", "write", path, "--slot", slot, image, *(["--pending"] if pending else []))
+    return path
+
+
+def card_state(path):
+    """dcos-card show's JSON for the card at @p path."""
+    return json.loads(tool("dcos-card", "--json", "show", path).stdout)
