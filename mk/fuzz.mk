@@ -84,7 +84,7 @@ DCOS_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/dcos/src/network/NetworkAddress
 	$(FUZZ_BUILD)/firmware/dcos/src/network/ClockServo.cpp.o
 DCOS_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/dcos/fuzz/fuzz_%.cpp.o,$(DCOS_FUZZ_TARGETS))
 DCOS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(DCOS_FUZZ_TARGETS))
-IMAGE_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(IMAGE_SRCS))
+IMAGE_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(IMAGE_SRCS) $(BOOT_RECORD_SRCS))
 IMAGE_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/image/fuzz/fuzz_%.cpp.o,$(IMAGE_FUZZ_TARGETS))
 IMAGE_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(IMAGE_FUZZ_TARGETS))
 HOST_IMAGE_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,host_tools/image/src/ElfPayload.cpp $(IMAGE_SRCS))

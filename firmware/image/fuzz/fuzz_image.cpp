@@ -8,9 +8,14 @@
 // is exactly a header and the payload it describes, for the board and
 // memory of the policy, signed by the key; a header checked alone agrees
 // with the whole image's verdict up to the payload; the input read as a
-// version text parses only to a version that formats back to it.
+// version text parses only to a version that formats back to it; the
+// input's first sector read as the card's boot state or configuration
+// (dcos-card show reads both from a card file) decodes only to a record
+// that encodes back to the same sector.
 #include "../../../fieldbus/can/fuzz/FuzzCheck.hpp"
 
+#include <boot/BootState.hpp>
+#include <boot/ConfigurationBlock.hpp>
 #include <image/ImageHeader.hpp>
 #include <image/ImageVerifier.hpp>
 #include <image/ImageVersion.hpp>
@@ -44,9 +49,32 @@ void checkVersionText(const uint8_t* data, size_t size)
 
 } // namespace
 
+template <typename Record>
+void checkRecord(const uint8_t* data, size_t size)
+{
+    if (size < boot::card::kSectorSize) {
+        return;
+    }
+    uint8_t sector[boot::card::kSectorSize];
+    std::memcpy(sector, data, sizeof sector);
+    Record record;
+    if (!Record::decode(sector, record)) {
+        return;
+    }
+    uint8_t again[boot::card::kSectorSize];
+    record.encode(again);
+    Record twice;
+    FUZZ_CHECK(Record::decode(again, twice));
+    uint8_t thrice[boot::card::kSectorSize];
+    twice.encode(thrice);
+    FUZZ_CHECK(std::memcmp(again, thrice, sizeof again) == 0);
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
     checkVersionText(data, size);
+    checkRecord<boot::BootState>(data, size);
+    checkRecord<boot::ConfigurationBlock>(data, size);
 
     const image::ImageResult<image::ImageHeader> decoded = image::ImageHeader::decode(data, size);
     if (decoded.ok()) {
