@@ -159,20 +159,23 @@ AtaError AtaPioDisk::checkRange(uint32_t lba, uint32_t count) const
     return AtaError::Ok;
 }
 
-AtaError AtaPioDisk::read(uint32_t lba, uint32_t count, void* buffer)
+AtaError AtaPioDisk::transfer(uint8_t command, uint32_t lba, uint32_t count, uint16_t* in, const uint16_t* out)
 {
     const AtaError range = checkRange(lba, count);
     if (range != AtaError::Ok) {
         return range;
     }
-    auto* words = static_cast<uint16_t*>(buffer);
     while (count > 0) {
         const uint32_t chunk = count < kSectorsPerCommand ? count : kSectorsPerCommand;
-        AtaError error = issue(reg::kCommandReadSectors, lba, chunk);
+        AtaError error = issue(command, lba, chunk);
         for (uint32_t sector = 0; error == AtaError::Ok && sector < chunk; ++sector) {
             error = waitForData();
             for (unsigned i = 0; error == AtaError::Ok && i < reg::kWordsPerSector; ++i) {
-                *words++ = command_.read16(reg::kData);
+                if (in != nullptr) {
+                    *in++ = command_.read16(reg::kData);
+                } else {
+                    command_.write16(reg::kData, *out++);
+                }
             }
         }
         if (error == AtaError::Ok) {
@@ -187,30 +190,17 @@ AtaError AtaPioDisk::read(uint32_t lba, uint32_t count, void* buffer)
     return AtaError::Ok;
 }
 
+AtaError AtaPioDisk::read(uint32_t lba, uint32_t count, void* buffer)
+{
+    return transfer(reg::kCommandReadSectors, lba, count, static_cast<uint16_t*>(buffer), nullptr);
+}
+
 AtaError AtaPioDisk::write(uint32_t lba, uint32_t count, const void* buffer)
 {
-    const AtaError range = checkRange(lba, count);
-    if (range != AtaError::Ok) {
-        return range;
-    }
-    const auto* words = static_cast<const uint16_t*>(buffer);
-    while (count > 0) {
-        const uint32_t chunk = count < kSectorsPerCommand ? count : kSectorsPerCommand;
-        AtaError error = issue(reg::kCommandWriteSectors, lba, chunk);
-        for (uint32_t sector = 0; error == AtaError::Ok && sector < chunk; ++sector) {
-            error = waitForData();
-            for (unsigned i = 0; error == AtaError::Ok && i < reg::kWordsPerSector; ++i) {
-                command_.write16(reg::kData, *words++);
-            }
-        }
-        if (error == AtaError::Ok) {
-            error = finish();
-        }
-        if (error != AtaError::Ok) {
-            return error;
-        }
-        lba += chunk;
-        count -= chunk;
+    const AtaError written =
+        transfer(reg::kCommandWriteSectors, lba, count, nullptr, static_cast<const uint16_t*>(buffer));
+    if (written != AtaError::Ok) {
+        return written;
     }
     // The card may hold the data in a cache: the write is done when it is
     // on the medium, so that a power cut after success loses nothing.

@@ -17,6 +17,7 @@
 #include <boot/BootSequence.hpp>
 #include <boot/BootState.hpp>
 #include <boot/CardLayout.hpp>
+#include <boot/Multiboot.hpp>
 #include <boot/ConfigurationBlock.hpp>
 #include <flash/FlashSession.hpp>
 #include <flash/SerialFramer.hpp>
@@ -76,14 +77,20 @@ public:
 
 StageConsole console;
 
+// One line on the console: the prefix, the formatted text, CR LF.
+void sayLine(const char* prefix, const char* format, va_list arguments)
+{
+    runtime::format(console, "%s", prefix);
+    runtime::formatTo(console, format, arguments);
+    runtime::format(console, "\r\n");
+}
+
 __attribute__((format(printf, 1, 2))) void say(const char* format, ...)
 {
-    runtime::format(console, "stage: ");
     va_list arguments;
     va_start(arguments, format);
-    runtime::formatTo(console, format, arguments);
+    sayLine("stage: ", format, arguments);
     va_end(arguments);
-    runtime::format(console, "\r\n");
 }
 
 [[noreturn]] void halt()
@@ -230,29 +237,7 @@ bool loadAndVerify(ata::AtaPioDisk& disk, uint8_t slot, uint32_t memoryEnd)
 
 // -- the hand-over ------------------------------------------------------------------
 
-// Multiboot Specification 0.6.96, 3.3: what the kernel's entry reads.
-struct MultibootInfo {
-    uint32_t flags;
-    uint32_t memLower;
-    uint32_t memUpper;
-    uint32_t bootDevice;
-    uint32_t cmdline;
-    uint32_t modsCount;
-    uint32_t modsAddr;
-    uint32_t syms[4];
-    uint32_t mmapLength;
-    uint32_t mmapAddr;
-    uint32_t drivesLength;
-    uint32_t drivesAddr;
-    uint32_t configTable;
-    uint32_t bootLoaderName;
-};
-constexpr uint32_t kMultibootMemory = 1u << 0;
-constexpr uint32_t kMultibootCommandLine = 1u << 2;
-constexpr uint32_t kMultibootLoaderName = 1u << 9;
-constexpr uint32_t kMultibootLoaderMagic = 0x2BADB002;
-
-MultibootInfo handover;
+boot::multiboot::Info handover;
 char commandLine[boot::ConfigurationBlock::kCommandLineSize + 96];
 const char loaderName[] = "DCOS stage loader";
 
@@ -279,7 +264,7 @@ const char loaderName[] = "DCOS stage loader";
                             configuration.commandLine, configuration.commandLine[0] != '\0' ? " " : "",
                             card::slotName(slot), version, trial ? " boot.trial=1" : "",
                             reverted ? " boot.reverted=1" : "");
-    handover.flags = kMultibootMemory | kMultibootCommandLine | kMultibootLoaderName;
+    handover.flags = boot::multiboot::kInfoMemory | boot::multiboot::kInfoCommandLine | boot::multiboot::kInfoLoaderName;
     handover.memLower = 640;
     handover.memUpper = upperKib;
     handover.cmdline = reinterpret_cast<uintptr_t>(commandLine);
@@ -291,7 +276,7 @@ const char loaderName[] = "DCOS stage loader";
         portWrite8(kWatchdogStop, 0);
     }
     say("starting slot %s at 0x%08lx", card::slotName(slot), static_cast<unsigned long>(image.entry));
-    asm volatile("jmp *%2" : : "a"(kMultibootLoaderMagic), "b"(&handover), "r"(image.entry) : "memory");
+    asm volatile("jmp *%2" : : "a"(boot::multiboot::kLoaderMagic), "b"(&handover), "r"(image.entry) : "memory");
     __builtin_unreachable();
 }
 
@@ -417,12 +402,10 @@ uint32_t recoverySequence = 0;
 // The verifier's mbedTLS and the I/O windows report what cannot go on here.
 extern "C" [[noreturn]] void dcosPanic(const char* format, ...)
 {
-    runtime::format(console, "stage: panic: ");
     va_list arguments;
     va_start(arguments, format);
-    runtime::formatTo(console, format, arguments);
+    sayLine("stage: panic: ", format, arguments);
     va_end(arguments);
-    runtime::format(console, "\r\n");
     halt();
 }
 

@@ -1,5 +1,6 @@
 // Turns the Multiboot v1 hand-over into a BootInfo and starts the kernel.
 #include <boot/BootInfo.hpp>
+#include <boot/Multiboot.hpp>
 
 #include <arch_x86/AssemblyLinkage.hpp>
 #include <arch_x86/Gdt.hpp>
@@ -15,28 +16,11 @@ extern Constructor __init_array_start[], __init_array_end[];
 
 namespace {
 
-// Multiboot Specification 0.6.96, 3.2 and 3.3.
-constexpr uint32_t multibootBootloaderMagic = 0x2BADB002;
-constexpr uint32_t multibootInfoMemory = 1u << 0;
-constexpr uint32_t multibootInfoCommandLine = 1u << 2;
-constexpr uint32_t multibootInfoLoaderName = 1u << 9;
-
-struct MultibootInfo {
-    uint32_t flags;
-    uint32_t memLower;
-    uint32_t memUpper;
-    uint32_t bootDevice;
-    uint32_t cmdline;
-    uint32_t modsCount;
-    uint32_t modsAddr;
-    uint32_t syms[4];
-    uint32_t mmapLength;
-    uint32_t mmapAddr;
-    uint32_t drivesLength;
-    uint32_t drivesAddr;
-    uint32_t configTable;
-    uint32_t bootLoaderName;
-};
+using MultibootInfo = boot::multiboot::Info;
+constexpr uint32_t multibootBootloaderMagic = boot::multiboot::kLoaderMagic;
+constexpr uint32_t multibootInfoMemory = boot::multiboot::kInfoMemory;
+constexpr uint32_t multibootInfoCommandLine = boot::multiboot::kInfoCommandLine;
+constexpr uint32_t multibootInfoLoaderName = boot::multiboot::kInfoLoaderName;
 
 // The command line is copied because the loader's copy lives in memory the
 // kernel does not reserve and may later reuse.

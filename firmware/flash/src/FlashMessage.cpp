@@ -90,8 +90,27 @@ private:
     size_t at_ = 0;
 };
 
-bool knownStatus(uint8_t value) { return value <= static_cast<uint8_t>(FlashStatus::Unsupported); }
-bool knownImageError(uint8_t value) { return value <= static_cast<uint8_t>(image::ImageError::Downgrade); }
+// A status byte, then for a refused image its reason: false for a value
+// out of range.
+bool readStatus(Reader& r, FlashMessage& m)
+{
+    const uint8_t value = r.u8();
+    if (value > static_cast<uint8_t>(FlashStatus::Unsupported)) {
+        return false;
+    }
+    m.status = static_cast<FlashStatus>(value);
+    return true;
+}
+
+bool readImageError(Reader& r, FlashMessage& m)
+{
+    const uint8_t value = r.u8();
+    if (value > static_cast<uint8_t>(image::ImageError::Downgrade)) {
+        return false;
+    }
+    m.imageError = static_cast<image::ImageError>(value);
+    return true;
+}
 bool slotOrNone(uint8_t value) { return value < 2 || value == 0xFF; }
 
 } // namespace
@@ -249,23 +268,14 @@ bool FlashMessage::decode(const uint8_t* data, size_t length, FlashMessage& out)
     case static_cast<uint8_t>(MessageType::AuthenticateReply):
     case static_cast<uint8_t>(MessageType::RestartReply):
     case static_cast<uint8_t>(MessageType::ErrorReply):
-        value = r.u8();
-        if (!knownStatus(value)) {
+        if (!readStatus(r, m)) {
             return false;
         }
-        m.status = static_cast<FlashStatus>(value);
         break;
     case static_cast<uint8_t>(MessageType::BeginReply):
-        value = r.u8();
-        if (!knownStatus(value)) {
+        if (!readStatus(r, m) || !readImageError(r, m)) {
             return false;
         }
-        m.status = static_cast<FlashStatus>(value);
-        value = r.u8();
-        if (!knownImageError(value)) {
-            return false;
-        }
-        m.imageError = static_cast<image::ImageError>(value);
         m.slot = r.u8();
         m.offset = r.u32();
         if (!slotOrNone(m.slot)) {
@@ -273,24 +283,15 @@ bool FlashMessage::decode(const uint8_t* data, size_t length, FlashMessage& out)
         }
         break;
     case static_cast<uint8_t>(MessageType::DataReply):
-        value = r.u8();
-        if (!knownStatus(value)) {
+        if (!readStatus(r, m)) {
             return false;
         }
-        m.status = static_cast<FlashStatus>(value);
         m.offset = r.u32();
         break;
     case static_cast<uint8_t>(MessageType::EndReply):
-        value = r.u8();
-        if (!knownStatus(value)) {
+        if (!readStatus(r, m) || !readImageError(r, m)) {
             return false;
         }
-        m.status = static_cast<FlashStatus>(value);
-        value = r.u8();
-        if (!knownImageError(value)) {
-            return false;
-        }
-        m.imageError = static_cast<image::ImageError>(value);
         break;
     default:
         return false;

@@ -109,6 +109,15 @@ std::string versionOf(const FlashMessage& hello, int slot)
     return hello.slotHolds[slot] ? hostimage::versionText(hello.slotVersion[slot]) : std::string("empty");
 }
 
+// A refusal's text: the status, and for a refused image its reason.
+std::string refusal(uint16_t node, const FlashMessage& reply)
+{
+    return fmt::format("node {}: {}{}", node, flash::flashStatusText(reply.status),
+                       reply.status == FlashStatus::ImageRefused
+                           ? fmt::format(": {}", image::imageErrorText(reply.imageError))
+                           : "");
+}
+
 const char* slotText(uint8_t slot) { return slot == 0 ? "A" : slot == 1 ? "B" : "none"; }
 
 nlohmann::json helloJson(const FlashMessage& hello)
@@ -232,10 +241,7 @@ int flashImage(Conversation& conversation, const Options& options)
         return fail(kExitFailed, error);
     }
     if (reply->status != FlashStatus::Ok) {
-        return fail(kExitRefused, fmt::format("node {}: {}{}", hello->node, flash::flashStatusText(reply->status),
-                                              reply->status == FlashStatus::ImageRefused
-                                                  ? fmt::format(": {}", image::imageErrorText(reply->imageError))
-                                                  : ""));
+        return fail(kExitRefused, refusal(hello->node, *reply));
     }
     const uint8_t slot = reply->slot;
     const uint32_t total = header.value().payloadSize;
@@ -288,10 +294,7 @@ int flashImage(Conversation& conversation, const Options& options)
         return fail(kExitFailed, error);
     }
     if (reply->status != FlashStatus::Ok) {
-        return fail(kExitRefused, fmt::format("node {}: {}{}", hello->node, flash::flashStatusText(reply->status),
-                                              reply->status == FlashStatus::ImageRefused
-                                                  ? fmt::format(": {}", image::imageErrorText(reply->imageError))
-                                                  : ""));
+        return fail(kExitRefused, refusal(hello->node, *reply));
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     bool restarted = false;

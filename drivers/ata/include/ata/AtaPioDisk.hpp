@@ -65,6 +65,9 @@ private:
     AtaError finish();
     AtaError issue(uint8_t command, uint32_t lba, uint32_t count);
     AtaError checkRange(uint32_t lba, uint32_t count) const;
+    /// Reads into @p in or writes from @p out (the other null), in commands
+    /// of at most 256 sectors.
+    AtaError transfer(uint8_t command, uint32_t lba, uint32_t count, uint16_t* in, const uint16_t* out);
 
     arch_x86::IoWindow command_;
     arch_x86::IoWindow control_;
