@@ -9,7 +9,8 @@ import re
 import subprocess
 import time
 
-from dcoslab.cards import BIN, BUILT, DEVELOPMENT_KEY, SECTOR, SLOT_LBA, card_state, new_card, signed, tool
+from dcoslab.cards import (BIN, BUILT, DEVELOPMENT_KEY, SECTOR, SLOT_LBA, card_state, new_card, put_in_slot, signed,
+                           tool)
 
 FIRMWARE = os.path.join(BUILT, "dcos486.elf")
 
@@ -47,10 +48,7 @@ def test_an_image_nothing_confirmed_boots_only_as_a_trial(boot, isa486, tmp_path
     # reader, or a download cut before it was marked pending) must prove
     # itself like any new image.
     card = new_card(tmp_path)
-    image = open(signed(tmp_path, "1.0.0"), "rb").read()
-    with open(card, "r+b") as handle:
-        handle.seek(SLOT_LBA["A"] * SECTOR)
-        handle.write(image[:256] + bytes(256) + image[256:])
+    put_in_slot(card, "A", signed(tmp_path, "1.0.0"))
     emulator = boot(isa486, card=card)
     emulator.expect(r"stage: no boot state on the card: a new card")
     emulator.expect(r"stage: no confirmed image: a valid one on trial")
@@ -80,10 +78,7 @@ def test_a_card_without_a_trusted_image_stays_in_recovery(boot, isa486, tmp_path
     card = new_card(tmp_path)
     # dcos-card refuses the stranger's image (the card does not trust its
     # key); a card reader would not: put it there byte for byte.
-    data = open(stranger, "rb").read()
-    with open(card, "r+b") as handle:
-        handle.seek(SLOT_LBA["A"] * SECTOR)
-        handle.write(data[:256] + bytes(256) + data[256:])
+    put_in_slot(card, "A", stranger)
     emulator = boot(isa486, card=card)
     emulator.expect(r"stage: slot A: signed by a key this controller does not trust")
     emulator.expect(r"stage: slot B: not a DCOS controller image")
