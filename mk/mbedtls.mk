@@ -48,7 +48,17 @@ $(MBEDTLS_FW_LIBRARY): $(MBEDTLS_FW_OBJS)
 # firmware against this library's headers: cold code, like mbedTLS itself.
 FW_IMAGE_SRCS := $(wildcard firmware/image/src/*.cpp)
 FW_IMAGE_OBJS := $(call fw_objects,$(FW_IMAGE_SRCS))
-# The on-target test of the verifier, in the test image.
-FW_IMAGE_USER_OBJS := $(FW_IMAGE_OBJS) $(FW_BUILD)/tests_renode/target/ImageVerifierTest.cpp.o
-$(FW_IMAGE_USER_OBJS): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS) $(FW_IMAGE_INCLUDES)
+# The on-target tests of the verifier, in the test image; one of them runs
+# Wycheproof's vectors, turned into C++ at build time.
+WYCHEPROOF_VECTORS := firmware/image/unit_tests/wycheproof/ecdsa_secp256r1_sha256_p1363_test.json
+WYCHEPROOF_INCLUDE := $(FW_BUILD)/generated/WycheproofVectors.inc
+FW_IMAGE_USER_OBJS := $(FW_IMAGE_OBJS) $(FW_BUILD)/tests_renode/target/ImageVerifierTest.cpp.o \
+	$(FW_BUILD)/tests_renode/target/WycheproofTest.cpp.o
+$(FW_IMAGE_USER_OBJS): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS) $(FW_IMAGE_INCLUDES) -I$(FW_BUILD)/generated
 $(FW_IMAGE_USER_OBJS): | $(MBEDTLS_FETCHED)
+$(FW_BUILD)/tests_renode/target/WycheproofTest.cpp.o: $(WYCHEPROOF_INCLUDE)
+
+$(WYCHEPROOF_INCLUDE): $(WYCHEPROOF_VECTORS) tests_renode/target/wycheproof_table.py
+	@mkdir -p $(dir $@)
+	@echo "  GEN     $@"
+	$(Q)$(PYTHON) tests_renode/target/wycheproof_table.py $(WYCHEPROOF_VECTORS) $@

@@ -16,7 +16,7 @@ import pytest
 from dcoslab.board import EXIT_PASS
 
 # On-target tests this module runs (see test_kernel_core.test_every_target_test_is_run).
-IMAGE_TARGET_TESTS = ["image"]
+IMAGE_TARGET_TESTS = ["image", "wycheproof"]
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TOOL = os.path.join(REPOSITORY, "build", "host_tools", "bin", "dcos-image")
@@ -198,4 +198,15 @@ def test_the_controller_verifies_images_with_mbedtls_built_for_the_i486(boot, is
     emulator.expect(r"one header bit changed: the signature does not verify")
     emulator.expect(r"one payload bit changed: the payload is not the one its signed header describes")
     emulator.expect(r"one signature bit changed: the signature does not verify")
+    emulator.expect_exit(EXIT_PASS)
+
+
+def test_the_controllers_own_mbedtls_passes_wycheproof(boot, isa486):
+    # The i486 build of mbedTLS has a configuration of its own
+    # (firmware/image/mbedtls/dcos_mbedtls_config.h): it is checked against
+    # all 219 Wycheproof P-256 SHA-256 cases on the emulated controller.
+    emulator = boot(isa486, "test")
+    emulator.expect(r"dcos> ")
+    emulator.send("test wycheproof --exit\r")
+    emulator.expect(r"219 vectors: 146 valid accepted, 69 invalid refused, 4 acceptable, 0 wrong", timeout=300)
     emulator.expect_exit(EXIT_PASS)
