@@ -62,6 +62,10 @@ FW_BENCH_KERNEL_OBJS := $(call fw_bench_objects,$(FW_SRCS)) $(FW_BUILD)/generate
 FW_BENCH_OBJS := $(call fw_bench_objects,$(FW_BENCH_SRCS))
 # Cold code is compiled for size here as in the production image (mk/firmware.mk).
 $(call fw_bench_objects,$(FW_COLD_SRCS)): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS)
+# The image benchmarks use the firmware's image verifier and mbedTLS (the
+# production objects: they do not depend on the kernel's table sizes).
+$(call fw_bench_objects,tests_renode/bench/ImageBench.cpp): FW_OBJECT_FLAGS := $(FW_IMAGE_INCLUDES)
+$(call fw_bench_objects,tests_renode/bench/ImageBench.cpp): | $(MBEDTLS_FETCHED)
 
 IMAGE_486_BENCH := $(BUILD)/486/dcos486-bench.elf
 BENCH_REPORT := $(BUILD)/bench/kernel.json
@@ -115,10 +119,10 @@ $(IMAGE_486_TEST_COUNTING): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_IMAGE_OBJS) $
 # and run the remote bench.
 firmware: $(IMAGE_486_BENCH) $(IMAGE_486_TEST_COUNTING)
 
-$(IMAGE_486_BENCH): $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS) firmware/boot/link.ld
+$(IMAGE_486_BENCH): $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS) $(FW_IMAGE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS)
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_BENCH_KERNEL_OBJS) $(FW_BENCH_OBJS) $(FW_IMAGE_OBJS) $(MBEDTLS_FW_LIBRARY)
 
 FW_BENCH_FLAGS_STAMP := $(FW_BENCH_BUILD)/flags.stamp
 $(FW_BENCH_FLAGS_STAMP): FORCE

@@ -14,10 +14,15 @@ MBEDTLS_FW_MODULES := asn1parse asn1write bignum constant_time ecdsa ecp ecp_cur
 	platform_util sha256
 MBEDTLS_FW_OBJS := $(patsubst %,$(MBEDTLS_FW_BUILD)/%.c.o,$(MBEDTLS_FW_MODULES))
 MBEDTLS_FW_LIBRARY := $(MBEDTLS_FW_BUILD)/libmbedcrypto.a
-# The firmware's code flags for C (FW_CODE_FLAGS less the C++ ones), -Os:
-# image checks run at boot and on an engineer's request, never on a path
-# make bench measures. mbedTLS is not ours, so its warnings are not errors.
-MBEDTLS_FW_CFLAGS := -std=c99 $(FW_ARCH_FLAGS) -mregparm=3 -freg-struct-return -mpreferred-stack-boundary=2 -Os \
+# The firmware's code flags for C (FW_CODE_FLAGS less the C++ ones), with
+# the optimisation that makes a boot's image check fastest (make bench,
+# Image.*): -O2 for the big-number and curve arithmetic (a signature
+# verified in 9 % fewer instructions than at -Os), -Os for SHA-256 (whose
+# rounds GCC's -O2 makes 9 % slower on the i486). mbedTLS is not ours, so
+# its warnings are not errors.
+MBEDTLS_OPTIMISATION := -O2
+$(MBEDTLS_FW_BUILD)/sha256.c.o: MBEDTLS_OPTIMISATION := -Os
+MBEDTLS_FW_CFLAGS := -std=c99 $(FW_ARCH_FLAGS) -mregparm=3 -freg-struct-return -mpreferred-stack-boundary=2 \
 	-falign-functions=1 -falign-jumps=1 -falign-loops=1 -falign-labels=1 -g -ffreestanding -fno-pic -fno-pie \
 	-fno-stack-protector -fno-asynchronous-unwind-tables -fno-unwind-tables -fomit-frame-pointer \
 	-fno-tree-loop-distribute-patterns -mgeneral-regs-only -ffunction-sections -fdata-sections \
@@ -34,10 +39,10 @@ $(MBEDTLS_FETCHED):
 # Named .c.o, as the firmware's objects are named .cpp.o: a plain %.o rule
 # would also match make's attempt to remake the dependency files (x.d from
 # x.d.o, by its built-in rule %: %.o).
-$(MBEDTLS_FW_BUILD)/%.c.o: $(MBEDTLS_FETCHED) firmware/image/mbedtls/dcos_mbedtls_config.h
+$(MBEDTLS_FW_BUILD)/%.c.o: $(MBEDTLS_FETCHED) firmware/image/mbedtls/dcos_mbedtls_config.h mk/mbedtls.mk
 	@mkdir -p $(dir $@)
 	@echo "  CC      $@"
-	$(Q)gcc $(MBEDTLS_FW_CFLAGS) -c $(MBEDTLS_TREE)/library/$*.c -o $@
+	$(Q)gcc $(MBEDTLS_FW_CFLAGS) $(MBEDTLS_OPTIMISATION) -c $(MBEDTLS_TREE)/library/$*.c -o $@
 
 $(MBEDTLS_FW_LIBRARY): $(MBEDTLS_FW_OBJS)
 	@echo "  AR      $@"
