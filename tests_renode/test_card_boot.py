@@ -119,6 +119,9 @@ def test_dcos_card_refuses_what_the_stage_loader_would_not_boot(tmp_path):
     assert shown["slots"]["A"]["valid"] is True and shown["slots"]["B"] is None
     assert shown["configuration"]["command_line"] == "node=3"
     tool("dcos-card", "write", card, "--slot", "B", signed(tmp_path, "1.1.0"), "--pending")
+    assert card_state(card)["boot_state"]["trial"] == "pending"
+    tool("dcos-card", "write", card, "--slot", "B", signed(tmp_path, "1.1.1"))
+    assert card_state(card)["boot_state"]["trial"] == "none", "the image the trial was for is gone"
     card_tool = os.path.join(BIN, "dcos-card")
 
     def refused(*arguments, code=1):

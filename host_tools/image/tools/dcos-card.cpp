@@ -230,6 +230,12 @@ int writeImage(const WriteOptions& options, bool json)
         next.trialSlot = static_cast<uint8_t>(slot);
         next.trial = boot::TrialState::Pending;
         cardFile->writeBootState(next);
+    } else if (state && state->trial != boot::TrialState::None && state->trialSlot == slot) {
+        // The slot's trial was another image: what is there now is not on trial.
+        boot::BootState next = *state;
+        next.trialSlot = boot::BootState::kNoSlot;
+        next.trial = boot::TrialState::None;
+        cardFile->writeBootState(next);
     } else if (confirmed == boot::BootState::kNoSlot) {
         // A card that confirms nothing yet (a new one): whoever makes it
         // vouches for the image, which is confirmed. The stage loader would
