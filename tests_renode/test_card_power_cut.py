@@ -108,7 +108,7 @@ def test_a_power_cut_during_a_download_leaves_the_card_as_it_was_and_the_downloa
     emulator.expect(r"stage: recovery: waiting for an image on this serial line")
     emulator.release_console()
     cut = subprocess.run([os.path.join(BIN, "dcos-flash"), "-d", f"unix:{emulator.console_socket_path}",
-                          "-k", DEVELOPMENT_KEY, "--timeout-ms", "1500", "--retries", "0", image],
+                          "-k", DEVELOPMENT_KEY, "--timeout-ms", "4000", "--retries", "0", image],
                          capture_output=True, text=True, timeout=300)
     assert cut.returncode == 4 and "no answer" in cut.stderr, cut.stdout + cut.stderr
     emulator.wait_power_cut()
@@ -137,7 +137,7 @@ def test_a_power_cut_before_a_whole_download_is_marked_pending_leaves_it_a_trial
     emulator.expect(r"stage: recovery: waiting for an image on this serial line")
     emulator.release_console()
     cut = subprocess.run([os.path.join(BIN, "dcos-flash"), "-d", f"unix:{emulator.console_socket_path}",
-                          "-k", DEVELOPMENT_KEY, "--timeout-ms", "1500", "--retries", "0", image],
+                          "-k", DEVELOPMENT_KEY, "--timeout-ms", "4000", "--retries", "0", image],
                          capture_output=True, text=True, timeout=300)
     assert cut.returncode == 4, cut.stdout + cut.stderr
     emulator.wait_power_cut()
