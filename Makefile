@@ -41,7 +41,10 @@ deps:
 	@mk/install-deps.sh
 
 run: deps
-ifeq ($(APP),)
+ifneq ($(CARD),)
+	@$(MAKE) --no-print-directory card
+	@$(PYTHON) tests_renode/launch.py --board isa486 --card $(CARD_486) $(ARGS)
+else ifeq ($(APP),)
 	@$(MAKE) --no-print-directory firmware
 	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(if $(filter minimal,$(KERNEL_CONFIG)),$(IMAGE_486_MINIMAL),$(IMAGE_486)) $(ARGS)
 else

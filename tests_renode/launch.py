@@ -29,6 +29,10 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--board", default="isa486", help="board definition in tests_renode/boards/")
     parser.add_argument("--image", help="firmware image (default: the board's production image)")
+    parser.add_argument("--card", metavar="CARD.IMG",
+                        help="boot from this CompactFlash card image through the BIOS and the stage loader "
+                             "instead of a firmware image (make card builds build/486/card-486.img; docs/boot.md); "
+                             "the card carries its own command line, so --append does not apply")
     parser.add_argument("--append", action="append", default=[], metavar="OPTION",
                         help="add to the kernel command line (repeatable): node=N sets the node id (1-65534, "
                              "default 1), tick_hz=N the system tick rate (19-10000 Hz, default 1000)")
@@ -69,14 +73,18 @@ def main():
         if port not in board.serial_ports:
             sys.exit(f"error: board {board.name} has no serial port '{port}'; its ports are: "
                      f"{', '.join(board.serial_ports)}")
-    image = arguments.image or board.image("production")
+    if arguments.card and (arguments.image or arguments.append):
+        sys.exit("error: --card boots the card's own image with its own command line: "
+                 "leave out --image and --append (dcos-card create --append sets the line)")
+    image = arguments.card or arguments.image or board.image("production")
     if not os.path.exists(image):
-        sys.exit(f"error: firmware image {image} does not exist; run 'make firmware'")
+        sys.exit(f"error: {'card' if arguments.card else 'firmware'} image {image} does not exist; "
+                 f"run 'make {'card' if arguments.card else 'firmware'}'")
     try:
         command = board.emulator_command(image, backends, append=" ".join(arguments.append),
                                          device_properties=properties, without_devices=arguments.without,
                                          extra_args=arguments.emulator_arg, line_ports=line_ports,
-                                         icount=bool(line_ports))
+                                         icount=bool(line_ports), card=bool(arguments.card))
     except (EmulatorNotBuilt, ValueError) as error:
         sys.exit(f"error: {error}")
     if arguments.print_command:

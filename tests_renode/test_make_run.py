@@ -28,6 +28,29 @@ def test_launcher_gives_an_interactive_console():
         session.close(force=True)
 
 
+def test_launcher_boots_a_card_through_the_bios_and_the_stage_loader(tmp_path):
+    # make run CARD=1 boots build/486/card-486.img; a copy here, since a boot
+    # may write the card's boot state.
+    card = tmp_path / "card.img"
+    card.write_bytes(open(os.path.join(REPOSITORY, "build", "486", "card-486.img"), "rb").read())
+    session = pexpect.spawn(sys.executable, [LAUNCHER, "--board", "isa486", "--card", str(card)], timeout=60,
+                            encoding="latin-1")
+    try:
+        session.expect(r"stage: DCOS stage loader")
+        session.expect(r"stage: slot A: isa486 \S+, signature and digest valid")
+        session.expect(r"loaded by DCOS stage loader|command line: boot\.slot=A")
+        session.expect(r"dcos> ")
+        session.send("boot\r")
+        session.expect(r"boot: slot A, version \S+")
+        session.expect(r"dcos> ")
+        session.send("\x01x")
+        session.expect(pexpect.EOF)
+    except (pexpect.TIMEOUT, pexpect.EOF) as error:
+        raise AssertionError(f"launcher session failed: {error}\n----- console -----\n{session.before}") from None
+    finally:
+        session.close(force=True)
+
+
 def test_unknown_board_is_refused_with_the_list():
     session = pexpect.spawn(sys.executable, [LAUNCHER, "--board", "vax"], timeout=60, encoding="latin-1")
     session.expect(pexpect.EOF)
