@@ -48,7 +48,8 @@ def test_a_node_in_recovery_takes_an_image_over_its_serial_line_and_tries_it(boo
     emulator = in_recovery(boot, isa486, card)
     info = json.loads(flash(emulator, "info").stdout)
     assert info == {"node": 4, "mode": "recovery", "protocol": 1, "confirmed": "none", "trial": "none",
-                    "trial_slot": "none", "slot_a": "empty", "slot_b": "empty"}, info
+                    "trial_slot": "none", "slot_a": "empty", "slot_b": "empty", "transfer_slot": "none",
+                    "transfer_offset": 0}, info
     image = signed(tmp_path, "2.0.0")
     done = json.loads(flash(emulator, "-k", DEVELOPMENT_KEY, "-n", "4", image).stdout)
     assert done["slot"] == "A" and done["version"] == "2.0.0" and done["restarted"] is True, done
@@ -89,7 +90,12 @@ def test_an_interrupted_transfer_resumes_where_it_stopped(boot, isa486, tmp_path
     time.sleep(3)  # About a quarter of the transfer.
     first.send_signal(signal.SIGKILL)
     first.wait(timeout=30)
-    done = json.loads(tool("dcos-flash", *command[1:], timeout=300).stdout)
+    held = json.loads(tool("dcos-flash", "-d", f"unix:{emulator.console_socket_path}", "--json", "info").stdout)
+    assert held["transfer_slot"] == "A" and held["transfer_offset"] > 0, held
+    refused = tool("dcos-flash", "-d", f"unix:{emulator.console_socket_path}", "-k", DEVELOPMENT_KEY, "--resume",
+                   signed(tmp_path, "2.0.1"), code=1)
+    assert "holds no interrupted transfer" in refused.stderr, "another image is not the one to resume"
+    done = json.loads(tool("dcos-flash", *command[1:], "--resume", timeout=300).stdout)
     assert 0 < done["resumed_from"] < done["bytes"], done
     assert done["restarted"] is False
     emulator.close()

@@ -175,6 +175,9 @@ size_t FlashMessage::encode(uint8_t* out, size_t capacity) const
             w.version(slotVersion[slotIndex]);
         }
         w.u16(maxBlock);
+        w.u8(transferSlot);
+        w.u32(transferOffset);
+        w.bytes(transferDigest, sizeof transferDigest);
         break;
     case MessageType::AuthenticateReply:
     case MessageType::RestartReply:
@@ -260,8 +263,11 @@ bool FlashMessage::decode(const uint8_t* data, size_t length, FlashMessage& out)
             m.slotVersion[slotIndex] = r.version();
         }
         m.maxBlock = r.u16();
+        m.transferSlot = r.u8();
+        m.transferOffset = r.u32();
+        r.bytes(m.transferDigest, sizeof m.transferDigest);
         if (!slotOrNone(m.confirmedSlot) || !slotOrNone(m.trialSlot) || m.trial > 2 || m.maxBlock == 0 ||
-            m.maxBlock > kMaxBlock) {
+            m.maxBlock > kMaxBlock || !slotOrNone(m.transferSlot)) {
             return false;
         }
         break;

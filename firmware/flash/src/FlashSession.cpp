@@ -102,6 +102,11 @@ FlashStatus FlashSession::hello(FlashMessage& reply)
         }
     }
     reply.maxBlock = kMaxBlock;
+    if (transferring_) {
+        reply.transferSlot = slot_;
+        reply.transferOffset = progress_;
+        image::Sha256::digest(headerBytes_, sizeof headerBytes_, reply.transferDigest);
+    }
     return FlashStatus::Ok;
 }
 

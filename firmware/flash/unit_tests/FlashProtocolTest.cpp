@@ -13,6 +13,8 @@
 
 #include "FlashTestHost.hpp"
 
+#include <image/Sha256.hpp>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -282,7 +284,14 @@ TEST_F(FlashSessionTest, ABeginWithTheSameHeaderResumesWhereTheTransferStopped)
     ASSERT_EQ(begin(image).status, FlashStatus::Ok);
     block(image, 0, 0, 1024);
     block(image, 1024, 1, 1024);
-    // The link dropped; a new session.
+    // The link dropped; a new session. Hello tells the host what it can resume.
+    const FlashMessage held = hello();
+    EXPECT_EQ(held.transferSlot, 0);
+    EXPECT_EQ(held.transferOffset, 2048u);
+    uint8_t headerDigest[32];
+    image::Sha256::digest(image.data(), 256, headerDigest);
+    EXPECT_TRUE(std::equal(std::begin(held.transferDigest), std::end(held.transferDigest), headerDigest))
+        << "the SHA-256 of the transfer's header";
     ASSERT_EQ(authenticate(), FlashStatus::Ok);
     const FlashMessage resumed = begin(image);
     ASSERT_EQ(resumed.status, FlashStatus::Ok);

@@ -1,7 +1,7 @@
 // dcos-flash: put a signed image on a controller over its serial line
 // (docs/guide/flashing.md, docs/protocols/flash.md).
 //
-//     dcos-flash -d DEVICE -k KEY.pem [-n NODE] IMAGE.dcos [--no-restart]
+//     dcos-flash -d DEVICE -k KEY.pem [-n NODE] IMAGE.dcos [--no-restart] [--resume]
 //     dcos-flash -d DEVICE info
 //
 // DEVICE is a serial device (/dev/ttyUSB0, 115200 bit/s 8N1) or a Unix
@@ -24,6 +24,7 @@
 #include <boot/Crc32.hpp>
 #include <flash/FlashMessage.hpp>
 #include <image/ImageHeader.hpp>
+#include <image/Sha256.hpp>
 
 #include <dcos/Version.hpp>
 
@@ -32,6 +33,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <algorithm>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -63,6 +65,7 @@ struct Options {
     std::string image;
     int node = -1;
     bool noRestart = false;
+    bool resumeOnly = false;
     long timeoutMs = 2000;
     int retries = 3;
     bool json = false;
@@ -130,7 +133,9 @@ nlohmann::json helloJson(const FlashMessage& hello)
             {"trial", hello.trial <= 2 ? trials[hello.trial] : "?"},
             {"trial_slot", slotText(hello.trialSlot)},
             {"slot_a", versionOf(hello, 0)},
-            {"slot_b", versionOf(hello, 1)}};
+            {"slot_b", versionOf(hello, 1)},
+            {"transfer_slot", slotText(hello.transferSlot)},
+            {"transfer_offset", hello.transferOffset}};
 }
 
 std::optional<FlashMessage> sayHello(Conversation& conversation, int& code)
@@ -169,6 +174,10 @@ int info(Conversation& conversation, const Options& options)
     fmt::print("confirmed     {}\n", out["confirmed"].get<std::string>());
     fmt::print("trial         {}{}\n", out["trial"].get<std::string>(),
                hello->trialSlot <= 1 ? fmt::format(" in slot {}", slotText(hello->trialSlot)) : "");
+    if (hello->transferSlot <= 1) {
+        fmt::print("transfer      into slot {}, {} bytes acknowledged (run the same image again to resume)\n",
+                   slotText(hello->transferSlot), hello->transferOffset);
+    }
     return kExitOk;
 }
 
@@ -213,6 +222,14 @@ int flashImage(Conversation& conversation, const Options& options)
     }
     if (options.node >= 0 && hello->node != options.node) {
         return fail(kExitRefused, fmt::format("the device reaches node {}, not node {}", hello->node, options.node));
+    }
+    uint8_t headerDigest[32];
+    image::Sha256::digest(image->data(), image::ImageHeader::kSize, headerDigest);
+    if (options.resumeOnly &&
+        (hello->transferSlot > 1 ||
+         !std::equal(std::begin(hello->transferDigest), std::end(hello->transferDigest), headerDigest))) {
+        return fail(kExitRefused, fmt::format("node {} holds no interrupted transfer of {} (--resume)", hello->node,
+                                              options.image));
     }
 
     // The challenge, signed: the node's proof that this session may write its card.
@@ -350,6 +367,9 @@ int main(int argc, char** argv)
     app.add_option("--retries", options.retries, "how often to send a request again on silence")
         ->check(CLI::Range(0, 100));
     app.add_flag("--no-restart", options.noRestart, "leave the image pending without restarting the node");
+    app.add_flag("--resume", options.resumeOnly,
+                 "only go on with the node's interrupted transfer of this image, never start one over "
+                 "(without it, a transfer resumes by itself when the node still holds it)");
     app.add_flag("--json", options.json, "machine-readable output: one JSON object");
     app.add_option("image", options.image, "the signed image to flash (dcos-image sign)");
     CLI::App* infoCommand = app.add_subcommand("info", "show the node's slots, versions and boot state");

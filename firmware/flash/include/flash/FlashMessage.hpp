@@ -77,6 +77,12 @@ struct FlashMessage {
     bool slotHolds[2] = {};
     image::ImageVersion slotVersion[2];
     uint16_t maxBlock = kMaxBlock;
+    /// The transfer the node holds (a Begin's, not ended): its slot (0xFF
+    /// none), the bytes acknowledged, and the SHA-256 of its image's
+    /// header, by which a host knows whether its image is the one to resume.
+    uint8_t transferSlot = 0xFF;
+    uint32_t transferOffset = 0;
+    uint8_t transferDigest[32] = {};
 
     // Authenticate
     uint8_t keyId[kKeyIdSize] = {};
