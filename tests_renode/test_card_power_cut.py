@@ -31,7 +31,9 @@ def updating_card(tmp_path, boot, isa486):
 def settle(boot, isa486, card):
     """Starts the board after a cut; returns (emulator at its prompt, slot it runs, on trial)."""
     emulator = boot(isa486, card=card)
-    match = emulator.expect(r"command line: node=3 boot\.slot=([AB]) boot\.version=(\S+)( boot\.trial=1)?")
+    # To the line's end: the console may have printed only part of it yet.
+    match = emulator.expect(r"command line: node=3 boot\.slot=([AB]) boot\.version=(\S+?)( boot\.trial=1)?"
+                            r"( boot\.reverted=1)?\r\n")
     slot, version, trial = match.group(1).decode(), match.group(2).decode(), match.group(3) is not None
     assert (slot, version) in (("A", "1.0.0"), ("B", "1.1.0")), (slot, version)
     if version == "1.1.0" and not trial:
