@@ -22,7 +22,7 @@ BOOT_SECTOR_BIN := $(BUILD)/486/boot-sector.bin
 STAGE_SRCS := \
 	firmware/boot/loader/stage_entry.S \
 	firmware/boot/loader/StageLoader.cpp \
-	firmware/boot/src/BootSequence.cpp \
+	firmware/boot/src/BootStateStore.cpp \
 	firmware/boot/src/BootState.cpp \
 	firmware/boot/src/CommandLine.cpp \
 	firmware/boot/src/ConfigurationBlock.cpp \

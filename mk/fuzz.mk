@@ -91,7 +91,7 @@ HOST_IMAGE_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,host_tools/image/
 HOST_IMAGE_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/image/fuzz/fuzz_%.cpp.o,$(HOST_IMAGE_FUZZ_TARGETS))
 HOST_IMAGE_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOST_IMAGE_FUZZ_TARGETS))
 FLASH_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) \
-	firmware/boot/src/BootState.cpp firmware/boot/src/Crc32.cpp)
+	firmware/boot/src/BootState.cpp firmware/boot/src/BootStateStore.cpp firmware/boot/src/Crc32.cpp)
 FLASH_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/flash/fuzz/fuzz_%.cpp.o,$(FLASH_FUZZ_TARGETS))
 FLASH_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(FLASH_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as

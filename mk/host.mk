@@ -15,7 +15,7 @@ HOST_PORTABLE_SRCS := \
 	firmware/boot/src/CommandLine.cpp \
 	firmware/boot/src/BootState.cpp \
 	firmware/boot/src/BootControl.cpp \
-	firmware/boot/src/BootSequence.cpp \
+	firmware/boot/src/BootStateStore.cpp \
 	firmware/boot/src/ConfigurationBlock.cpp \
 	firmware/boot/src/Crc32.cpp \
 	$(wildcard firmware/shell/src/*.cpp) \

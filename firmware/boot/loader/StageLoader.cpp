@@ -18,6 +18,7 @@
 #include <boot/BootState.hpp>
 #include <boot/CardLayout.hpp>
 #include <boot/Multiboot.hpp>
+#include <boot/TrialWatchdog.hpp>
 #include <boot/ConfigurationBlock.hpp>
 #include <flash/FlashSession.hpp>
 #include <flash/SerialFramer.hpp>
@@ -139,14 +140,6 @@ bool enableA20()
     portWrite8(0x92, static_cast<uint8_t>((portRead8(0x92) | 0x02) & ~0x01));
     return a20Enabled();
 }
-
-// The board's watchdog: an iBASE IB700-compatible timer (QEMU's ib700),
-// ports 0x441 (a write stops it) and 0x443 (a write starts it; the value's
-// low four bits pick the time, 30 s less 2 s per step). The stage loader
-// arms it for a trial boot only; the new image stops it when it confirms.
-constexpr uint16_t kWatchdogStop = 0x441;
-constexpr uint16_t kWatchdogStart = 0x443;
-constexpr uint8_t kWatchdogTrialSetting = 0; // 30 s
 
 // -- the card ---------------------------------------------------------------------
 
@@ -270,10 +263,10 @@ const char loaderName[] = "DCOS stage loader";
     handover.cmdline = reinterpret_cast<uintptr_t>(commandLine);
     handover.bootLoaderName = reinterpret_cast<uintptr_t>(loaderName);
     if (trial) {
-        portWrite8(kWatchdogStart, kWatchdogTrialSetting);
-        say("watchdog armed: the new image must confirm within 30 s");
+        boot::watchdog::armForTrial();
+        say("watchdog armed: the new image must confirm within %u s", boot::watchdog::kTrialSeconds);
     } else {
-        portWrite8(kWatchdogStop, 0);
+        boot::watchdog::stop();
     }
     say("starting slot %s at 0x%08lx", card::slotName(slot), static_cast<unsigned long>(image.entry));
     asm volatile("jmp *%2" : : "a"(boot::multiboot::kLoaderMagic), "b"(&handover), "r"(image.entry) : "memory");
@@ -281,20 +274,19 @@ const char loaderName[] = "DCOS stage loader";
 }
 
 // The node id, as the kernel will take it: the configuration's, else
-// "node=" on the configuration's command line, else 1 (the kernel's default).
+// "node=" on the configuration's command line read by the kernel's own rule
+// (boot::parseNodeId), else 1 (the kernel's default).
 uint16_t nodeId()
 {
     if (configuration.nodeId != 0) {
         return configuration.nodeId;
     }
     char text[8];
-    unsigned long value = 0;
+    uint16_t node = 1;
     if (boot::findCommandLineOption(configuration.commandLine, "node", text, sizeof text)) {
-        for (const char* digit = text; *digit >= '0' && *digit <= '9'; ++digit) {
-            value = value * 10 + static_cast<unsigned long>(*digit - '0');
-        }
+        (void)boot::parseNodeId(text, node);
     }
-    return value != 0 && value < 0xFFFF ? static_cast<uint16_t>(value) : 1;
+    return node;
 }
 
 // What makes this start's challenges its own: the real-time clock's time
@@ -445,24 +437,23 @@ extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
         recovery("the configuration trusts no key, so no image can be verified");
     }
 
-    // What the card says, for the console; BootSequence reads it again to decide.
-    boot::BootState stored;
-    unsigned stateCopy = 0;
-    if (readRecordCopies(disk, card::kBootStateLba) && boot::BootState::newest(sectorA, sectorB, stored, stateCopy)) {
-        say("boot state %lu: confirmed slot %s, trial %s%s", static_cast<unsigned long>(stored.sequence),
-            card::slotName(stored.confirmedSlot),
-            stored.trial == boot::TrialState::None      ? "none"
-            : stored.trial == boot::TrialState::Pending ? "pending in slot "
-                                                        : "booting in slot ",
-            stored.trial == boot::TrialState::None ? "" : card::slotName(stored.trialSlot));
-    } else {
+    boot::AtaSectorStore store(disk);
+    const boot::StoredBootState stored = boot::BootStateStore::read(store);
+    if (stored.present) {
+        const boot::BootState& state = stored.state;
+        say("boot state %lu: confirmed slot %s, trial %s%s", static_cast<unsigned long>(state.sequence),
+            card::slotName(state.confirmedSlot),
+            state.trial == boot::TrialState::None      ? "none"
+            : state.trial == boot::TrialState::Pending ? "pending in slot "
+                                                       : "booting in slot ",
+            state.trial == boot::TrialState::None ? "" : card::slotName(state.trialSlot));
+    } else if (stored.readable) {
         say("no boot state on the card: a new card");
     }
-    boot::AtaSectorStore store(disk);
-    const boot::BootDecision decision =
-        boot::BootSequence::decide(store, [&](uint8_t slot) { return loadAndVerify(disk, slot, memoryEnd); });
+    const boot::BootDecision decision = boot::BootSequence::decide(
+        store, stored, [&](uint8_t slot) { return loadAndVerify(disk, slot, memoryEnd); });
     const boot::BootPlan& plan = decision.plan;
-    recoverySequence = decision.hadState ? decision.stored.sequence : 0;
+    recoverySequence = stored.present ? stored.state.sequence : 0;
     say("%s", plan.reason);
     if (decision.cardFailed) {
         recovery(plan.reason);

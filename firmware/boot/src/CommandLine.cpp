@@ -1,5 +1,7 @@
 #include <boot/BootInfo.hpp>
 
+#include <stddef.h>
+
 namespace boot {
 
 bool findCommandLineOption(const char* commandLine, const char* key, char* value, uint32_t capacity)
@@ -35,6 +37,23 @@ bool findCommandLineOption(const char* commandLine, const char* key, char* value
         }
     }
     return false;
+}
+
+bool parseNodeId(const char* text, uint16_t& node)
+{
+    uint32_t value = 0;
+    size_t digits = 0;
+    for (; text[digits] != '\0'; ++digits) {
+        if (text[digits] < '0' || text[digits] > '9' || digits == 5) {
+            return false;
+        }
+        value = value * 10 + static_cast<uint32_t>(text[digits] - '0');
+    }
+    if (digits == 0 || value < 1 || value > 0xFFFE) {
+        return false;
+    }
+    node = static_cast<uint16_t>(value);
+    return true;
 }
 
 } // namespace boot

@@ -36,3 +36,19 @@ TEST(CommandLine, LongValueIsTruncatedAndTerminated)
 }
 
 } // namespace
+
+TEST(CommandLine, NodeIdsAreOneTo65534InAtMostFiveDigits)
+{
+    uint16_t node = 9;
+    EXPECT_TRUE(boot::parseNodeId("4", node));
+    EXPECT_EQ(node, 4);
+    EXPECT_TRUE(boot::parseNodeId("65534", node));
+    EXPECT_EQ(node, 65534);
+    EXPECT_TRUE(boot::parseNodeId("00012", node));
+    EXPECT_EQ(node, 12);
+    for (const char* text : {"", "0", "65535", "99999", "000001", "4x", "-4", " 4", "4 "}) {
+        node = 9;
+        EXPECT_FALSE(boot::parseNodeId(text, node)) << text;
+        EXPECT_EQ(node, 9) << "unchanged: " << text;
+    }
+}

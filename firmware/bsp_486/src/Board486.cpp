@@ -175,18 +175,9 @@ static_assert(Pit8254::minimumRateHz == minimumTickRateHz && Pit8254::maximumRat
 void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
 {
     char nodeText[8];
-    if (boot::findCommandLineOption(bootInfo.commandLine, "node", nodeText, sizeof nodeText)) {
-        uint32_t value = 0;
-        bool valid = nodeText[0] != '\0';
-        for (const char* p = nodeText; *p != '\0' && valid; ++p) {
-            valid = *p >= '0' && *p <= '9' && p - nodeText < 5;
-            value = value * 10 + static_cast<uint32_t>(*p - '0');
-        }
-        if (valid && value >= 1 && value <= 0xFFFE) {
-            node = static_cast<uint16_t>(value);
-        } else {
-            runtime::format(uart, "warning: node=%s is not a node id from 1 to 65534; using 1\r\n", nodeText);
-        }
+    if (boot::findCommandLineOption(bootInfo.commandLine, "node", nodeText, sizeof nodeText) &&
+        !boot::parseNodeId(nodeText, node)) {
+        runtime::format(uart, "warning: node=%s is not a node id from 1 to 65534; using 1\r\n", nodeText);
     }
     pic.initialise(static_cast<uint8_t>(arch_x86::firstIrqVector));
     arch_x86::Idt::setInterruptHandler(dispatchInterrupt);

@@ -1,5 +1,6 @@
 #include <flash/FlashSession.hpp>
 
+#include <boot/BootStateStore.hpp>
 #include <boot/CardLayout.hpp>
 #include <boot/Crc32.hpp>
 #include <image/EcdsaP256.hpp>
@@ -12,19 +13,8 @@ namespace {
 namespace card = boot::card;
 using Sector = uint8_t[card::kSectorSize];
 
-bool sameBytes(const uint8_t* a, const uint8_t* b, size_t count)
-{
-    for (size_t i = 0; i < count; ++i) {
-        if (a[i] != b[i]) {
-            return false;
-        }
-    }
-    return true;
-}
-
-// Sector buffers: the session handles one request at a time.
+// A sector buffer: the session handles one request at a time.
 Sector scratch;
-Sector scratchB;
 uint8_t readBack[kMaxBlock];
 
 } // namespace
@@ -34,22 +24,6 @@ FlashSession::FlashSession(FlashStore& store, const image::TrustedKey* keys, siz
     : store_(store), keys_(keys), keyCount_(keyCount), identity_(identity)
 {
     image::Sha256::digest(seed, seedLength, seed_);
-}
-
-bool FlashSession::readState(boot::BootState& state, unsigned& copy, bool& present)
-{
-    if (!store_.read(card::kBootStateLba, 1, scratch) || !store_.read(card::kBootStateLba + 1, 1, scratchB)) {
-        return false;
-    }
-    present = boot::BootState::newest(scratch, scratchB, state, copy);
-    return true;
-}
-
-bool FlashSession::writeState(boot::BootState state, bool present, unsigned copy)
-{
-    state.sequence = present ? state.sequence + 1 : 1;
-    state.encode(scratch);
-    return store_.write(card::kBootStateLba + (present ? copy ^ 1u : 0u), 1, scratch);
 }
 
 bool FlashSession::slotHeader(uint8_t slot, image::ImageHeader& header)
@@ -86,13 +60,11 @@ FlashStatus FlashSession::hello(FlashMessage& reply)
     for (size_t i = 0; i < kChallengeSize; ++i) {
         reply.challenge[i] = challenge_[i];
     }
-    boot::BootState state;
-    unsigned copy = 0;
-    bool present = false;
-    if (readState(state, copy, present) && present) {
-        reply.confirmedSlot = state.confirmedSlot;
-        reply.trial = static_cast<uint8_t>(state.trial);
-        reply.trialSlot = state.trialSlot;
+    const boot::StoredBootState stored = boot::BootStateStore::read(store_);
+    if (stored.present) {
+        reply.confirmedSlot = stored.state.confirmedSlot;
+        reply.trial = static_cast<uint8_t>(stored.state.trial);
+        reply.trialSlot = stored.state.trialSlot;
     }
     for (uint8_t slot = 0; slot < card::kSlotCount; ++slot) {
         image::ImageHeader header;
@@ -120,12 +92,7 @@ FlashStatus FlashSession::authenticate(const FlashMessage& request)
     if (!fresh) {
         return FlashStatus::AuthenticationFailed;
     }
-    const image::TrustedKey* key = nullptr;
-    for (size_t i = 0; i < keyCount_; ++i) {
-        if (sameBytes(keys_[i].id, request.keyId, kKeyIdSize)) {
-            key = &keys_[i];
-        }
-    }
+    const image::TrustedKey* key = image::TrustedKey::find(request.keyId, keys_, keyCount_);
     if (key == nullptr) {
         return FlashStatus::AuthenticationFailed;
     }
@@ -140,13 +107,11 @@ FlashStatus FlashSession::authenticate(const FlashMessage& request)
 
 FlashStatus FlashSession::begin(const FlashMessage& request, FlashMessage& reply)
 {
-    boot::BootState state;
-    unsigned copy = 0;
-    bool present = false;
-    if (!readState(state, copy, present)) {
+    const boot::StoredBootState stored = boot::BootStateStore::read(store_);
+    if (!stored.readable) {
         return FlashStatus::CardError;
     }
-    const uint8_t confirmed = present ? state.confirmedSlot : boot::BootState::kNoSlot;
+    const uint8_t confirmed = stored.present ? stored.state.confirmedSlot : boot::BootState::kNoSlot;
     image::ImageVersion installed;
     image::ImagePolicy policy = image::ImagePolicy::forBoard(identity_.board);
     if (identity_.memoryEnd < policy.memoryEnd) {
@@ -172,16 +137,17 @@ FlashStatus FlashSession::begin(const FlashMessage& request, FlashMessage& reply
     }
     const uint8_t slot = confirmed == 0 ? 1 : 0;
     reply.slot = slot;
-    if (transferring_ && slot == slot_ && sameBytes(headerBytes_, request.header, sizeof headerBytes_)) {
+    if (transferring_ && slot == slot_ && __builtin_memcmp(headerBytes_, request.header, sizeof headerBytes_) == 0) {
         reply.offset = progress_; // The same image again: resume.
         return FlashStatus::Ok;
     }
     // A new transfer into the slot. A trial the slot held is dropped first,
     // so that a half-written image is never pending.
-    if (present && state.trial != boot::TrialState::None && state.trialSlot == slot) {
-        state.trial = boot::TrialState::None;
-        state.trialSlot = boot::BootState::kNoSlot;
-        if (!writeState(state, present, copy)) {
+    if (stored.present && stored.state.trial != boot::TrialState::None && stored.state.trialSlot == slot) {
+        boot::BootState cleared = stored.state;
+        cleared.trial = boot::TrialState::None;
+        cleared.trialSlot = boot::BootState::kNoSlot;
+        if (!boot::BootStateStore::writeNext(store_, stored, cleared)) {
             return FlashStatus::CardError;
         }
     }
@@ -262,22 +228,22 @@ FlashStatus FlashSession::end(FlashMessage& reply)
         hash.update(readBack, chunk);
         done += chunk;
     }
-    uint8_t digest[32];
+    uint8_t digest[image::ImageHeader::kDigestSize];
     hash.finish(digest);
-    if (!sameBytes(digest, header_.payloadDigest, sizeof digest)) {
-        reply.imageError = image::ImageError::PayloadMismatch;
+    const image::ImageError payload = image::ImageVerifier::checkPayloadDigest(header_, digest);
+    if (payload != image::ImageError::Ok) {
+        reply.imageError = payload;
         transferring_ = false;
         return FlashStatus::ImageRefused;
     }
-    boot::BootState state;
-    unsigned copy = 0;
-    bool present = false;
-    if (!readState(state, copy, present)) {
+    const boot::StoredBootState stored = boot::BootStateStore::read(store_);
+    if (!stored.readable) {
         return FlashStatus::CardError;
     }
-    state.trialSlot = slot_;
-    state.trial = boot::TrialState::Pending;
-    if (!writeState(state, present, copy)) {
+    boot::BootState pending = stored.state;
+    pending.trialSlot = slot_;
+    pending.trial = boot::TrialState::Pending;
+    if (!boot::BootStateStore::writeNext(store_, stored, pending)) {
         return FlashStatus::CardError;
     }
     transferring_ = false;

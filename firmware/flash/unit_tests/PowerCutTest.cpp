@@ -65,8 +65,8 @@ struct Booted {
 // One start of the controller: the stage loader's decision on the card.
 Booted bootOnce(MemoryCard& store, const image::TrustedKey& key)
 {
-    const boot::BootDecision decision =
-        boot::BootSequence::decide(store, [&](uint8_t slot) { return slotVerifies(store, slot, key); });
+    const boot::BootDecision decision = boot::BootSequence::decide(
+        store, boot::BootStateStore::read(store), [&](uint8_t slot) { return slotVerifies(store, slot, key); });
     Booted result;
     result.booted = decision.plan.action == boot::BootPlan::Action::Boot && !decision.cardFailed;
     result.slot = decision.plan.slot;

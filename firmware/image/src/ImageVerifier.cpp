@@ -16,7 +16,10 @@ bool sameDigest(const uint8_t (&a)[ImageHeader::kDigestSize], const uint8_t (&b)
     return true;
 }
 
-const TrustedKey* keyWithId(const uint8_t (&id)[ImageHeader::kDigestSize], const TrustedKey* keys, size_t count)
+} // namespace
+
+const TrustedKey* TrustedKey::find(const uint8_t (&id)[ImageHeader::kDigestSize], const TrustedKey* keys,
+                                   size_t count)
 {
     for (size_t i = 0; keys != nullptr && i < count; ++i) {
         if (sameDigest(keys[i].id, id)) {
@@ -25,8 +28,6 @@ const TrustedKey* keyWithId(const uint8_t (&id)[ImageHeader::kDigestSize], const
     }
     return nullptr;
 }
-
-} // namespace
 
 TrustedKey TrustedKey::fromPoint(const uint8_t (&point)[EcdsaP256::kPublicKeySize])
 {
@@ -76,7 +77,7 @@ ImageResult<ImageHeader> ImageVerifier::checkHeader(const uint8_t* bytes, size_t
         uint64_t{header.loadAddress} + header.memorySize > policy.memoryEnd) {
         return ImageError::BadAddresses;
     }
-    const TrustedKey* key = keyWithId(header.keyId, keys, keyCount);
+    const TrustedKey* key = TrustedKey::find(header.keyId, keys, keyCount);
     if (key == nullptr) {
         return ImageError::UnknownKey;
     }
@@ -98,6 +99,11 @@ ImageError ImageVerifier::checkPayload(const ImageHeader& header, const uint8_t*
     }
     uint8_t digest[ImageHeader::kDigestSize];
     Sha256::digest(payload, length, digest);
+    return checkPayloadDigest(header, digest);
+}
+
+ImageError ImageVerifier::checkPayloadDigest(const ImageHeader& header, const uint8_t (&digest)[ImageHeader::kDigestSize])
+{
     return sameDigest(digest, header.payloadDigest) ? ImageError::Ok : ImageError::PayloadMismatch;
 }
 

@@ -1,5 +1,7 @@
 #include <hostimage/CardFile.hpp>
 
+#include <boot/BootStateStore.hpp>
+
 #include <algorithm>
 #include <cstring>
 
@@ -69,29 +71,37 @@ std::optional<boot::ConfigurationBlock> CardFile::configuration() const
     return block;
 }
 
-std::optional<boot::BootState> CardFile::bootState(unsigned* copy) const
+std::optional<boot::BootState> CardFile::bootState()
 {
-    boot::BootState state;
-    unsigned found = 0;
-    if (!boot::BootState::newest(asSector(sector(card::kBootStateLba)), asSector(sector(card::kBootStateLba + 1)), state,
-                                 found)) {
+    const boot::StoredBootState stored = boot::BootStateStore::read(*this);
+    if (!stored.present) {
         return std::nullopt;
     }
-    if (copy != nullptr) {
-        *copy = found;
-    }
-    return state;
+    return stored.state;
 }
 
-void CardFile::writeBootState(boot::BootState state)
+void CardFile::writeBootState(const boot::BootState& state)
 {
-    unsigned copy = 0;
-    const std::optional<boot::BootState> current = bootState(&copy);
-    state.sequence = current ? current->sequence + 1 : 1;
-    const unsigned target = current ? copy ^ 1u : 0u;
-    Sector record;
-    state.encode(record);
-    std::copy(std::begin(record), std::end(record), sector(card::kBootStateLba + target));
+    (void)boot::BootStateStore::writeNext(*this, boot::BootStateStore::read(*this), state);
+}
+
+bool CardFile::read(uint32_t lba, uint32_t count, void* buffer)
+{
+    if (uint64_t{lba} + count > bytes_.size() / card::kSectorSize) {
+        return false;
+    }
+    std::copy_n(sector(lba), size_t{count} * card::kSectorSize, static_cast<uint8_t*>(buffer));
+    return true;
+}
+
+bool CardFile::write(uint32_t lba, uint32_t count, const void* buffer)
+{
+    if (uint64_t{lba} + count > bytes_.size() / card::kSectorSize) {
+        return false;
+    }
+    const auto* from = static_cast<const uint8_t*>(buffer);
+    std::copy(from, from + size_t{count} * card::kSectorSize, sector(lba));
+    return true;
 }
 
 std::vector<uint8_t> CardFile::slotImage(uint32_t slot) const

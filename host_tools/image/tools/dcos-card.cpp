@@ -283,7 +283,7 @@ const char* trialName(boot::TrialState trial)
 int show(const std::string& path, bool json)
 {
     int code = kExitOk;
-    const std::optional<hostimage::CardFile> cardFile = openCard(path, code);
+    std::optional<hostimage::CardFile> cardFile = openCard(path, code);
     if (!cardFile) {
         return code;
     }

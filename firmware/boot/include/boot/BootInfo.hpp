@@ -24,6 +24,10 @@ struct BootInfo {
 /// the key is present; a bare "key" yields an empty value.
 bool findCommandLineOption(const char* commandLine, const char* key, char* value, uint32_t capacity);
 
+/// Reads a node id written as "node=" takes it: 1 to 65534 in decimal, at
+/// most five digits, nothing else. False (and @p node unchanged) otherwise.
+bool parseNodeId(const char* text, uint16_t& node);
+
 /// The image's extent in memory, from the linker script.
 struct ImageLayout {
     uintptr_t start;

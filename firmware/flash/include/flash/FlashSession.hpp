@@ -65,8 +65,6 @@ private:
     FlashStatus begin(const FlashMessage& request, FlashMessage& reply);
     FlashStatus data(const FlashMessage& request, FlashMessage& reply);
     FlashStatus end(FlashMessage& reply);
-    bool readState(boot::BootState& state, unsigned& copy, bool& present);
-    bool writeState(boot::BootState state, bool present, unsigned copy);
     bool slotHeader(uint8_t slot, image::ImageHeader& header);
 
     FlashStore& store_;

@@ -28,6 +28,8 @@ struct TrustedKey {
 
     /// The key of that point, its id computed.
     static TrustedKey fromPoint(const uint8_t (&point)[EcdsaP256::kPublicKeySize]);
+    /// The key among @p count @p keys whose id is @p id; null when none is.
+    static const TrustedKey* find(const uint8_t (&id)[ImageHeader::kDigestSize], const TrustedKey* keys, size_t count);
 };
 
 /// What the checking side allows.
@@ -62,6 +64,10 @@ public:
     /// Checks @p length bytes of payload against the digest of a header
     /// checkHeader() accepted.
     static ImageError checkPayload(const ImageHeader& header, const uint8_t* payload, size_t length);
+
+    /// Checks the SHA-256 of a payload the caller hashed itself (a payload
+    /// read back from a card piece by piece) against the header's.
+    static ImageError checkPayloadDigest(const ImageHeader& header, const uint8_t (&digest)[ImageHeader::kDigestSize]);
 
     /// Both checks on a whole image in memory.
     static ImageResult<ImageHeader> verify(const uint8_t* image, size_t length, const TrustedKey* keys,

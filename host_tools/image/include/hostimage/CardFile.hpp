@@ -7,6 +7,7 @@
 #pragma once
 
 #include <boot/BootState.hpp>
+#include <boot/SectorStore.hpp>
 #include <boot/ConfigurationBlock.hpp>
 
 #include <image/ImageHeader.hpp>
@@ -18,7 +19,7 @@
 
 namespace hostimage {
 
-class CardFile {
+class CardFile final : public boot::SectorStore {
 public:
     /// A new card of @p sectors sectors: the boot sector and the stage
     /// loader (flat binaries), the configuration in both copies, no boot
@@ -33,11 +34,16 @@ public:
 
     /// The configuration's newest valid copy, if any.
     std::optional<boot::ConfigurationBlock> configuration() const;
-    /// The boot state's newest valid copy and its index, if any.
-    std::optional<boot::BootState> bootState(unsigned* copy = nullptr) const;
+    /// The boot state's newest valid copy, if any (boot::BootStateStore).
+    std::optional<boot::BootState> bootState();
     /// Writes @p state as the next record: sequence one past the newest,
-    /// into the other copy.
-    void writeBootState(boot::BootState state);
+    /// into the other copy (boot::BootStateStore::writeNext).
+    void writeBootState(const boot::BootState& state);
+
+    /// The card's sectors, as the firmware's boot code reads and writes
+    /// them; false for sectors beyond the card.
+    bool read(uint32_t lba, uint32_t count, void* buffer) override;
+    bool write(uint32_t lba, uint32_t count, const void* buffer) override;
 
     /// The image in @p slot, header and payload as a file holds them;
     /// empty when the slot's first sector holds no image header.
