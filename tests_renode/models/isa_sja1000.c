@@ -1864,6 +1864,14 @@ static const MemoryRegionOps sja_card_ops = {
 static void chan_hardware_reset(Sja1000Channel *ch)
 {
     can_sja_hardware_reset(&ch->core);
+    /*
+     * The core's reset empties the receive FIFO (RMC 0, RBSA 0) but leaves
+     * its write position where the last frame ended: the next frame would
+     * land there while the CPU reads from RBSA 0, a frame's bytes read from
+     * the wrong place after every restart of the board. A chip's FIFO
+     * starts empty at address 0 (DS 6.4.17, RBSA after a hardware reset).
+     */
+    ch->core.rx_ptr = 0;
     chan_drop_events(ch);
     ch->alc = 0;
     ch->ecc = 0;
