@@ -108,11 +108,11 @@ $(FOOTPRINT_MAP_MINIMAL): $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) firmware/boot/
 IMAGE_486_TEST_COUNTING := $(BUILD)/486/dcos486-test-counting.elf
 FW_COUNTER_OBJS := $(call fw_objects,tests_renode/bench/counter/InstructionCounter.cpp)
 
-$(IMAGE_486_TEST_COUNTING): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_IMAGE_OBJS) $(MBEDTLS_FW_LIBRARY) $(FW_COUNTER_OBJS) \
+$(IMAGE_486_TEST_COUNTING): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) $(FW_COUNTER_OBJS) \
 		firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_COUNTER_OBJS) $(FW_IMAGE_OBJS) \
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_COUNTER_OBJS) $(FW_FLASH_SERVICE_OBJS) \
 		$(MBEDTLS_FW_LIBRARY)
 
 # Built with the other images, so the emulator suite can check the framework

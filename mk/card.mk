@@ -16,7 +16,8 @@ BOOT_SECTOR_ELF := $(BUILD)/486/boot-sector.elf
 BOOT_SECTOR_BIN := $(BUILD)/486/boot-sector.bin
 
 # The stage loader: its own entry and main, the card's records, the ATA
-# driver, the image verifier with mbedTLS, and the runtime's memory,
+# driver, the image verifier with mbedTLS, the flash protocol with the CAN
+# card's chip core and ISO-TP for recovery, and the runtime's memory,
 # formatting and division. Objects are the firmware's (same flags), linked
 # at 0x10000 by its own script.
 STAGE_SRCS := \
@@ -27,8 +28,12 @@ STAGE_SRCS := \
 	firmware/boot/src/CommandLine.cpp \
 	firmware/boot/src/ConfigurationBlock.cpp \
 	firmware/boot/src/Crc32.cpp \
+	firmware/bsp_486/src/BoardReset.cpp \
 	$(ATA_DRIVER_PORTABLE_SRCS) \
 	$(FLASH_PORTABLE_SRCS) \
+	drivers/can/src/BitTiming.cpp \
+	drivers/can/src/Sja1000Chip.cpp \
+	$(filter-out %/SlcanCodec.cpp %/FrameText.cpp,$(CAN_PORTABLE_SRCS)) \
 	firmware/runtime/src/CxxRuntime.cpp \
 	firmware/runtime/src/Format.cpp \
 	firmware/runtime/src/Int64Division.cpp \

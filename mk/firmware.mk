@@ -142,6 +142,16 @@ fw_objects = $(patsubst %,$(FW_BUILD)/%.o,$(1))
 # images that link them.
 include mk/mbedtls.mk
 FW_OBJS := $(call fw_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
+# The flash service (firmware/flash, FlashService.hpp), with the flash
+# protocol, the image verifier and mbedTLS it runs on: the production and
+# test images and the SDK's library carry it; the bench and minimal images
+# do not, and the kernel reaches it only through weak hooks
+# (dcos/internal/FlashServiceHooks.hpp). Its objects are the stage
+# loader's (mk/card.mk), compiled for size: none is on a real-time path.
+FW_FLASH_TARGET_OBJS := $(call fw_objects,$(FLASH_TARGET_SRCS))
+FW_FLASH_SERVICE_OBJS := $(call fw_objects,$(FLASH_PORTABLE_SRCS)) $(FW_FLASH_TARGET_OBJS) $(FW_IMAGE_OBJS)
+$(FW_FLASH_TARGET_OBJS): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS) $(FW_IMAGE_INCLUDES) -Ifirmware/flash/include
+$(FW_FLASH_TARGET_OBJS): | $(MBEDTLS_FETCHED)
 FW_TARGET_TEST_OBJS := $(call fw_objects,$(FW_TARGET_TEST_SRCS))
 FW_MINIMAL_OBJS := $(call fw_objects,$(FW_MINIMAL_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o
 FW_SELFCHECK_OBJS := $(call fw_objects,$(FW_SELFCHECK_SRCS))
@@ -159,18 +169,18 @@ FW_IMAGES_STAMP := $(FW_BUILD)/images.stamp
 
 firmware: $(IMAGE_486) $(IMAGE_486_TEST) $(IMAGE_486_MINIMAL) $(IMAGE_486_MINIMAL_TEST)
 
-$(IMAGE_486): $(FW_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
+$(IMAGE_486): $(FW_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS)
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY)
 
-# The test image also checks controller images with mbedTLS built for the
-# i486 (mk/mbedtls.mk), which its on-target test "image" runs.
-$(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_IMAGE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld \
+# The test image carries the flash service too, and its on-target tests
+# "image" and "wycheproof" check controller images with the same mbedTLS.
+$(IMAGE_486_TEST): $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld \
 		$(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_IMAGE_OBJS) $(MBEDTLS_FW_LIBRARY)
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY)
 
 $(IMAGE_486_MINIMAL): $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
@@ -192,7 +202,7 @@ update_if_changed = { new='$@.new.'$$$$; cat > "$$new" && { cmp -s "$$new" '$@' 
 # an object taken out of an image relinks it.
 $(FW_IMAGES_STAMP): FORCE
 	@mkdir -p $(dir $@)
-	@echo '$(FW_LDFLAGS) $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) $(FW_MINIMAL_TARGET_TEST_OBJS) $(FW_IMAGE_OBJS)' | $(update_if_changed)
+	@echo '$(FW_LDFLAGS) $(FW_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) $(FW_MINIMAL_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS)' | $(update_if_changed)
 
 # Objects depend on the flags they were compiled with: a change of flags
 # rebuilds everything instead of linking stale objects.

@@ -45,7 +45,7 @@ HOST_IMAGE_FUZZ_TARGETS := elf_payload
 HOST_IMAGE_FUZZ_CORPUS := host_tools/image/fuzz/corpus
 HOST_IMAGE_FUZZ_REPORT := $(BUILD)/reports/fuzz-host-image-tests.xml
 # The flash protocol's node side (firmware/flash/fuzz): framing and session.
-FLASH_FUZZ_TARGETS := flash_session
+FLASH_FUZZ_TARGETS := flash_session flash_can
 FLASH_FUZZ_CORPUS := firmware/flash/fuzz/corpus
 FLASH_FUZZ_REPORT := $(BUILD)/reports/fuzz-flash-tests.xml
 
@@ -90,7 +90,7 @@ IMAGE_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(IMAGE_FUZZ_TARGETS))
 HOST_IMAGE_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,host_tools/image/src/ElfPayload.cpp $(IMAGE_SRCS))
 HOST_IMAGE_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/image/fuzz/fuzz_%.cpp.o,$(HOST_IMAGE_FUZZ_TARGETS))
 HOST_IMAGE_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOST_IMAGE_FUZZ_TARGETS))
-FLASH_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) \
+FLASH_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) $(CAN_PORTABLE_SRCS) \
 	firmware/boot/src/BootState.cpp firmware/boot/src/BootStateStore.cpp firmware/boot/src/Crc32.cpp)
 FLASH_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/flash/fuzz/fuzz_%.cpp.o,$(FLASH_FUZZ_TARGETS))
 FLASH_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(FLASH_FUZZ_TARGETS))

@@ -65,7 +65,8 @@ $(DCOS_IMAGE) $(DCOS_CARD): $(HOST_TOOLS_BIN)/%: $(BUILD)/host/host_tools/image/
 	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto
 
 $(DCOS_FLASH): $(BUILD)/host/host_tools/flash/tools/dcos-flash.cpp.o \
-	$(patsubst %,$(BUILD)/host/%.o,$(HOSTFLASH_SRCS) $(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS))
+	$(patsubst %,$(BUILD)/host/%.o,$(HOSTFLASH_SRCS) $(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS) \
+		$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto

@@ -25,10 +25,12 @@ EXAMPLE_APPS := $(patsubst %/,%,$(sort $(dir $(wildcard docs/examples/*/*.cpp)))
 
 .PHONY: sdk install app test-app test-examples
 
-$(LIBRARY_486): $(FW_OBJS)
+# The full configuration's library carries the flash service, as the
+# production image does (mk/firmware.mk), with mbedTLS's objects.
+$(LIBRARY_486): $(FW_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_OBJS)
 	@mkdir -p $(dir $@)
 	@echo "  AR      $@"
-	$(Q)rm -f $@ && ar rcs $@ $(FW_OBJS)
+	$(Q)rm -f $@ && ar rcs $@ $(FW_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_OBJS)
 
 $(LIBRARY_486_MINIMAL): $(FW_MINIMAL_OBJS)
 	@mkdir -p $(dir $@)

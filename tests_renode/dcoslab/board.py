@@ -120,7 +120,12 @@ class Board:
         if card:
             if append:
                 raise ValueError("a card carries its own command line (dcos-card create --append), not -append")
-            command += ["-drive", card_drive or f"file={image},if=ide,format=raw,index=0", "-boot", "c",
+            # cache=unsafe: the card's FLUSH CACHE is not an fsync of the
+            # host's file. Under -icount a board polls on in emulated time
+            # while the host syncs, and a busy host's fsync can outlast the
+            # driver's bounded wait (drivers/ata); what reaches the file is
+            # the same, and power cuts are the filter's (dcoslab/powercut.py).
+            command += ["-drive", card_drive or f"file={image},if=ide,format=raw,index=0,cache=unsafe", "-boot", "c",
                         "-device", "ib700", "-watchdog-action", "reset"]
         else:
             command += ["-kernel", image, "-no-reboot"]

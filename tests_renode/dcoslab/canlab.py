@@ -235,7 +235,10 @@ class CanLab:
         kernel command line of every board; the key "append" of a board's
         wiring gives that board its own (e.g. "node=2"), the key "devices"
         more device properties ({"isa-mfio": {"wiring": "plant", ...}}) and
-        the key "args" more emulator arguments (a -chardev for them). cpu
+        the key "args" more emulator arguments (a -chardev for them), the
+        key "card" a CompactFlash card image the board boots from instead of
+        the image kind (docs/boot.md), and the key "expect" what its console
+        shows once it is up, instead of the shell's prompt. cpu
         replaces the board's CPU model on every board (the remote bench's
         counting image runs on the board's benchmark_cpu, whose time-stamp
         counter counts instructions under -icount)."""
@@ -244,6 +247,7 @@ class CanLab:
         self.hub = Hub(self.socket_path, buses, expect=list(wiring), pace=pace, timeout=timeout, lines=lines)
         self.hub.start()
         self.boards = {}
+        prompts = {}
         try:
             for name, channels in wiring.items():
                 properties = {"hub": self.socket_path, "hub-name": name}
@@ -251,9 +255,15 @@ class CanLab:
                 board_append = append
                 devices = {}
                 board_args = []
+                card = None
+                prompt = r"dcos> "
                 for key, value in channels.items():
                     if key == "append":
                         board_append = value
+                    elif key == "card":
+                        card = value
+                    elif key == "expect":
+                        prompt = value
                     elif key == "devices":
                         devices = value
                     elif key == "args":
@@ -269,12 +279,15 @@ class CanLab:
                     options["line_ports"] = line_ports
                 if cpu:
                     options["cpu"] = cpu
+                if card:
+                    options["card"] = card
                 emulator = boot(board_definition, kind, icount=True, name=name,
                                 device_properties={"isa-sja1000": properties, **devices},
                                 extra_args=["-rtc", f"base={RTC_BASE}", *board_args], **options)
                 self.boards[name] = LabBoard(name, emulator, self.hub)
-            for board in self.boards.values():
-                board.emulator.expect(r"dcos> ", timeout=timeout)
+                prompts[name] = prompt
+            for name, board in self.boards.items():
+                board.emulator.expect(prompts[name], timeout=timeout)
         except BaseException:
             self.close()
             raise

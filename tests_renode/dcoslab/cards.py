@@ -31,11 +31,13 @@ def signed(directory, version, firmware="dcos486.elf", key=DEVELOPMENT_KEY):
     return path
 
 
-def new_card(directory, *slots, append="node=3"):
-    """A card trusting the development key, with (slot, image, pending) written in order."""
+def new_card(directory, *slots, append="node=3", options=()):
+    """A card trusting the development key, with (slot, image, pending) written in order;
+    options go to dcos-card create (e.g. ("--bitrate", "1000000"))."""
     path = os.path.join(str(directory), "card.img")
     tool("dcos-card", "create", "-o", path, "--boot-sector", os.path.join(BUILT, "boot-sector.bin"),
-         "--stage", os.path.join(BUILT, "stage-loader.bin"), "-p", DEVELOPMENT_KEY + ".pub", "--append", append)
+         "--stage", os.path.join(BUILT, "stage-loader.bin"), "-p", DEVELOPMENT_KEY + ".pub", "--append", append,
+         *options)
     for slot, image, pending in slots:
         tool("dcos-card", "write", path, "--slot", slot, image, *(["--pending"] if pending else []))
     return path

@@ -28,6 +28,8 @@ static_assert(static_cast<uint8_t>(dcos::SystemMessageType::DsmPublication) ==
               static_cast<uint8_t>(can::MessageType::DsmPublication));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RelayedPublication) ==
               static_cast<uint8_t>(can::MessageType::RelayedPublication));
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::Flashing) ==
+              static_cast<uint8_t>(can::MessageType::Flashing));
 
 namespace {
 
@@ -38,7 +40,7 @@ bool isSystemMessage(can::MessageType type)
            type == can::MessageType::NameQuery || type == can::MessageType::RoutedRequest ||
            type == can::MessageType::NodeStarted ||
            type == can::MessageType::DsmPublication || type == can::MessageType::RelayedPublication ||
-           type == can::MessageType::TimeSync;
+           type == can::MessageType::TimeSync || type == can::MessageType::Flashing;
 }
 
 } // namespace

@@ -20,12 +20,18 @@
 #include <boot/Multiboot.hpp>
 #include <boot/TrialWatchdog.hpp>
 #include <boot/ConfigurationBlock.hpp>
+#include <bsp/BoardReset.hpp>
+#include <flash/CanFlashServer.hpp>
 #include <flash/FlashSession.hpp>
 #include <flash/SerialFramer.hpp>
 #include <image/ImageVerifier.hpp>
 
 #include <arch_x86/PortIo.hpp>
+#include <can/MessageIdentifier.hpp>
 #include <dcos/Version.hpp>
+#include <sja1000/BitTiming.hpp>
+#include <sja1000/IsaCardSettings.hpp>
+#include <sja1000/Sja1000Chip.hpp>
 #include <runtime/Format.hpp>
 
 #include <stdarg.h>
@@ -315,26 +321,109 @@ uint8_t clockSecond()
     return portRead8(0x71);
 }
 
-// Restarts the board: the keyboard controller pulses the processor's reset
-// line (8042 command 0xFE, IBM PC/AT Technical Reference).
+// Restarts the board once the console has sent its last character.
 [[noreturn]] void resetBoard()
 {
     for (unsigned poll = 0; poll < 100000 && (portRead8(kCom1LineStatus) & kTransmitterIdle) == 0; ++poll) {
     }
-    for (unsigned poll = 0; poll < 100000 && (portRead8(0x64) & 0x02) != 0; ++poll) {
-    }
-    portWrite8(0x64, 0xFE);
-    halt();
+    bsp::resetBoard();
 }
+
+// -- CAN in recovery: the first channel of the board's CAN card, polled ----------
+
+// The bit rate when the configuration names none: the kernel driver's.
+constexpr uint32_t kDefaultCanBitRate = 125000;
+
+class RecoveryCan {
+public:
+    RecoveryCan()
+        : chip_(arch_x86::IoWindow::ports(sja1000::kIsaCardDefaultBase, sja1000::reg::kWindowSize))
+    {
+    }
+
+    // Whether a chip answers and takes the bus at @p bitRate, taking every
+    // extended frame (the server picks its own), with no interrupt.
+    const char* start(uint32_t bitRate)
+    {
+        const dcos::Result<sja1000::BitTiming> timing = sja1000::BitTimingCalculator::forBitRate(bitRate);
+        if (!timing.ok()) {
+            return "the configuration's CAN bit rate cannot be made by the card";
+        }
+        if (chip_.probe() != dcos::Status::Ok) {
+            return "no CAN card answers";
+        }
+        if (chip_.configure(timing.value(), sja1000::AcceptanceFilter::extended(0, 0), 0) != dcos::Status::Ok ||
+            chip_.start(sja1000::BusMode::Normal) != dcos::Status::Ok) {
+            return "the CAN card does not start";
+        }
+        return nullptr;
+    }
+
+    // The next frame received, if any.
+    bool receive(can::CanFrame& frame)
+    {
+        if ((chip_.status() & sja1000::reg::kStatusReceiveBuffer) == 0) {
+            return false;
+        }
+        const can::LinkResult<can::CanFrame> read = chip_.readReceiveBuffer();
+        if (!read.ok()) {
+            return false;
+        }
+        frame = read.value();
+        return true;
+    }
+
+    // Queues @p frame; the caller waits for transmitted() before the next.
+    void send(const can::CanFrame& frame)
+    {
+        // The transmit buffer is free: the last frame completed, or was
+        // given up on below (transmitted() never has two in flight).
+        chip_.writeTransmitBuffer(frame);
+        chip_.transmit();
+        pending_ = true;
+    }
+
+    // True once, when the frame sent last has left.
+    bool transmitted()
+    {
+        if (!pending_ || (chip_.status() & sja1000::reg::kStatusTransmitComplete) == 0) {
+            return false;
+        }
+        pending_ = false;
+        return true;
+    }
+
+    // A frame nobody acknowledges is repeated by the chip for ever: the
+    // caller gives up on it after its ISO-TP time-out, and so does the chip.
+    void giveUp()
+    {
+        if (pending_) {
+            chip_.abortTransmission();
+            pending_ = false;
+        }
+    }
+
+    bool pending() const { return pending_; }
+
+private:
+    sja1000::Sja1000Chip chip_;
+    bool pending_ = false;
+};
 
 ata::AtaPioDisk* recoveryDisk = nullptr;
 uint32_t recoveryMemoryEnd = 16u << 20;
 uint32_t recoverySequence = 0;
 
 // Recovery: the stage loader serves the flash protocol on COM1 (framed,
-// so the console's text around it does not matter) until a host has put
-// a verified image on the card and asks for a restart, which boots it as a
-// trial. Without a card or a trusted key there is nothing to serve.
+// so the console's text around it does not matter) and on the CAN card's
+// first channel (ISO-TP, as CAN node number the configuration's node id)
+// until a host has put a verified image on the card and asks for a
+// restart, which boots it as a trial. One session serves both: a host uses
+// either. Without a card or a trusted key there is nothing to serve.
+//
+// The only clock here is the real-time clock's seconds, so the ISO-TP
+// time-outs run on whole seconds: a 1 s time-out ends between 1 and 2 s
+// after its start, as the serial line's abandoned frame does.
 [[noreturn]] void recovery(const char* why)
 {
     say("recovery: %s", why);
@@ -342,7 +431,6 @@ uint32_t recoverySequence = 0;
         say("recovery: no card or no trusted key: halted");
         halt();
     }
-    say("recovery: waiting for an image on this serial line (dcos-flash)");
     boot::AtaSectorStore store(*recoveryDisk);
     flash::SessionIdentity identity;
     identity.node = nodeId();
@@ -357,15 +445,55 @@ uint32_t recoverySequence = 0;
     flash::SerialFramer receiver;
     uint8_t reply[flash::kMaxMessage];
     uint8_t framed[flash::kMaxMessage + flash::SerialFramer::kOverhead];
+
+    RecoveryCan bus;
+    const uint32_t bitRate = configuration.canBitRate != 0 ? configuration.canBitRate : kDefaultCanBitRate;
+    const bool nodeNumbered = identity.node <= can::MessageIdentifier::kMaxNodeNumber;
+    const char* canProblem = nodeNumbered ? bus.start(bitRate) : "the node id is no CAN node number (1 to 254)";
+    const bool onCan = canProblem == nullptr;
+    flash::CanFlashServer server(session, static_cast<uint8_t>(identity.node));
+    if (onCan) {
+        say("recovery: waiting for an image on this serial line or on CAN as node %u at %lu bit/s (dcos-flash)",
+            unsigned(identity.node), static_cast<unsigned long>(bitRate));
+    } else {
+        say("recovery: CAN not served: %s", canProblem);
+        say("recovery: waiting for an image on this serial line (dcos-flash)");
+    }
+
     // A frame left unfinished for two ticks of the real-time clock's
     // seconds (one to two seconds) is abandoned: its sender went away.
     uint8_t lastSecond = clockSecond();
+    uint64_t seconds = 0;
     unsigned silentSeconds = 0;
+    auto send = [&](const flash::CanFlashServer::Output& output) {
+        if (output.transmit) {
+            bus.send(output.frame);
+        }
+    };
     for (;;) {
+        const uint64_t now = seconds * 1000000000ull;
+        if (onCan) {
+            can::CanFrame frame;
+            if (bus.transmitted()) {
+                send(server.onTransmitConfirmed(now));
+            } else if (!bus.pending() && bus.receive(frame)) {
+                send(server.onFrame(frame, now));
+            } else if (bus.pending() && server.nextDeadlineNs() <= now) {
+                bus.giveUp(); // Nobody takes it: the sender's N_As ends the reply.
+                send(server.poll(now));
+            } else if (!bus.pending() && server.nextDeadlineNs() <= now) {
+                send(server.poll(now));
+            }
+            flash::RestartTarget target{};
+            if (server.restartDue(target)) {
+                resetBoard();
+            }
+        }
         if ((portRead8(kCom1LineStatus) & kDataReady) == 0) {
             const uint8_t second = clockSecond();
             if (second != lastSecond) {
                 lastSecond = second;
+                ++seconds;
                 if (receiver.inFrame() && ++silentSeconds >= 2) {
                     receiver.reset();
                     silentSeconds = 0;
@@ -449,6 +577,17 @@ extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
             state.trial == boot::TrialState::None ? "" : card::slotName(state.trialSlot));
     } else if (stored.readable) {
         say("no boot state on the card: a new card");
+    }
+    if (stored.present && stored.state.recoveryRequested) {
+        // Once: the mark goes before recovery starts, so that a node whose
+        // host went away boots its image again at the next reset.
+        boot::BootState cleared = stored.state;
+        cleared.recoveryRequested = false;
+        recoverySequence = stored.state.sequence + 1;
+        if (!boot::BootStateStore::writeNext(store, stored, cleared)) {
+            recovery("asked to stay in recovery, and the boot state cannot be written");
+        }
+        recovery("a flash tool asked the node to stay in recovery");
     }
     const boot::BootDecision decision = boot::BootSequence::decide(
         store, stored, [&](uint8_t slot) { return loadAndVerify(disk, slot, memoryEnd); });

@@ -22,6 +22,7 @@ void BootState::encode(uint8_t (&sector)[kSize]) const
     sector[14] = trialSlot;
     sector[15] = static_cast<uint8_t>(trial);
     put32(sector + 16, reverts);
+    sector[20] = recoveryRequested ? 1 : 0;
     record::seal(sector);
 }
 
@@ -36,7 +37,8 @@ bool BootState::decode(const uint8_t (&sector)[kSize], BootState& out)
     state.trialSlot = sector[14];
     state.trial = static_cast<TrialState>(sector[15]);
     state.reverts = get32(sector + 16);
-    if (!slotOrNone(state.confirmedSlot) || !slotOrNone(state.trialSlot) || sector[15] > 2) {
+    state.recoveryRequested = sector[20] == 1;
+    if (!slotOrNone(state.confirmedSlot) || !slotOrNone(state.trialSlot) || sector[15] > 2 || sector[20] > 1) {
         return false;
     }
     const bool trialNamed = state.trial != TrialState::None;

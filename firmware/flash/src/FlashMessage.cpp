@@ -95,7 +95,7 @@ private:
 bool readStatus(Reader& r, FlashMessage& m)
 {
     const uint8_t value = r.u8();
-    if (value > static_cast<uint8_t>(FlashStatus::Unsupported)) {
+    if (value > static_cast<uint8_t>(FlashStatus::SlotInUse)) {
         return false;
     }
     m.status = static_cast<FlashStatus>(value);
@@ -128,6 +128,8 @@ const char* flashStatusText(FlashStatus status)
     case FlashStatus::NoTransfer: return "no transfer in progress, or not every byte has arrived";
     case FlashStatus::Malformed: return "a malformed request";
     case FlashStatus::Unsupported: return "a request the node does not serve here";
+    case FlashStatus::SlotInUse:
+        return "the node runs a trial image from the slot the new image needs: confirm it or restart the node first";
     }
     return "unknown status";
 }

@@ -137,6 +137,11 @@ FlashStatus FlashSession::begin(const FlashMessage& request, FlashMessage& reply
     }
     const uint8_t slot = confirmed == 0 ? 1 : 0;
     reply.slot = slot;
+    if (slot == identity_.runningSlot) {
+        // The node runs an image on trial from this slot: writing over it
+        // would take the image the node must confirm, or revert from.
+        return FlashStatus::SlotInUse;
+    }
     if (transferring_ && slot == slot_ && __builtin_memcmp(headerBytes_, request.header, sizeof headerBytes_) == 0) {
         reply.offset = progress_; // The same image again: resume.
         return FlashStatus::Ok;
@@ -207,6 +212,20 @@ FlashStatus FlashSession::data(const FlashMessage& request, FlashMessage& reply)
     ++sequence_;
     reply.offset = progress_;
     return FlashStatus::Ok;
+}
+
+FlashStatus FlashSession::requestRecovery()
+{
+    const boot::StoredBootState stored = boot::BootStateStore::read(store_);
+    if (!stored.readable) {
+        return FlashStatus::CardError;
+    }
+    if (stored.present && stored.state.recoveryRequested) {
+        return FlashStatus::Ok;
+    }
+    boot::BootState next = stored.state;
+    next.recoveryRequested = true;
+    return boot::BootStateStore::writeNext(store_, stored, next) ? FlashStatus::Ok : FlashStatus::CardError;
 }
 
 FlashStatus FlashSession::end(FlashMessage& reply)
@@ -283,12 +302,12 @@ size_t FlashSession::handle(const uint8_t* request, size_t length, uint8_t* repl
     case MessageType::Restart:
         if (!authenticated_) {
             reply.status = FlashStatus::NotAuthenticated;
-        } else if (message.target != RestartTarget::Boot) {
-            reply.status = FlashStatus::Unsupported;
         } else {
-            restartRequested_ = true;
-            restartTarget_ = message.target;
-            reply.status = FlashStatus::Ok;
+            reply.status = message.target == RestartTarget::Recovery ? requestRecovery() : FlashStatus::Ok;
+            if (reply.status == FlashStatus::Ok) {
+                restartRequested_ = true;
+                restartTarget_ = message.target;
+            }
         }
         break;
     default:

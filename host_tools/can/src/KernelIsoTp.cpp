@@ -77,16 +77,20 @@ int openSocket(const std::string& interface, const can::IsoTpConfig& config, boo
 
 } // namespace
 
-IsoTpOutcome kernelIsoTpSend(const std::string& interface, const can::IsoTpConfig& config,
-                             const std::vector<uint8_t>& message, std::chrono::milliseconds timeout)
+std::unique_ptr<KernelIsoTpSocket> KernelIsoTpSocket::open(const std::string& interface,
+                                                           const can::IsoTpConfig& config, TransportError& error)
+{
+    const int fd = openSocket(interface, config, true, error);
+    return fd < 0 ? nullptr : std::unique_ptr<KernelIsoTpSocket>(new KernelIsoTpSocket(fd));
+}
+
+KernelIsoTpSocket::~KernelIsoTpSocket() { ::close(fd_); }
+
+IsoTpOutcome KernelIsoTpSocket::send(const std::vector<uint8_t>& message, std::chrono::milliseconds timeout)
 {
     IsoTpOutcome outcome;
     if (message.empty() || message.size() > kMaxMessage) {
         outcome.transport = {TransportError::Kind::BadArgument, "an ISO-TP message is 1 to 4095 bytes"};
-        return outcome;
-    }
-    const int fd = openSocket(interface, config, true, outcome.transport);
-    if (fd < 0) {
         return outcome;
     }
     // A bound on the whole write: the kernel's own N_Bs ends a transfer
@@ -94,8 +98,8 @@ IsoTpOutcome kernelIsoTpSend(const std::string& interface, const can::IsoTpConfi
     timeval limit{};
     limit.tv_sec = static_cast<time_t>(timeout.count() / 1000);
     limit.tv_usec = static_cast<suseconds_t>((timeout.count() % 1000) * 1000);
-    (void)::setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &limit, sizeof limit);
-    const ssize_t written = ::write(fd, message.data(), message.size());
+    (void)::setsockopt(fd_, SOL_SOCKET, SO_SNDTIMEO, &limit, sizeof limit);
+    const ssize_t written = ::write(fd_, message.data(), message.size());
     if (written != static_cast<ssize_t>(message.size())) {
         if (written < 0 && (errno == ECOMM || errno == EAGAIN || errno == EWOULDBLOCK)) {
             // The kernel reports a transfer it gave up (N_Bs, a flow
@@ -105,19 +109,13 @@ IsoTpOutcome kernelIsoTpSend(const std::string& interface, const can::IsoTpConfi
             outcome.transport = {TransportError::Kind::Io, systemError("the kernel did not send the message")};
         }
     }
-    ::close(fd);
     return outcome;
 }
 
-IsoTpOutcome kernelIsoTpReceive(const std::string& interface, const can::IsoTpConfig& config,
-                                std::chrono::milliseconds firstFrameTimeout)
+IsoTpOutcome KernelIsoTpSocket::receive(std::chrono::milliseconds firstFrameTimeout)
 {
     IsoTpOutcome outcome;
-    const int fd = openSocket(interface, config, false, outcome.transport);
-    if (fd < 0) {
-        return outcome;
-    }
-    pollfd ready{fd, POLLIN, 0};
+    pollfd ready{fd_, POLLIN, 0};
     const int polled = ::poll(&ready, 1, static_cast<int>(firstFrameTimeout.count()));
     if (polled == 0) {
         outcome.error = can::LinkError::TimeoutCr;
@@ -125,7 +123,7 @@ IsoTpOutcome kernelIsoTpReceive(const std::string& interface, const can::IsoTpCo
         outcome.transport = {TransportError::Kind::Io, systemError("waiting for the ISO-TP message failed")};
     } else {
         std::vector<uint8_t> buffer(kMaxMessage + 1);
-        const ssize_t got = ::read(fd, buffer.data(), buffer.size());
+        const ssize_t got = ::read(fd_, buffer.data(), buffer.size());
         if (got > 0) {
             buffer.resize(static_cast<size_t>(got));
             outcome.message = std::move(buffer);
@@ -136,8 +134,23 @@ IsoTpOutcome kernelIsoTpReceive(const std::string& interface, const can::IsoTpCo
             outcome.transport = {TransportError::Kind::Io, systemError("reading the ISO-TP message failed")};
         }
     }
-    ::close(fd);
     return outcome;
+}
+
+IsoTpOutcome kernelIsoTpSend(const std::string& interface, const can::IsoTpConfig& config,
+                             const std::vector<uint8_t>& message, std::chrono::milliseconds timeout)
+{
+    IsoTpOutcome outcome;
+    const std::unique_ptr<KernelIsoTpSocket> socket = KernelIsoTpSocket::open(interface, config, outcome.transport);
+    return socket ? socket->send(message, timeout) : outcome;
+}
+
+IsoTpOutcome kernelIsoTpReceive(const std::string& interface, const can::IsoTpConfig& config,
+                                std::chrono::milliseconds firstFrameTimeout)
+{
+    IsoTpOutcome outcome;
+    const std::unique_ptr<KernelIsoTpSocket> socket = KernelIsoTpSocket::open(interface, config, outcome.transport);
+    return socket ? socket->receive(firstFrameTimeout) : outcome;
 }
 
 } // namespace hostcan

@@ -1,4 +1,4 @@
-#include <hostflash/FlashLink.hpp>
+#include <hostflash/SerialFlashLink.hpp>
 
 #include <fmt/core.h>
 
@@ -33,7 +33,7 @@ bool writeAll(int descriptor, const uint8_t* data, size_t length)
 
 } // namespace
 
-std::unique_ptr<FlashLink> FlashLink::open(const std::string& device, LinkError& error, std::string& why)
+std::unique_ptr<SerialFlashLink> SerialFlashLink::open(const std::string& device, LinkError& error, std::string& why)
 {
     if (device.empty()) {
         error = LinkError::BadArgument;
@@ -59,7 +59,7 @@ std::unique_ptr<FlashLink> FlashLink::open(const std::string& device, LinkError&
             }
             return nullptr;
         }
-        return std::unique_ptr<FlashLink>(new FlashLink(descriptor));
+        return std::unique_ptr<SerialFlashLink>(new SerialFlashLink(descriptor));
     }
     const int descriptor = ::open(device.c_str(), O_RDWR | O_NOCTTY | O_CLOEXEC);
     if (descriptor < 0) {
@@ -77,12 +77,12 @@ std::unique_ptr<FlashLink> FlashLink::open(const std::string& device, LinkError&
         ::tcsetattr(descriptor, TCSANOW, &settings);
         ::tcflush(descriptor, TCIOFLUSH);
     }
-    return std::unique_ptr<FlashLink>(new FlashLink(descriptor));
+    return std::unique_ptr<SerialFlashLink>(new SerialFlashLink(descriptor));
 }
 
-FlashLink::~FlashLink() { ::close(descriptor_); }
+SerialFlashLink::~SerialFlashLink() { ::close(descriptor_); }
 
-LinkError FlashLink::exchange(const flash::FlashMessage& request, flash::FlashMessage& reply,
+LinkError SerialFlashLink::exchange(const flash::FlashMessage& request, flash::FlashMessage& reply,
                               std::chrono::milliseconds timeout, std::string& why)
 {
     uint8_t payload[flash::kMaxMessage];

@@ -1,27 +1,40 @@
-// dcos-flash: put a signed image on a controller over its serial line
-// (docs/guide/flashing.md, docs/protocols/flash.md).
+// dcos-flash: put a signed image on a controller over CAN or its serial
+// line (docs/guide/flashing.md, docs/protocols/flash.md).
 //
+//     dcos-flash -i IFACE -n NODE -k KEY.pem IMAGE.dcos [--no-restart] [--no-wait] [--resume]
 //     dcos-flash -d DEVICE -k KEY.pem [-n NODE] IMAGE.dcos [--no-restart] [--resume]
-//     dcos-flash -d DEVICE info
+//     dcos-flash (-i IFACE -n NODE | -d DEVICE) info
+//     dcos-flash (-i IFACE -n NODE | -d DEVICE) -k KEY.pem restart [--recovery]
 //
-// DEVICE is a serial device (/dev/ttyUSB0, 115200 bit/s 8N1) or a Unix
-// socket (unix:/path, the emulated board's console). The session is
-// authenticated with KEY.pem, a signing key the node's card trusts. The
-// transfer resumes by itself where an interrupted one stopped, if the node
-// still holds it. After the image is verified on the node and marked
-// pending, the node restarts into it as a trial (unless --no-restart); the
-// image must then confirm (boot confirm), or the node reverts.
+// IFACE is a CAN interface as every DCOS tool takes it (can0,
+// slcan:/dev/ttyACM0, lab:/hub.sock:can0), NODE the node's CAN node
+// number; the running application's flash service answers there, and so
+// does the stage loader in recovery. DEVICE is a serial device
+// (/dev/ttyUSB0, 115200 bit/s 8N1) or a Unix socket (unix:/path, the
+// emulated board's console), which carries the protocol in recovery. The
+// session is authenticated with KEY.pem, a signing key the node's card
+// trusts. The transfer resumes by itself where an interrupted one stopped,
+// if the node still holds it. After the image is verified on the node and
+// marked pending, the node restarts into it as a trial (unless
+// --no-restart); the image must then confirm (boot confirm), or the node
+// reverts. On CAN the tool then waits for that outcome (unless --no-wait).
 //
-// Every command takes --json. Exit status: 0 done; 1 refused by the node
-// (authentication, the image, the node id), with the reason; 2 bad
-// arguments; 3 the device or a file is not available; 4 the link failed (no
-// answer, the line closed) or the key is not P-256.
+// Every command takes --json. Exit status: 0 done (and, when waited for,
+// confirmed); 1 refused by the node (authentication, the image, the node
+// id), or the trial reverted, with the reason; 2 bad arguments; 3 the
+// device, interface or a file is not available; 4 the link failed (no
+// answer, the line closed), the key is not P-256, or the trial's outcome
+// did not come in time.
+#include <hostflash/CanFlashLink.hpp>
 #include <hostflash/FlashLink.hpp>
+#include <hostflash/SerialFlashLink.hpp>
 
 #include <hostimage/SigningKey.hpp>
 #include <hostimage/ToolFiles.hpp>
 
+#include <boot/BootState.hpp>
 #include <boot/Crc32.hpp>
+#include <can/MessageIdentifier.hpp>
 #include <flash/FlashMessage.hpp>
 #include <image/ImageHeader.hpp>
 #include <image/Sha256.hpp>
@@ -32,11 +45,12 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -61,11 +75,18 @@ int fail(int code, const std::string& message)
 
 struct Options {
     std::string device;
+    std::string interface;
     std::string key;
     std::string image;
     int node = -1;
+    int source = flash::kCanHostNode;
+    int priority = flash::kCanFlashPriority;
+    bool kernelIsoTp = false;
     bool noRestart = false;
+    bool noWait = false;
+    long confirmTimeoutS = 120;
     bool resumeOnly = false;
+    bool recovery = false;
     long timeoutMs = 2000;
     int retries = 3;
     bool json = false;
@@ -99,6 +120,7 @@ public:
     }
 
     unsigned retransmissions() const { return retransmissions_; }
+    hostflash::FlashLink& link() { return link_; }
 
 private:
     hostflash::FlashLink& link_;
@@ -156,6 +178,131 @@ std::optional<FlashMessage> sayHello(Conversation& conversation, int& code)
     return reply;
 }
 
+std::optional<hostimage::SigningKey> readKey(const Options& options, int& code)
+{
+    std::string error;
+    const std::optional<std::vector<uint8_t>> pem = hostimage::readWholeFile(options.key, error);
+    if (!pem) {
+        code = fail(kExitNotAvailable, error);
+        return std::nullopt;
+    }
+    std::optional<hostimage::SigningKey> key = hostimage::SigningKey::fromPem(std::string(pem->begin(), pem->end()), error);
+    if (!key) {
+        code = fail(kExitFailed, fmt::format("{}: {}", options.key, error));
+    }
+    return key;
+}
+
+// The challenge, signed: the node's proof that this session may write its card.
+int authenticateSession(Conversation& conversation, const FlashMessage& hello, const hostimage::SigningKey& key)
+{
+    std::string error;
+    FlashMessage authenticate;
+    authenticate.type = MessageType::Authenticate;
+    uint8_t digest[32];
+    flash::authenticationDigest(hello.node, hello.challenge, digest);
+    const image::TrustedKey keyId = hostimage::trustedKeyOf(key.publicPoint());
+    std::copy(std::begin(keyId.id), std::end(keyId.id), authenticate.keyId);
+    if (!key.sign(digest, authenticate.signature, error)) {
+        return fail(kExitFailed, error);
+    }
+    const std::optional<FlashMessage> reply = conversation.ask(authenticate, error);
+    if (!reply) {
+        return fail(kExitFailed, error);
+    }
+    if (reply->status != FlashStatus::Ok) {
+        return fail(kExitRefused, fmt::format("node {}: {}", hello.node, flash::flashStatusText(reply->status)));
+    }
+    return kExitOk;
+}
+
+int sendRestart(Conversation& conversation, uint16_t node, flash::RestartTarget target)
+{
+    std::string error;
+    FlashMessage restart;
+    restart.type = MessageType::Restart;
+    restart.target = target;
+    const std::optional<FlashMessage> reply = conversation.ask(restart, error);
+    if (!reply) {
+        return fail(kExitFailed, error);
+    }
+    if (reply->status != FlashStatus::Ok) {
+        return fail(kExitRefused, fmt::format("node {}: {}", node, flash::flashStatusText(reply->status)));
+    }
+    return kExitOk;
+}
+
+// How a trial ended, as the node's Hello tells it after its restart.
+enum class TrialOutcome { Confirmed, Reverted, Recovery, NoAnswer };
+
+const char* trialOutcomeName(TrialOutcome outcome)
+{
+    switch (outcome) {
+    case TrialOutcome::Confirmed: return "confirmed";
+    case TrialOutcome::Reverted: return "reverted";
+    case TrialOutcome::Recovery: return "recovery";
+    case TrialOutcome::NoAnswer: return "no answer";
+    }
+    return "?";
+}
+
+// Asks the restarted node once a second until its boot state says how the
+// trial of @p slot ended: confirmed, or reverted by the stage loader.
+TrialOutcome waitForTrial(hostflash::FlashLink& link, uint8_t slot, const Options& options)
+{
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(options.confirmTimeoutS);
+    uint8_t tag = 0x80;
+    while (std::chrono::steady_clock::now() < deadline) {
+        FlashMessage hello;
+        hello.type = MessageType::Hello;
+        hello.tag = ++tag;
+        FlashMessage reply;
+        std::string why;
+        const auto asked = std::chrono::steady_clock::now();
+        if (link.exchange(hello, reply, std::chrono::milliseconds(1000), why) == LinkError::None &&
+            reply.type == MessageType::HelloReply) {
+            if (reply.mode == flash::NodeMode::Recovery) {
+                return TrialOutcome::Recovery;
+            }
+            const auto trial = static_cast<boot::TrialState>(reply.trial);
+            if (trial == boot::TrialState::None) {
+                return reply.confirmedSlot == slot ? TrialOutcome::Confirmed : TrialOutcome::Reverted;
+            }
+        }
+        std::this_thread::sleep_until(asked + std::chrono::seconds(1));
+    }
+    return TrialOutcome::NoAnswer;
+}
+
+int restartCommand(Conversation& conversation, const Options& options)
+{
+    int code = kExitOk;
+    const std::optional<hostimage::SigningKey> key = readKey(options, code);
+    if (!key) {
+        return code;
+    }
+    const std::optional<FlashMessage> hello = sayHello(conversation, code);
+    if (!hello) {
+        return code;
+    }
+    if (const int refused = authenticateSession(conversation, *hello, *key); refused != kExitOk) {
+        return refused;
+    }
+    const flash::RestartTarget target = options.recovery ? flash::RestartTarget::Recovery : flash::RestartTarget::Boot;
+    if (const int refused = sendRestart(conversation, hello->node, target); refused != kExitOk) {
+        return refused;
+    }
+    if (options.json) {
+        fmt::print("{}\n", nlohmann::json{{"node", hello->node}, {"restarted", true},
+                                          {"into", options.recovery ? "recovery" : "boot"}}
+                               .dump());
+    } else {
+        fmt::print("node {}: restarting{}\n", hello->node,
+                   options.recovery ? " into the stage loader's recovery (it stays there this once)" : "");
+    }
+    return kExitOk;
+}
+
 int info(Conversation& conversation, const Options& options)
 {
     int code = kExitOk;
@@ -205,22 +352,17 @@ int flashImage(Conversation& conversation, const Options& options)
                                               image::imageErrorText(header.ok() ? image::ImageError::Truncated
                                                                                 : header.error())));
     }
-    const std::optional<std::vector<uint8_t>> pem = hostimage::readWholeFile(options.key, error);
-    if (!pem) {
-        return fail(kExitNotAvailable, error);
-    }
-    const std::optional<hostimage::SigningKey> key =
-        hostimage::SigningKey::fromPem(std::string(pem->begin(), pem->end()), error);
+    int code = kExitOk;
+    const std::optional<hostimage::SigningKey> key = readKey(options, code);
     if (!key) {
-        return fail(kExitFailed, fmt::format("{}: {}", options.key, error));
+        return code;
     }
 
-    int code = kExitOk;
     const std::optional<FlashMessage> hello = sayHello(conversation, code);
     if (!hello) {
         return code;
     }
-    if (options.node >= 0 && hello->node != options.node) {
+    if (options.device.size() != 0 && options.node >= 0 && hello->node != options.node) {
         return fail(kExitRefused, fmt::format("the device reaches node {}, not node {}", hello->node, options.node));
     }
     uint8_t headerDigest[32];
@@ -232,28 +374,14 @@ int flashImage(Conversation& conversation, const Options& options)
                                               options.image));
     }
 
-    // The challenge, signed: the node's proof that this session may write its card.
-    FlashMessage authenticate;
-    authenticate.type = MessageType::Authenticate;
-    uint8_t digest[32];
-    flash::authenticationDigest(hello->node, hello->challenge, digest);
-    const image::TrustedKey keyId = hostimage::trustedKeyOf(key->publicPoint());
-    std::copy(std::begin(keyId.id), std::end(keyId.id), authenticate.keyId);
-    if (!key->sign(digest, authenticate.signature, error)) {
-        return fail(kExitFailed, error);
-    }
-    std::optional<FlashMessage> reply = conversation.ask(authenticate, error);
-    if (!reply) {
-        return fail(kExitFailed, error);
-    }
-    if (reply->status != FlashStatus::Ok) {
-        return fail(kExitRefused, fmt::format("node {}: {}", hello->node, flash::flashStatusText(reply->status)));
+    if (const int refused = authenticateSession(conversation, *hello, *key); refused != kExitOk) {
+        return refused;
     }
 
     FlashMessage begin;
     begin.type = MessageType::Begin;
     std::copy(image->begin(), image->begin() + image::ImageHeader::kSize, begin.header);
-    reply = conversation.ask(begin, error);
+    std::optional<FlashMessage> reply = conversation.ask(begin, error);
     if (!reply) {
         return fail(kExitFailed, error);
     }
@@ -316,63 +444,98 @@ int flashImage(Conversation& conversation, const Options& options)
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     bool restarted = false;
     if (!options.noRestart) {
-        FlashMessage restart;
-        restart.type = MessageType::Restart;
-        reply = conversation.ask(restart, error);
-        if (!reply) {
-            return fail(kExitFailed, error);
-        }
-        if (reply->status != FlashStatus::Ok) {
-            return fail(kExitRefused, fmt::format("node {}: {}", hello->node, flash::flashStatusText(reply->status)));
+        if (const int refused = sendRestart(conversation, hello->node, flash::RestartTarget::Boot); refused != kExitOk) {
+            return refused;
         }
         restarted = true;
     }
+    // On CAN the restarted node answers again: wait for its trial's end.
+    const bool wait = restarted && !options.noWait && conversation.link().reachesRunningNode();
+    if (wait && !options.json) {
+        fmt::print(stderr, "node {}: restarted into the trial; waiting up to {} s for it to confirm "
+                           "('boot confirm' on the node) or revert\n", hello->node, options.confirmTimeoutS);
+    }
+    const TrialOutcome outcome = wait ? waitForTrial(conversation.link(), slot, options) : TrialOutcome::NoAnswer;
     const std::string version = hostimage::versionText(header.value().version);
     if (options.json) {
-        fmt::print("{}\n", nlohmann::json{{"node", hello->node},
-                                          {"slot", slotText(slot)},
-                                          {"version", version},
-                                          {"bytes", total},
-                                          {"resumed_from", resumedFrom},
-                                          {"seconds", seconds},
-                                          {"retransmissions", conversation.retransmissions()},
-                                          {"pending", true},
-                                          {"restarted", restarted}}
-                               .dump());
+        nlohmann::json out{{"node", hello->node},
+                           {"slot", slotText(slot)},
+                           {"version", version},
+                           {"bytes", total},
+                           {"resumed_from", resumedFrom},
+                           {"seconds", seconds},
+                           {"retransmissions", conversation.retransmissions()},
+                           {"pending", true},
+                           {"restarted", restarted}};
+        if (wait) {
+            out["trial"] = trialOutcomeName(outcome);
+        }
+        fmt::print("{}\n", out.dump());
     } else {
         fmt::print("node {}: {} written to slot {}{}, verified, pending\n", hello->node, version, slotText(slot),
                    resumedFrom != 0 ? fmt::format(" (resumed at byte {})", resumedFrom) : "");
-        fmt::print("{}\n", restarted ? "restarted into the trial: confirm it on the node ('boot confirm') within "
-                                       "the watchdog's 30 s, or it reverts"
-                                     : "not restarted (--no-restart): the next start tries it");
+        if (wait) {
+            fmt::print("node {}: trial {}\n", hello->node,
+                       outcome == TrialOutcome::Confirmed  ? "confirmed: the node runs it from now on"
+                       : outcome == TrialOutcome::Reverted ? "reverted: it did not confirm, the old image runs"
+                       : outcome == TrialOutcome::Recovery ? "ended in the stage loader's recovery"
+                                                           : "outcome unknown: the node did not answer in time");
+        } else {
+            fmt::print("{}\n", restarted ? "restarted into the trial: confirm it on the node ('boot confirm') within "
+                                           "the watchdog's 30 s, or it reverts"
+                                         : "not restarted (--no-restart): the next start tries it");
+        }
     }
-    return kExitOk;
+    if (!wait || outcome == TrialOutcome::Confirmed) {
+        return kExitOk;
+    }
+    return outcome == TrialOutcome::NoAnswer ? kExitFailed : kExitRefused;
 }
 
 } // namespace
 
 int main(int argc, char** argv)
 {
-    CLI::App app{"dcos-flash: put a signed image on a controller over its serial line", "dcos-flash"};
+    CLI::App app{"dcos-flash: put a signed image on a controller over CAN or its serial line", "dcos-flash"};
     app.set_version_flag("--version", std::string("dcos-flash ") + dcos::versionString);
-    app.footer("exit status: 0 done, 1 refused by the node, 2 bad arguments, 3 device or file not available, "
-               "4 link failed or key not P-256\n"
+    app.footer("exit status: 0 done (and confirmed, when waited for), 1 refused by the node or the trial reverted, "
+               "2 bad arguments, 3 device, interface or file not available, 4 link failed, key not P-256, or no "
+               "outcome in time\n"
+               "interfaces: can0 (SocketCAN), slcan:/dev/ttyACM0[@bitrate], lab:/path/hub.sock:can0 (the lab bus)\n"
                "devices: /dev/ttyUSB0 (115200 bit/s 8N1), unix:/path (the emulated board's console)");
     Options options;
-    app.add_option("-d,--device", options.device, "the node's serial line")->required();
+    CLI::Option* interfaceOption =
+        app.add_option("-i,--interface", options.interface, "the CAN interface the node is on (needs -n)");
+    CLI::Option* deviceOption = app.add_option("-d,--device", options.device, "the node's serial line (in recovery)");
+    interfaceOption->excludes(deviceOption);
     app.add_option("-k,--key", options.key, "a signing key the node's card trusts (PEM)");
-    app.add_option("-n,--node", options.node, "the node id expected at the other end")->check(CLI::Range(0, 0xFFFE));
+    app.add_option("-n,--node", options.node,
+                   "CAN: the node's CAN node number; serial: the node id expected at the other end")
+        ->check(CLI::Range(0, 0xFFFE));
+    app.add_option("--source", options.source, "CAN: this tool's CAN node number")
+        ->check(CLI::Range(0, int{can::MessageIdentifier::kMaxNodeNumber}));
+    app.add_option("--priority", options.priority, "CAN: the bus priority of the transfer, 0 (most urgent) to 31")
+        ->check(CLI::Range(0, 31));
+    app.add_flag("--kernel-isotp", options.kernelIsoTp,
+                 "CAN: segment with the Linux kernel's ISO-TP socket (can-isotp), not our own; SocketCAN only");
     app.add_option("--timeout-ms", options.timeoutMs, "how long to wait for each answer")
         ->check(CLI::Range(10L, 600000L));
     app.add_option("--retries", options.retries, "how often to send a request again on silence")
         ->check(CLI::Range(0, 100));
     app.add_flag("--no-restart", options.noRestart, "leave the image pending without restarting the node");
+    app.add_flag("--no-wait", options.noWait, "CAN: do not wait for the trial to confirm or revert");
+    app.add_option("--confirm-timeout", options.confirmTimeoutS, "CAN: seconds to wait for the trial's outcome")
+        ->check(CLI::Range(1L, 3600L));
     app.add_flag("--resume", options.resumeOnly,
                  "only go on with the node's interrupted transfer of this image, never start one over "
                  "(without it, a transfer resumes by itself when the node still holds it)");
     app.add_flag("--json", options.json, "machine-readable output: one JSON object");
     app.add_option("image", options.image, "the signed image to flash (dcos-image sign)");
     CLI::App* infoCommand = app.add_subcommand("info", "show the node's slots, versions and boot state");
+    CLI::App* restartCommandLine =
+        app.add_subcommand("restart", "restart the node (needs -k): into its image, or with --recovery into the "
+                                      "stage loader's recovery");
+    restartCommandLine->add_flag("--recovery", options.recovery, "stay in the stage loader's recovery on this start");
 
     try {
         app.parse(argc, argv);
@@ -380,12 +543,34 @@ int main(int argc, char** argv)
         const int code = app.exit(error);
         return code == 0 ? kExitOk : kExitUsage;
     }
-    if (!*infoCommand && (options.image.empty() || options.key.empty())) {
+    if (options.interface.empty() && options.device.empty()) {
+        return fail(kExitUsage, "say how to reach the node: -i INTERFACE -n NODE (CAN) or -d DEVICE (serial)");
+    }
+    if (!options.interface.empty() && options.node < 0) {
+        return fail(kExitUsage, "on CAN, -n names the node's CAN node number");
+    }
+    if (!*infoCommand && !*restartCommandLine && (options.image.empty() || options.key.empty())) {
         return fail(kExitUsage, "flashing needs an image and -k KEY.pem (or the 'info' command)");
+    }
+    if (*restartCommandLine && options.key.empty()) {
+        return fail(kExitUsage, "restart needs -k KEY.pem: only an authenticated session restarts a node");
     }
     LinkError error = LinkError::None;
     std::string why;
-    const std::unique_ptr<hostflash::FlashLink> link = hostflash::FlashLink::open(options.device, error, why);
+    std::unique_ptr<hostflash::FlashLink> link;
+    if (!options.interface.empty()) {
+        if (options.node > can::MessageIdentifier::kMaxNodeNumber) {
+            return fail(kExitUsage, fmt::format("CAN node numbers are 0 to {}", can::MessageIdentifier::kMaxNodeNumber));
+        }
+        hostflash::CanFlashAddress address;
+        address.node = static_cast<uint8_t>(options.node);
+        address.host = static_cast<uint8_t>(options.source);
+        address.priority = static_cast<uint8_t>(options.priority);
+        address.kernelIsoTp = options.kernelIsoTp;
+        link = hostflash::CanFlashLink::open(options.interface, address, error, why);
+    } else {
+        link = hostflash::SerialFlashLink::open(options.device, error, why);
+    }
     if (!link) {
         return fail(error == LinkError::BadArgument ? kExitUsage
                     : error == LinkError::NotAvailable ? kExitNotAvailable
@@ -393,5 +578,8 @@ int main(int argc, char** argv)
                     why);
     }
     Conversation conversation(*link, options);
-    return *infoCommand ? info(conversation, options) : flashImage(conversation, options);
+    if (*infoCommand) {
+        return info(conversation, options);
+    }
+    return *restartCommandLine ? restartCommand(conversation, options) : flashImage(conversation, options);
 }

@@ -9,18 +9,12 @@
 // base + 0x20 with its own line.
 #pragma once
 
+#include <sja1000/IsaCardSettings.hpp>
 #include <sja1000/Sja1000Controller.hpp>
 
 #include <iobus/IsaResourceManager.hpp>
 
 namespace sja1000 {
-
-/// The switch settings of the lab's two-channel card (docs/protocols/labbus.md).
-constexpr uint16_t kIsaCardDefaultBase = 0x280;
-constexpr uint8_t kIsaCardDefaultIrq0 = 10;
-constexpr uint8_t kIsaCardDefaultIrq1 = 11;
-/// The second channel's base, from the first's.
-constexpr uint16_t kIsaSecondChannelOffset = 0x20;
 
 class IsaSja1000Channel final : public Sja1000Controller {
 public:

@@ -14,7 +14,10 @@
 //       15    1  trial: 0 none, 1 pending (the next boot tries it),
 //                2 booting (booted once, not confirmed yet)
 //       16    4  reverts: trials that never confirmed, since the card was made
-//       20  488  0
+//       20    1  recovery requested: 1 = the next start stays in the stage
+//                loader's recovery (a flash tool's Restart into recovery);
+//                the stage loader clears it as it obeys, so it holds once
+//       21  487  0
 //      508    4  CRC-32 of bytes 0 to 507
 #pragma once
 
@@ -41,6 +44,7 @@ struct BootState {
     uint8_t trialSlot = kNoSlot;
     TrialState trial = TrialState::None;
     uint32_t reverts = 0;
+    bool recoveryRequested = false;
 
     void encode(uint8_t (&sector)[kSize]) const;
     /// False for anything but a whole, valid record: magic, format, CRC,

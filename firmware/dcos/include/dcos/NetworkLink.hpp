@@ -35,6 +35,7 @@ enum class SystemMessageType : uint8_t {
     NodeStarted = 0x14, ///< A node's first message on an interface since it started, to the broadcast address (remote-transactions.md, "A node that starts again").
     DsmPublication = 0x20, ///< A part of a publication, to the broadcast address (docs/protocols/publications.md).
     RelayedPublication = 0x21, ///< A relay header or a publication's frame, from a gateway (publications.md, "Across a gateway").
+    Flashing = 0x50, ///< A frame of the flash protocol's ISO-TP connection (docs/protocols/flash.md, "On CAN"), for the flash service.
 };
 
 /// One system message as a link carries it.

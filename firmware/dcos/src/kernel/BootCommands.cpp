@@ -8,6 +8,7 @@
 #include <boot/BootControl.hpp>
 #include <boot/BootInfo.hpp>
 #include <boot/CardLayout.hpp>
+#include <dcos/internal/FlashServiceHooks.hpp>
 #include <runtime/Text.hpp>
 #include <shell/Shell.hpp>
 #include <shell/ShellCommand.hpp>
@@ -34,6 +35,8 @@ shell::CommandResult bootCommand(shell::Shell& shell, int argc, char** argv)
     ata::AtaPioDisk disk = ata::AtaPioDisk::primary();
     boot::AtaSectorStore store(disk);
     boot::BootControl control(store);
+    // A flash session over CAN may be writing the same boot state.
+    const internal::CardHold hold;
     if (argc == 2 && runtime::textEquals(argv[1], "confirm")) {
         const boot::ConfirmOutcome outcome = control.confirm(running);
         shell.print("boot: %s\r\n", boot::confirmOutcomeText(outcome));

@@ -8,6 +8,7 @@
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/ApplicationLoader.hpp>
+#include <dcos/internal/FlashServiceHooks.hpp>
 #include <dcos/internal/KernelConfiguration.hpp>
 
 #include <boot/Panic.hpp>
@@ -73,6 +74,12 @@ Result<ObjectId> startShell(ObjectId lifeSemaphore)
 // semaphore and wakes this task with Abandoned (seed 7.11).
 void rootTaskEntry(uintptr_t)
 {
+    // The flash service, in an image that has it, is up before any
+    // application task runs: an application that faults at once can still
+    // be replaced over the bus.
+    if (flashServiceStart != nullptr) {
+        flashServiceStart();
+    }
     ApplicationLoader::startLinked();
     SemaphoreAttributes life;
     life.name = "shell-life";

@@ -13,6 +13,7 @@
 #include <dcos/internal/NetworkTables.hpp>
 #include <dcos/internal/PublicationMessage.hpp>
 #include <dcos/internal/RemoteAgent.hpp>
+#include <dcos/internal/FlashServiceHooks.hpp>
 #include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/SemaphoreManager.hpp>
@@ -1670,6 +1671,17 @@ void workerEntry(uintptr_t index)
     }
 }
 
+// A frame of the flash protocol goes to the flash service, in the images
+// that link it (firmware/flash/src/FlashService.cpp); the others drop it.
+void onFlashingFrame(uint8_t interface, const SystemMessage& message)
+{
+    if (flashServiceFrame != nullptr) {
+        flashServiceFrame(interface, message);
+    } else {
+        ++statistics.noFlashService;
+    }
+}
+
 void receiverEntry(uintptr_t)
 {
     constexpr uint32_t kAllLinks = (kNetworkInterfaces >= 32) ? ~0u : ((1u << kNetworkInterfaces) - 1);
@@ -1717,6 +1729,7 @@ void receiverEntry(uintptr_t)
                 case SystemMessageType::RelayedPublication: onRelayedPublication(interface, message); break;
                 case SystemMessageType::NodeStarted: onNodeStarted(message); break;
                 case SystemMessageType::TimeSync: onTimeSyncMessage(interface, message); break;
+                case SystemMessageType::Flashing: onFlashingFrame(interface, message); break;
                 }
             }
         }

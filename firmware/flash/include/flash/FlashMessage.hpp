@@ -51,6 +51,7 @@ enum class FlashStatus : uint8_t {
     NoTransfer = 7,       ///< Data or End without a Begin, or End before every byte arrived.
     Malformed = 8,        ///< A request that does not decode.
     Unsupported = 9,      ///< A request this node does not serve here.
+    SlotInUse = 10,       ///< Begin: the slot the image would go to holds the image the node runs (a trial not confirmed yet).
 };
 
 /// One line for an engineer.

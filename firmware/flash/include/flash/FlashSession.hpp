@@ -13,7 +13,9 @@
 // order, each with its sequence number and CRC; a Begin with the same
 // header resumes where the last block ended. End reads the slot back, checks
 // the payload's digest and only then marks the slot pending. Restart asks
-// the caller to restart the node, which then tries the image as a trial.
+// the caller to restart the node, which then tries the image as a trial;
+// Restart into recovery first marks the boot state so that the stage
+// loader stays in recovery on that one start (BootState::recoveryRequested).
 #pragma once
 
 #include <flash/FlashMessage.hpp>
@@ -36,6 +38,10 @@ struct SessionIdentity {
     NodeMode mode = NodeMode::Recovery;
     /// Where the node's memory ends: an image must fit below it.
     uint32_t memoryEnd = 16u << 20;
+    /// The slot the running application was loaded from (the boot.slot of
+    /// its command line); kNoSlot in recovery, or when it was not started
+    /// from the card. Begin never writes into it.
+    uint8_t runningSlot = boot::BootState::kNoSlot;
 };
 
 class FlashSession {
@@ -65,6 +71,7 @@ private:
     FlashStatus begin(const FlashMessage& request, FlashMessage& reply);
     FlashStatus data(const FlashMessage& request, FlashMessage& reply);
     FlashStatus end(FlashMessage& reply);
+    FlashStatus requestRecovery();
     bool slotHeader(uint8_t slot, image::ImageHeader& header);
 
     FlashStore& store_;

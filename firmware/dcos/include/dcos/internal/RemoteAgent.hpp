@@ -108,6 +108,8 @@ struct RemoteStatistics {
     uint32_t nodesStarted = 0;     ///< Other nodes' announcements that they started, heard on any interface.
     uint32_t holdsFreed = 0;       ///< Binary semaphores freed because their holder's node started again.
     uint32_t timersOfRestarted = 0; ///< Timers deleted because their owner's node started again.
+    // The flash protocol (docs/protocols/flash.md, "On CAN").
+    uint32_t noFlashService = 0;   ///< Flashing frames received by an image without the flash service.
     // The instruction counts of the last transaction (the remote bench).
     RemoteInstructions instructions{};
 };
