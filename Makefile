@@ -86,7 +86,7 @@ test-emulator: firmware sdk
 # Builds the bench image and runs every benchmark on the board's benchmark CPU
 # with exact instruction counting, and under KVM where it works; prints the
 # seed's Tables 9.2-9.11 for DCOS and writes $(PRIMITIVES_REPORT) and $(BENCH_REPORT);
-# runs Thread-Metric; reports the footprint of the full production image and
+# runs Thread-Metric; measures a flash over CAN (tests_renode/bench/flash_bench.py); reports the footprint of the full production image and
 # of the minimal one by component;
 # and prints every figure against its budget in $(BENCH_BUDGETS). STRICT=1
 # fails when any figure offends its budget (docs/performance.md, "Budgets").
@@ -94,10 +94,12 @@ test-emulator: firmware sdk
 # reads a figure a failed step left behind.
 bench: deps
 	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH) $(IMAGE_486) $(IMAGE_486_MINIMAL) $(IMAGE_486_TEST_COUNTING) $(FOOTPRINT_MAP) $(FOOTPRINT_MAP_MINIMAL)
-	@rm -f $(PRIMITIVES_REPORT) $(THREAD_METRIC_REPORT) $(REMOTE_REPORT) $(FOOTPRINT_REPORT) $(BUDGET_REPORT)
+	@rm -f $(PRIMITIVES_REPORT) $(THREAD_METRIC_REPORT) $(REMOTE_REPORT) $(FLASH_REPORT) $(FOOTPRINT_REPORT) $(BUDGET_REPORT)
 	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board isa486 --output $(BENCH_REPORT) --primitives $(PRIMITIVES_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/thread_metric/run_thread_metric.py --board isa486 --output $(THREAD_METRIC_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/bench/remote_bench.py --output $(REMOTE_REPORT) --budgets $(BENCH_BUDGETS)
+	@$(MAKE) --no-print-directory card loader host-tools
+	@$(PYTHON) tests_renode/bench/flash_bench.py --output $(FLASH_REPORT)
 	@$(PYTHON) tests_renode/bench/footprint.py --maps $(FOOTPRINT_MAPS) --build-directory $(FW_BUILD) --output $(FOOTPRINT_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/bench/budgets.py --budgets $(BENCH_BUDGETS) --primitives $(PRIMITIVES_REPORT) --thread-metric $(THREAD_METRIC_REPORT) --footprint $(FOOTPRINT_REPORT) --remote $(REMOTE_REPORT) --output $(BUDGET_REPORT) $(BENCH_STRICT)
 

@@ -74,6 +74,7 @@ THREAD_METRIC_REPORT := $(BUILD)/bench/thread_metric.json
 FOOTPRINT_REPORT := $(BUILD)/bench/footprint.json
 BUDGET_REPORT := $(BUILD)/bench/budgets.json
 REMOTE_REPORT := $(BUILD)/bench/remote.json
+FLASH_REPORT := $(BUILD)/bench/flash.json
 BENCH_BUDGETS := tests_renode/bench/budgets.toml
 # STRICT=1 makes 'make bench' fail on every figure that offends its budget
 # (tests_renode/bench/budgets.py); without it the verdict is only printed.

@@ -41,15 +41,17 @@ class World:
         self._emulators = []
 
     def boot(self, board, kind, icount=False, name=None, device_properties=None, extra_args=(), append="",
-             cpu=None):
+             cpu=None, card=None):
         """The lab plugin's boot fixture, for a module-scoped CanLab; the emulators close with the world.
 
         kind is an image kind of the board or the path of an image file; cpu
         replaces the board's CPU model (the remote bench's counting image
-        runs on the board's benchmark_cpu)."""
-        image = kind if os.path.sep in kind else board.image(kind)
+        runs on the board's benchmark_cpu); card, a CompactFlash card image the
+        board boots from instead (docs/boot.md)."""
+        image = card or (kind if os.path.sep in kind else board.image(kind))
         emulator = Emulator(board, image, append=append, icount=icount, cpu=cpu,
-                            device_properties=device_properties, extra_args=extra_args, name=name)
+                            device_properties=device_properties, extra_args=extra_args, name=name,
+                            card=card is not None)
         self._emulators.append(emulator)
         return emulator.start()
 
