@@ -1,0 +1,122 @@
+"""Flashing over real SocketCAN (docs/protocols/flash.md, "On CAN"):
+dcos-flash in the lab VM on the Linux kernel's can0 (slcan, bridged to the
+lab hub), once with its own ISO-TP on a raw CAN socket and once through
+the kernel's own can-isotp socket (--kernel-isotp), which segments,
+reassembles and paces the flow control for it: an implementation we did
+not write on the tool's side of every transfer.
+
+The emulated 486 board boots from its card (the production image in slot
+A) and runs as CAN node 3; the VM's tool asks it for its state, then puts
+a small signed image (16 KiB of payload, made here with the development
+key) into its inactive slot while it runs, without restarting it. Emulated
+time is paced at a twentieth of wall time, so that the VM, slow under an
+emulated CPU, answers within the node's ISO-TP time-outs (1 s emulated,
+20 s of wall time).
+"""
+
+import json
+import os
+import subprocess
+import tempfile
+
+import pytest
+
+from dcoslab.board import REPOSITORY, load_board
+from dcoslab.canlab import CanLab
+from dcoslab.cards import BIN, DEVELOPMENT_KEY, card_state, new_card, signed
+from dcoslab.labvm import LabVM, SlcanSetup
+from dcoslab.remote import attach_node
+from dcoslab.slcan_bridge import SlcanBridge
+from dcoslab.vmworld import BridgedWorld, attach_reports, hold_world
+
+pytestmark = pytest.mark.xdist_group("test_flash_labvm")
+
+BITRATE = 500_000
+PACE = 0.05
+NODE = 3
+BOOT_TIMEOUT = 400
+STEP = 600
+# Under the tree's build folder, not /tmp: the VM sees the host's files there.
+WORK_ROOT = os.path.join(REPOSITORY, "build", "labvm-flash")
+
+
+def tiny_image(work):
+    """A signed image of 16 KiB of payload: a loop and a page of data, linked at 1 MiB, never started."""
+    source, obj, elf = (os.path.join(work, name) for name in ("tiny.S", "tiny.o", "tiny.elf"))
+    with open(source, "w", encoding="ascii") as handle:
+        handle.write(".globl _start\n.text\n_start: jmp _start\n.data\n.fill 16384,1,0x5a\n")
+    subprocess.run(["gcc", "-m32", "-c", source, "-o", obj], check=True)
+    subprocess.run(["ld", "-m", "elf_i386", "-nostdlib", "-static", "-N", "-Ttext=0x100000", "-o", elf, obj],
+                   check=True, capture_output=True)
+    image = os.path.join(work, "tiny.dcos")
+    subprocess.run([os.path.join(BIN, "dcos-image"), "sign", "-k", DEVELOPMENT_KEY, "--board", "isa486",
+                    "--version", "2.0.0", "-o", image, elf], check=True, capture_output=True)
+    return image
+
+
+def vm_script(image):
+    tool = os.path.join(BIN, "dcos-flash")
+    common = f"-i can0 -n {NODE} --json --timeout-ms 15000"
+    return f"""
+. /run/labvm/lib.sh
+echo "@@INFO $({tool} {common} info) status=$?@@"
+echo "@@KINFO $({tool} {common} --kernel-isotp info) status=$?@@"
+echo "@@FLASH $({tool} {common} --kernel-isotp -k {DEVELOPMENT_KEY} --no-restart {image} 2>&1) status=$?@@"
+"""
+
+
+@pytest.fixture(scope="module")
+def world():
+    os.makedirs(WORK_ROOT, exist_ok=True)
+    work = tempfile.TemporaryDirectory(dir=WORK_ROOT)
+
+    def build(world):
+        image = tiny_image(work.name)
+        card = new_card(work.name, ("A", signed(work.name, "1.0.0"), False))
+        world.card = card
+        world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BITRATE},
+                           {"board1": {"bus0": "can0", "card": card}}, pace=PACE, timeout=BOOT_TIMEOUT)
+        world.board = world.lab.board("board1")
+        attach_node(world.board, NODE, [], BITRATE, timeout=STEP)
+        world.vm = LabVM(vm_script(image), slcan=SlcanSetup("can0", BITRATE), connect_slcan=False,
+                         boot_timeout=BOOT_TIMEOUT, timeout=1200)
+        world.vm.start()
+        world.bridge = SlcanBridge(world.vm.slcan_socket_path, world.lab.socket_path, "can0").start()
+        world.bridge.wait_for(lambda b: b.is_open, BOOT_TIMEOUT, "slcand to open the channel")
+
+    with work:
+        yield from hold_world(BridgedWorld(), build)
+
+
+@pytest.fixture(autouse=True)
+def _reports(request):
+    attach_reports(request)
+
+
+def marked(world, tag):
+    match = world.vm.expect(rf"@@{tag} (.*?) status=(\d+)@@", timeout=STEP)
+    return match.group(1).decode(), int(match.group(2))
+
+
+def test_dcos_flash_in_the_lab_vm_reads_the_node_over_socketcan_with_both_iso_tp_implementations(world):
+    own, status = marked(world, "INFO")
+    assert status == 0, own
+    kernel, status = marked(world, "KINFO")
+    assert status == 0, kernel
+    expected = {"node": NODE, "mode": "application", "protocol": 1, "confirmed": "A", "trial": "none",
+                "trial_slot": "none", "slot_a": "1.0.0", "slot_b": "empty", "transfer_slot": "none",
+                "transfer_offset": 0}
+    assert json.loads(own) == expected and json.loads(kernel) == expected, (own, kernel)
+
+
+def test_the_kernels_iso_tp_flashes_the_running_node(world):
+    output, status = marked(world, "FLASH")
+    assert status == 0, output
+    done = json.loads(output)
+    assert done["slot"] == "B" and done["version"] == "2.0.0" and done["bytes"] == 16386, done
+    assert done["restarted"] is False, done
+    # The node ran on: its console answers, and its card holds the image pending.
+    assert "flash: service running" in world.board.command("flash", timeout=STEP)
+    state = card_state(world.card)
+    assert state["boot_state"]["trial"] == "pending" and state["boot_state"]["trial_slot"] == "B", state
+    assert state["slots"]["B"]["valid"] is True and state["slots"]["B"]["version"] == "2.0.0", state
