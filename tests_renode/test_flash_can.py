@@ -131,3 +131,25 @@ def test_a_node_nobody_has_and_a_wrong_interface_are_named(canlab, tmp_path):
     unnumbered = subprocess.run([os.path.join(BIN, "dcos-flash"), "-i", "can0", "info"], capture_output=True,
                                 text=True, timeout=TIMEOUT)
     assert unnumbered.returncode == 2 and "-n names the node's CAN node number" in unnumbered.stderr
+
+
+def test_nodes_on_one_bus_are_addressed_each_by_its_own_number(canlab, tmp_path):
+    cards = {}
+    for node in (3, 4):
+        directory = tmp_path / f"node{node}"
+        directory.mkdir()
+        cards[node] = new_card(directory, ("A", signed(directory, f"1.0.{node}"), False), append=f"node={node}")
+    lab = canlab({"can0": BITRATE}, {"board3": {"bus0": "can0", "card": cards[3]},
+                                     "board4": {"bus0": "can0", "card": cards[4]}})
+    attach_node(lab.board("board3"), 3, [4], BITRATE)
+    attach_node(lab.board("board4"), 4, [3], BITRATE)
+    for node in (3, 4):
+        asked = subprocess.run([os.path.join(BIN, "dcos-flash"), "-i", f"lab:{lab.socket_path}:can0", "-n", str(node),
+                                "--json", "info"], capture_output=True, text=True, timeout=TIMEOUT)
+        assert asked.returncode == 0, asked.stderr
+        info = json.loads(asked.stdout)
+        assert info["node"] == node and info["slot_a"] == f"1.0.{node}", info
+    # Only the node addressed answered each time.
+    for board in ("board3", "board4"):
+        counters = lab.board(board).command("flash")
+        assert "  requests 1\r" in counters, counters
