@@ -15,6 +15,7 @@
 // to the card (no Authenticate succeeds without the seed key's private
 // half); the next deadline never lies in the past after a poll.
 #include "../../../fieldbus/can/fuzz/FuzzCheck.hpp"
+#include "FuzzSeedKey.hpp"
 
 #include <flash/CanFlashServer.hpp>
 #include <flash/FlashSession.hpp>
@@ -27,13 +28,6 @@
 #include <cstring>
 
 namespace {
-
-// The public key of the image fuzz target's seed (its private key was thrown away).
-constexpr uint8_t kSeedKey[65] = {
-    0x04, 0xb1, 0x5c, 0xea, 0xff, 0xe7, 0x0d, 0xe4, 0xeb, 0xec, 0x0e, 0x9d, 0x77, 0xde, 0x8e, 0xb3, 0x23,
-    0xe6, 0xae, 0x57, 0x65, 0x3a, 0x0b, 0xc0, 0x6e, 0x9e, 0x82, 0x80, 0xce, 0x58, 0x56, 0x66, 0x64, 0xca,
-    0x9a, 0xff, 0xbc, 0xca, 0x81, 0x5a, 0xab, 0x6d, 0x3d, 0x02, 0xad, 0x8d, 0x13, 0xf4, 0xcf, 0x5e, 0x5b,
-    0x34, 0xf6, 0x87, 0xba, 0xa4, 0x4a, 0xdc, 0xbd, 0xe2, 0x68, 0x47, 0xaa, 0x78, 0x84};
 
 constexpr uint8_t kNode = 9;
 
@@ -85,7 +79,7 @@ void checkOutput(const flash::CanFlashServer& server, const flash::CanFlashServe
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
-    static const image::TrustedKey key = image::TrustedKey::fromPoint(kSeedKey);
+    static const image::TrustedKey key = image::TrustedKey::fromPoint(flash_fuzz::kSeedKey);
     BlankCard store;
     flash::SessionIdentity identity;
     identity.node = kNode;

@@ -274,19 +274,36 @@ TrialOutcome waitForTrial(hostflash::FlashLink& link, uint8_t slot, const Option
     return TrialOutcome::NoAnswer;
 }
 
+// Hello, the node id checked on a serial line, and Authenticate with the
+// key of -k: the session every writing command begins with. The Hello's
+// reply, or nothing with @p code set.
+std::optional<FlashMessage> openSession(Conversation& conversation, const Options& options, int& code)
+{
+    const std::optional<hostimage::SigningKey> key = readKey(options, code);
+    if (!key) {
+        return std::nullopt;
+    }
+    std::optional<FlashMessage> hello = sayHello(conversation, code);
+    if (!hello) {
+        return std::nullopt;
+    }
+    if (options.device.size() != 0 && options.node >= 0 && hello->node != options.node) {
+        code = fail(kExitRefused, fmt::format("the device reaches node {}, not node {}", hello->node, options.node));
+        return std::nullopt;
+    }
+    code = authenticateSession(conversation, *hello, *key);
+    if (code != kExitOk) {
+        return std::nullopt;
+    }
+    return hello;
+}
+
 int restartCommand(Conversation& conversation, const Options& options)
 {
     int code = kExitOk;
-    const std::optional<hostimage::SigningKey> key = readKey(options, code);
-    if (!key) {
-        return code;
-    }
-    const std::optional<FlashMessage> hello = sayHello(conversation, code);
+    const std::optional<FlashMessage> hello = openSession(conversation, options, code);
     if (!hello) {
         return code;
-    }
-    if (const int refused = authenticateSession(conversation, *hello, *key); refused != kExitOk) {
-        return refused;
     }
     const flash::RestartTarget target = options.recovery ? flash::RestartTarget::Recovery : flash::RestartTarget::Boot;
     if (const int refused = sendRestart(conversation, hello->node, target); refused != kExitOk) {
@@ -353,17 +370,9 @@ int flashImage(Conversation& conversation, const Options& options)
                                                                                 : header.error())));
     }
     int code = kExitOk;
-    const std::optional<hostimage::SigningKey> key = readKey(options, code);
-    if (!key) {
-        return code;
-    }
-
-    const std::optional<FlashMessage> hello = sayHello(conversation, code);
+    const std::optional<FlashMessage> hello = openSession(conversation, options, code);
     if (!hello) {
         return code;
-    }
-    if (options.device.size() != 0 && options.node >= 0 && hello->node != options.node) {
-        return fail(kExitRefused, fmt::format("the device reaches node {}, not node {}", hello->node, options.node));
     }
     uint8_t headerDigest[32];
     image::Sha256::digest(image->data(), image::ImageHeader::kSize, headerDigest);
@@ -372,10 +381,6 @@ int flashImage(Conversation& conversation, const Options& options)
          !std::equal(std::begin(hello->transferDigest), std::end(hello->transferDigest), headerDigest))) {
         return fail(kExitRefused, fmt::format("node {} holds no interrupted transfer of {} (--resume)", hello->node,
                                               options.image));
-    }
-
-    if (const int refused = authenticateSession(conversation, *hello, *key); refused != kExitOk) {
-        return refused;
     }
 
     FlashMessage begin;
