@@ -91,8 +91,8 @@ FOOTPRINT_MAP_MINIMAL := $(FOOTPRINT_MAPS)/dcos486-minimal.map
 link_map = @mkdir -p $(dir $@) && echo "  MAP     $@" && \
 	ld $(FW_LDFLAGS) -Map=$@ -o $(@:.map=-map.elf) $(1) && rm -f $(@:.map=-map.elf)
 
-$(FOOTPRINT_MAP): $(FW_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
-	$(call link_map,$(FW_OBJS))
+$(FOOTPRINT_MAP): $(FW_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld $(FW_IMAGES_STAMP)
+	$(call link_map,$(FW_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY))
 
 $(FOOTPRINT_MAP_MINIMAL): $(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	$(call link_map,$(FW_MINIMAL_OBJS) $(FW_SELFCHECK_OBJS))
