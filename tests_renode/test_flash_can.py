@@ -90,6 +90,8 @@ def test_a_node_told_to_stay_in_recovery_takes_an_image_there_over_can(canlab, t
     board.emulator.expect(r"stage: recovery: a flash tool asked the node to stay in recovery", timeout=TIMEOUT)
     board.emulator.expect(rf"stage: recovery: waiting for an image on this serial line or on CAN as node {NODE} "
                           rf"at {BITRATE} bit/s", timeout=TIMEOUT)
+    # The chip takes part once it has seen the bus idle for 11 bits.
+    lab.hub.wait_on_bus(["board1.0"], TIMEOUT)
     output, _ = finished(flash_tool(lab, "info"))
     info = json.loads(output)
     assert info["mode"] == "recovery" and info["confirmed"] == "A", info

@@ -136,16 +136,26 @@ void transmit(uint8_t interface, const CanFlashServer::Output& output)
     }
 }
 
-// Bytes that differ from one start of the node to the next, for the challenges.
+// Bytes that differ from one start of the node to the next, for the
+// challenges: the calendar time (the real-time clock's, read at boot) and
+// the uptime, both to the nanosecond. Not secret: a challenge only has to
+// be new (docs/protocols/flash.md). No time-stamp counter: an i486 has none.
 void challengeSeed(uint8_t (&seed)[16])
 {
     const uint64_t uptime = dcos::TimerAgent::Uptime();
-    uint64_t counter;
-    asm volatile("rdtsc" : "=A"(counter));
+    const Result<dcos::DateTime> now = dcos::TimerAgent::GetSystemClock();
+    const dcos::DateTime clock = now.ok() ? now.value() : dcos::DateTime{};
     for (int i = 0; i < 8; ++i) {
         seed[i] = static_cast<uint8_t>(uptime >> (8 * i));
-        seed[8 + i] = static_cast<uint8_t>(counter >> (8 * i));
     }
+    seed[8] = static_cast<uint8_t>(clock.year);
+    seed[9] = clock.month ^ static_cast<uint8_t>(clock.year >> 8);
+    seed[10] = clock.day;
+    seed[11] = clock.hour;
+    seed[12] = clock.minute;
+    seed[13] = clock.second;
+    seed[14] = static_cast<uint8_t>(clock.nanosecond);
+    seed[15] = static_cast<uint8_t>(clock.nanosecond >> 8);
 }
 
 void serviceEntry(uintptr_t)

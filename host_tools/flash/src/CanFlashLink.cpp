@@ -61,7 +61,10 @@ LinkError CanFlashLink::exchange(const flash::FlashMessage& request, flash::Flas
         kernel_ ? kernel_->send(bytes, timeout) : hostcan::isoTpSend(*transport_, config_, bytes);
     if (sent.transport) {
         why = sent.transport.message;
-        return linkErrorOf(sent.transport);
+        // Nobody acknowledged the frame: the node may be restarting, so
+        // this is silence, worth asking again, not a broken link.
+        return sent.transport.kind == hostcan::TransportError::Kind::Refused ? LinkError::Timeout
+                                                                            : linkErrorOf(sent.transport);
     }
     if (sent.error != can::LinkError::Ok) {
         // The node took no part of it (no flow control): as silence.

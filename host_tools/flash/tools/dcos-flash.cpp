@@ -115,7 +115,7 @@ public:
             }
             ++retransmissions_;
         }
-        why = fmt::format("no answer from the node after {} attempts", options_.retries + 1);
+        why = fmt::format("no answer from the node after {} attempts ({})", options_.retries + 1, why);
         return std::nullopt;
     }
 
