@@ -54,15 +54,25 @@ def tiny_image(work):
     return image
 
 
-def vm_script(image):
-    tool = os.path.join(BIN, "dcos-flash")
+def vm_script():
+    """The VM's commands. The tool, the image and the key come in as files
+    (/run/labvm/files): the host's /tmp, where a CI clone may live, is not
+    visible there."""
+    files = "/run/labvm/files"
     common = f"-i can0 -n {NODE} --json --timeout-ms 15000"
     return f"""
 . /run/labvm/lib.sh
-echo "@@INFO $({tool} {common} info) status=$?@@"
-echo "@@KINFO $({tool} {common} --kernel-isotp info) status=$?@@"
-echo "@@FLASH $({tool} {common} --kernel-isotp -k {DEVELOPMENT_KEY} --no-restart {image} 2>&1) status=$?@@"
+cp {files}/dcos-flash /tmp/dcos-flash && chmod 755 /tmp/dcos-flash
+out=$(/tmp/dcos-flash {common} info 2>&1); echo "@@INFO $out status=$?@@"
+out=$(/tmp/dcos-flash {common} --kernel-isotp info 2>&1); echo "@@KINFO $out status=$?@@"
+out=$(/tmp/dcos-flash {common} --kernel-isotp -k {files}/key.pem --no-restart {files}/tiny.dcos 2>&1)
+echo "@@FLASH $out status=$?@@"
 """
+
+
+def carried(path):
+    with open(path, "rb") as handle:
+        return handle.read()
 
 
 @pytest.fixture(scope="module")
@@ -78,7 +88,9 @@ def world():
                            {"board1": {"bus0": "can0", "card": card}}, pace=PACE, timeout=BOOT_TIMEOUT)
         world.board = world.lab.board("board1")
         attach_node(world.board, NODE, [], BITRATE, timeout=STEP)
-        world.vm = LabVM(vm_script(image), slcan=SlcanSetup("can0", BITRATE), connect_slcan=False,
+        files = {"dcos-flash": carried(os.path.join(BIN, "dcos-flash")), "tiny.dcos": carried(image),
+                 "key.pem": carried(DEVELOPMENT_KEY)}
+        world.vm = LabVM(vm_script(), slcan=SlcanSetup("can0", BITRATE), connect_slcan=False, files=files,
                          boot_timeout=BOOT_TIMEOUT, timeout=1200)
         world.vm.start()
         world.bridge = SlcanBridge(world.vm.slcan_socket_path, world.lab.socket_path, "can0").start()
