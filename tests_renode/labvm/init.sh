@@ -23,6 +23,11 @@ mount -t devtmpfs devtmpfs /dev
 
 power_off() {
     sync
+    # The console's last lines (the command's end marker among them) may
+    # still sit in the serial driver's buffer: poweroff -f would drop them,
+    # and the host would see the VM end without a result. A busy host
+    # drains the emulated UART slowly, so give it a second.
+    sleep 1
     poweroff -f
     sleep 10
     echo o >/proc/sysrq-trigger
