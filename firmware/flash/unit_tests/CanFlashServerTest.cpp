@@ -142,6 +142,19 @@ private:
     std::optional<std::vector<uint8_t>> reply_;
 };
 
+// The encoded Data request for the first KiB of @p image's payload, with @p tag.
+std::vector<uint8_t> firstBlock(const std::vector<uint8_t>& image, uint8_t tag)
+{
+    const std::vector<uint8_t> bytes(image.begin() + 256, image.begin() + 256 + 1024);
+    FlashMessage m;
+    m.type = MessageType::Data;
+    m.tag = tag;
+    m.length = 1024;
+    m.crc = boot::crc32(bytes.data(), bytes.size());
+    m.bytes = bytes.data();
+    return encoded(m);
+}
+
 class CanFlashServerTest : public ::testing::Test {
 protected:
     CanFlashServerTest()
@@ -241,14 +254,7 @@ TEST_F(CanFlashServerTest, AHostThatStopsInMidMessageIsForgottenAfterNCr)
     // The host's 20th frame and everything after it are lost: the node's
     // receiver waits N_Cr (1 s), aborts, and the host's request gets no reply.
     bus.dropToNode = [](unsigned index, const can::CanFrame&) { return index >= 20; };
-    FlashMessage m;
-    m.type = MessageType::Data;
-    m.tag = 99;
-    std::vector<uint8_t> bytes(image.begin() + 256, image.end());
-    m.length = 1024;
-    m.crc = boot::crc32(bytes.data(), bytes.size());
-    m.bytes = bytes.data();
-    EXPECT_FALSE(bus.exchange(encoded(m), 3000 * kMs).has_value());
+    EXPECT_FALSE(bus.exchange(firstBlock(image, 99), 3000 * kMs).has_value());
     EXPECT_FALSE(server.busy());
     EXPECT_GE(server.statistics().aborted, 1u);
     // The host comes back and sends the block again: it is taken whole.
@@ -263,14 +269,7 @@ TEST_F(CanFlashServerTest, ALostConsecutiveFrameEndsTheRequestAndTheRetryIsTaken
     const std::vector<uint8_t> image = imageOf(1024, {1, 0, 0, 0});
     ASSERT_EQ(host.begin(image).status, FlashStatus::Ok);
     bus.dropToNode = [](unsigned index, const can::CanFrame&) { return index == 7; };
-    FlashMessage m;
-    m.type = MessageType::Data;
-    m.tag = 42;
-    std::vector<uint8_t> bytes(image.begin() + 256, image.end());
-    m.length = 1024;
-    m.crc = boot::crc32(bytes.data(), bytes.size());
-    m.bytes = bytes.data();
-    EXPECT_FALSE(bus.exchange(encoded(m), 3000 * kMs).has_value()) << "a gap in the sequence: no message";
+    EXPECT_FALSE(bus.exchange(firstBlock(image, 42), 3000 * kMs).has_value()) << "a gap in the sequence: no message";
     bus.dropToNode = nullptr;
     EXPECT_EQ(host.block(image, 0, 0, 1024).status, FlashStatus::Ok) << "nothing was written from the broken one";
 }
