@@ -622,7 +622,13 @@ static void chan_run_events(Sja1000Channel *ch)
     ch->running_events = true;
     while ((event = QTAILQ_FIRST(&ch->events)) && event->time <= now) {
         QTAILQ_REMOVE(&ch->events, event, next);
-        if (event->epoch == ch->epoch) {
+        /*
+         * A fault is the lab's command about the chip, not a consequence of
+         * bus traffic the chip may have left: the hub tags it with the epoch
+         * it knew at the boundary, which a reconfiguration in the quantum
+         * before has already ended, so it applies whatever the epoch.
+         */
+        if (event->epoch == ch->epoch || event->kind == EV_FAULT) {
             chan_apply_event(ch, event);
         }
         g_free(event);
@@ -1341,6 +1347,10 @@ static void chan_apply_event(Sja1000Channel *ch, ChanEvent *event)
         }
         break;
     case EV_FAULT:
+        if (chan_in_reset(ch)) {
+            /* In reset mode the chip takes no part in the bus: nothing to force. */
+            break;
+        }
         if (event->arg == FAULT_BUS_OFF) {
             if (!ch->bus_off) {
                 ch->tec = FC_BUS_OFF_LIMIT;
