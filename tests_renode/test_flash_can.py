@@ -75,10 +75,14 @@ def test_a_running_node_takes_an_image_over_can_and_the_tool_waits_for_its_confi
 
 def test_a_node_told_to_stay_in_recovery_takes_an_image_there_over_can(canlab, tmp_path):
     # The card's configuration names the bus's bit rate: the stage loader has
-    # no other way to know it.
+    # no other way to know it, and the kernel brings can0 up on the network
+    # at it as it starts, with no console command.
     card = new_card(tmp_path, ("A", signed(tmp_path, "1.0.0"), False), options=("--bitrate", str(BITRATE)))
     lab, board = lab_with_card(canlab, card)
-    attach_node(board, NODE, [], BITRATE)
+    boot_lines = board.emulator.transcript
+    assert f"command line: can0={BITRATE} node={NODE} boot.slot=A" in boot_lines, boot_lines
+    assert f"can0 carries interface 0: 130.1.0.{NODE}/16, CAN node {NODE}" in boot_lines, boot_lines
+    lab.hub.wait_on_bus(["board1.0"], TIMEOUT)
 
     stranger = tmp_path / "stranger.pem"
     tool("dcos-image", "keygen", "-o", str(stranger))
@@ -104,8 +108,9 @@ def test_a_node_told_to_stay_in_recovery_takes_an_image_there_over_can(canlab, t
     board.emulator.expect(r"stage: a new image on trial", timeout=TIMEOUT)
     board.emulator.expect(r"command line: .*boot\.slot=B boot\.version=1\.2\.0 boot\.trial=1", timeout=TIMEOUT)
     board.emulator.expect(r"dcos> ", timeout=TIMEOUT)
-    # A second image while that trial runs unconfirmed would need its slot: refused, nothing written.
-    attach_node(board, NODE, [], BITRATE)
+    # A second image while that trial runs unconfirmed would need its slot:
+    # refused, nothing written. The trial image is on the bus by itself too.
+    lab.hub.wait_on_bus(["board1.0"], TIMEOUT)
     _, errors = finished(flash_tool(lab, "-k", DEVELOPMENT_KEY, signed(tmp_path, "1.3.0")), code=1)
     assert "runs a trial image from the slot the new image needs" in errors, errors
     assert "confirmed:" in board.command("boot confirm")

@@ -820,3 +820,36 @@ def test_a_held_acquire_and_an_alarm_torn_or_duplicated_on_the_bus_are_performed
     # The alarm went off once, to node 1's console.
     assert call(one, "events 2000")[:2] == ("ok", 0x20)
     assert call(one, "events 300")[0] == "timed out"
+
+
+def test_nodes_whose_command_line_names_a_bit_rate_are_on_the_network_from_boot(canlab):
+    # "can0=RATE" (the stage loader puts the card configuration's bit rate
+    # there) brings can0 up as interface 0 before the console starts: only
+    # the peers' maps are typed, and a remote call works at once.
+    lab = canlab({"can0": BIT_RATE}, {"board1": {"bus0": "can0", "append": f"node=1 can0={BIT_RATE}"},
+                                      "board2": {"bus0": "can0", "append": f"node=2 can0={BIT_RATE}"},
+                                      "board3": {"bus0": "can0", "append": "node=3 can0=12345"},
+                                      "board4": {"bus0": "can0", "append": f"node=300 can0={BIT_RATE}"}})
+    one, two, three, four = (lab.board(name) for name in ("board1", "board2", "board3", "board4"))
+    for board, node in ((one, 1), (two, 2)):
+        booted = board.emulator.transcript
+        assert f"can0 up at 0x280 irq 10: {BIT_RATE} bit/s" in booted, booted
+        assert f"can0 carries interface 0: 130.1.0.{node}/16, CAN node {node}" in booted, booted
+        assert f"  0  can    0  130.1.0.{node}/16  physical {node}" in board.command("net"), board.command("net")
+    # Each announced itself as it came up (NodeStarted), as 'can attach' makes it.
+    lab.hub.wait_for_records(lambda records: len(dcos_frames(lab, NODE_STARTED, records)) >= 2, 60,
+                             "both nodes' announcements")
+    assert sorted(source for _, _, source, _ in dcos_frames(lab, NODE_STARTED)) == [1, 2], lab.hub.log_text()
+    for board, peer in ((one, 2), (two, 1)):
+        for line in (f"net map {peer} 130.1.0.{peer}", f"net neighbour 130.1.0.{peer} {peer}"):
+            assert "error:" not in board.command(line)
+    semaphore = created(two, "remote sem 1 2", "RSEM")
+    assert call(one, f"acquire {semaphore} 0")[0] == "ok"
+    # A rate the chip cannot make, and a node id no CAN node number can
+    # carry: each said at boot, the channel left down, the node running on.
+    booted = three.emulator.transcript
+    assert "error: bit rate '12345' cannot be made exactly" in booted and "can0: not started" in booted, booted
+    assert "can0 is down" in three.command("can stats can0")
+    booted = four.emulator.transcript
+    assert "error: node 300 is no CAN node number (1 to 254); can0: not started" in booted, booted
+    assert f"can0 up at 0x280 irq 10: {BIT_RATE} bit/s" in four.command(f"can up can0 {BIT_RATE}")

@@ -20,8 +20,13 @@
 #include <dcos/NetworkInterfacesManager.hpp>
 #include <dcos/SystemAgent.hpp>
 #include <dcos/internal/KernelConfig.hpp>
+#include <dcos/internal/KernelContext.hpp>
+#include <dcos/internal/NetworkBootHooks.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
+#include <boot/BootInfo.hpp>
+#include <bsp/Board.hpp>
+#include <can/MessageIdentifier.hpp>
 #include <runtime/Text.hpp>
 #include <shell/Shell.hpp>
 
@@ -141,6 +146,73 @@ bool parseMilliseconds(shell::Shell& shell, const char* text, unsigned long& ms)
     return true;
 }
 
+// Installs the channel's driver with the system agent and keeps it open,
+// unless it is already; says why not on @p out.
+bool install(runtime::CharacterSink& out, unsigned channel)
+{
+    IsaSja1000Channel& driver = consoleChannels[channel];
+    if (driver.installed()) {
+        return true;
+    }
+    iobus::IsaConflict conflict;
+    const dcos::Result<dcos::ObjectId> installed = driver.install(kNames[channel], dcos::Visibility::Regional,
+                                                                  &conflict);
+    if (!installed.ok()) {
+        if (installed.status() == Status::AlreadyExists) {
+            char text[96];
+            iobus::IsaResourceManager::describe(conflict, text, sizeof text);
+            runtime::format(out, "error: %s\r\n", text);
+        } else {
+            runtime::format(out, "error: cannot install %s: %s\r\n", kNames[channel],
+                            dcos::statusName(installed.status()));
+        }
+        return false;
+    }
+    // The device belongs to the system, so that no task's recovery
+    // (the shell's, should it fail) takes the channel away.
+    (void)systemAgent.XferOwnership(installed.value(), dcos::ObjectId{});
+    const Status opened = systemAgent.Open(installed.value());
+    if (opened != Status::Ok) {
+        runtime::format(out, "error: no SJA1000 answers at 0x%03x: %s\r\n", driver.base(),
+                        dcos::statusName(opened));
+        (void)driver.uninstall(); // Not open, so it goes.
+        return false;
+    }
+    return true;
+}
+
+// Sets the installed channel's bit rate and prints the line 'can up'
+// prints; says why not on @p out.
+bool setBitRate(runtime::CharacterSink& out, unsigned channel, uint32_t rate)
+{
+    IsaSja1000Channel& driver = consoleChannels[channel];
+    const Status set = systemAgent.Control(driver.id(), Sja1000Controller::kSetBitRate, &rate, sizeof rate);
+    if (set != Status::Ok) {
+        runtime::format(out, "error: cannot set the bit rate: %s\r\n", dcos::statusName(set));
+        return false;
+    }
+    const BusState state = stateOf(channel);
+    runtime::format(out, "%s up at 0x%03x irq %u: %lu bit/s, sample point %u.%u %%, %s\r\n", kNames[channel],
+                    driver.base(), driver.irq(), static_cast<unsigned long>(state.bitRate),
+                    state.samplePointPermille / 10, state.samplePointPermille % 10, stateName(state.errorState));
+    return true;
+}
+
+// Whether @p text is a bit rate the chip makes exactly; says why not on @p out.
+bool parseBitRate(runtime::CharacterSink& out, const char* text, uint32_t& rate)
+{
+    unsigned long value = 0;
+    if (!shell::Shell::parseUnsigned(text, value) || value > UINT32_MAX ||
+        !BitTimingCalculator::forBitRate(static_cast<uint32_t>(value)).ok()) {
+        runtime::format(out, "error: bit rate '%s' cannot be made exactly; the CiA rates are 10000, 20000, 50000, "
+                             "125000, 250000, 500000, 800000 and 1000000\r\n",
+                        text);
+        return false;
+    }
+    rate = static_cast<uint32_t>(value);
+    return true;
+}
+
 CommandResult up(shell::Shell& shell, int argc, char** argv)
 {
     unsigned channel;
@@ -151,56 +223,17 @@ CommandResult up(shell::Shell& shell, int argc, char** argv)
     if (!parseChannel(shell, argv[2], channel)) {
         return CommandResult::Failed;
     }
-    unsigned long rate = Sja1000Controller::kDefaultBitRate;
-    if (argc == 4 && (!shell::Shell::parseUnsigned(argv[3], rate) || !BitTimingCalculator::forBitRate(
-                                                                         static_cast<uint32_t>(rate)).ok())) {
-        shell.print("error: bit rate '%s' cannot be made exactly; the CiA rates are 10000, 20000, 50000, 125000, "
-                    "250000, 500000, 800000 and 1000000\r\n",
-                    argv[3]);
+    uint32_t rate = Sja1000Controller::kDefaultBitRate;
+    if (argc == 4 && !parseBitRate(shell.output(), argv[3], rate)) {
         return CommandResult::Failed;
     }
-    if (attachedToNetwork(shell, channel)) {
+    if (attachedToNetwork(shell, channel) || !install(shell.output(), channel)) {
         return CommandResult::Failed;
-    }
-    IsaSja1000Channel& driver = consoleChannels[channel];
-    if (!driver.installed()) {
-        iobus::IsaConflict conflict;
-        const dcos::Result<dcos::ObjectId> installed = driver.install(kNames[channel], dcos::Visibility::Regional,
-                                                                      &conflict);
-        if (!installed.ok()) {
-            if (installed.status() == Status::AlreadyExists) {
-                char text[96];
-                iobus::IsaResourceManager::describe(conflict, text, sizeof text);
-                shell.print("error: %s\r\n", text);
-            } else {
-                shell.print("error: cannot install %s: %s\r\n", kNames[channel], dcos::statusName(installed.status()));
-            }
-            return CommandResult::Failed;
-        }
-        // The device belongs to the system, so that no task's recovery
-        // (the shell's, should it fail) takes the channel away.
-        (void)systemAgent.XferOwnership(installed.value(), dcos::ObjectId{});
-        const Status opened = systemAgent.Open(installed.value());
-        if (opened != Status::Ok) {
-            shell.print("error: no SJA1000 answers at 0x%03x: %s\r\n", driver.base(), dcos::statusName(opened));
-            (void)driver.uninstall(); // Not open, so it goes.
-            return CommandResult::Failed;
-        }
     }
     // The owner learns of every state change from now on, not only while a
     // command that sends or receives runs.
     listenHere(channel);
-    uint32_t bitRate = static_cast<uint32_t>(rate);
-    const Status set = systemAgent.Control(driver.id(), Sja1000Controller::kSetBitRate, &bitRate, sizeof bitRate);
-    if (set != Status::Ok) {
-        shell.print("error: cannot set the bit rate: %s\r\n", dcos::statusName(set));
-        return CommandResult::Failed;
-    }
-    const BusState state = stateOf(channel);
-    shell.print("%s up at 0x%03x irq %u: %lu bit/s, sample point %u.%u %%, %s\r\n", kNames[channel], driver.base(),
-                driver.irq(), static_cast<unsigned long>(state.bitRate), state.samplePointPermille / 10,
-                state.samplePointPermille % 10, stateName(state.errorState));
-    return CommandResult::Ok;
+    return setBitRate(shell.output(), channel, rate) ? CommandResult::Ok : CommandResult::Failed;
 }
 
 CommandResult down(shell::Shell& shell, int argc, char** argv)
@@ -777,8 +810,8 @@ CommandResult statistics(shell::Shell& shell, int argc, char** argv)
     return CommandResult::Ok;
 }
 
-// The network interface of kind CAN on controller @p channel; prints why none.
-bool interfaceOfChannel(shell::Shell& shell, unsigned channel, uint8_t& interface, dcos::NetworkInterface& entry)
+// The network interface of kind CAN on controller @p channel, if any.
+bool findInterfaceOfChannel(unsigned channel, uint8_t& interface, dcos::NetworkInterface& entry)
 {
     for (unsigned i = 0; i < dcos::internal::kNetworkInterfaces; ++i) {
         const dcos::Result<dcos::NetworkInterface> found = dcos::NetworkInterfacesManager::GetInterface(
@@ -789,10 +822,27 @@ bool interfaceOfChannel(shell::Shell& shell, unsigned channel, uint8_t& interfac
             return true;
         }
     }
-    shell.print("error: no network interface is on %s; add one with 'net interface can %u <address>/<length> "
-                "<node number>'\r\n",
-                kNames[channel], channel);
     return false;
+}
+
+// Gives network interface @p interface (@p entry) the channel's link, and
+// prints what it carries; says why not on @p out.
+bool attachChannel(runtime::CharacterSink& out, unsigned channel, uint8_t interface,
+                   const dcos::NetworkInterface& entry)
+{
+    networkLinks[channel].bind(consoleChannels[channel].id());
+    const Status attached = dcos::NetworkInterfacesManager::AttachLink(interface, networkLinks[channel]);
+    if (attached != Status::Ok) {
+        runtime::format(out, "error: cannot attach %s to interface %u: %s\r\n", kNames[channel], interface,
+                        dcos::statusName(attached));
+        return false;
+    }
+    attachedInterface[channel] = interface;
+    char address[dcos::NetworkAddress::kTextSize];
+    entry.address.format(address);
+    runtime::format(out, "%s carries interface %u: %s/%u, CAN node %lu\r\n", kNames[channel], interface, address,
+                    entry.prefixLength, static_cast<unsigned long>(entry.physical));
+    return true;
 }
 
 CommandResult attach(shell::Shell& shell, int argc, char** argv)
@@ -803,22 +853,13 @@ CommandResult attach(shell::Shell& shell, int argc, char** argv)
     }
     uint8_t interface;
     dcos::NetworkInterface entry;
-    if (!interfaceOfChannel(shell, channel, interface, entry)) {
+    if (!findInterfaceOfChannel(channel, interface, entry)) {
+        shell.print("error: no network interface is on %s; add one with 'net interface can %u <address>/<length> "
+                    "<node number>'\r\n",
+                    kNames[channel], channel);
         return CommandResult::Failed;
     }
-    networkLinks[channel].bind(consoleChannels[channel].id());
-    const Status attached = dcos::NetworkInterfacesManager::AttachLink(interface, networkLinks[channel]);
-    if (attached != Status::Ok) {
-        shell.print("error: cannot attach %s to interface %u: %s\r\n", kNames[channel], interface,
-                    dcos::statusName(attached));
-        return CommandResult::Failed;
-    }
-    attachedInterface[channel] = interface;
-    char address[dcos::NetworkAddress::kTextSize];
-    entry.address.format(address);
-    shell.print("%s carries interface %u: %s/%u, CAN node %lu\r\n", kNames[channel], interface, address,
-                entry.prefixLength, static_cast<unsigned long>(entry.physical));
-    return CommandResult::Ok;
+    return attachChannel(shell.output(), channel, interface, entry) ? CommandResult::Ok : CommandResult::Failed;
 }
 
 CommandResult detach(shell::Shell& shell, int argc, char** argv)
@@ -839,6 +880,44 @@ CommandResult detach(shell::Shell& shell, int argc, char** argv)
     listenHere(channel);
     shell.print("%s detached from interface %u\r\n", kNames[channel], attachedInterface[channel]);
     return CommandResult::Ok;
+}
+
+// Brings channel @p channel up at the rate in @p rateText and attaches it
+// as a network interface by the boot rule (NetworkBootHooks.hpp); says on
+// @p out what it did or why not.
+void startAtBoot(runtime::CharacterSink& out, unsigned channel, const char* rateText)
+{
+    uint32_t rate = 0;
+    if (!parseBitRate(out, rateText, rate)) {
+        runtime::format(out, "%s: not started\r\n", kNames[channel]);
+        return;
+    }
+    const uint16_t node = dcos::internal::localNode();
+    if (node > can::MessageIdentifier::kMaxNodeNumber) {
+        runtime::format(out, "error: node %u is no CAN node number (1 to %u); %s: not started\r\n", unsigned(node),
+                        unsigned(can::MessageIdentifier::kMaxNodeNumber), kNames[channel]);
+        return;
+    }
+    if (!install(out, channel) || !setBitRate(out, channel, rate)) {
+        runtime::format(out, "%s: not started\r\n", kNames[channel]);
+        return;
+    }
+    uint8_t interface = 0;
+    dcos::NetworkInterface entry;
+    if (!findInterfaceOfChannel(channel, interface, entry)) {
+        const dcos::NetworkAddress address = dcos::NetworkAddress::fromOctets(
+            130, static_cast<uint8_t>(channel + 1), 0, static_cast<uint8_t>(node));
+        const dcos::Result<uint8_t> added = dcos::NetworkInterfacesManager::AddInterface(
+            dcos::InterfaceKind::Can, static_cast<uint8_t>(channel), address, 16, node);
+        if (!added.ok() || !findInterfaceOfChannel(channel, interface, entry)) {
+            runtime::format(out, "error: cannot add a network interface on %s: %s; it stays up, not attached\r\n",
+                            kNames[channel], dcos::statusName(added.status()));
+            return;
+        }
+    }
+    if (!attachChannel(out, channel, interface, entry)) {
+        runtime::format(out, "%s: up, not attached\r\n", kNames[channel]);
+    }
 }
 
 constexpr shell::Subcommand kSubcommands[] = {
@@ -876,3 +955,17 @@ DCOS_SHELL_COMMAND_DETAILED(canShellCommand, "can", "bring CAN channels up and d
                             canCommand);
 
 } // namespace sja1000
+
+namespace dcos::internal {
+
+void networkBootStart()
+{
+    char rate[16];
+    for (unsigned channel = 0; channel < sja1000::kChannels; ++channel) {
+        if (boot::findCommandLineOption(dcos::bootInfo().commandLine, sja1000::kNames[channel], rate, sizeof rate)) {
+            sja1000::startAtBoot(bsp::console(), channel, rate);
+        }
+    }
+}
+
+} // namespace dcos::internal

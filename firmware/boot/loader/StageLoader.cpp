@@ -237,7 +237,9 @@ bool loadAndVerify(ata::AtaPioDisk& disk, uint8_t slot, uint32_t memoryEnd)
 // -- the hand-over ------------------------------------------------------------------
 
 boot::multiboot::Info handover;
-char commandLine[boot::ConfigurationBlock::kCommandLineSize + 96];
+// The configuration's line, "node=65535 can0=1000000 " before it and the
+// boot's facts (a 31-character version at most) after it.
+char commandLine[boot::ConfigurationBlock::kCommandLineSize + 128];
 const char loaderName[] = "DCOS stage loader";
 
 [[noreturn]] void start(const image::ImageHeader& image, uint8_t slot, bool trial, bool reverted, uint32_t upperKib)
@@ -251,16 +253,23 @@ const char loaderName[] = "DCOS stage loader";
     image.version.format(version, sizeof version);
     // The kernel learns where it came from on its command line: the
     // configuration's own line, then the boot's facts (docs/boot.md).
-    // The configuration's node id reaches the kernel as "node=" unless its
-    // command line names one itself.
+    // The configuration's node id reaches the kernel as "node=", and its
+    // CAN bit rate as "can0=", which brings can0 up on the network at boot,
+    // unless its command line names them itself.
     char nodeText[16] = {};
-    char ignored[8];
+    char rateText[20] = {};
+    char ignored[16];
     if (configuration.nodeId != 0 &&
         !boot::findCommandLineOption(configuration.commandLine, "node", ignored, sizeof ignored)) {
         runtime::formatToBuffer(nodeText, sizeof nodeText, "node=%u ", static_cast<unsigned>(configuration.nodeId));
     }
-    runtime::formatToBuffer(commandLine, sizeof commandLine, "%s%s%sboot.slot=%s boot.version=%s%s%s", nodeText,
-                            configuration.commandLine, configuration.commandLine[0] != '\0' ? " " : "",
+    if (configuration.canBitRate != 0 &&
+        !boot::findCommandLineOption(configuration.commandLine, "can0", ignored, sizeof ignored)) {
+        runtime::formatToBuffer(rateText, sizeof rateText, "can0=%lu ",
+                                static_cast<unsigned long>(configuration.canBitRate));
+    }
+    runtime::formatToBuffer(commandLine, sizeof commandLine, "%s%s%s%sboot.slot=%s boot.version=%s%s%s", nodeText,
+                            rateText, configuration.commandLine, configuration.commandLine[0] != '\0' ? " " : "",
                             card::slotName(slot), version, trial ? " boot.trial=1" : "",
                             reverted ? " boot.reverted=1" : "");
     handover.flags = boot::multiboot::kInfoMemory | boot::multiboot::kInfoCommandLine | boot::multiboot::kInfoLoaderName;

@@ -22,10 +22,6 @@
 #include <image/ImageVerifier.hpp>
 #include <runtime/Format.hpp>
 
-namespace dcos {
-const boot::BootInfo& bootInfo();
-}
-
 namespace flash {
 
 namespace {

@@ -389,7 +389,8 @@ int main(int argc, char** argv)
         ->required();
     createCommand->add_option("--node", createOptions.node, "the node id (0: the kernel's default)")
         ->check(CLI::Range(0, 0xFFFE));
-    createCommand->add_option("--bitrate", createOptions.bitRate, "the CAN bit rate (0: the driver's default)");
+    createCommand->add_option("--bitrate", createOptions.bitRate, "the CAN bit rate: the node starts can0 on the network at it (0: can0 stays down at boot, "
+                                      "recovery listens at 125000)");
     createCommand->add_option("--append", createOptions.append, "the kernel command line (up to 159 characters)");
     createCommand->add_option("--sectors", createOptions.sectors, "the card's size in sectors")
         ->check(CLI::Range(card::kMinimumCardSectors, 1u << 22));

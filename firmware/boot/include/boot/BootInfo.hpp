@@ -44,3 +44,9 @@ ImageLayout imageLayout();
 
 /// The loader-independent kernel entry. It never returns.
 [[noreturn]] void kernelMain(const boot::BootInfo& bootInfo);
+
+namespace dcos {
+/// What the loader told the kernel (a copy kernelMain keeps): the command
+/// line and the memory, for any part of the kernel that reads them.
+const boot::BootInfo& bootInfo();
+} // namespace dcos

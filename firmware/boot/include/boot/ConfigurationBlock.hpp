@@ -10,7 +10,8 @@
 //       12    1  format, 1
 //       13    1  trusted keys, 0 to 4
 //       14    2  node id (0: the kernel's default, 1)
-//       16    4  CAN bit rate in bit/s (0: the driver's default)
+//       16    4  CAN bit rate in bit/s: the kernel starts can0 on the network
+//                at it (0: it stays down; recovery listens at 125 kbit/s)
 //       20  260  trusted keys: public points, 65 bytes each (SEC 1 uncompressed)
 //      280  160  kernel command line, printable ASCII, NUL-terminated
 //      440   68  0

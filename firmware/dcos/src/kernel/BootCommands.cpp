@@ -15,8 +15,6 @@
 
 namespace dcos {
 
-const boot::BootInfo& bootInfo();
-
 namespace {
 
 const char* trialText(boot::TrialState trial)

@@ -10,6 +10,7 @@
 #include <dcos/internal/ApplicationLoader.hpp>
 #include <dcos/internal/FlashServiceHooks.hpp>
 #include <dcos/internal/KernelConfiguration.hpp>
+#include <dcos/internal/NetworkBootHooks.hpp>
 
 #include <boot/Panic.hpp>
 #include <bsp/Board.hpp>
@@ -79,6 +80,11 @@ void rootTaskEntry(uintptr_t)
     // be replaced over the bus.
     if (flashServiceStart != nullptr) {
         flashServiceStart();
+    }
+    // The links the command line names (the card's configuration puts its
+    // bit rate there) are up before the application, which may use them.
+    if (networkBootStart != nullptr) {
+        networkBootStart();
     }
     ApplicationLoader::startLinked();
     SemaphoreAttributes life;

@@ -15,7 +15,6 @@
 
 namespace dcos {
 
-const boot::BootInfo& bootInfo();
 uintptr_t firstFreeMemory();
 
 namespace {
