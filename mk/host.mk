@@ -16,6 +16,7 @@ HOST_PORTABLE_SRCS := \
 	firmware/boot/src/BootState.cpp \
 	firmware/boot/src/BootControl.cpp \
 	firmware/boot/src/BootStateStore.cpp \
+	firmware/boot/src/ConfigurationStore.cpp \
 	firmware/boot/src/ConfigurationBlock.cpp \
 	firmware/boot/src/Crc32.cpp \
 	$(wildcard firmware/shell/src/*.cpp) \

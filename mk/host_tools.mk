@@ -22,7 +22,7 @@ HOSTIMAGE_SRCS := $(wildcard host_tools/image/src/*.cpp)
 HOSTFLASH_SRCS := $(wildcard host_tools/flash/src/*.cpp)
 # The card's records, the firmware's own code (firmware/boot), which the
 # host's card tool writes and reads.
-BOOT_RECORD_SRCS := firmware/boot/src/BootState.cpp firmware/boot/src/BootStateStore.cpp \
+BOOT_RECORD_SRCS := firmware/boot/src/BootState.cpp firmware/boot/src/BootStateStore.cpp firmware/boot/src/ConfigurationStore.cpp \
 	firmware/boot/src/ConfigurationBlock.cpp firmware/boot/src/Crc32.cpp
 HOST_TOOLS_LIBS := -lfmt -lmodbus -ltomlplusplus -lmbedcrypto
 

@@ -141,6 +141,37 @@ def test_dcos_card_refuses_what_the_stage_loader_would_not_boot(tmp_path):
     assert not (tmp_path / "x.img").exists()
 
 
+def test_dcos_card_writes_the_nodes_identity_for_the_configuration_protocol(tmp_path):
+    # docs/protocols/config.md: the serial number a scan finds the node by,
+    # its configuration key, whether queries are closed, the lockout.
+    key = tmp_path / "node.key"
+    key.write_text("00112233445566778899aabbccddeeff" * 2 + "\n")
+    card = new_card(tmp_path, options=("--serial", "4711", "--config-key", str(key), "--closed-queries",
+                                       "--lockout", "90"))
+    configuration = card_state(card)["configuration"]
+    assert (configuration["serial"], configuration["configuration_key"], configuration["queries"],
+            configuration["lockout_seconds"]) == (4711, True, "closed", 90), configuration
+    with open(card, "rb") as handle:
+        handle.seek(SECTOR * 256 + 440)  # The configuration's first copy (docs/boot.md), its identity fields.
+        fields = handle.read(39)
+    assert fields[:4] == (4711).to_bytes(4, "little") and fields[4:36] == bytes.fromhex(key.read_text().strip())
+    assert fields[36] == 3 and fields[37:39] == (90).to_bytes(2, "little")
+    # Without them: no serial, no key (nothing can be changed over the bus), open queries, 60 s.
+    (tmp_path / "plain").mkdir()
+    plain = card_state(new_card(tmp_path / "plain"))["configuration"]
+    assert (plain["serial"], plain["configuration_key"], plain["queries"], plain["lockout_seconds"]) == \
+        (0, False, "open", 60), plain
+    # A key file that is not 64 hexadecimal digits is refused before any card is made.
+    bad = tmp_path / "bad.key"
+    bad.write_text("00112233")
+    result = subprocess.run([os.path.join(BIN, "dcos-card"), "create", "-o", str(tmp_path / "bad.img"),
+                             "--boot-sector", os.path.join(BUILT, "boot-sector.bin"), "--stage",
+                             os.path.join(BUILT, "stage-loader.bin"), "-p", DEVELOPMENT_KEY + ".pub",
+                             "--config-key", str(bad)], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 4 and "64 hexadecimal digits" in result.stderr, result.stderr
+    assert not (tmp_path / "bad.img").exists()
+
+
 def test_dcos_card_keeps_the_confirmed_slot_and_refuses_a_downgrade(boot, isa486, tmp_path):
     card = new_card(tmp_path, ("A", signed(tmp_path, "1.2.0"), False))
     emulator = boot(isa486, card=card)

@@ -13,7 +13,12 @@ constexpr char kMagic[8] = {'D', 'C', 'O', 'S', 'C', 'O', 'N', 'F'};
 constexpr uint8_t kFormat = 1;
 constexpr size_t kKeysOffset = 20;
 constexpr size_t kCommandLineOffset = kKeysOffset + ConfigurationBlock::kMaximumKeys * ConfigurationBlock::kKeySize;
-static_assert(kCommandLineOffset + ConfigurationBlock::kCommandLineSize <= kCrcOffset, "the record fits its sector");
+constexpr size_t kSerialOffset = kCommandLineOffset + ConfigurationBlock::kCommandLineSize;
+constexpr size_t kConfigurationKeyOffset = kSerialOffset + 4;
+constexpr size_t kFlagsOffset = kConfigurationKeyOffset + ConfigurationBlock::kConfigurationKeySize;
+constexpr size_t kLockoutOffset = kFlagsOffset + 1;
+static_assert(kSerialOffset == 440 && kFlagsOffset == 476, "the layout of ConfigurationBlock.hpp");
+static_assert(kLockoutOffset + 2 <= kCrcOffset, "the record fits its sector");
 
 } // namespace
 
@@ -32,6 +37,13 @@ void ConfigurationBlock::encode(uint8_t (&sector)[kSize]) const
     for (size_t i = 0; i + 1 < kCommandLineSize && commandLine[i] != '\0'; ++i) {
         sector[kCommandLineOffset + i] = static_cast<uint8_t>(commandLine[i]);
     }
+    put32(sector + kSerialOffset, serialNumber);
+    for (size_t i = 0; i < kConfigurationKeySize; ++i) {
+        sector[kConfigurationKeyOffset + i] = hasConfigurationKey() ? configurationKey[i] : 0;
+    }
+    sector[kFlagsOffset] = flags;
+    sector[kLockoutOffset] = static_cast<uint8_t>(lockoutSeconds);
+    sector[kLockoutOffset + 1] = static_cast<uint8_t>(lockoutSeconds >> 8);
     record::seal(sector);
 }
 
@@ -68,6 +80,15 @@ bool ConfigurationBlock::decode(const uint8_t (&sector)[kSize], ConfigurationBlo
     if (length == kCommandLineSize) {
         return false; // Not terminated.
     }
+    block.serialNumber = get32(sector + kSerialOffset);
+    block.flags = sector[kFlagsOffset];
+    if ((block.flags & ~kKnownFlags) != 0) {
+        return false;
+    }
+    for (size_t i = 0; i < kConfigurationKeySize; ++i) {
+        block.configurationKey[i] = sector[kConfigurationKeyOffset + i];
+    }
+    block.lockoutSeconds = static_cast<uint16_t>(sector[kLockoutOffset] | (sector[kLockoutOffset + 1] << 8));
     out = block;
     return true;
 }

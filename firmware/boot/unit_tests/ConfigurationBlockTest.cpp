@@ -96,3 +96,52 @@ TEST(ConfigurationBlockTest, TheNewerValidCopyCounts)
 }
 
 } // namespace
+
+TEST(ConfigurationBlockTest, TheIdentityFieldsRoundTripAndARecordWithoutThemReadsAsDefaults)
+{
+    ConfigurationBlock block = sample();
+    block.serialNumber = 0xA1B2C3D4;
+    for (size_t i = 0; i < ConfigurationBlock::kConfigurationKeySize; ++i) {
+        block.configurationKey[i] = static_cast<uint8_t>(0xF0 - i);
+    }
+    block.flags = ConfigurationBlock::kHasConfigurationKey | ConfigurationBlock::kQueriesClosed;
+    block.lockoutSeconds = 300;
+    uint8_t sector[512];
+    block.encode(sector);
+    // The layout of the header's table, byte for byte.
+    EXPECT_EQ(sector[440], 0xD4);
+    EXPECT_EQ(sector[443], 0xA1);
+    EXPECT_EQ(sector[444], 0xF0);
+    EXPECT_EQ(sector[475], 0xF0 - 31);
+    EXPECT_EQ(sector[476], 3);
+    EXPECT_EQ(sector[477] | sector[478] << 8, 300);
+    ConfigurationBlock decoded;
+    ASSERT_TRUE(ConfigurationBlock::decode(sector, decoded));
+    EXPECT_EQ(decoded.serialNumber, 0xA1B2C3D4u);
+    EXPECT_EQ(std::memcmp(decoded.configurationKey, block.configurationKey, sizeof block.configurationKey), 0);
+    EXPECT_TRUE(decoded.hasConfigurationKey());
+    EXPECT_TRUE(decoded.queriesClosed());
+    EXPECT_EQ(decoded.effectiveLockoutSeconds(), 300);
+
+    // A record written before these fields existed holds zeros there.
+    uint8_t older[512];
+    sample().encode(older);
+    ASSERT_TRUE(ConfigurationBlock::decode(older, decoded));
+    EXPECT_EQ(decoded.serialNumber, 0u);
+    EXPECT_FALSE(decoded.hasConfigurationKey());
+    EXPECT_FALSE(decoded.queriesClosed());
+    EXPECT_EQ(decoded.effectiveLockoutSeconds(), ConfigurationBlock::kDefaultLockoutSeconds);
+}
+
+TEST(ConfigurationBlockTest, AKeyNotMarkedSetIsNotWrittenAndAnUnknownFlagIsRefused)
+{
+    ConfigurationBlock block = sample();
+    block.configurationKey[0] = 0x55; // Without kHasConfigurationKey: not a key.
+    uint8_t sector[512];
+    block.encode(sector);
+    EXPECT_EQ(sector[444], 0);
+    block.flags = 0x04;
+    block.encode(sector);
+    ConfigurationBlock ignored;
+    EXPECT_FALSE(ConfigurationBlock::decode(sector, ignored));
+}

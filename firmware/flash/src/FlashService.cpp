@@ -7,8 +7,7 @@
 #include <boot/AtaSectorStore.hpp>
 #include <boot/BootControl.hpp>
 #include <boot/BootInfo.hpp>
-#include <boot/ConfigurationBlock.hpp>
-#include <boot/RecordCopies.hpp>
+#include <boot/ConfigurationStore.hpp>
 #include <bsp/Board.hpp>
 #include <bsp/BoardReset.hpp>
 #include <can/MessageIdentifier.hpp>
@@ -60,18 +59,15 @@ size_t trustedKeyCount = 0;
 // The card's configuration: the keys it trusts. Read once, at the task's start.
 const char* readConfiguration(boot::SectorStore& store)
 {
-    uint8_t copies[2][boot::card::kSectorSize];
-    if (!store.read(boot::card::kConfigurationLba, 1, copies[0]) ||
-        !store.read(boot::card::kConfigurationLba + 1, 1, copies[1])) {
+    const boot::StoredConfiguration stored = boot::ConfigurationStore::read(store);
+    if (!stored.readable) {
         return "the card cannot be read";
     }
-    boot::ConfigurationBlock configuration;
-    unsigned copy = 0;
-    if (!boot::newestCopy(copies[0], copies[1], configuration, copy)) {
+    if (!stored.present) {
         return "the card holds no valid configuration";
     }
-    for (size_t i = 0; i < configuration.keyCount; ++i) {
-        trustedKeys[trustedKeyCount++] = image::TrustedKey::fromPoint(configuration.keys[i]);
+    for (size_t i = 0; i < stored.configuration.keyCount; ++i) {
+        trustedKeys[trustedKeyCount++] = image::TrustedKey::fromPoint(stored.configuration.keys[i]);
     }
     return trustedKeyCount == 0 ? "the card's configuration trusts no key" : nullptr;
 }

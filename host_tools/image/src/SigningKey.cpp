@@ -1,9 +1,8 @@
 #include <hostimage/SigningKey.hpp>
 
-#include <mbedtls/ctr_drbg.h>
+#include <hostimage/RandomGenerator.hpp>
+
 #include <mbedtls/ecdsa.h>
-#include <mbedtls/entropy.h>
-#include <mbedtls/error.h>
 #include <mbedtls/pk.h>
 
 #include <fmt/core.h>
@@ -13,43 +12,6 @@
 namespace hostimage {
 
 namespace {
-
-std::string describe(const char* what, int code)
-{
-    char text[128];
-    mbedtls_strerror(code, text, sizeof text);
-    return fmt::format("{}: {} (mbedTLS -0x{:04X})", what, text, static_cast<unsigned>(-code));
-}
-
-// A deterministic random bit generator seeded from the system's entropy,
-// freed on every path.
-class Random {
-public:
-    Random()
-    {
-        mbedtls_entropy_init(&entropy_);
-        mbedtls_ctr_drbg_init(&drbg_);
-        static const char personalisation[] = "dcos-image";
-        status_ = mbedtls_ctr_drbg_seed(&drbg_, mbedtls_entropy_func, &entropy_,
-                                        reinterpret_cast<const unsigned char*>(personalisation),
-                                        sizeof personalisation - 1);
-    }
-    ~Random()
-    {
-        mbedtls_ctr_drbg_free(&drbg_);
-        mbedtls_entropy_free(&entropy_);
-    }
-    Random(const Random&) = delete;
-    Random& operator=(const Random&) = delete;
-
-    int status() const { return status_; }
-    mbedtls_ctr_drbg_context* drbg() { return &drbg_; }
-
-private:
-    mbedtls_entropy_context entropy_;
-    mbedtls_ctr_drbg_context drbg_;
-    int status_;
-};
 
 // The key's curve must be P-256: the controllers verify nothing else.
 bool onP256(mbedtls_pk_context& pk)
@@ -86,9 +48,9 @@ SigningKey::SigningKey(std::shared_ptr<Context> context) : context_(std::move(co
 
 std::optional<SigningKey> SigningKey::generate(std::string& error)
 {
-    Random random;
+    RandomGenerator random("dcos-image");
     if (random.status() != 0) {
-        error = describe("cannot seed the random generator from the system's entropy", random.status());
+        error = describeMbedtlsError("cannot seed the random generator from the system's entropy", random.status());
         return std::nullopt;
     }
     auto context = std::make_shared<Context>();
@@ -98,7 +60,7 @@ std::optional<SigningKey> SigningKey::generate(std::string& error)
                                      random.drbg());
     }
     if (status != 0) {
-        error = describe("cannot generate a P-256 key", status);
+        error = describeMbedtlsError("cannot generate a P-256 key", status);
         return std::nullopt;
     }
     SigningKey key(context);
@@ -115,7 +77,7 @@ std::optional<SigningKey> SigningKey::fromPem(const std::string& pem, std::strin
     const std::vector<unsigned char> bytes = pemBytes(pem);
     const int status = mbedtls_pk_parse_key(&context->pk, bytes.data(), bytes.size(), nullptr, 0);
     if (status != 0) {
-        error = describe("not a private key in PEM", status);
+        error = describeMbedtlsError("not a private key in PEM", status);
         return std::nullopt;
     }
     if (!onP256(context->pk)) {
@@ -153,9 +115,9 @@ bool SigningKey::sign(const uint8_t (&digest)[32], uint8_t (&signature)[image::E
 {
     // The nonce comes from the key and the digest (RFC 6979); the random
     // generator only blinds the computation against side channels.
-    Random random;
+    RandomGenerator random("dcos-image");
     if (random.status() != 0) {
-        error = describe("cannot seed the random generator from the system's entropy", random.status());
+        error = describeMbedtlsError("cannot seed the random generator from the system's entropy", random.status());
         return false;
     }
     mbedtls_ecp_keypair* key = mbedtls_pk_ec(context_->pk);
@@ -174,7 +136,7 @@ bool SigningKey::sign(const uint8_t (&digest)[32], uint8_t (&signature)[image::E
     mbedtls_mpi_free(&s);
     mbedtls_mpi_free(&r);
     if (status != 0) {
-        error = describe("cannot sign", status);
+        error = describeMbedtlsError("cannot sign", status);
         return false;
     }
     return true;
@@ -191,7 +153,7 @@ std::optional<SigningKey::PublicPoint> SigningKey::publicPointFromPem(const std:
         status = mbedtls_pk_parse_key(&context.pk, bytes.data(), bytes.size(), nullptr, 0);
     }
     if (status != 0) {
-        error = describe("not a public or private key in PEM", status);
+        error = describeMbedtlsError("not a public or private key in PEM", status);
         return std::nullopt;
     }
     if (!onP256(context.pk)) {

@@ -4,6 +4,7 @@
 //
 //     dcos-card create -o CARD --boot-sector BIN --stage BIN -p PUB.pem [-p ...]
 //                      [--node N] [--bitrate B] [--append TEXT] [--sectors N] [--force]
+//                      [--serial N] [--config-key KEY] [--closed-queries] [--lockout S]
 //     dcos-card write CARD --slot A|B IMAGE.dcos [--pending] [--allow-downgrade]
 //     dcos-card show CARD
 //
@@ -19,8 +20,10 @@
 //
 // Exit status: 0 done; 1 the card or the image is refused (the reason is
 // printed); 2 bad arguments; 3 a file cannot be read or written; 4 a key is
-// not a P-256 key.
+// not usable (a signing key not on P-256, a configuration key file not 64
+// hexadecimal digits).
 #include <hostimage/CardFile.hpp>
+#include <hostimage/ConfigurationKeyFile.hpp>
 #include <hostimage/SigningKey.hpp>
 #include <hostimage/ToolFiles.hpp>
 
@@ -65,6 +68,10 @@ struct CreateOptions {
     std::string append;
     uint32_t sectors = card::kBuiltCardSectors;
     bool force = false;
+    uint32_t serial = 0;
+    std::string configurationKey;
+    bool closedQueries = false;
+    uint16_t lockoutSeconds = 0;
 };
 
 int create(const CreateOptions& options, bool json)
@@ -85,7 +92,22 @@ int create(const CreateOptions& options, bool json)
     configuration.nodeId = options.node;
     configuration.canBitRate = options.bitRate;
     std::strncpy(configuration.commandLine, options.append.c_str(), sizeof configuration.commandLine - 1);
+    configuration.serialNumber = options.serial;
+    configuration.lockoutSeconds = options.lockoutSeconds;
     std::string error;
+    if (!options.configurationKey.empty()) {
+        bool unreadable = false;
+        const std::optional<hostimage::ConfigurationKey> key =
+            hostimage::readConfigurationKey(options.configurationKey, error, unreadable);
+        if (!key) {
+            return fail(unreadable ? kExitFile : kExitKey, error);
+        }
+        std::copy(key->begin(), key->end(), configuration.configurationKey);
+        configuration.flags |= boot::ConfigurationBlock::kHasConfigurationKey;
+    }
+    if (options.closedQueries) {
+        configuration.flags |= boot::ConfigurationBlock::kQueriesClosed;
+    }
     nlohmann::json keyIds = nlohmann::json::array();
     for (const std::string& path : options.keys) {
         bool unreadable = false;
@@ -119,6 +141,10 @@ int create(const CreateOptions& options, bool json)
                                           {"sectors", options.sectors},
                                           {"node", options.node},
                                           {"bitrate", options.bitRate},
+                                          {"serial", options.serial},
+                                          {"configuration_key", !options.configurationKey.empty()},
+                                          {"queries", options.closedQueries ? "closed" : "open"},
+                                          {"lockout_seconds", configuration.effectiveLockoutSeconds()},
                                           {"trusted_keys", keyIds}}
                                .dump());
     } else {
@@ -300,6 +326,10 @@ int show(const std::string& path, bool json)
         out["configuration"] = {{"sequence", configuration->sequence},
                                 {"node", configuration->nodeId},
                                 {"bitrate", configuration->canBitRate},
+                                {"serial", configuration->serialNumber},
+                                {"configuration_key", configuration->hasConfigurationKey()},
+                                {"queries", configuration->queriesClosed() ? "closed" : "open"},
+                                {"lockout_seconds", configuration->effectiveLockoutSeconds()},
                                 {"command_line", configuration->commandLine},
                                 {"trusted_keys", ids}};
     } else {
@@ -344,6 +374,9 @@ int show(const std::string& path, bool json)
         fmt::print("configuration {}: node {}, bit rate {}, {} trusted key(s), command line \"{}\"\n",
                    configuration->sequence, configuration->nodeId, configuration->canBitRate, keys.size(),
                    configuration->commandLine);
+        fmt::print("identity      serial {}, configuration key {}, queries {}, lockout {} s\n",
+                   configuration->serialNumber, configuration->hasConfigurationKey() ? "set" : "none",
+                   configuration->queriesClosed() ? "closed" : "open", configuration->effectiveLockoutSeconds());
     } else {
         fmt::print("configuration none valid\n");
     }
@@ -376,7 +409,7 @@ int main(int argc, char** argv)
     app.set_version_flag("--version", std::string("dcos-card ") + dcos::versionString);
     app.require_subcommand(1);
     app.footer("exit status: 0 done, 1 card or image refused, 2 bad arguments, 3 file not readable or writable, "
-               "4 key not P-256");
+               "4 key not usable (a signing key not P-256, a configuration key not 64 hex digits)");
     bool json = false;
     app.add_flag("--json", json, "machine-readable output: one JSON object");
 
@@ -395,6 +428,15 @@ int main(int argc, char** argv)
     createCommand->add_option("--sectors", createOptions.sectors, "the card's size in sectors")
         ->check(CLI::Range(card::kMinimumCardSectors, 1u << 22));
     createCommand->add_flag("--force", createOptions.force, "replace an existing card image");
+    createCommand->add_option("--serial", createOptions.serial,
+                              "the node's serial number, which dcos-config scan finds it by (0: none)");
+    createCommand->add_option("--config-key", createOptions.configurationKey,
+                              "the node's configuration key (dcos-config keygen): without one nothing can be "
+                              "changed over the bus");
+    createCommand->add_flag("--closed-queries", createOptions.closedQueries,
+                            "dcos-config's queries need the configuration key too");
+    createCommand->add_option("--lockout", createOptions.lockoutSeconds,
+                              "seconds a node refuses changes after three wrong keys (0: 60)");
 
     WriteOptions writeOptions;
     CLI::App* writeCommand = app.add_subcommand("write", "write a signed image into a slot");

@@ -14,8 +14,16 @@
 //                at it (0: it stays down; recovery listens at 125 kbit/s)
 //       20  260  trusted keys: public points, 65 bytes each (SEC 1 uncompressed)
 //      280  160  kernel command line, printable ASCII, NUL-terminated
-//      440   68  0
+//      440    4  serial number (0: none), set at manufacture
+//      444   32  configuration key, for the configuration protocol's MACs
+//                (docs/protocols/config.md), set at manufacture
+//      476    1  flags: bit 0 the key is set, bit 1 queries are closed
+//      477    2  lockout after three wrong MACs, in seconds (0: 60)
+//      479   29  0
 //      508    4  CRC-32 of bytes 0 to 507
+//
+// Bytes 440 to 478 were 0 in the first records of format 1, which read as
+// no serial number, no key, open queries and the default lockout.
 #pragma once
 
 #include <boot/CardLayout.hpp>
@@ -31,6 +39,14 @@ struct ConfigurationBlock {
     static constexpr size_t kMaximumKeys = 4;
     static constexpr size_t kKeySize = 65;
     static constexpr size_t kCommandLineSize = 160;
+    static constexpr size_t kConfigurationKeySize = 32;
+    /// flags: the configuration key is set.
+    static constexpr uint8_t kHasConfigurationKey = 1u << 0;
+    /// flags: the configuration protocol's queries need a MAC too.
+    static constexpr uint8_t kQueriesClosed = 1u << 1;
+    static constexpr uint8_t kKnownFlags = kHasConfigurationKey | kQueriesClosed;
+    /// The lockout when the record names none.
+    static constexpr uint16_t kDefaultLockoutSeconds = 60;
 
     uint32_t sequence = 0;
     uint8_t keyCount = 0;
@@ -38,11 +54,22 @@ struct ConfigurationBlock {
     uint32_t canBitRate = 0;
     uint8_t keys[kMaximumKeys][kKeySize] = {};
     char commandLine[kCommandLineSize] = {};
+    uint32_t serialNumber = 0;
+    uint8_t configurationKey[kConfigurationKeySize] = {};
+    uint8_t flags = 0;
+    uint16_t lockoutSeconds = 0;
+
+    bool hasConfigurationKey() const { return (flags & kHasConfigurationKey) != 0; }
+    bool queriesClosed() const { return (flags & kQueriesClosed) != 0; }
+    uint16_t effectiveLockoutSeconds() const
+    {
+        return lockoutSeconds != 0 ? lockoutSeconds : kDefaultLockoutSeconds;
+    }
 
     void encode(uint8_t (&sector)[kSize]) const;
     /// False for anything but a whole, valid record: magic, format, CRC, at
     /// most four keys each in uncompressed form, a terminated printable
-    /// command line, node id not 0xFFFF.
+    /// command line, node id not 0xFFFF, no unknown flag.
     static bool decode(const uint8_t (&sector)[kSize], ConfigurationBlock& out);
 };
 
