@@ -30,6 +30,8 @@ static_assert(static_cast<uint8_t>(dcos::SystemMessageType::RelayedPublication) 
               static_cast<uint8_t>(can::MessageType::RelayedPublication));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::Flashing) ==
               static_cast<uint8_t>(can::MessageType::Flashing));
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::Configuration) ==
+              static_cast<uint8_t>(can::MessageType::Configuration));
 
 namespace {
 
@@ -40,7 +42,8 @@ bool isSystemMessage(can::MessageType type)
            type == can::MessageType::NameQuery || type == can::MessageType::RoutedRequest ||
            type == can::MessageType::NodeStarted ||
            type == can::MessageType::DsmPublication || type == can::MessageType::RelayedPublication ||
-           type == can::MessageType::TimeSync || type == can::MessageType::Flashing;
+           type == can::MessageType::TimeSync || type == can::MessageType::Flashing ||
+           type == can::MessageType::Configuration;
 }
 
 } // namespace
@@ -100,9 +103,10 @@ Status CanNetworkLink::Send(const dcos::SystemMessage& message)
     if (destination > can::MessageIdentifier::kBroadcast || message.length > can::CanFrame::kMaxDataLength) {
         return Status::InvalidArgument;
     }
+    const uint8_t source = message.source == dcos::NetworkLink::kBroadcast ? can::MessageIdentifier::kBroadcast
+                                                                           : static_cast<uint8_t>(ownPhysical_);
     const can::LinkResult<can::MessageIdentifier> identifier = can::MessageIdentifier::make(
-        message.priority, static_cast<can::MessageType>(message.type), static_cast<uint8_t>(destination),
-        static_cast<uint8_t>(ownPhysical_));
+        message.priority, static_cast<can::MessageType>(message.type), static_cast<uint8_t>(destination), source);
     if (!identifier.ok()) {
         return Status::InvalidArgument;
     }

@@ -89,7 +89,7 @@ bool frameOf(const SystemMessage& message, can::CanFrame& frame)
         return false; // Flashing frames are never broadcast.
     }
     const can::LinkResult<can::MessageIdentifier> identifier =
-        can::MessageIdentifier::make(message.priority, can::MessageType::Flashing,
+        can::MessageIdentifier::make(message.priority, static_cast<can::MessageType>(message.type),
                                      static_cast<uint8_t>(message.destination), static_cast<uint8_t>(message.source));
     if (!identifier.ok()) {
         return false;

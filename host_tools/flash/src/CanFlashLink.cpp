@@ -1,6 +1,5 @@
 #include <hostflash/CanFlashLink.hpp>
 
-#include <hostcan/IsoTpEndpoint.hpp>
 
 #include <can/MessageIdentifier.hpp>
 
@@ -32,14 +31,11 @@ std::unique_ptr<CanFlashLink> CanFlashLink::open(const std::string& interface, c
                           can::MessageIdentifier::kMaxNodeNumber, address.host, address.node);
         return nullptr;
     }
-    std::unique_ptr<CanFlashLink> link(
-        new CanFlashLink(address, flash::canFlashConnection(address.node, address.host, address.priority, true)));
+    std::unique_ptr<CanFlashLink> link(new CanFlashLink(address));
     hostcan::TransportError opened;
-    if (address.kernelIsoTp) {
-        link->kernel_ = hostcan::KernelIsoTpSocket::open(interface, link->config_, opened);
-    } else {
-        link->transport_ = hostcan::openTransport(interface, opened);
-    }
+    link->requester_ = hostcan::IsoTpRequester::open(
+        interface, flash::canFlashConnection(address.node, address.host, address.priority, true), address.kernelIsoTp,
+        opened);
     if (opened) {
         error = linkErrorOf(opened);
         why = opened.message;
@@ -57,44 +53,24 @@ LinkError CanFlashLink::exchange(const flash::FlashMessage& request, flash::Flas
         why = "the request does not encode";
         return LinkError::BadArgument;
     }
-    const hostcan::IsoTpOutcome sent =
-        kernel_ ? kernel_->send(bytes, timeout) : hostcan::isoTpSend(*transport_, config_, bytes);
-    if (sent.transport) {
-        why = sent.transport.message;
-        // Nobody acknowledged the frame: the node may be restarting, so
-        // this is silence, worth asking again, not a broken link.
-        return sent.transport.kind == hostcan::TransportError::Kind::Refused ? LinkError::Timeout
-                                                                            : linkErrorOf(sent.transport);
-    }
-    if (sent.error != can::LinkError::Ok) {
-        // The node took no part of it (no flow control): as silence.
-        why = fmt::format("node {} did not take the request: {}", address_.node, can::linkErrorName(sent.error));
-        return LinkError::Timeout;
-    }
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    for (;;) {
-        const auto left =
-            std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-        if (left.count() <= 0) {
-            why = "no reply";
-            return LinkError::Timeout;
-        }
-        const hostcan::IsoTpOutcome received =
-            kernel_ ? kernel_->receive(left) : hostcan::isoTpReceive(*transport_, config_, left);
-        if (received.transport) {
-            why = received.transport.message;
-            return linkErrorOf(received.transport);
-        }
-        if (received.error != can::LinkError::Ok) {
-            continue; // A reply that broke off, or none yet: wait out the time.
-        }
-        flash::FlashMessage decoded;
-        if (flash::FlashMessage::decode(received.message.data(), received.message.size(), decoded) &&
-            decoded.tag == request.tag) {
+    const hostcan::ExchangeOutcome outcome =
+        requester_->exchange(bytes, timeout, [&](const std::vector<uint8_t>& received) {
+            flash::FlashMessage decoded;
+            if (!flash::FlashMessage::decode(received.data(), received.size(), decoded) ||
+                decoded.tag != request.tag) {
+                return false;
+            }
             reply = decoded;
-            return LinkError::None;
-        }
+            return true;
+        });
+    switch (outcome.result) {
+    case hostcan::ExchangeResult::Replied: return LinkError::None;
+    case hostcan::ExchangeResult::Silent:
+        why = fmt::format("node {}: {}", address_.node, outcome.why);
+        return LinkError::Timeout;
+    case hostcan::ExchangeResult::Failed: why = outcome.why; return linkErrorOf(outcome.transport);
     }
+    return LinkError::Failed;
 }
 
 } // namespace hostflash

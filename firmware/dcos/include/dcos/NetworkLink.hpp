@@ -35,7 +35,8 @@ enum class SystemMessageType : uint8_t {
     NodeStarted = 0x14, ///< A node's first message on an interface since it started, to the broadcast address (remote-transactions.md, "A node that starts again").
     DsmPublication = 0x20, ///< A part of a publication, to the broadcast address (docs/protocols/publications.md).
     RelayedPublication = 0x21, ///< A relay header or a publication's frame, from a gateway (publications.md, "Across a gateway").
-    Flashing = 0x50, ///< A frame of the flash protocol's ISO-TP connection (docs/protocols/flash.md, "On CAN"), for the flash service.
+    Configuration = 0x40, ///< A frame of the configuration protocol (docs/protocols/config.md, "On CAN"), for the system engineering interface agent.
+    Flashing = 0x50, ///< A frame of the flash protocol's ISO-TP connection (docs/protocols/flash.md, "On CAN"), for the system engineering interface agent.
 };
 
 /// One system message as a link carries it.
@@ -44,7 +45,10 @@ struct SystemMessage {
     uint8_t priority = 0;
     SystemMessageType type = SystemMessageType::RemoteRequest;
     /// Physical addresses on the link's network (the CAN node numbers). The
-    /// source is filled in by Receive; Send puts the link's own address.
+    /// source is filled in by Receive; Send puts the link's own address,
+    /// unless the source is kBroadcast: then the network's "any node" (on
+    /// CAN 255), which the configuration protocol's answers to a scan and
+    /// from a selected node carry (docs/protocols/config.md, "Scanning").
     uint32_t destination = 0;
     uint32_t source = 0;
     uint8_t length = 0;

@@ -1671,9 +1671,10 @@ void workerEntry(uintptr_t index)
     }
 }
 
-// A frame of the flash protocol goes to the flash service, in the images
-// that link it (firmware/flash/src/FlashService.cpp); the others drop it.
-void onFlashingFrame(uint8_t interface, const SystemMessage& message)
+// A frame of the flash or the configuration protocol goes to the system
+// engineering interface agent, in the images that link it
+// (firmware/flash/src/FlashService.cpp); the others drop it.
+void onEngineeringFrame(uint8_t interface, const SystemMessage& message)
 {
     if (flashServiceFrame != nullptr) {
         flashServiceFrame(interface, message);
@@ -1729,7 +1730,8 @@ void receiverEntry(uintptr_t)
                 case SystemMessageType::RelayedPublication: onRelayedPublication(interface, message); break;
                 case SystemMessageType::NodeStarted: onNodeStarted(message); break;
                 case SystemMessageType::TimeSync: onTimeSyncMessage(interface, message); break;
-                case SystemMessageType::Flashing: onFlashingFrame(interface, message); break;
+                case SystemMessageType::Flashing:
+                case SystemMessageType::Configuration: onEngineeringFrame(interface, message); break;
                 }
             }
         }

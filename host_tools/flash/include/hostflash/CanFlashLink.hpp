@@ -8,8 +8,7 @@
 
 #include <hostflash/FlashLink.hpp>
 
-#include <hostcan/KernelIsoTp.hpp>
-#include <hostcan/Transport.hpp>
+#include <hostcan/IsoTpRequester.hpp>
 
 #include <flash/CanFlashServer.hpp>
 
@@ -37,12 +36,10 @@ public:
     bool reachesRunningNode() const override { return true; }
 
 private:
-    CanFlashLink(const CanFlashAddress& address, const can::IsoTpConfig& config) : address_(address), config_(config) {}
+    explicit CanFlashLink(const CanFlashAddress& address) : address_(address) {}
 
     CanFlashAddress address_;
-    can::IsoTpConfig config_;
-    std::unique_ptr<hostcan::Transport> transport_;
-    std::unique_ptr<hostcan::KernelIsoTpSocket> kernel_;
+    std::unique_ptr<hostcan::IsoTpRequester> requester_;
 };
 
 } // namespace hostflash
