@@ -8,6 +8,7 @@ CAN_PORTABLE_SRCS := \
 	fieldbus/can/src/IsoTpConfig.cpp \
 	fieldbus/can/src/IsoTpPci.cpp \
 	fieldbus/can/src/IsoTpReceiver.cpp \
+	fieldbus/can/src/IsoTpRequestServer.cpp \
 	fieldbus/can/src/IsoTpSender.cpp \
 	fieldbus/can/src/LinkError.cpp \
 	fieldbus/can/src/MessageIdentifier.cpp \

@@ -1,94 +1,32 @@
 #include <flash/FlashMessage.hpp>
 
 #include <image/Sha256.hpp>
+#include <runtime/ByteCursor.hpp>
 
 namespace flash {
 
 namespace {
 
-// Bounds-checked little-endian writing and reading of one message.
-class Writer {
-public:
-    Writer(uint8_t* out, size_t capacity) : out_(out), capacity_(capacity) {}
+using Writer = runtime::ByteWriter;
+using Reader = runtime::ByteReader;
 
-    void u8(uint8_t value)
-    {
-        if (at_ < capacity_) {
-            out_[at_] = value;
-        }
-        ++at_;
-    }
-    void u16(uint16_t value)
-    {
-        u8(static_cast<uint8_t>(value));
-        u8(static_cast<uint8_t>(value >> 8));
-    }
-    void u32(uint32_t value)
-    {
-        u16(static_cast<uint16_t>(value));
-        u16(static_cast<uint16_t>(value >> 16));
-    }
-    void bytes(const uint8_t* data, size_t count)
-    {
-        for (size_t i = 0; i < count; ++i) {
-            u8(data != nullptr ? data[i] : 0);
-        }
-    }
-    void version(const image::ImageVersion& v)
-    {
-        u8(v.major);
-        u8(v.minor);
-        u16(v.patch);
-        u32(v.build);
-    }
-    size_t finish() const { return at_ <= capacity_ ? at_ : 0; }
+void writeVersion(Writer& w, const image::ImageVersion& v)
+{
+    w.u8(v.major);
+    w.u8(v.minor);
+    w.u16(v.patch);
+    w.u32(v.build);
+}
 
-private:
-    uint8_t* out_;
-    size_t capacity_;
-    size_t at_ = 0;
-};
-
-class Reader {
-public:
-    Reader(const uint8_t* data, size_t length) : data_(data), length_(length) {}
-
-    uint8_t u8() { return at_ < length_ ? data_[at_++] : (++at_, 0); }
-    uint16_t u16()
-    {
-        const uint16_t low = u8();
-        return static_cast<uint16_t>(low | (u8() << 8));
-    }
-    uint32_t u32()
-    {
-        const uint32_t low = u16();
-        return low | (static_cast<uint32_t>(u16()) << 16);
-    }
-    void bytes(uint8_t* out, size_t count)
-    {
-        for (size_t i = 0; i < count; ++i) {
-            out[i] = u8();
-        }
-    }
-    const uint8_t* here() const { return at_ <= length_ ? data_ + at_ : nullptr; }
-    void skip(size_t count) { at_ += count; }
-    image::ImageVersion version()
-    {
-        image::ImageVersion v;
-        v.major = u8();
-        v.minor = u8();
-        v.patch = u16();
-        v.build = u32();
-        return v;
-    }
-    /// Every byte read, and none missing.
-    bool exact() const { return at_ == length_; }
-
-private:
-    const uint8_t* data_;
-    size_t length_;
-    size_t at_ = 0;
-};
+image::ImageVersion readVersion(Reader& r)
+{
+    image::ImageVersion v;
+    v.major = r.u8();
+    v.minor = r.u8();
+    v.patch = r.u16();
+    v.build = r.u32();
+    return v;
+}
 
 // A status byte, then for a refused image its reason: false for a value
 // out of range.
@@ -174,7 +112,7 @@ size_t FlashMessage::encode(uint8_t* out, size_t capacity) const
         w.u8(trialSlot);
         for (int slotIndex = 0; slotIndex < 2; ++slotIndex) {
             w.u8(slotHolds[slotIndex] ? 1 : 0);
-            w.version(slotVersion[slotIndex]);
+            writeVersion(w, slotVersion[slotIndex]);
         }
         w.u16(maxBlock);
         w.u8(transferSlot);
@@ -262,7 +200,7 @@ bool FlashMessage::decode(const uint8_t* data, size_t length, FlashMessage& out)
                 return false;
             }
             m.slotHolds[slotIndex] = holds == 1;
-            m.slotVersion[slotIndex] = r.version();
+            m.slotVersion[slotIndex] = readVersion(r);
         }
         m.maxBlock = r.u16();
         m.transferSlot = r.u8();

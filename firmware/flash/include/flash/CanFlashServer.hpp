@@ -11,18 +11,23 @@
 // a control task's frame (seed 6.4: the task priority is the bus
 // priority, and flashing is background work).
 //
-// Pure code, with no controller and no clock of its own, like the ISO-TP
-// state machines it drives: the caller feeds it the frames received, the
-// moment its last emitted frame was sent, and the time; it answers each
-// input with at most one frame to transmit. The kernel's flash service
-// (FlashService.cpp) and the stage loader's polled recovery both run it,
-// and the host tests run it against the host's own ISO-TP.
+// The connection itself is the link layer's generic request server
+// (can::IsoTpRequestServer), which the configuration protocol shares; this
+// class gives it the flash protocol's message type and block size, and
+// hands it the session. Pure code, with no controller and no clock of its
+// own: the caller feeds it the frames received, the moment its last emitted
+// frame was sent, and the time; it answers each input with at most one
+// frame to transmit. The kernel's flash service (FlashService.cpp) and the
+// stage loader's polled recovery both run it, and the host tests run it
+// against the host's own ISO-TP.
 //
 // One connection at a time: a single or first frame from another host (or
 // at another priority) ends the old connection and begins the new one, as
 // a new Hello on the serial line does. A request that arrives while the
 // reply to the last one is still being sent ends that reply: its host has
-// stopped waiting for it.
+// stopped waiting for it. Flashing frames are never broadcast: a server
+// whose own node is 255 (the kernel service's before it knows its
+// interface) serves nothing.
 #pragma once
 
 #include <flash/FlashMessage.hpp>
@@ -30,7 +35,7 @@
 
 #include <can/CanFrame.hpp>
 #include <can/IsoTpConfig.hpp>
-#include <can/IsoTpReceiver.hpp>
+#include <can/IsoTpRequestServer.hpp>
 #include <can/IsoTpSender.hpp>
 
 #include <stddef.h>
@@ -53,34 +58,25 @@ constexpr uint8_t kCanNodeBlockSize = 16;
 /// ISO 15765-2's 1000 ms.
 can::IsoTpConfig canFlashConnection(uint8_t node, uint8_t host, uint8_t priority, bool hostSide);
 
-struct CanFlashStatistics {
-    uint32_t requests = 0;   ///< Requests received whole and answered.
-    uint32_t replies = 0;    ///< Replies sent whole.
-    uint32_t aborted = 0;    ///< Transfers ended without their message (time-outs, sequence errors, a new request).
-    uint32_t ignored = 0;    ///< Frames not for this node's flash protocol, or refused by ISO-TP.
-    uint32_t connections = 0; ///< Connections begun with a new host or priority.
-};
+using CanFlashStatistics = can::IsoTpRequestStatistics;
 
-class CanFlashServer {
+class CanFlashServer : private can::IsoTpRequestHandler {
 public:
     /// What one input asks of the caller.
-    struct Output {
-        bool transmit = false; ///< Send `frame` now, and report with onTransmitConfirmed when it went.
-        can::CanFrame frame;
-    };
+    using Output = can::IsoTpRequestServer::Output;
 
     /// Serves @p session to hosts on the bus as CAN node @p ownNode.
-    CanFlashServer(FlashSession& session, uint8_t ownNode) : session_(session), ownNode_(ownNode) {}
+    CanFlashServer(FlashSession& session, uint8_t ownNode);
 
     /// A frame from the bus, any frame: only the flash protocol's frames to
     /// this node are taken.
-    Output onFrame(const can::CanFrame& frame, uint64_t nowNs);
+    Output onFrame(const can::CanFrame& frame, uint64_t nowNs) { return server_.onFrame(frame, nowNs); }
     /// The last frame this server asked to transmit is on the bus.
-    Output onTransmitConfirmed(uint64_t nowNs);
+    Output onTransmitConfirmed(uint64_t nowNs) { return server_.onTransmitConfirmed(nowNs); }
     /// Lets time pass; call it at nextDeadlineNs() or later.
-    Output poll(uint64_t nowNs);
+    Output poll(uint64_t nowNs) { return server_.poll(nowNs); }
     /// When poll() has something to do, or can::IsoTpSender::kNoDeadline.
-    uint64_t nextDeadlineNs() const;
+    uint64_t nextDeadlineNs() const { return server_.nextDeadlineNs(); }
 
     /// True, with the target, once the reply to a Restart has been sent (or
     /// its sending given up): the caller restarts the node now.
@@ -91,28 +87,22 @@ public:
     void setOwnNode(uint8_t ownNode);
 
     /// The host of the current connection (valid after the first request).
-    uint8_t peer() const { return peer_; }
+    uint8_t peer() const { return server_.peer(); }
     /// Whether a request or reply is on its way.
-    bool busy() const { return !receiver_.idle() || !sender_.idle(); }
-    const CanFlashStatistics& statistics() const { return statistics_; }
+    bool busy() const { return server_.busy(); }
+    const CanFlashStatistics& statistics() const { return server_.statistics(); }
 
 private:
-    void connect(uint8_t host, uint8_t priority);
-    Output afterReceive(const can::IsoTpStep& step, uint64_t nowNs);
-    Output afterSend(const can::IsoTpStep& step);
+    size_t handleRequest(const uint8_t* request, size_t length, uint8_t* reply, size_t capacity,
+                         uint64_t nowNs) override;
+    void replyEnded(bool sent) override;
 
     FlashSession& session_;
-    uint8_t ownNode_;
-    bool connected_ = false;
-    uint8_t peer_ = 0;
-    uint8_t priority_ = 0;
-    can::IsoTpReceiver receiver_;
-    can::IsoTpSender sender_;
     bool replyingToRestart_ = false;
     bool restartDue_ = false;
-    CanFlashStatistics statistics_;
     uint8_t request_[kMaxMessage] = {};
     uint8_t reply_[kMaxMessage] = {};
+    can::IsoTpRequestServer server_;
 };
 
 } // namespace flash
