@@ -67,6 +67,7 @@ include drivers/can/can.mk
 include drivers/modbus/modbus.mk
 include drivers/ata/ata.mk
 include firmware/flash/flash.mk
+include firmware/sei/sei.mk
 
 # Sources every image contains, whatever its kernel configuration: the
 # runtime, the CPU, the loader's entry and the board.
@@ -148,9 +149,15 @@ FW_OBJS := $(call fw_objects,$(FW_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp
 # do not, and the kernel reaches it only through weak hooks
 # (dcos/internal/FlashServiceHooks.hpp). Its objects are the stage
 # loader's (mk/card.mk), compiled for size: none is on a real-time path.
+# The same task is the system engineering interface agent's: it serves the
+# configuration protocol (firmware/sei, docs/protocols/config.md) too.
 FW_FLASH_TARGET_OBJS := $(call fw_objects,$(FLASH_TARGET_SRCS))
-FW_FLASH_SERVICE_OBJS := $(call fw_objects,$(FLASH_PORTABLE_SRCS)) $(FW_FLASH_TARGET_OBJS) $(FW_IMAGE_OBJS)
-$(FW_FLASH_TARGET_OBJS): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS) $(FW_IMAGE_INCLUDES) -Ifirmware/flash/include
+FW_SEI_OBJS := $(call fw_objects,$(SEI_PORTABLE_SRCS) $(SEI_TARGET_SRCS))
+FW_FLASH_SERVICE_OBJS := $(call fw_objects,$(FLASH_PORTABLE_SRCS)) $(FW_FLASH_TARGET_OBJS) $(FW_SEI_OBJS) \
+	$(FW_IMAGE_OBJS)
+$(FW_FLASH_TARGET_OBJS) $(FW_SEI_OBJS): FW_OBJECT_FLAGS := $(FW_COLD_FLAGS) $(FW_IMAGE_INCLUDES) \
+	-Ifirmware/flash/include -Ifirmware/sei/include
+$(FW_SEI_OBJS): | $(MBEDTLS_FETCHED)
 $(FW_FLASH_TARGET_OBJS): | $(MBEDTLS_FETCHED)
 FW_TARGET_TEST_OBJS := $(call fw_objects,$(FW_TARGET_TEST_SRCS))
 FW_MINIMAL_OBJS := $(call fw_objects,$(FW_MINIMAL_SRCS)) $(FW_BUILD)/generated/BuildRevision.cpp.o

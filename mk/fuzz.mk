@@ -13,7 +13,7 @@
 # caused it is kept in $(FUZZ_BUILD)/artifacts/<target>/.
 
 FUZZ_BUILD := $(BUILD)/fuzz
-# Fuzzing time per target; seventeen targets, so 'make test' spends about 255 s here.
+# Fuzzing time per target; nineteen targets, so 'make test' spends about 285 s here.
 FUZZ_SECONDS ?= 15
 FUZZ_TARGETS := frame isotp slcan frametext
 FUZZ_CORPUS := fieldbus/can/fuzz/corpus
@@ -48,6 +48,11 @@ HOST_IMAGE_FUZZ_REPORT := $(BUILD)/reports/fuzz-host-image-tests.xml
 FLASH_FUZZ_TARGETS := flash_session flash_can
 FLASH_FUZZ_CORPUS := firmware/flash/fuzz/corpus
 FLASH_FUZZ_REPORT := $(BUILD)/reports/fuzz-flash-tests.xml
+# The configuration protocol's node side (firmware/sei/fuzz): requests and
+# CAN frames, scans included.
+SEI_FUZZ_TARGETS := sei_server
+SEI_FUZZ_CORPUS := firmware/sei/fuzz/corpus
+SEI_FUZZ_REPORT := $(BUILD)/reports/fuzz-sei-tests.xml
 
 FUZZ_CXX := clang++
 # toml++ is compiled into the fuzz targets as Debian's shared library, which
@@ -62,7 +67,8 @@ FUZZ_CXXFLAGS := -std=c++20 -O1 -g -fno-omit-frame-pointer -fno-sanitize-recover
 	-Wall -Wextra -Wno-missing-field-initializers -Werror -MMD -MP \
 	-Ifieldbus/can/include -Ifieldbus/modbus/include -Ifirmware/dcos/include \
 	-Ihost_tools/modbus/include -I/usr/include/modbus -Ifirmware/image/include -Ihost_tools/image/include \
-	-Ifirmware/flash/include -Ifirmware/boot/include -Ifirmware/runtime/include $(TOML_RELEASE_ASSERT)
+	-Ifirmware/flash/include -Ifirmware/boot/include -Ifirmware/runtime/include -Ifirmware/sei/include \
+	$(TOML_RELEASE_ASSERT)
 # Objects are instrumented for coverage without libFuzzer's main; the
 # targets are linked with it.
 FUZZ_COMPILE_FLAGS := $(FUZZ_CXXFLAGS) -fsanitize=fuzzer-no-link,$(FUZZ_SANITIZERS)
@@ -94,12 +100,15 @@ FLASH_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(FLASH_PORTABLE_SRCS)
 	firmware/boot/src/BootState.cpp firmware/boot/src/BootStateStore.cpp firmware/boot/src/Crc32.cpp)
 FLASH_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/flash/fuzz/fuzz_%.cpp.o,$(FLASH_FUZZ_TARGETS))
 FLASH_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(FLASH_FUZZ_TARGETS))
+SEI_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(SEI_PORTABLE_SRCS) firmware/image/src/Sha256.cpp $(CAN_PORTABLE_SRCS))
+SEI_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/sei/fuzz/fuzz_%.cpp.o,$(SEI_FUZZ_TARGETS))
+SEI_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(SEI_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as
 # intermediate files and be deleted after every build.
 .SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS) $(MODBUS_FUZZ_LIBRARY_OBJS) $(MODBUS_FUZZ_TARGET_OBJS) \
 	$(HOST_MODBUS_FUZZ_LIBRARY_OBJS) $(HOST_MODBUS_FUZZ_TARGET_OBJS) $(DCOS_FUZZ_LIBRARY_OBJS) $(DCOS_FUZZ_TARGET_OBJS) \
 	$(IMAGE_FUZZ_LIBRARY_OBJS) $(IMAGE_FUZZ_TARGET_OBJS) $(HOST_IMAGE_FUZZ_LIBRARY_OBJS) $(HOST_IMAGE_FUZZ_TARGET_OBJS) \
-	$(FLASH_FUZZ_LIBRARY_OBJS) $(FLASH_FUZZ_TARGET_OBJS)
+	$(FLASH_FUZZ_LIBRARY_OBJS) $(FLASH_FUZZ_TARGET_OBJS) $(SEI_FUZZ_LIBRARY_OBJS) $(SEI_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
@@ -107,7 +116,7 @@ fuzz: deps
 	@$(MAKE) --no-print-directory test-fuzz
 
 fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARIES) $(DCOS_FUZZ_BINARIES) \
-	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES) $(FLASH_FUZZ_BINARIES)
+	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES) $(FLASH_FUZZ_BINARIES) $(SEI_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite.
@@ -128,6 +137,8 @@ test-fuzz:
 		--seconds $(FUZZ_SECONDS) --report $(HOST_IMAGE_FUZZ_REPORT) $(HOST_IMAGE_FUZZ_TARGETS) || status=1; \
 	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(FLASH_FUZZ_CORPUS) \
 		--seconds $(FUZZ_SECONDS) --report $(FLASH_FUZZ_REPORT) $(FLASH_FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(SEI_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(SEI_FUZZ_REPORT) $(SEI_FUZZ_TARGETS) || status=1; \
 	exit $${status:-0}
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
@@ -164,6 +175,11 @@ $(HOST_IMAGE_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/imag
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lmbedcrypto
 
 $(FLASH_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/flash/fuzz/fuzz_%.cpp.o $(FLASH_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lmbedcrypto
+
+$(SEI_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/sei/fuzz/fuzz_%.cpp.o $(SEI_FUZZ_LIBRARY_OBJS)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lmbedcrypto

@@ -4,7 +4,7 @@
 HOST_BUILD := $(BUILD)/host
 HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Wno-missing-field-initializers -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES) \
 	-Ihost_tools/can/include $(HOSTMODBUS_CXXFLAGS) -Ifirmware/image/include -Ihost_tools/image/include \
-	-Ifirmware/flash/include -Ihost_tools/flash/include
+	-Ifirmware/flash/include -Ihost_tools/flash/include -Ifirmware/sei/include -Ihost_tools/config/include
 
 # Firmware sources with no hardware access of their own (chip drivers go
 # through the mocked port I/O).
@@ -36,7 +36,9 @@ HOST_PORTABLE_SRCS := \
 	$(IMAGE_SRCS) \
 	$(HOSTIMAGE_SRCS) \
 	$(FLASH_PORTABLE_SRCS) \
-	$(HOSTFLASH_SRCS)
+	$(HOSTFLASH_SRCS) \
+	$(SEI_PORTABLE_SRCS) \
+	$(HOSTCONFIG_SRCS)
 
 HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp drivers/*/unit_tests/*.cpp fieldbus/*/unit_tests/*.cpp \
 	host_tools/*/unit_tests/*.cpp)

@@ -20,6 +20,9 @@ IMAGE_SRCS := $(wildcard firmware/image/src/*.cpp)
 HOSTIMAGE_SRCS := $(wildcard host_tools/image/src/*.cpp)
 # dcos-flash's link to a node (host_tools/flash), on the protocol's own code (firmware/flash).
 HOSTFLASH_SRCS := $(wildcard host_tools/flash/src/*.cpp)
+# dcos-config's scan, requests and link to the nodes (host_tools/config), on
+# the configuration protocol's own code (firmware/sei).
+HOSTCONFIG_SRCS := $(wildcard host_tools/config/src/*.cpp)
 # The card's records, the firmware's own code (firmware/boot), which the
 # host's card tool writes and reads.
 BOOT_RECORD_SRCS := firmware/boot/src/BootState.cpp firmware/boot/src/BootStateStore.cpp firmware/boot/src/ConfigurationStore.cpp \
@@ -32,7 +35,8 @@ DCOS_MODBUS_SIM := $(HOST_TOOLS_BIN)/dcos-modbus-sim
 DCOS_IMAGE := $(HOST_TOOLS_BIN)/dcos-image
 DCOS_CARD := $(HOST_TOOLS_BIN)/dcos-card
 DCOS_FLASH := $(HOST_TOOLS_BIN)/dcos-flash
-HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE) $(DCOS_CARD) $(DCOS_FLASH)
+DCOS_CONFIG := $(HOST_TOOLS_BIN)/dcos-config
+HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE) $(DCOS_CARD) $(DCOS_FLASH) $(DCOS_CONFIG)
 
 host-tools: $(HOST_TOOLS)
 
@@ -66,6 +70,13 @@ $(DCOS_IMAGE) $(DCOS_CARD): $(HOST_TOOLS_BIN)/%: $(BUILD)/host/host_tools/image/
 
 $(DCOS_FLASH): $(BUILD)/host/host_tools/flash/tools/dcos-flash.cpp.o \
 	$(patsubst %,$(BUILD)/host/%.o,$(HOSTFLASH_SRCS) $(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS) \
+		$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto
+
+$(DCOS_CONFIG): $(BUILD)/host/host_tools/config/tools/dcos-config.cpp.o \
+	$(patsubst %,$(BUILD)/host/%.o,$(HOSTCONFIG_SRCS) $(SEI_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS) \
 		$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"

@@ -3,6 +3,12 @@
 
 #include <flash/FlashSession.hpp>
 
+#include <sei/CanSeiServer.hpp>
+#include <sei/SeiAuthenticator.hpp>
+#include <sei/SeiNodeBackend.hpp>
+#include <sei/SeiServer.hpp>
+#include <sei/SeiService.hpp>
+
 #include <ata/AtaPioDisk.hpp>
 #include <boot/AtaSectorStore.hpp>
 #include <boot/BootControl.hpp>
@@ -15,6 +21,7 @@
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/TimerAgent.hpp>
+#include <dcos/Version.hpp>
 #include <dcos/internal/FlashServiceHooks.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/RemoteAgent.hpp>
@@ -46,17 +53,32 @@ volatile uint32_t head = 0;
 volatile uint32_t tail = 0;
 
 constexpr uint32_t kFrameEvent = 1u << 0;
-constexpr size_t kStackBytes = 8192;
+// The task keeps both protocols' servers on its stack (their buffers are a
+// whole message each way), and the image checks and card calls run below
+// them.
+constexpr size_t kStackBytes = 16384;
+constexpr size_t kServersBytes = sizeof(CanFlashServer) + sizeof(FlashSession) + sizeof(sei::CanSeiServer) +
+                                 sizeof(sei::SeiServer) + sizeof(sei::SeiAuthenticator) +
+                                 sizeof(sei::SeiNodeBackend) + sizeof(ata::AtaPioDisk) + sizeof(boot::AtaSectorStore);
+static_assert(kServersBytes <= kStackBytes / 2, "the servers leave half the agent's stack to the calls they make");
 
 ObjectId serviceTask;
 ObjectId cardSemaphore;
 FlashServiceState state;
 const CanFlashServer* liveServer = nullptr;
+const sei::CanSeiServer* liveSeiServer = nullptr;
+const sei::SeiAuthenticator* liveAuthenticator = nullptr;
+const sei::SeiServer* liveSeiProtocol = nullptr;
 
 image::TrustedKey trustedKeys[boot::ConfigurationBlock::kMaximumKeys];
 size_t trustedKeyCount = 0;
+// The card's configuration as the task found it at its start: the keys it
+// trusts, and the node's identity for the configuration protocol.
+boot::ConfigurationBlock configuration;
+bool configured = false;
 
-// The card's configuration: the keys it trusts. Read once, at the task's start.
+// Reads the card's configuration once, at the task's start; says why
+// images cannot be taken, or null.
 const char* readConfiguration(boot::SectorStore& store)
 {
     const boot::StoredConfiguration stored = boot::ConfigurationStore::read(store);
@@ -66,8 +88,10 @@ const char* readConfiguration(boot::SectorStore& store)
     if (!stored.present) {
         return "the card holds no valid configuration";
     }
-    for (size_t i = 0; i < stored.configuration.keyCount; ++i) {
-        trustedKeys[trustedKeyCount++] = image::TrustedKey::fromPoint(stored.configuration.keys[i]);
+    configuration = stored.configuration;
+    configured = true;
+    for (size_t i = 0; i < configuration.keyCount; ++i) {
+        trustedKeys[trustedKeyCount++] = image::TrustedKey::fromPoint(configuration.keys[i]);
     }
     return trustedKeyCount == 0 ? "the card's configuration trusts no key" : nullptr;
 }
@@ -81,16 +105,22 @@ uint8_t ownNodeOf(uint8_t interface)
                : can::MessageIdentifier::kBroadcast;
 }
 
-// The frame a queued message was on the bus.
+// The frame a queued message was on the bus. Only the configuration
+// protocol's scans and its selected node's connection use the broadcast
+// address; a host never sends from it.
 bool frameOf(const SystemMessage& message, can::CanFrame& frame)
 {
+    const bool toEveryNode = message.destination == dcos::NetworkLink::kBroadcast;
     if (message.source > can::MessageIdentifier::kMaxNodeNumber ||
-        message.destination > can::MessageIdentifier::kMaxNodeNumber) {
-        return false; // Flashing frames are never broadcast.
+        (toEveryNode && message.type != SystemMessageType::Configuration) ||
+        (!toEveryNode && message.destination > can::MessageIdentifier::kMaxNodeNumber)) {
+        return false;
     }
+    const uint8_t destination =
+        toEveryNode ? can::MessageIdentifier::kBroadcast : static_cast<uint8_t>(message.destination);
     const can::LinkResult<can::MessageIdentifier> identifier =
-        can::MessageIdentifier::make(message.priority, static_cast<can::MessageType>(message.type),
-                                     static_cast<uint8_t>(message.destination), static_cast<uint8_t>(message.source));
+        can::MessageIdentifier::make(message.priority, static_cast<can::MessageType>(message.type), destination,
+                                     static_cast<uint8_t>(message.source));
     if (!identifier.ok()) {
         return false;
     }
@@ -103,8 +133,10 @@ bool frameOf(const SystemMessage& message, can::CanFrame& frame)
     return true;
 }
 
-// Sends what the server asked for, with an echo that confirms it.
-void transmit(uint8_t interface, const CanFlashServer::Output& output)
+// Sends what a server asked for, with an echo that confirms it: of its
+// protocol's message type, and from the broadcast address when the server
+// answers as the configuration protocol's selected node or to a scan.
+void transmit(uint8_t interface, const can::IsoTpRequestServer::Output& output)
 {
     if (!output.transmit) {
         return;
@@ -115,8 +147,11 @@ void transmit(uint8_t interface, const CanFlashServer::Output& output)
     }
     SystemMessage message;
     message.priority = identifier.value().priority();
-    message.type = SystemMessageType::Flashing;
+    message.type = static_cast<SystemMessageType>(identifier.value().type());
     message.destination = identifier.value().destination();
+    if (identifier.value().source() == can::MessageIdentifier::kBroadcast) {
+        message.source = dcos::NetworkLink::kBroadcast;
+    }
     message.length = output.frame.length();
     for (uint8_t i = 0; i < message.length; ++i) {
         message.data[i] = output.frame.data()[i];
@@ -176,11 +211,43 @@ void serviceEntry(uintptr_t)
     FlashSession session(store, trustedKeys, trustedKeyCount, identity, seed, sizeof seed);
     CanFlashServer server(session, can::MessageIdentifier::kBroadcast);
     liveServer = &server;
+
+    // The configuration protocol (docs/protocols/config.md), with the key,
+    // serial number and lockout the card's configuration holds. Its
+    // challenges are drawn from the same start-unique seed, told apart by a
+    // byte so that they never repeat the flash protocol's, and from the
+    // configuration's sequence and serial number: a node's first challenge
+    // differs from any it drew before a store, and from another node's.
+    uint8_t seiSeed[sizeof seed + 8];
+    for (size_t i = 0; i < sizeof seed; ++i) {
+        seiSeed[i] = seed[i];
+    }
+    seiSeed[0] ^= 0x5E;
+    for (size_t i = 0; i < 4; ++i) {
+        seiSeed[sizeof seed + i] = static_cast<uint8_t>(configuration.sequence >> (8 * i));
+        seiSeed[sizeof seed + 4 + i] = static_cast<uint8_t>(configuration.serialNumber >> (8 * i));
+    }
+    sei::SeiNodeBackend backend(store, configuration.serialNumber,
+                                running.fromCard && running.version[0] != '\0' ? running.version
+                                                                                : dcos::versionString);
+    sei::SeiAuthenticator authenticator(configured && configuration.hasConfigurationKey()
+                                            ? configuration.configurationKey
+                                            : nullptr,
+                                        identity.node, configuration.serialNumber, configuration.lockoutSeconds,
+                                        seiSeed, sizeof seiSeed);
+    sei::SeiServer seiServer(backend, authenticator);
+    sei::CanSeiServer seiCan(seiServer, can::MessageIdentifier::kBroadcast);
+    liveSeiServer = &seiCan;
+    liveAuthenticator = &authenticator;
+    liveSeiProtocol = &seiServer;
+
     uint8_t interface = 0xFF;
     uint8_t ownNode = can::MessageIdentifier::kBroadcast;
 
     for (;;) {
-        const uint64_t deadline = server.nextDeadlineNs();
+        const uint64_t flashDeadline = server.nextDeadlineNs();
+        const uint64_t seiDeadline = seiCan.nextDeadlineNs();
+        const uint64_t deadline = flashDeadline < seiDeadline ? flashDeadline : seiDeadline;
         const uint64_t now = dcos::TimerAgent::Uptime();
         const uint64_t wait = deadline == can::IsoTpSender::kNoDeadline ? dcos::kWaitForever
                               : deadline > now                         ? deadline - now
@@ -194,9 +261,11 @@ void serviceEntry(uintptr_t)
             const SystemMessage message = queued.message;
             tail = tail + 1;
             const uint64_t at = dcos::TimerAgent::Uptime();
+            const bool configurationFrame = message.type == SystemMessageType::Configuration;
             if (message.echo) {
                 if (from == interface) {
-                    transmit(interface, server.onTransmitConfirmed(at));
+                    transmit(interface, configurationFrame ? seiCan.onTransmitConfirmed(at)
+                                                           : server.onTransmitConfirmed(at));
                 }
                 continue;
             }
@@ -205,28 +274,36 @@ void serviceEntry(uintptr_t)
                 continue;
             }
             if (from != interface) {
-                // The first frame from this interface: the server answers as
+                // The first frame from this interface: the servers answer as
                 // its CAN node, and a new connection begins there.
                 interface = from;
                 ownNode = ownNodeOf(from);
                 server.setOwnNode(ownNode);
+                seiCan.setOwnNode(ownNode);
+                backend.setCanNode(ownNode);
                 state.interface = from;
             }
-            CanFlashServer::Output output;
+            can::IsoTpRequestServer::Output output;
             {
                 // A request's card work holds the card (the boot command's confirmation waits).
                 dcos::internal::CardHold hold;
-                output = server.onFrame(frame, at);
+                output = configurationFrame ? seiCan.onFrame(frame, at) : server.onFrame(frame, at);
             }
             transmit(interface, output);
         }
-        transmit(interface, server.poll(dcos::TimerAgent::Uptime()));
+        const uint64_t later = dcos::TimerAgent::Uptime();
+        transmit(interface, server.poll(later));
+        transmit(interface, seiCan.poll(later));
         state.peer = server.peer();
         RestartTarget target{};
         if (server.restartDue(target)) {
             runtime::format(bsp::console(), "flash: restarting %s, as host %u asked\r\n",
                             target == RestartTarget::Boot ? "into the new image" : "into the stage loader's recovery",
                             unsigned(server.peer()));
+            bsp::resetBoard();
+        }
+        if (seiCan.restartDue()) {
+            runtime::format(bsp::console(), "sei: restarting, as a configuration host asked\r\n");
             bsp::resetBoard();
         }
     }
@@ -245,6 +322,28 @@ FlashServiceState flashServiceState()
 }
 
 } // namespace flash
+
+namespace sei {
+
+SeiServiceState seiServiceState()
+{
+    SeiServiceState copy;
+    if (flash::liveSeiServer == nullptr || flash::liveAuthenticator == nullptr || flash::liveSeiProtocol == nullptr) {
+        return copy;
+    }
+    const uint64_t now = dcos::TimerAgent::Uptime();
+    copy.running = true;
+    copy.hasKey = flash::liveAuthenticator->hasKey();
+    copy.queriesClosed = flash::configuration.queriesClosed();
+    copy.serial = flash::configuration.serialNumber;
+    copy.lockoutSecondsLeft = flash::liveAuthenticator->lockoutSecondsLeft(now);
+    copy.badMacs = flash::liveAuthenticator->badMacs();
+    copy.selected = flash::liveSeiProtocol->selected();
+    copy.can = flash::liveSeiServer->statistics();
+    return copy;
+}
+
+} // namespace sei
 
 namespace dcos::internal {
 

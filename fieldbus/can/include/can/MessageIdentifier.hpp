@@ -19,7 +19,12 @@
 // every node's frames different, which CAN requires: two nodes sending the
 // same identifier with different data at the same time would both win
 // arbitration and then destroy each other's frame with bit errors.
-// Destination 255 is the broadcast address; a source cannot be 255.
+// Destination 255 is the broadcast address. A source cannot be 255, but
+// in the configuration protocol (docs/protocols/config.md, "Scanning"):
+// there every node a scan's probe matches answers with the same frame from
+// source 255, on purpose, so that any number of them are one frame, and
+// the selected node answers from 255 as the one node the broadcast
+// address stands for.
 #pragma once
 
 #include <can/CanFrame.hpp>
@@ -72,7 +77,7 @@ public:
         if (!isAssignedMessageType(static_cast<uint8_t>(type))) {
             return LinkError::UnassignedMessageType;
         }
-        if (source == kBroadcast) {
+        if (source == kBroadcast && type != MessageType::Configuration) {
             return LinkError::InvalidNodeNumber;
         }
         return MessageIdentifier(priority, type, destination, source);

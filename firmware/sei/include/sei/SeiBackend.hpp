@@ -1,0 +1,73 @@
+// What the configuration protocol's server (SeiServer) needs of the node it
+// runs in: who the node is, its card's configuration, and the writing of
+// that configuration. The kernel's service reads and writes the card
+// (boot/ConfigurationBlock.hpp, both copies as boot/RecordCopies.hpp says);
+// the host tests and the fuzz target keep it in memory.
+//
+// No call may block for long: the server answers one request at a time,
+// and a write of the card is the longest thing it waits for.
+#pragma once
+
+#include <sei/SeiResult.hpp>
+#include <sei/SeiStatus.hpp>
+
+#include <stdint.h>
+
+namespace sei {
+
+/// Who the node is now, as Identify tells it.
+struct SeiIdentity {
+    /// The node id the kernel runs with (not the configured one, which
+    /// takes effect at the next start).
+    uint16_t nodeId = 0;
+    /// The CAN node number the node answers as.
+    uint8_t canNode = 0;
+    /// As in an image header (image::BoardType: 1 isa486).
+    uint8_t board = 0;
+    /// Set at manufacture; 0 for none (such a node never answers a scan).
+    uint32_t serial = 0;
+    /// The running firmware's version, NUL-terminated, valid as long as the
+    /// backend; at most kSeiMaxText characters are sent.
+    const char* versionText = "";
+};
+
+/// The card's configuration record, as GetConfiguration tells it.
+struct SeiConfiguration {
+    uint32_t sequence = 0;
+    /// 0: the kernel's default, 1.
+    uint16_t nodeId = 0;
+    /// In bit/s; 0: CAN is not started at boot.
+    uint32_t bitRate = 0;
+    /// GetConfiguration needs a MAC.
+    bool queriesClosed = false;
+    /// The lockout after three wrong MACs (0: 60 s).
+    uint16_t lockoutSeconds = 0;
+    /// The kernel command line, NUL-terminated; at most kSeiMaxText
+    /// characters are sent.
+    const char* commandLine = "";
+};
+
+class SeiBackend {
+public:
+    virtual SeiIdentity identity() = 0;
+    /// The configuration, or CardError. The texts stay valid until the next call.
+    virtual SeiResult<SeiConfiguration> readConfiguration() = 0;
+    /// Writes @p nodeId (1 to 254, checked by the server) into the
+    /// configuration with the next sequence: that sequence, or CardError
+    /// with nothing changed.
+    virtual SeiResult<uint32_t> writeNodeId(uint16_t nodeId) = 0;
+    /// Writes @p bitRate as writeNodeId writes a node id.
+    virtual SeiResult<uint32_t> writeBitRate(uint32_t bitRate) = 0;
+    /// Whether the node's CAN controller makes @p bitRate (not 0) exactly.
+    virtual bool bitRateValid(uint32_t bitRate) = 0;
+    /// An authenticated Restart is taken: whatever must be done before the
+    /// node goes down (the reply is sent first, then the caller restarts
+    /// the node: SeiServer::restartRequested). Anything but Ok refuses the
+    /// Restart with that status.
+    virtual SeiStatus prepareRestart() = 0;
+
+protected:
+    ~SeiBackend() = default;
+};
+
+} // namespace sei
