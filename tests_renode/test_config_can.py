@@ -11,6 +11,7 @@ import re
 import subprocess
 
 from dcoslab.cards import BIN, new_card, signed, card_state, tool
+from dcoslab.configwire import read_wire
 
 BITRATE = 1_000_000
 # Generous: bounds on a hung board or tool, not speeds. The probe wait is
@@ -73,6 +74,23 @@ def test_two_fresh_nodes_sharing_a_number_are_found_by_serial_and_one_is_renumbe
         assert (info["node"], info["serial"], info["can_node"]) == (node, serial, node), info
     found, _ = config(lab, "scan")
     assert [(n["serial"], n["node"]) for n in found] == [(1001, 1), (2002, 2)], found
+    # Every frame on the bus, read by an observer written from the protocol's
+    # page: each decodes, and the exchanges are what the tool says it did.
+    wire = read_wire(lab.hub.frames())
+    requests = [m for m in wire if m["direction"] == "request"]
+    replies = [m for m in wire if m["direction"] == "reply"]
+    assert {m["command"] for m in requests} >= {"ProbeSerial", "Select", "Deselect", "Identify", "Challenge",
+                                                "SetNodeId", "Restart"}, requests
+    assert [m["status"] for m in replies if m["command"] == "SetNodeId"] == ["BadMac", "Ok"], replies
+    assert [m["node_id"] for m in requests if m["command"] == "SetNodeId"] == [2, 2], requests
+    # Addressed by serial number: the selected node answered from the broadcast address.
+    assert {m["source"] for m in replies if m["command"] in ("SetNodeId", "Restart", "Select")} == {255}, replies
+    assert all(m["status"] == "Ok" for m in replies if m["command"] == "ProbeSerial")
+    # Each signed request followed a challenge to the same address.
+    for index, message in enumerate(requests):
+        if message["command"] in ("SetNodeId", "Restart"):
+            earlier = [m for m in requests[:index] if m["destination"] == message["destination"]]
+            assert earlier and earlier[-1]["command"] == "Challenge", requests[:index + 1]
     lab.close()
     assert card_state(cards[2002])["configuration"]["node"] == 2
     assert card_state(cards[1001])["configuration"]["node"] == 0
@@ -101,6 +119,10 @@ def test_wrong_keys_lock_a_node_out_and_the_lockout_ends(canlab, tmp_path):
     lab.hub.wait_until(lab.hub.now_ns + 3_500_000_000, TIMEOUT)
     written, _ = config(lab, "set-bitrate", "-n", "3", "-K", key, "500000")
     assert written["bit_rate"] == 500000, written
+    statuses = [(m["command"], m["status"]) for m in read_wire(lab.hub.frames()) if m["direction"] == "reply"
+                and m["command"] in ("Challenge", "SetBitRate")]
+    assert statuses[-2:] == [("Challenge", "Ok"), ("SetBitRate", "Ok")], statuses
+    assert ("SetBitRate", "BadMac") in statuses and ("Challenge", "LockedOut") in statuses, statuses
     # A rate the chip cannot make is refused after the key is checked, and nothing is written.
     _, errors = config(lab, "set-bitrate", "-n", "3", "-K", key, "12345", code=1)
     assert "12345" in errors or "cannot" in errors, errors
