@@ -244,6 +244,35 @@ int reach(ConfigClient& client, Selection& selection, const Options& options, No
     return kExitOk;
 }
 
+// A node reached for one command: the link, the client on it, the
+// selection that ends (Deselect) when this goes, and who the node is.
+// Members go in reverse order, so the Deselect still has its client.
+struct ReachedNode {
+    std::unique_ptr<hostconfig::CanConfigLink> link;
+    std::unique_ptr<ConfigClient> client;
+    std::unique_ptr<Selection> selection;
+    NodeIdentity node;
+    std::string who;
+};
+
+// Opens the link to the node -n or --serial names, selects it in the
+// latter case, and identifies it; an exit status other than kExitOk when
+// any step fails (it has been said why).
+int reachNode(const Options& options, ReachedNode& reached)
+{
+    int code = kExitOk;
+    reached.link =
+        openLink(options, options.bySerial ? can::MessageIdentifier::kBroadcast : static_cast<uint8_t>(options.node),
+                 code);
+    if (!reached.link) {
+        return code;
+    }
+    reached.client = std::make_unique<ConfigClient>(
+        *reached.link, hostconfig::ClientOptions{std::chrono::milliseconds(options.timeoutMs), options.retries});
+    reached.selection = std::make_unique<Selection>(*reached.client);
+    return reach(*reached.client, *reached.selection, options, reached.node, reached.who);
+}
+
 int keygen(const Options& options)
 {
     std::string error;
@@ -333,19 +362,13 @@ int info(const Options& options)
             return code;
         }
     }
-    std::unique_ptr<hostconfig::CanConfigLink> link =
-        openLink(options, options.bySerial ? can::MessageIdentifier::kBroadcast : static_cast<uint8_t>(options.node),
-                 code);
-    if (!link) {
-        return code;
+    ReachedNode reached;
+    if (const int status = reachNode(options, reached); status != kExitOk) {
+        return status;
     }
-    ConfigClient client(*link, {std::chrono::milliseconds(options.timeoutMs), options.retries});
-    Selection selection(client);
-    NodeIdentity node;
-    std::string who;
-    if (const int reached = reach(client, selection, options, node, who); reached != kExitOk) {
-        return reached;
-    }
+    ConfigClient& client = *reached.client;
+    const NodeIdentity& node = reached.node;
+    const std::string& who = reached.who;
     if (!key && node.queriesClosed()) {
         return fail(kExitUsage, fmt::format("{} has closed queries (dcos-card create --closed-queries): give its "
                                             "configuration key with -K KEYFILE to read its configuration",
@@ -389,19 +412,13 @@ int change(const Options& options, Change what)
     if (!key) {
         return code;
     }
-    std::unique_ptr<hostconfig::CanConfigLink> link =
-        openLink(options, options.bySerial ? can::MessageIdentifier::kBroadcast : static_cast<uint8_t>(options.node),
-                 code);
-    if (!link) {
-        return code;
+    ReachedNode reached;
+    if (const int status = reachNode(options, reached); status != kExitOk) {
+        return status;
     }
-    ConfigClient client(*link, {std::chrono::milliseconds(options.timeoutMs), options.retries});
-    Selection selection(client);
-    NodeIdentity node;
-    std::string who;
-    if (const int reached = reach(client, selection, options, node, who); reached != kExitOk) {
-        return reached;
-    }
+    ConfigClient& client = *reached.client;
+    const NodeIdentity& node = reached.node;
+    const std::string& who = reached.who;
     uint32_t sequence = 0;
     ConfigError error;
     switch (what) {
