@@ -112,6 +112,20 @@ TEST(MessageIdentifier, RefusedFields)
     EXPECT_TRUE(MessageIdentifier::make(0, MessageType::TimeSync, MessageIdentifier::kBroadcast, 254).ok());
 }
 
+TEST(MessageIdentifier, OnlyTheConfigurationProtocolSendsFromTheBroadcastAddress)
+{
+    // Its scans' answers and its selected node (docs/protocols/config.md, "Scanning").
+    const can::LinkResult<MessageIdentifier> answer =
+        MessageIdentifier::make(31, MessageType::Configuration, 254, MessageIdentifier::kBroadcast);
+    ASSERT_TRUE(answer.ok());
+    EXPECT_EQ(answer.value().encode(), 0x1F40FEFFu);
+    EXPECT_TRUE(MessageIdentifier::decode(0x1F40FEFF).ok());
+    for (const MessageType type : {MessageType::Flashing, MessageType::RemoteReply, MessageType::NodeStarted}) {
+        EXPECT_EQ(MessageIdentifier::make(31, type, 254, MessageIdentifier::kBroadcast).error(),
+                  LinkError::InvalidNodeNumber);
+    }
+}
+
 TEST(MessageIdentifier, OnlyTheListedTypesAreAssigned)
 {
     int assigned = 0;
