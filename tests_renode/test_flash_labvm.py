@@ -24,10 +24,8 @@ import pytest
 from dcoslab.board import REPOSITORY, load_board
 from dcoslab.canlab import CanLab
 from dcoslab.cards import BIN, DEVELOPMENT_KEY, card_state, new_card, signed
-from dcoslab.labvm import LabVM, SlcanSetup
 from dcoslab.remote import attach_node
-from dcoslab.slcan_bridge import SlcanBridge
-from dcoslab.vmworld import BridgedWorld, attach_reports, hold_world
+from dcoslab.vmworld import BridgedWorld, attach_reports, hold_world, start_bridged_vm, vm_status
 
 pytestmark = pytest.mark.xdist_group("test_flash_labvm")
 
@@ -90,11 +88,7 @@ def world():
         attach_node(world.board, NODE, [], BITRATE, timeout=STEP)
         files = {"dcos-flash": carried(os.path.join(BIN, "dcos-flash")), "tiny.dcos": carried(image),
                  "key.pem": carried(DEVELOPMENT_KEY)}
-        world.vm = LabVM(vm_script(), slcan=SlcanSetup("can0", BITRATE), connect_slcan=False, files=files,
-                         boot_timeout=BOOT_TIMEOUT, timeout=1200)
-        world.vm.start()
-        world.bridge = SlcanBridge(world.vm.slcan_socket_path, world.lab.socket_path, "can0").start()
-        world.bridge.wait_for(lambda b: b.is_open, BOOT_TIMEOUT, "slcand to open the channel")
+        start_bridged_vm(world, vm_script(), BITRATE, files, BOOT_TIMEOUT, 1200)
 
     with work:
         yield from hold_world(BridgedWorld(), build)
@@ -106,8 +100,7 @@ def _reports(request):
 
 
 def marked(world, tag):
-    match = world.vm.expect(rf"@@{tag} (.*?) status=(\d+)@@", timeout=STEP)
-    return match.group(1).decode(), int(match.group(2))
+    return vm_status(world, tag, STEP)
 
 
 def test_dcos_flash_in_the_lab_vm_reads_the_node_over_socketcan_with_both_iso_tp_implementations(world):

@@ -96,6 +96,26 @@ class BridgedWorld(World):
         super().close()
 
 
+def start_bridged_vm(world, script, bitrate, files, boot_timeout, timeout):
+    """Starts the lab VM with `script` and `files` (carried in as bytes:
+    the VM does not see the host's /tmp) and the slcan bridge between its
+    can0 and the world's lab bus; returns once slcand has opened the channel."""
+    from dcoslab.labvm import LabVM, SlcanSetup
+    from dcoslab.slcan_bridge import SlcanBridge
+
+    world.vm = LabVM(script, slcan=SlcanSetup("can0", bitrate), connect_slcan=False, files=files,
+                     boot_timeout=boot_timeout, timeout=timeout)
+    world.vm.start()
+    world.bridge = SlcanBridge(world.vm.slcan_socket_path, world.lab.socket_path, "can0").start()
+    world.bridge.wait_for(lambda b: b.is_open, boot_timeout, "slcand to open the channel")
+
+
+def vm_status(world, tag, timeout):
+    """What the VM printed as `@@<tag> <output> status=<code>@@`: (output, code)."""
+    match = world.vm.expect(rf"@@{tag} (.*?) status=(\d+)@@", timeout=timeout)
+    return match.group(1).decode(), int(match.group(2))
+
+
 def hold_world(world, build):
     """A module fixture's body: build(world) boots its pieces; the world is
     yielded to the module's tests and closed afterwards, or at once if
