@@ -145,5 +145,11 @@ def test_a_node_without_a_key_changes_nothing_and_closed_queries_need_the_key(ca
     assert info["queries"] == "closed" and info["configuration"]["node"] == 0, info
     # Nobody at a number: silence, exit 4.
     _, errors = config(lab, "--retries", "1", "--timeout-ms", "500", "info", "-n", "77", code=4)
+    # A node id set over the bus wins over the "node=" the card was made with.
+    config(lab, "set-node", "-n", "5", "-K", key, "6")
+    config(lab, "restart", "-n", "5", "-K", key)
+    board5 = lab.board("board5")
+    board5.emulator.expect(r"command line: node=6 can0=1000000 node=5 boot\.slot=A", timeout=TIMEOUT)
+    board5.emulator.expect(r"can0 carries interface 0: 130\.1\.0\.6/16, CAN node 6", timeout=TIMEOUT)
     lab.close()
     assert card_state(open_card)["configuration"]["node"] == 0

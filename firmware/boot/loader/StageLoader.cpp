@@ -254,17 +254,17 @@ const char loaderName[] = "DCOS stage loader";
     // The kernel learns where it came from on its command line: the
     // configuration's own line, then the boot's facts (docs/boot.md).
     // The configuration's node id reaches the kernel as "node=", and its
-    // CAN bit rate as "can0=", which brings can0 up on the network at boot,
-    // unless its command line names them itself.
+    // CAN bit rate as "can0=", which brings can0 up on the network at boot.
+    // They come before the configuration's own line, so they win over the
+    // same options there (the kernel takes an option's first word): a node
+    // id or bit rate changed over the bus (docs/protocols/config.md) takes
+    // effect whatever the line a card was made with says.
     char nodeText[16] = {};
     char rateText[20] = {};
-    char ignored[16];
-    if (configuration.nodeId != 0 &&
-        !boot::findCommandLineOption(configuration.commandLine, "node", ignored, sizeof ignored)) {
+    if (configuration.nodeId != 0) {
         runtime::formatToBuffer(nodeText, sizeof nodeText, "node=%u ", static_cast<unsigned>(configuration.nodeId));
     }
-    if (configuration.canBitRate != 0 &&
-        !boot::findCommandLineOption(configuration.commandLine, "can0", ignored, sizeof ignored)) {
+    if (configuration.canBitRate != 0) {
         runtime::formatToBuffer(rateText, sizeof rateText, "can0=%lu ",
                                 static_cast<unsigned long>(configuration.canBitRate));
     }
