@@ -96,6 +96,17 @@ def test_a_power_cut_at_the_revert_of_a_trial_that_never_confirmed(boot, isa486,
 # header sector, its payload's 243 sectors one by one, and the pending
 # state: 245 writes. Cut before the first, in the middle, and before the
 # payload's last sector; the cut before the pending state is below.
+def assert_cut(cut):
+    """dcos-flash's end at the cut: the board stopped at the failed write,
+    so nothing answered (exit 4). On a busy host the board's ATA driver may
+    give up on the write first (its wait is a count of polls, and this
+    board runs in host time), and the node answers that its card failed
+    (exit 1); the write did not reach the card either way, and the board
+    stops at it all the same (wait_power_cut)."""
+    assert (cut.returncode == 4 and "no answer" in cut.stderr) or \
+        (cut.returncode == 1 and "the node's card cannot be read or written" in cut.stderr), cut.stdout + cut.stderr
+
+
 @pytest.mark.parametrize("writes", [0, 122, 243])
 def test_a_power_cut_during_a_download_leaves_the_card_as_it_was_and_the_download_can_be_retried(
         boot, isa486, tmp_path, writes):
@@ -112,7 +123,7 @@ def test_a_power_cut_during_a_download_leaves_the_card_as_it_was_and_the_downloa
     cut = subprocess.run([os.path.join(BIN, "dcos-flash"), "-d", f"unix:{emulator.console_socket_path}",
                           "-k", DEVELOPMENT_KEY, "--timeout-ms", "4000", "--retries", "0", image],
                          capture_output=True, text=True, timeout=300)
-    assert cut.returncode == 4 and "no answer" in cut.stderr, cut.stdout + cut.stderr
+    assert_cut(cut)
     emulator.wait_power_cut()
     emulator.close()
     assert card_state(card)["boot_state"]["trial"] == "none", "nothing half-written is pending"
@@ -141,7 +152,7 @@ def test_a_power_cut_before_a_whole_download_is_marked_pending_leaves_it_a_trial
     cut = subprocess.run([os.path.join(BIN, "dcos-flash"), "-d", f"unix:{emulator.console_socket_path}",
                           "-k", DEVELOPMENT_KEY, "--timeout-ms", "4000", "--retries", "0", image],
                          capture_output=True, text=True, timeout=300)
-    assert cut.returncode == 4, cut.stdout + cut.stderr
+    assert_cut(cut)
     emulator.wait_power_cut()
     emulator.close()
     state = card_state(card)
