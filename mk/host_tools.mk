@@ -80,4 +80,4 @@ $(DCOS_CONFIG): $(BUILD)/host/host_tools/config/tools/dcos-config.cpp.o \
 		$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto -ltomlplusplus

@@ -48,7 +48,8 @@ DCOS_TARGET_SRCS := \
 	firmware/dcos/src/network/RemoteAgent.cpp \
 	firmware/dcos/src/network/NameService.cpp \
 	firmware/dcos/src/network/GlobalTime.cpp \
-	firmware/dcos/src/network/NetworkCommands.cpp
+	firmware/dcos/src/network/NetworkCommands.cpp \
+	firmware/dcos/src/ObjectDirectory.cpp
 
 # The full configuration's kernel, in link order (which is the order of the
 # console commands' and the agents' recovery tables).

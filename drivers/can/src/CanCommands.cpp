@@ -968,4 +968,16 @@ void networkBootStart()
     }
 }
 
+void switchCanBitRate(uint32_t rate)
+{
+    for (unsigned channel = 0; channel < sja1000::kChannels; ++channel) {
+        if (!sja1000::consoleChannels[channel].installed()) {
+            continue;
+        }
+        runtime::format(bsp::console(), "%s: switching to %lu bit/s, as a configuration host asked\r\n",
+                        sja1000::kNames[channel], static_cast<unsigned long>(rate));
+        (void)sja1000::setBitRate(bsp::console(), channel, rate);
+    }
+}
+
 } // namespace dcos::internal

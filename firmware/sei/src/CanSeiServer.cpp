@@ -12,12 +12,11 @@ using can::MessageIdentifier;
 static_assert(SeiServer::kMaxNodeId == MessageIdentifier::kMaxNodeNumber,
               "SetNodeId takes exactly the node ids a CAN node number can carry");
 
-// The scanning commands: every node on the bus takes them from the
-// broadcast address, selected or not.
+// The scanning commands and ActivateBitRate: every node on the bus takes
+// them from the broadcast address, selected or not.
 bool isScanCommand(uint8_t code)
 {
-    return code == static_cast<uint8_t>(SeiCommand::ProbeSerial) || code == static_cast<uint8_t>(SeiCommand::Select) ||
-           code == static_cast<uint8_t>(SeiCommand::Deselect);
+    return isSeiCommand(code) && seiCommandIsBroadcast(static_cast<SeiCommand>(code));
 }
 
 // The length of the message a single frame carries, or 0 when the frame is

@@ -86,8 +86,126 @@ SeiServer::Outcome SeiServer::perform(const SeiMessage& request, const uint8_t* 
         selected_ = false;
         outcome.answer = false;
         break;
+    case SeiCommand::ActivateBitRate:
+        // Every node on the bus takes it, so none answers (they would not
+        // all say the same); the rate is the one an authenticated command
+        // configured, so the command needs no MAC of its own.
+        backend_.activateBitRate(request.delayMs, nowNs);
+        outcome.answer = false;
+        break;
+    case SeiCommand::ListObjects:
+    case SeiCommand::FindObject:
+    case SeiCommand::ObjectInfo:
+    case SeiCommand::NodeStatistics:
+    case SeiCommand::Monitor:
+        outcome.status = admitQuery(request, bytes, length, nowNs);
+        if (outcome.status == SeiStatus::Ok) {
+            outcome.status = manage(request, nowNs, reply);
+        }
+        break;
+    case SeiCommand::SetConfiguration:
+        outcome.status = authenticate(request, bytes, length, nowNs);
+        if (outcome.status == SeiStatus::Ok) {
+            outcome.status = setConfiguration(request, reply);
+        }
+        break;
+    case SeiCommand::CreateTask:
+    case SeiCommand::StartTask:
+    case SeiCommand::StopTask:
+    case SeiCommand::KillTask:
+    case SeiCommand::CreateObject:
+    case SeiCommand::DeleteObject:
+    case SeiCommand::AddObjects:
+        outcome.status = authenticate(request, bytes, length, nowNs);
+        if (outcome.status == SeiStatus::Ok) {
+            outcome.status = manage(request, nowNs, reply);
+        }
+        break;
     }
     return outcome;
+}
+
+SeiStatus SeiServer::admitQuery(const SeiMessage& request, const uint8_t* bytes, size_t length, uint64_t nowNs)
+{
+    // As GetConfiguration: a MAC that comes is checked; without one, the
+    // query is open unless the node's queries are closed.
+    if (request.hasMac) {
+        return authenticate(request, bytes, length, nowNs);
+    }
+    if (backend_.queriesClosed()) {
+        const SeiStatus admitted = authenticator_.admit(nowNs);
+        return admitted != SeiStatus::Ok ? admitted : SeiStatus::NotPermitted;
+    }
+    return SeiStatus::Ok;
+}
+
+SeiStatus SeiServer::manage(const SeiMessage& request, uint64_t nowNs, SeiMessage& reply)
+{
+    uint8_t kernel = 0;
+    switch (request.command) {
+    case SeiCommand::ListObjects:
+        kernel = backend_.listObjects(request.objectType, request.first, reply);
+        break;
+    case SeiCommand::FindObject:
+        kernel = backend_.findObject(request.objectType, request.name, request.nameLength, reply.objectId);
+        break;
+    case SeiCommand::ObjectInfo:
+        kernel = backend_.objectInfo(request.objectId, reply);
+        break;
+    case SeiCommand::NodeStatistics:
+        kernel = backend_.nodeStatistics(reply);
+        break;
+    case SeiCommand::Monitor:
+        kernel = backend_.monitor(request, nowNs);
+        break;
+    case SeiCommand::CreateTask:
+        kernel = backend_.createTask(request, reply.objectId);
+        break;
+    case SeiCommand::StartTask:
+        kernel = backend_.startTask(request.objectId);
+        break;
+    case SeiCommand::StopTask:
+        kernel = backend_.stopTask(request.objectId);
+        break;
+    case SeiCommand::KillTask:
+        kernel = backend_.killTask(request.objectId);
+        break;
+    case SeiCommand::CreateObject:
+        kernel = backend_.createObject(request, reply.objectId);
+        break;
+    case SeiCommand::DeleteObject:
+        kernel = backend_.deleteObject(request.objectId);
+        break;
+    case SeiCommand::AddObjects:
+        kernel = backend_.addObjects(request.objectType, request.count);
+        break;
+    default:
+        return SeiStatus::UnknownCommand;
+    }
+    reply.kernelStatus = kernel;
+    return kernel == 0 ? SeiStatus::Ok : SeiStatus::KernelRefused;
+}
+
+SeiStatus SeiServer::setConfiguration(const SeiMessage& request, SeiMessage& reply)
+{
+    // The same values SetNodeId and SetBitRate take, for the same reasons.
+    if (request.nodeId < kMinNodeId || request.nodeId > kMaxNodeId || request.bitRate == 0 ||
+        !backend_.bitRateValid(request.bitRate)) {
+        return SeiStatus::InvalidArgument;
+    }
+    SeiConfiguration configuration;
+    configuration.nodeId = request.nodeId;
+    configuration.bitRate = request.bitRate;
+    configuration.queriesClosed = (request.flags & kSeiConfigurationQueriesClosed) != 0;
+    configuration.lockoutSeconds = request.lockoutSeconds;
+    configuration.commandLine = request.text;
+    configuration.commandLineLength = request.textLength;
+    const SeiResult<uint32_t> written = backend_.writeConfiguration(configuration);
+    if (!written.ok()) {
+        return written.status();
+    }
+    reply.sequence = written.value();
+    return SeiStatus::Ok;
 }
 
 SeiStatus SeiServer::authenticate(const SeiMessage& request, const uint8_t* bytes, size_t length, uint64_t nowNs)

@@ -16,6 +16,7 @@ const char* seiStatusText(SeiStatus status)
     case SeiStatus::InvalidArgument: return "a value the node cannot take";
     case SeiStatus::CardError: return "the node's card cannot be read or written; nothing changed";
     case SeiStatus::NotPermitted: return "the node's queries are closed: a MAC is needed";
+    case SeiStatus::KernelRefused: return "the node's kernel refused it";
     }
     return "unknown status";
 }

@@ -55,6 +55,52 @@ void expectSame(const SeiMessage& a, const SeiMessage& b)
     EXPECT_EQ(a.lockoutSeconds, b.lockoutSeconds);
     EXPECT_EQ(a.probeBits, b.probeBits);
     EXPECT_EQ(a.probeValue, b.probeValue);
+    EXPECT_EQ(a.kernelStatus, b.kernelStatus);
+    EXPECT_EQ(a.objectType, b.objectType);
+    EXPECT_EQ(a.first, b.first);
+    EXPECT_EQ(a.next, b.next);
+    ASSERT_EQ(a.entryCount, b.entryCount);
+    for (size_t i = 0; i < a.entryCount; ++i) {
+        EXPECT_EQ(a.entries[i].id, b.entries[i].id);
+        EXPECT_EQ(a.entries[i].owner, b.entries[i].owner);
+        EXPECT_EQ(std::string(a.entries[i].name, a.entries[i].nameLength),
+                  std::string(b.entries[i].name, b.entries[i].nameLength));
+    }
+    EXPECT_EQ(a.objectId, b.objectId);
+    EXPECT_EQ(a.owner, b.owner);
+    EXPECT_EQ(a.state, b.state);
+    EXPECT_EQ(std::string(a.name != nullptr ? a.name : "", a.nameLength),
+              std::string(b.name != nullptr ? b.name : "", b.nameLength));
+    EXPECT_EQ(a.priority, b.priority);
+    EXPECT_EQ(a.stackSize, b.stackSize);
+    EXPECT_EQ(a.argument, b.argument);
+    EXPECT_EQ(a.visibility, b.visibility);
+    EXPECT_EQ(a.parameters[0], b.parameters[0]);
+    EXPECT_EQ(a.parameters[1], b.parameters[1]);
+    EXPECT_EQ(a.count, b.count);
+    ASSERT_EQ(a.valueCount, b.valueCount);
+    for (size_t i = 0; i < a.valueCount; ++i) {
+        EXPECT_EQ(a.values[i], b.values[i]);
+    }
+    EXPECT_EQ(a.uptimeNs, b.uptimeNs);
+    EXPECT_EQ(a.taskSwitches, b.taskSwitches);
+    EXPECT_EQ(a.stackFree, b.stackFree);
+    ASSERT_EQ(a.tableCount, b.tableCount);
+    for (size_t i = 0; i < a.tableCount; ++i) {
+        EXPECT_EQ(a.tables[i].type, b.tables[i].type);
+        EXPECT_EQ(a.tables[i].used, b.tables[i].used);
+        EXPECT_EQ(a.tables[i].capacity, b.tables[i].capacity);
+    }
+    EXPECT_EQ(a.delayMs, b.delayMs);
+    EXPECT_EQ(a.leaseSeconds, b.leaseSeconds);
+    EXPECT_EQ(a.periodMs, b.periodMs);
+    EXPECT_EQ(a.monitorFlags, b.monitorFlags);
+    ASSERT_EQ(a.channelCount, b.channelCount);
+    for (size_t i = 0; i < a.channelCount; ++i) {
+        EXPECT_EQ(a.channels[i].publisher, b.channels[i].publisher);
+        EXPECT_EQ(a.channels[i].offset, b.channels[i].offset);
+        EXPECT_EQ(a.channels[i].format, b.channels[i].format);
+    }
 }
 
 // Encodes @p m, checks the bytes against @p expected, decodes them back to
@@ -146,15 +192,20 @@ TEST(SeiMessageTest, IdentifyReply)
                   0x06, 0x00, 0x00});
 }
 
-TEST(SeiMessageTest, TheLongestIdentifyReplyIsTheLargestMessage)
+TEST(SeiMessageTest, TheLongestSetConfigurationIsTheLargestMessage)
 {
     const std::string text(sei::kSeiMaxText, 'v');
-    SeiMessage m = reply(SeiCommand::Identify);
+    SeiMessage m = request(SeiCommand::SetConfiguration);
+    fillMac(m);
     m.text = text.c_str();
     m.textLength = static_cast<uint8_t>(text.size());
     EXPECT_EQ(encoded(m).size(), sei::kSeiMaxMessage);
     uint8_t small[sei::kSeiMaxMessage - 1];
     EXPECT_EQ(m.encode(small, sizeof small), 0u) << "does not fit";
+    SeiMessage identify = reply(SeiCommand::Identify);
+    identify.text = text.c_str();
+    identify.textLength = static_cast<uint8_t>(text.size());
+    EXPECT_LT(encoded(identify).size(), sei::kSeiMaxMessage);
 }
 
 TEST(SeiMessageTest, ChallengeReply)
@@ -209,9 +260,13 @@ TEST(SeiMessageTest, SelectReply)
 
 TEST(SeiMessageTest, ARefusalCarriesOnlyItsStatusButALockoutItsSecondsLeft)
 {
-    for (const SeiCommand command : {SeiCommand::Identify, SeiCommand::Challenge, SeiCommand::GetConfiguration,
-                                     SeiCommand::SetNodeId, SeiCommand::SetBitRate, SeiCommand::Restart,
-                                     SeiCommand::ProbeSerial, SeiCommand::Select, SeiCommand::Deselect}) {
+    for (const SeiCommand command :
+         {SeiCommand::Identify, SeiCommand::Challenge, SeiCommand::GetConfiguration, SeiCommand::SetNodeId,
+          SeiCommand::SetBitRate, SeiCommand::Restart, SeiCommand::ProbeSerial, SeiCommand::Select,
+          SeiCommand::Deselect, SeiCommand::ActivateBitRate, SeiCommand::ListObjects, SeiCommand::FindObject,
+          SeiCommand::ObjectInfo, SeiCommand::NodeStatistics, SeiCommand::Monitor, SeiCommand::SetConfiguration,
+          SeiCommand::CreateTask, SeiCommand::StartTask, SeiCommand::StopTask, SeiCommand::KillTask,
+          SeiCommand::CreateObject, SeiCommand::DeleteObject, SeiCommand::AddObjects}) {
         const uint8_t code = static_cast<uint8_t>(static_cast<uint8_t>(command) | sei::kSeiReplyBit);
         roundTrip(reply(command, SeiStatus::Malformed), {code, 0x01});
         roundTrip(reply(command, SeiStatus::NotPermitted), {code, 0x0A});
@@ -234,8 +289,8 @@ TEST(SeiMessageTest, TheReplyToARequestThatCannotBeRead)
 TEST(SeiMessageTest, UnknownCodesAndStatusesAreRefused)
 {
     SeiMessage m;
-    for (const Bytes& bytes : {Bytes{}, Bytes{0x00}, Bytes{0x04}, Bytes{0x7F}, Bytes{0x84, 0x00}, Bytes{0x81, 11},
-                               Bytes{0xFF, 11}, Bytes{0xFF}}) {
+    for (const Bytes& bytes : {Bytes{}, Bytes{0x00}, Bytes{0x09}, Bytes{0x7F}, Bytes{0x89, 0x00}, Bytes{0x81, 12},
+                               Bytes{0xFF, 12}, Bytes{0xFF}, Bytes{0x24}, Bytes{0x37, 0, 0}}) {
         EXPECT_FALSE(SeiMessage::decode(bytes.data(), bytes.size(), m)) << bytes.size();
     }
     EXPECT_FALSE(SeiMessage::decode(nullptr, 1, m));
@@ -245,15 +300,206 @@ TEST(SeiMessageTest, CommandsAndTheirMacs)
 {
     EXPECT_TRUE(sei::isSeiCommand(0x01));
     EXPECT_TRUE(sei::isSeiCommand(0x22));
-    EXPECT_FALSE(sei::isSeiCommand(0x23));
+    EXPECT_TRUE(sei::isSeiCommand(0x23));
+    EXPECT_FALSE(sei::isSeiCommand(0x24));
+    EXPECT_FALSE(sei::isSeiCommand(0x37));
     EXPECT_FALSE(sei::isSeiCommand(0x81));
     EXPECT_TRUE(sei::seiCommandNeedsMac(SeiCommand::SetNodeId));
     EXPECT_TRUE(sei::seiCommandNeedsMac(SeiCommand::SetBitRate));
     EXPECT_TRUE(sei::seiCommandNeedsMac(SeiCommand::Restart));
     EXPECT_FALSE(sei::seiCommandNeedsMac(SeiCommand::GetConfiguration));
     EXPECT_FALSE(sei::seiCommandNeedsMac(SeiCommand::Select));
+    for (const SeiCommand change : {SeiCommand::SetConfiguration, SeiCommand::CreateTask, SeiCommand::StartTask,
+                                    SeiCommand::StopTask, SeiCommand::KillTask, SeiCommand::CreateObject,
+                                    SeiCommand::DeleteObject, SeiCommand::AddObjects}) {
+        EXPECT_TRUE(sei::seiCommandNeedsMac(change));
+        EXPECT_FALSE(sei::seiCommandIsQuery(change));
+        EXPECT_FALSE(sei::seiCommandIsBroadcast(change));
+    }
+    for (const SeiCommand query : {SeiCommand::GetConfiguration, SeiCommand::ListObjects, SeiCommand::FindObject,
+                                   SeiCommand::ObjectInfo, SeiCommand::NodeStatistics, SeiCommand::Monitor}) {
+        EXPECT_FALSE(sei::seiCommandNeedsMac(query));
+        EXPECT_TRUE(sei::seiCommandIsQuery(query));
+    }
+    for (const SeiCommand broadcast :
+         {SeiCommand::ProbeSerial, SeiCommand::Select, SeiCommand::Deselect, SeiCommand::ActivateBitRate}) {
+        EXPECT_TRUE(sei::seiCommandIsBroadcast(broadcast));
+        EXPECT_FALSE(sei::seiCommandNeedsMac(broadcast));
+    }
+    EXPECT_FALSE(sei::seiCommandIsBroadcast(SeiCommand::Identify));
     EXPECT_STREQ(sei::seiStatusText(SeiStatus::NoKey),
                  "the node holds no configuration key: nothing can be changed over the bus");
+}
+
+// The management commands (docs/protocols/config.md, "Objects and tasks").
+
+TEST(SeiMessageTest, ObjectQueries)
+{
+    SeiMessage list = request(SeiCommand::ListObjects);
+    list.objectType = 10;
+    list.first = 0x0102;
+    roundTrip(list, {0x04, 10, 0x02, 0x01});
+    fillMac(list);
+    roundTrip(list, withMac({0x04, 10, 0x02, 0x01}));
+
+    SeiMessage find = request(SeiCommand::FindObject);
+    find.objectType = 8;
+    find.name = "speed";
+    find.nameLength = 5;
+    roundTrip(find, {0x05, 8, 5, 's', 'p', 'e', 'e', 'd'});
+
+    SeiMessage info = request(SeiCommand::ObjectInfo);
+    info.objectId = 0x0005A001;
+    roundTrip(info, {0x06, 0x01, 0xA0, 0x05, 0x00});
+    roundTrip(request(SeiCommand::NodeStatistics), {0x07});
+}
+
+TEST(SeiMessageTest, ANameLongerThanFifteenIsMalformed)
+{
+    SeiMessage m;
+    const Bytes bytes = {0x05, 8, 16, 'a', 'b', 'c', 'd', 'e', 'f', 'g', 'h', 'i', 'j', 'k', 'l', 'm', 'n', 'o', 'p'};
+    EXPECT_FALSE(SeiMessage::decode(bytes.data(), bytes.size(), m));
+}
+
+TEST(SeiMessageTest, ListObjectsReply)
+{
+    SeiMessage m = reply(SeiCommand::ListObjects);
+    m.next = 9;
+    m.entryCount = 2;
+    m.entries[0] = {0x00051001, 0, "root", 4};
+    m.entries[1] = {0x00051002, 0x00051001, "", 0};
+    roundTrip(m, {0x84, 0x00, 0x09, 0x00, 2, 0x01, 0x10, 0x05, 0x00, 0, 0, 0, 0, 4, 'r', 'o', 'o', 't', 0x02, 0x10,
+                  0x05, 0x00, 0x01, 0x10, 0x05, 0x00, 0});
+    Bytes tooMany = {0x84, 0x00, 0xFF, 0xFF, 9};
+    EXPECT_FALSE(SeiMessage::decode(tooMany.data(), tooMany.size(), m));
+}
+
+TEST(SeiMessageTest, ObjectInfoReply)
+{
+    SeiMessage m = reply(SeiCommand::ObjectInfo);
+    m.objectType = 1;
+    m.state = 5;
+    m.owner = 0;
+    m.name = "pid";
+    m.nameLength = 3;
+    m.valueCount = 2;
+    m.values[0] = 8;
+    m.values[1] = 0x0102030405060708ull;
+    roundTrip(m, {0x86, 0x00, 1, 5, 0, 0, 0, 0, 3, 'p', 'i', 'd', 2, 8, 0, 0, 0, 0, 0, 0, 0, 0x08, 0x07, 0x06, 0x05,
+                  0x04, 0x03, 0x02, 0x01});
+}
+
+TEST(SeiMessageTest, NodeStatisticsReply)
+{
+    SeiMessage m = reply(SeiCommand::NodeStatistics);
+    m.uptimeNs = 0x100000002ull;
+    m.taskSwitches = 3;
+    m.stackFree = 4;
+    m.tableCount = 1;
+    m.tables[0] = {10, 5, 64};
+    roundTrip(m, {0x87, 0x00, 2, 0, 0, 0, 1, 0, 0, 0, 3, 0, 0, 0, 4, 0, 0, 0, 1, 10, 5, 0, 64, 0});
+}
+
+TEST(SeiMessageTest, MonitorRequest)
+{
+    SeiMessage m = request(SeiCommand::Monitor);
+    m.leaseSeconds = 30;
+    m.periodMs = 100;
+    m.monitorFlags = sei::kSeiMonitorLog;
+    m.channelCount = 2;
+    m.channels[0] = {0x00058001, 0, sei::SeiSampleFormat::I32};
+    m.channels[1] = {0x00058002, 14, sei::SeiSampleFormat::U16};
+    roundTrip(m, {0x08, 30, 0, 100, 0, 1, 2, 0x01, 0x80, 0x05, 0x00, 0, 5, 0x02, 0x80, 0x05, 0x00, 14, 2});
+    Bytes pastThePage = {0x08, 30, 0, 100, 0, 0, 1, 0x01, 0x80, 0x05, 0x00, 13, 4};
+    EXPECT_FALSE(SeiMessage::decode(pastThePage.data(), pastThePage.size(), m)) << "four bytes from 13";
+    Bytes badFormat = {0x08, 30, 0, 100, 0, 0, 1, 0x01, 0x80, 0x05, 0x00, 0, 6};
+    EXPECT_FALSE(SeiMessage::decode(badFormat.data(), badFormat.size(), m));
+    Bytes badFlags = {0x08, 30, 0, 100, 0, 2, 0};
+    EXPECT_FALSE(SeiMessage::decode(badFlags.data(), badFlags.size(), m));
+    Bytes nineChannels = {0x08, 30, 0, 100, 0, 0, 9};
+    EXPECT_FALSE(SeiMessage::decode(nineChannels.data(), nineChannels.size(), m));
+}
+
+TEST(SeiMessageTest, SetConfigurationRequest)
+{
+    SeiMessage m = request(SeiCommand::SetConfiguration);
+    m.nodeId = 7;
+    m.bitRate = 500000;
+    m.flags = sei::kSeiConfigurationQueriesClosed;
+    m.lockoutSeconds = 90;
+    m.text = "x=1";
+    m.textLength = 3;
+    fillMac(m);
+    roundTrip(m, withMac({0x13, 7, 0, 0x20, 0xA1, 0x07, 0x00, 1, 90, 0, 3, 'x', '=', '1'}));
+    Bytes unknownFlag = withMac({0x13, 7, 0, 0x20, 0xA1, 0x07, 0x00, 2, 90, 0, 0});
+    EXPECT_FALSE(SeiMessage::decode(unknownFlag.data(), unknownFlag.size(), m));
+}
+
+TEST(SeiMessageTest, TaskAndObjectCommands)
+{
+    SeiMessage create = request(SeiCommand::CreateTask);
+    create.text = "sampler";
+    create.textLength = 7;
+    create.name = "s2";
+    create.nameLength = 2;
+    create.priority = 9;
+    create.stackSize = 4096;
+    create.argument = 0x11223344;
+    fillMac(create);
+    roundTrip(create, withMac({0x30, 7, 's', 'a', 'm', 'p', 'l', 'e', 'r', 2, 's', '2', 9, 0x00, 0x10, 0x00, 0x00,
+                               0x44, 0x33, 0x22, 0x11}));
+
+    for (const SeiCommand command :
+         {SeiCommand::StartTask, SeiCommand::StopTask, SeiCommand::KillTask, SeiCommand::DeleteObject}) {
+        SeiMessage m = request(command);
+        m.objectId = 0x00051003;
+        fillMac(m);
+        roundTrip(m, withMac({static_cast<uint8_t>(command), 0x03, 0x10, 0x05, 0x00}));
+    }
+
+    SeiMessage object = request(SeiCommand::CreateObject);
+    object.objectType = 10;
+    object.name = "lock";
+    object.nameLength = 4;
+    object.visibility = 1;
+    object.parameters[0] = 1;
+    object.parameters[1] = sei::kSeiSemaphoreInheritance;
+    fillMac(object);
+    roundTrip(object, withMac({0x34, 10, 4, 'l', 'o', 'c', 'k', 1, 1, 0, 0, 0, 2, 0, 0, 0}));
+
+    SeiMessage add = request(SeiCommand::AddObjects);
+    add.objectType = 1;
+    add.count = 8;
+    fillMac(add);
+    roundTrip(add, withMac({0x36, 1, 8, 0}));
+
+    SeiMessage activate = request(SeiCommand::ActivateBitRate);
+    activate.delayMs = 500;
+    roundTrip(activate, {0x23, 0xF4, 0x01});
+}
+
+TEST(SeiMessageTest, RepliesWithAnId)
+{
+    for (const SeiCommand command : {SeiCommand::FindObject, SeiCommand::CreateTask, SeiCommand::CreateObject}) {
+        SeiMessage m = reply(command);
+        m.objectId = 0x0005A003;
+        roundTrip(m, {static_cast<uint8_t>(static_cast<uint8_t>(command) | 0x80), 0x00, 0x03, 0xA0, 0x05, 0x00});
+    }
+    SeiMessage written = reply(SeiCommand::SetConfiguration);
+    written.sequence = 12;
+    roundTrip(written, {0x93, 0x00, 12, 0, 0, 0});
+    for (const SeiCommand command : {SeiCommand::StartTask, SeiCommand::StopTask, SeiCommand::KillTask,
+                                     SeiCommand::DeleteObject, SeiCommand::AddObjects, SeiCommand::Monitor}) {
+        roundTrip(reply(command), {static_cast<uint8_t>(static_cast<uint8_t>(command) | 0x80), 0x00});
+    }
+}
+
+TEST(SeiMessageTest, AKernelRefusalCarriesTheKernelsStatus)
+{
+    SeiMessage m = reply(SeiCommand::CreateObject, SeiStatus::KernelRefused);
+    m.kernelStatus = 4; // TableFull
+    roundTrip(m, {0xB4, 11, 4});
+    EXPECT_STREQ(sei::seiStatusText(SeiStatus::KernelRefused), "the node's kernel refused it");
 }
 
 } // namespace

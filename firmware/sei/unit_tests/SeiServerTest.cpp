@@ -322,7 +322,7 @@ TEST_F(SeiServerTest, AFailingCardChangesNothing)
 TEST_F(SeiServerTest, RequestsThatCannotBeReadAreRefused)
 {
     EXPECT_EQ(host.raw({}), (Bytes{0xFF, 0x01})) << "empty";
-    EXPECT_EQ(host.raw({0x05}), (Bytes{0xFF, 0x02})) << "no such command";
+    EXPECT_EQ(host.raw({0x09}), (Bytes{0xFF, 0x02})) << "no such command";
     EXPECT_EQ(host.raw({0x81, 0x00}), (Bytes{0xFF, 0x02})) << "a reply is no request";
     EXPECT_EQ(host.raw({0x01, 0x00}), (Bytes{0x81, 0x01})) << "Identify one byte longer";
     EXPECT_EQ(host.raw({0x03, 0x00}), (Bytes{0x83, 0x01})) << "GetConfiguration with part of a MAC";

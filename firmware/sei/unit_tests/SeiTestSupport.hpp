@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <functional>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -105,6 +106,226 @@ public:
     }
     bool bitRateValid(uint32_t bitRate) override { return validRates.count(bitRate) != 0; }
     sei::SeiStatus prepareRestart() override { return restartStatus; }
+    sei::SeiResult<uint32_t> writeConfiguration(const sei::SeiConfiguration& written) override
+    {
+        if (failing) {
+            return SeiStatus::CardError;
+        }
+        ++writes;
+        const uint32_t sequence = configuration.sequence;
+        configuration = written;
+        configuration.sequence = sequence + 1;
+        commandLine.assign(written.commandLine, written.commandLineLength);
+        return configuration.sequence;
+    }
+    bool queriesClosed() override { return configuration.queriesClosed; }
+    void activateBitRate(uint16_t delayMs, uint64_t nowNs) override
+    {
+        activations.push_back({delayMs, nowNs});
+    }
+
+    // The kernel's statuses (dcos/Status.hpp), as numbers on the wire.
+    static constexpr uint8_t kInvalidId = 1, kWrongType = 3, kTableFull = 4, kInvalidArgument = 6,
+                             kNotFound = 13, kAlreadyExists = 14, kNotSupported = 18;
+    // Object types (dcos/ObjectId.hpp).
+    static constexpr uint8_t kTask = 1, kTimer = 3, kDevice = 4, kPool = 5, kHeap = 6, kPort = 7, kPublisher = 8,
+                             kSemaphore = 10;
+
+    /// An object in the node's tables; its id is (node 5, type, index).
+    struct Object {
+        uint8_t type = 0;
+        uint32_t owner = 0;
+        std::string name;
+        uint8_t state = 2; // dcos::TaskState::Ready
+        uint8_t priority = 0;
+        uint32_t stackSize = 0;
+    };
+
+    static uint32_t idOf(uint8_t type, uint16_t index) { return (5u << 16) | (uint32_t{type} << 12) | index; }
+
+    uint8_t listObjects(uint8_t type, uint16_t first, SeiMessage& reply) override
+    {
+        if (capacity.count(type) == 0) {
+            return kInvalidArgument;
+        }
+        reply.entryCount = 0;
+        reply.next = sei::kSeiListEnd;
+        listed.clear();
+        for (const auto& [object, value] : objects) {
+            const uint16_t index = static_cast<uint16_t>(object & 0xFFF);
+            if (value.type != type || index < first) {
+                continue;
+            }
+            if (reply.entryCount == sei::kSeiMaxListEntries) {
+                reply.next = index;
+                break;
+            }
+            listed.push_back(value.name);
+            sei::SeiObjectEntry& entry = reply.entries[reply.entryCount++];
+            entry.id = object;
+            entry.owner = value.owner;
+            entry.nameLength = static_cast<uint8_t>(value.name.size());
+        }
+        for (size_t i = 0; i < reply.entryCount; ++i) {
+            reply.entries[i].name = listed[i].c_str();
+        }
+        return 0;
+    }
+    uint8_t findObject(uint8_t type, const char* name, uint8_t length, uint32_t& found) override
+    {
+        const std::string wanted(name, length);
+        for (const auto& [object, value] : objects) {
+            if (value.type == type && value.name == wanted) {
+                found = object;
+                return 0;
+            }
+        }
+        return capacity.count(type) == 0 ? kInvalidArgument : kNotFound;
+    }
+    uint8_t objectInfo(uint32_t object, SeiMessage& reply) override
+    {
+        const auto it = objects.find(object);
+        if (it == objects.end()) {
+            return kInvalidId;
+        }
+        reply.objectType = it->second.type;
+        reply.state = it->second.type == kTask ? it->second.state : 0;
+        reply.owner = it->second.owner;
+        reply.name = it->second.name.c_str();
+        reply.nameLength = static_cast<uint8_t>(it->second.name.size());
+        reply.valueCount = it->second.type == kTask ? 2 : 0;
+        reply.values[0] = it->second.priority;
+        reply.values[1] = it->second.stackSize;
+        return 0;
+    }
+    uint8_t nodeStatistics(SeiMessage& reply) override
+    {
+        reply.uptimeNs = 123456789012ull;
+        reply.taskSwitches = 4242;
+        reply.stackFree = 65536;
+        reply.tableCount = 0;
+        for (const auto& [type, slots] : capacity) {
+            sei::SeiTableUsage& usage = reply.tables[reply.tableCount++];
+            usage.type = type;
+            usage.used = static_cast<uint16_t>(countOf(type));
+            usage.capacity = static_cast<uint16_t>(slots);
+        }
+        return 0;
+    }
+    uint8_t createTask(const SeiMessage& request, uint32_t& created) override
+    {
+        const std::string entry(request.text, request.textLength);
+        if (entries.count(entry) == 0) {
+            return kNotFound;
+        }
+        if (request.priority > 31 || request.stackSize < 1024) {
+            return kInvalidArgument;
+        }
+        Object task;
+        task.type = kTask;
+        task.name.assign(request.name, request.nameLength);
+        task.priority = request.priority;
+        task.stackSize = request.stackSize;
+        return add(task, created);
+    }
+    uint8_t startTask(uint32_t task) override { return setState(task, 2); }
+    uint8_t stopTask(uint32_t task) override { return setState(task, 5); }
+    uint8_t killTask(uint32_t task) override
+    {
+        const uint8_t checked = checkTask(task);
+        if (checked == 0) {
+            objects.erase(task);
+        }
+        return checked;
+    }
+    uint8_t createObject(const SeiMessage& request, uint32_t& created) override
+    {
+        if (request.objectType != kSemaphore && request.objectType != kPort && request.objectType != kPublisher) {
+            return request.objectType == kPool || request.objectType == kHeap ? kNotSupported : kInvalidArgument;
+        }
+        Object object;
+        object.type = request.objectType;
+        object.name.assign(request.name, request.nameLength);
+        return add(object, created);
+    }
+    uint8_t deleteObject(uint32_t object) override
+    {
+        const auto it = objects.find(object);
+        if (it == objects.end()) {
+            return kInvalidId;
+        }
+        objects.erase(it);
+        return 0;
+    }
+    uint8_t addObjects(uint8_t type, uint16_t count) override
+    {
+        if (capacity.count(type) == 0 || capacity[type] + count > 64) {
+            return kInvalidArgument;
+        }
+        capacity[type] += count;
+        return 0;
+    }
+    uint8_t monitor(const SeiMessage& request, uint64_t) override
+    {
+        for (size_t i = 0; i < request.channelCount; ++i) {
+            const auto it = objects.find(request.channels[i].publisher);
+            if (it == objects.end()) {
+                return kInvalidId;
+            }
+            if (it->second.type != kPublisher) {
+                return kWrongType;
+            }
+        }
+        monitorRequests.push_back(request);
+        return 0;
+    }
+
+    size_t countOf(uint8_t type) const
+    {
+        return static_cast<size_t>(std::count_if(objects.begin(), objects.end(),
+                                                 [type](const auto& entry) { return entry.second.type == type; }));
+    }
+
+    /// Adds @p object with the next index of its type; TableFull or AlreadyExists as the kernel says them.
+    uint8_t add(const Object& object, uint32_t& created)
+    {
+        if (countOf(object.type) >= capacity[object.type]) {
+            return kTableFull;
+        }
+        for (const auto& [other, value] : objects) {
+            if (value.type == object.type && !object.name.empty() && value.name == object.name) {
+                return kAlreadyExists;
+            }
+        }
+        created = idOf(object.type, nextIndex++);
+        objects[created] = object;
+        return 0;
+    }
+    uint8_t checkTask(uint32_t task)
+    {
+        const auto it = objects.find(task);
+        if (it == objects.end()) {
+            return ((task >> 12) & 0xF) == kTask ? kInvalidId : kWrongType;
+        }
+        return it->second.type == kTask ? 0 : kWrongType;
+    }
+    uint8_t setState(uint32_t task, uint8_t state)
+    {
+        const uint8_t checked = checkTask(task);
+        if (checked == 0) {
+            objects[task].state = state;
+        }
+        return checked;
+    }
+
+    std::map<uint32_t, Object> objects;
+    std::map<uint8_t, size_t> capacity = {{kTask, 8}, {kTimer, 8}, {kDevice, 8}, {kPool, 4},
+                                          {kHeap, 4}, {kPort, 8}, {kPublisher, 8}, {kSemaphore, 8}};
+    std::set<std::string> entries = {"sampler", "logger"};
+    uint16_t nextIndex = 1;
+    std::vector<std::string> listed;
+    std::vector<SeiMessage> monitorRequests;
+    std::vector<std::pair<uint16_t, uint64_t>> activations;
 
     sei::SeiIdentity id;
     sei::SeiConfiguration configuration;
@@ -172,7 +393,13 @@ public:
         return reply.value_or(Bytes{});
     }
 
-    SeiMessage ask(const SeiMessage& message) { return decode(raw(encoded(message))); }
+    /// The reply's names and text point into the host's last reply: valid
+    /// until the next ask.
+    SeiMessage ask(const SeiMessage& message)
+    {
+        last_ = raw(encoded(message));
+        return decode(last_);
+    }
 
     static SeiMessage decode(const Bytes& bytes)
     {
@@ -208,7 +435,11 @@ public:
     }
 
     /// Asks @p message signed under the last challenge.
-    SeiMessage askSigned(const SeiMessage& message) { return decode(raw(signedBytes(message))); }
+    SeiMessage askSigned(const SeiMessage& message)
+    {
+        last_ = raw(signedBytes(message));
+        return decode(last_);
+    }
 
     /// A new challenge, then @p message signed under it.
     SeiMessage authenticated(const SeiMessage& message)
@@ -225,6 +456,7 @@ private:
     uint16_t nodeId_;
     uint32_t serial_;
     std::array<uint8_t, sei::kSeiChallengeSize> challenge_ = {};
+    Bytes last_;
 };
 
 inline SeiMessage setNodeId(uint16_t nodeId)

@@ -62,6 +62,7 @@ ConfigError ConfigClient::ask(const Bytes& request, SeiCommand command, SeiMessa
             error.kind = ConfigError::Kind::Refused;
             error.status = out.status;
             error.lockoutSecondsLeft = out.lockoutSecondsLeft;
+            error.kernelStatus = out.kernelStatus;
         }
         return error;
     }
@@ -149,13 +150,23 @@ ConfigError ConfigClient::authenticated(const NodeIdentity& node, const Configur
     return error;
 }
 
+ConfigError ConfigClient::query(const NodeIdentity& node, const ConfigurationKey* key, const SeiMessage& request,
+                                SeiMessage& out)
+{
+    return key != nullptr ? authenticated(node, *key, request, out) : ask(encodeRequest(request), request.command, out);
+}
+
+ConfigError ConfigClient::change(const NodeIdentity& node, const ConfigurationKey& key, const SeiMessage& request,
+                                 SeiMessage& out, bool once)
+{
+    return authenticated(node, key, request, out, once);
+}
+
 ConfigError ConfigClient::getConfiguration(const NodeIdentity& node, const ConfigurationKey* key,
                                            NodeConfiguration& out)
 {
-    const SeiMessage request = requestOf(SeiCommand::GetConfiguration);
     SeiMessage reply;
-    const ConfigError error = key != nullptr ? authenticated(node, *key, request, reply)
-                                             : ask(encodeRequest(request), SeiCommand::GetConfiguration, reply);
+    const ConfigError error = query(node, key, requestOf(SeiCommand::GetConfiguration), reply);
     if (!error) {
         out = NodeConfiguration::from(reply);
     }

@@ -136,6 +136,8 @@ std::string refusalText(const std::string& who, sei::SeiStatus status, uint16_t 
     case sei::SeiStatus::NotPermitted:
         return fmt::format("{} has closed queries: give its configuration key with -K to read its configuration",
                            who);
+    case sei::SeiStatus::KernelRefused:
+        return fmt::format("{}'s kernel refused it", who);
     }
     return fmt::format("{} answered with an unknown status {}", who, static_cast<unsigned>(status));
 }

@@ -13,6 +13,8 @@
 #include <sei/SeiMessage.hpp>
 #include <sei/SeiServer.hpp>
 
+#include "../../../firmware/sei/unit_tests/SeiTestSupport.hpp"
+
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -40,36 +42,8 @@ inline ConfigurationKey keyOf(uint8_t first)
     return key;
 }
 
-/// A node's identity and card in memory.
-class MemoryBackend final : public sei::SeiBackend {
-public:
-    sei::SeiIdentity identity() override { return id; }
-    sei::SeiResult<sei::SeiConfiguration> readConfiguration() override
-    {
-        sei::SeiConfiguration copy = configuration;
-        copy.commandLine = commandLine.c_str();
-        return copy;
-    }
-    sei::SeiResult<uint32_t> writeNodeId(uint16_t nodeId) override
-    {
-        ++writes;
-        configuration.nodeId = nodeId;
-        return ++configuration.sequence;
-    }
-    sei::SeiResult<uint32_t> writeBitRate(uint32_t bitRate) override
-    {
-        ++writes;
-        configuration.bitRate = bitRate;
-        return ++configuration.sequence;
-    }
-    bool bitRateValid(uint32_t bitRate) override { return bitRate == 125000 || bitRate == 250000 || bitRate == 500000; }
-    sei::SeiStatus prepareRestart() override { return sei::SeiStatus::Ok; }
-
-    sei::SeiIdentity id;
-    sei::SeiConfiguration configuration;
-    std::string commandLine = "can0=250000";
-    unsigned writes = 0;
-};
+/// A node's identity, card and objects in memory: the protocol's own tests'.
+using MemoryBackend = sei_test::MemoryBackend;
 
 /// A whole node: backend, authenticator (with @p key, or none) and server.
 struct MemoryNode {
@@ -93,6 +67,7 @@ struct MemoryNode {
         backend.configuration.nodeId = canNode;
         backend.configuration.bitRate = 250000;
         backend.configuration.queriesClosed = queriesClosed;
+        backend.commandLine = "can0=250000";
         return backend;
     }
 

@@ -38,6 +38,7 @@
 // PublisherObject like a local one, so Read is the same code, fast path
 // included. The network receiver task fills it from the frames it
 // reassembles, once per publication whichever bus brought it first.
+#include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/DsmAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/DsmManager.hpp>
@@ -479,6 +480,11 @@ RemotePublisherInfo DsmManager::remotePublisher(size_t slot)
 }
 
 DCOS_RESOURCE_RECOVERY(dsmRecovery, "distributed shared memory", recoverDsm);
+
+ObjectTableView publisherTableView()
+{
+    return publisherTable.view();
+}
 
 } // namespace dcos::internal
 

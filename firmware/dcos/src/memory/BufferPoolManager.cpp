@@ -1,5 +1,6 @@
 // The buffer pool memory agent's kernel side (seed 7.7): the pool table,
 // holders, serialisation and resource recovery around internal::BufferPool.
+#include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/internal/BufferPool.hpp>
 #include <dcos/internal/BufferPoolManager.hpp>
 #include <dcos/internal/HeapManager.hpp>
@@ -402,6 +403,11 @@ size_t BufferPoolManager::usedCount()
 size_t BufferPoolManager::capacity() { return kPoolCapacity; }
 
 DCOS_RESOURCE_RECOVERY(bufferPoolRecovery, "buffer pool", recoverPools);
+
+ObjectTableView bufferPoolTableView()
+{
+    return poolTable.view();
+}
 
 } // namespace dcos::internal
 

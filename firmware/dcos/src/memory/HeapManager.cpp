@@ -1,5 +1,6 @@
 // The segmented heap memory agent's kernel side (seed 7.8): the heap table,
 // holders, serialisation and resource recovery around internal::SegmentedHeap.
+#include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/internal/BufferPool.hpp>
 #include <dcos/internal/BufferPoolManager.hpp>
 #include <dcos/internal/HeapManager.hpp>
@@ -356,6 +357,11 @@ size_t HeapManager::usedCount()
 size_t HeapManager::capacity() { return kHeapCapacity; }
 
 DCOS_RESOURCE_RECOVERY(heapRecovery, "heap", recoverHeaps);
+
+ObjectTableView heapTableView()
+{
+    return heapTable.view();
+}
 
 } // namespace dcos::internal
 

@@ -15,6 +15,7 @@
 // receives, so a port has exactly one receiver (N-to-1) and the owner cannot
 // give the port away while it waits in Receive; the owner or a super user may
 // Delete; only the owner transfers ownership.
+#include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/MessagePortAgent.hpp>
 #include <dcos/TaskAgent.hpp>
 #include <dcos/internal/RemoteForward.hpp>
@@ -164,6 +165,11 @@ MessageBufferCounts PortManager::bufferCounts()
 }
 
 DCOS_RESOURCE_RECOVERY(portRecovery, "message port", recoverPorts);
+
+ObjectTableView messagePortTableView()
+{
+    return portTable.view();
+}
 
 } // namespace dcos::internal
 

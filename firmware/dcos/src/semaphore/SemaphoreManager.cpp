@@ -8,6 +8,7 @@
 // changes (a task starts waiting, times out, is killed or changes priority,
 // the semaphore is released or deleted) the holder is recomputed, so it
 // drops back only as it releases the semaphores that lent it priority.
+#include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
@@ -417,6 +418,11 @@ size_t freeHoldsOfNode(uint16_t node)
 }
 
 [[gnu::noinline]] Status releaseFull(ObjectId id) { return orRemote(releaseLocal(id), RemoteService::SemaphoreRelease, id, 0); }
+
+ObjectTableView semaphoreTableView()
+{
+    return table.view();
+}
 
 } // namespace internal
 

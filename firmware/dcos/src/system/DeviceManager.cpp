@@ -1,6 +1,7 @@
 // The system agent's device management (dissertation 7.3.2): the kernel-side
 // DeviceManager, the SystemAgent interface functions that forward to it, and
 // the agent's resource recovery.
+#include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/DeviceManager.hpp>
 
@@ -326,6 +327,11 @@ unsigned recoverDevices(ObjectId deadTask)
 } // namespace
 
 DCOS_RESOURCE_RECOVERY(deviceRecovery, "system agent: devices", recoverDevices);
+
+ObjectTableView deviceTableView()
+{
+    return deviceManager().tableView();
+}
 
 } // namespace dcos::internal
 

@@ -1,3 +1,4 @@
+#include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/ObjectTable.hpp>
@@ -912,6 +913,11 @@ bool currentTaskIsSuperUser() { return !Scheduler::started() || Scheduler::curre
 uint16_t localNode() { return bsp::nodeId(); }
 
 size_t taskSlotOf(ObjectId task) { return table.slotNumber(task); }
+
+ObjectTableView taskTableView()
+{
+    return table.view();
+}
 
 } // namespace dcos::internal
 

@@ -1,3 +1,4 @@
+#include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/GregorianCalendar.hpp>
 #include <dcos/internal/CalendarCache.hpp>
 #include <dcos/internal/DayClockWheel.hpp>
@@ -570,6 +571,11 @@ Status TimerManager::addTimerObjects(size_t count)
 size_t TimerManager::timerCount() { return timerTable.usedCount(); }
 
 DCOS_RESOURCE_RECOVERY(timerRecovery, "timer", recoverTimers);
+
+ObjectTableView timerTableView()
+{
+    return timerTable.view();
+}
 
 } // namespace dcos::internal
 

@@ -8,6 +8,7 @@
 // and a write of the card is the longest thing it waits for.
 #pragma once
 
+#include <sei/SeiMessage.hpp>
 #include <sei/SeiResult.hpp>
 #include <sei/SeiStatus.hpp>
 
@@ -42,9 +43,11 @@ struct SeiConfiguration {
     bool queriesClosed = false;
     /// The lockout after three wrong MACs (0: 60 s).
     uint16_t lockoutSeconds = 0;
-    /// The kernel command line, NUL-terminated; at most kSeiMaxText
-    /// characters are sent.
+    /// The kernel command line: readConfiguration gives it NUL-terminated
+    /// (at most kSeiMaxText characters are sent); writeConfiguration takes
+    /// commandLineLength characters, not terminated.
     const char* commandLine = "";
+    uint8_t commandLineLength = 0;
 };
 
 class SeiBackend {
@@ -60,6 +63,47 @@ public:
     virtual SeiResult<uint32_t> writeBitRate(uint32_t bitRate) = 0;
     /// Whether the node's CAN controller makes @p bitRate (not 0) exactly.
     virtual bool bitRateValid(uint32_t bitRate) = 0;
+    /// Writes @p configuration's node id, bit rate, closed queries, lockout
+    /// and command line (checked by the server) as the next record, keeping
+    /// the key and serial number: that sequence, or CardError.
+    virtual SeiResult<uint32_t> writeConfiguration(const SeiConfiguration& configuration) = 0;
+    /// Whether the node's queries are closed now (the configuration's flag
+    /// as last read or written), without reading the card.
+    virtual bool queriesClosed() = 0;
+    /// ActivateBitRate: in @p delayMs, the node switches its CAN controller
+    /// to the configured bit rate if it runs at another one.
+    virtual void activateBitRate(uint16_t delayMs, uint64_t nowNs) = 0;
+
+    // The management commands (seed 7.14, 4.3.4). Each returns the kernel's
+    // dcos::Status as its value (0, Ok, or why the kernel refused), which
+    // the server sends back with KernelRefused, and fills in the reply's
+    // fields on Ok. Names written into the reply stay valid until the
+    // backend's next call.
+
+    /// ListObjects: up to kSeiMaxListEntries objects of @p type from table
+    /// index @p first on (entries, entryCount, next).
+    virtual uint8_t listObjects(uint8_t type, uint16_t first, SeiMessage& reply) = 0;
+    /// FindObject: the id of the local object of @p type named so.
+    virtual uint8_t findObject(uint8_t type, const char* name, uint8_t length, uint32_t& id) = 0;
+    /// ObjectInfo: objectType, state, owner, name and the type's values.
+    virtual uint8_t objectInfo(uint32_t id, SeiMessage& reply) = 0;
+    /// NodeStatistics: uptimeNs, taskSwitches, stackFree, tables.
+    virtual uint8_t nodeStatistics(SeiMessage& reply) = 0;
+    /// CreateTask: a task named request.name running the image's entry
+    /// point request.text, at request.priority with request.stackSize bytes
+    /// of stack and request.argument.
+    virtual uint8_t createTask(const SeiMessage& request, uint32_t& id) = 0;
+    virtual uint8_t startTask(uint32_t id) = 0;
+    virtual uint8_t stopTask(uint32_t id) = 0;
+    virtual uint8_t killTask(uint32_t id) = 0;
+    /// CreateObject: request.objectType, name, visibility and parameters.
+    virtual uint8_t createObject(const SeiMessage& request, uint32_t& id) = 0;
+    virtual uint8_t deleteObject(uint32_t id) = 0;
+    virtual uint8_t addObjects(uint8_t type, uint16_t count) = 0;
+    /// Monitor: starts, renews or (lease 0) stops the stream to the host
+    /// that asked.
+    virtual uint8_t monitor(const SeiMessage& request, uint64_t nowNs) = 0;
+
     /// An authenticated Restart is taken: whatever must be done before the
     /// node goes down (the reply is sent first, then the caller restarts
     /// the node: SeiServer::restartRequested). Anything but Ok refuses the

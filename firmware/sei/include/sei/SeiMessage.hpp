@@ -38,13 +38,45 @@ constexpr uint8_t kSeiIdentifySelected = 1u << 3;      ///< The selected node on
 /// GetConfiguration's flags.
 constexpr uint8_t kSeiConfigurationQueriesClosed = 1u << 0;
 
+/// SetConfiguration's and GetConfiguration's flags.
+constexpr uint8_t kSeiConfigurationFlagsKnown = kSeiConfigurationQueriesClosed;
+
+/// The longest object name (dcos::internal::kObjectNameCapacity - 1).
+constexpr size_t kSeiMaxName = 15;
+/// ListObjects: the most objects one reply lists.
+constexpr size_t kSeiMaxListEntries = 8;
+/// ListObjects: the reply's "next" when the list is complete.
+constexpr uint16_t kSeiListEnd = 0xFFFF;
+/// ObjectInfo: the most figures one reply carries.
+constexpr size_t kSeiMaxValues = 10;
+/// NodeStatistics: the most object tables one reply describes.
+constexpr size_t kSeiMaxTables = 8;
+/// Monitor: the most publications one stream samples.
+constexpr size_t kSeiMaxMonitorChannels = 8;
+/// Monitor's flags: bit 0, the node's console output goes to the host too.
+constexpr uint8_t kSeiMonitorLog = 1u << 0;
+constexpr uint8_t kSeiMonitorFlagsKnown = kSeiMonitorLog;
+/// CreateObject's parameters.
+constexpr size_t kSeiObjectParameters = 2;
+/// CreateObject of a semaphore: parameter 0 is the initial count,
+/// parameter 1 these flags (none: a binary semaphore, waiters by priority).
+constexpr uint32_t kSeiSemaphoreCounting = 1u << 0;
+constexpr uint32_t kSeiSemaphoreInheritance = 1u << 1;
+constexpr uint32_t kSeiSemaphoreFifo = 1u << 2;
+constexpr uint32_t kSeiSemaphoreFlagsKnown = kSeiSemaphoreCounting | kSeiSemaphoreInheritance | kSeiSemaphoreFifo;
+
 /// Code and status, which every reply starts with.
 constexpr size_t kSeiReplyHeaderSize = 2;
 /// Identify's reply without its text: node id, CAN node number, board,
 /// serial number, protocol, flags, bit rate, configured node id, text length.
 constexpr size_t kSeiIdentifyReplyFixedSize = kSeiReplyHeaderSize + 2 + 1 + 1 + 4 + 1 + 1 + 4 + 2 + 1;
-/// The largest message: Identify's reply with the longest text.
-constexpr size_t kSeiMaxMessage = kSeiIdentifyReplyFixedSize + kSeiMaxText;
+/// SetConfiguration's request without its text: code, node id, bit rate,
+/// flags, lockout seconds, text length, and its MAC.
+constexpr size_t kSeiSetConfigurationFixedSize = 1 + 2 + 4 + 1 + 2 + 1 + kSeiMacSize;
+/// The largest message: SetConfiguration with the longest command line
+/// (Identify's reply with the longest text is 8 bytes shorter).
+constexpr size_t kSeiMaxMessage = kSeiSetConfigurationFixedSize + kSeiMaxText;
+static_assert(kSeiMaxMessage >= kSeiIdentifyReplyFixedSize + kSeiMaxText, "every reply fits a message");
 
 enum class SeiCommand : uint8_t {
     Identify = 0x01,         ///< What the node is; never needs a MAC.
@@ -56,14 +88,80 @@ enum class SeiCommand : uint8_t {
     ProbeSerial = 0x20,      ///< Scanning: does any node's serial number begin so?
     Select = 0x21,           ///< Scanning: the node with this serial number answers on the broadcast address.
     Deselect = 0x22,         ///< Scanning: no node does any more.
+    ActivateBitRate = 0x23,  ///< Scanning class: every node switches to its configured bit rate after a delay.
+
+    // Queries of the node's objects (seed 7.14); a MAC when queries are closed.
+    ListObjects = 0x04,      ///< The objects of one type, a page at a time.
+    FindObject = 0x05,       ///< The id of the object of one type with this name.
+    ObjectInfo = 0x06,       ///< An object's owner, name, state and figures.
+    NodeStatistics = 0x07,   ///< Uptime, task switches, free stack memory, the tables' use.
+    Monitor = 0x08,          ///< Start, renew or stop the stream of samples and console output to the host.
+
+    // Changes (MAC).
+    SetConfiguration = 0x13, ///< Writes the whole configuration record but its keys and serial number.
+    CreateTask = 0x30,       ///< A task running an entry point the image declares.
+    StartTask = 0x31,        ///< Resumes a stopped task.
+    StopTask = 0x32,         ///< Suspends a task.
+    KillTask = 0x33,         ///< Ends a task; what it holds is recovered.
+    CreateObject = 0x34,     ///< A semaphore, message port, buffer pool, heap or publisher.
+    DeleteObject = 0x35,     ///< Deletes an object of any of those types (a task: as KillTask).
+    AddObjects = 0x36,       ///< Grows an agent's object table (the seed's AddObjects).
+};
+
+/// One object in a ListObjects reply.
+struct SeiObjectEntry {
+    uint32_t id = 0;
+    /// The owning task's id, 0 for the system.
+    uint32_t owner = 0;
+    /// Not terminated; into the decoded buffer, and encode copies from it.
+    const char* name = nullptr;
+    uint8_t nameLength = 0;
+};
+
+/// One table's use in a NodeStatistics reply.
+struct SeiTableUsage {
+    uint8_t type = 0; ///< dcos::ObjectType.
+    uint16_t used = 0;
+    uint16_t capacity = 0;
+};
+
+/// What a Monitor stream samples: a publication's current page, a field of
+/// it read as @p format at @p offset.
+enum class SeiSampleFormat : uint8_t {
+    U8 = 0,
+    I8 = 1,
+    U16 = 2,
+    I16 = 3,
+    U32 = 4,
+    I32 = 5,
+};
+constexpr uint8_t kSeiLastSampleFormat = static_cast<uint8_t>(SeiSampleFormat::I32);
+/// The bytes a sample of @p format takes in a publication's page.
+constexpr uint8_t seiSampleSize(SeiSampleFormat format)
+{
+    return format <= SeiSampleFormat::I8 ? 1 : format <= SeiSampleFormat::I16 ? 2 : 4;
+}
+/// A publication's page (dcos::kDsmPageSize).
+constexpr uint8_t kSeiPageSize = 16;
+
+struct SeiMonitorChannel {
+    uint32_t publisher = 0;
+    uint8_t offset = 0;
+    SeiSampleFormat format = SeiSampleFormat::U8;
 };
 
 /// Whether @p code is a command's request code.
 bool isSeiCommand(uint8_t code);
 
-/// Whether a request of @p command carries a MAC always (SetNodeId,
-/// SetBitRate, Restart); GetConfiguration's is optional.
+/// Whether a request of @p command carries a MAC always (every command that
+/// changes anything).
 bool seiCommandNeedsMac(SeiCommand command);
+/// Whether a request of @p command may carry a MAC and must when the node's
+/// queries are closed (GetConfiguration, the object queries, Monitor).
+bool seiCommandIsQuery(SeiCommand command);
+/// Whether every node takes @p command from the broadcast address,
+/// selected or not (ProbeSerial, Select, Deselect, ActivateBitRate).
+bool seiCommandIsBroadcast(SeiCommand command);
 
 /// The bits of a serial number ProbeSerial compares: the top @p bits of
 /// them (0 to 32).
@@ -88,8 +186,8 @@ struct SeiMessage {
     SeiStatus status = SeiStatus::Ok;
     uint16_t lockoutSecondsLeft = 0;
 
-    /// SetNodeId, SetBitRate, Restart: the MAC, always; GetConfiguration:
-    /// when hasMac.
+    /// Every command that changes anything: the MAC, always; the queries
+    /// (seiCommandIsQuery): when hasMac.
     bool hasMac = false;
     uint8_t mac[kSeiMacSize] = {};
 
@@ -111,8 +209,9 @@ struct SeiMessage {
     uint32_t bitRate = 0;
     /// Identify reply: the configured node id.
     uint16_t configuredNodeId = 0;
-    /// Identify reply: the version text; GetConfiguration reply: the
-    /// command line. Not terminated; into the decoded buffer, and encode
+    /// Identify reply: the version text; GetConfiguration reply and
+    /// SetConfiguration request: the command line; CreateTask request: the
+    /// entry point's name. Not terminated; into the decoded buffer, and encode
     /// copies from it.
     const char* text = nullptr;
     uint8_t textLength = 0;
@@ -130,6 +229,58 @@ struct SeiMessage {
     /// == probeValue and its serial number is not 0.
     uint8_t probeBits = 0;
     uint32_t probeValue = 0;
+
+    /// Replies KernelRefused: the kernel's dcos::Status.
+    uint8_t kernelStatus = 0;
+
+    /// ListObjects, FindObject, CreateObject, AddObjects requests, ObjectInfo
+    /// reply: a dcos::ObjectType.
+    uint8_t objectType = 0;
+    /// ListObjects request: the first table index to list; reply: the
+    /// index to ask for next, kSeiListEnd when the list is complete.
+    uint16_t first = 0;
+    uint16_t next = kSeiListEnd;
+    /// ListObjects reply.
+    uint8_t entryCount = 0;
+    SeiObjectEntry entries[kSeiMaxListEntries] = {};
+    /// ObjectInfo, StartTask, StopTask, KillTask, DeleteObject requests;
+    /// FindObject, CreateTask, CreateObject replies.
+    uint32_t objectId = 0;
+    /// ObjectInfo reply: the owner (0 for the system) and the state
+    /// (tasks: dcos::TaskState; other objects: 0).
+    uint32_t owner = 0;
+    uint8_t state = 0;
+    /// FindObject, CreateTask, CreateObject requests, ObjectInfo reply: the
+    /// object's name (CreateTask: the new task's). Not terminated; as text.
+    const char* name = nullptr;
+    uint8_t nameLength = 0;
+    /// CreateTask request: the entry point's name is in text.
+    uint8_t priority = 0;
+    uint32_t stackSize = 0;
+    uint32_t argument = 0;
+    /// CreateObject request: dcos::Visibility and the type's two parameters.
+    uint8_t visibility = 0;
+    uint32_t parameters[kSeiObjectParameters] = {};
+    /// AddObjects request: how many slots to add.
+    uint16_t count = 0;
+    /// ObjectInfo reply: the type's figures (docs/protocols/config.md).
+    uint8_t valueCount = 0;
+    uint64_t values[kSeiMaxValues] = {};
+    /// NodeStatistics reply.
+    uint64_t uptimeNs = 0;
+    uint32_t taskSwitches = 0;
+    uint32_t stackFree = 0;
+    uint8_t tableCount = 0;
+    SeiTableUsage tables[kSeiMaxTables] = {};
+    /// ActivateBitRate request: how long every node waits before it switches.
+    uint16_t delayMs = 0;
+    /// Monitor request: how long the stream runs unless renewed (0 stops
+    /// it), how often it samples, kSeiMonitor* flags and the channels.
+    uint16_t leaseSeconds = 0;
+    uint16_t periodMs = 0;
+    uint8_t monitorFlags = 0;
+    uint8_t channelCount = 0;
+    SeiMonitorChannel channels[kSeiMaxMonitorChannels] = {};
 
     /// Writes the message into @p out; its length, or 0 when it does not fit.
     size_t encode(uint8_t* out, size_t capacity) const;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <sei/SeiBackend.hpp>
+#include <sei/SeiMonitorControl.hpp>
 
 #include <boot/ConfigurationBlock.hpp>
 #include <boot/SectorStore.hpp>
@@ -36,6 +37,34 @@ public:
     SeiResult<uint32_t> writeBitRate(uint32_t bitRate) override;
     bool bitRateValid(uint32_t bitRate) override;
     SeiStatus prepareRestart() override { return SeiStatus::Ok; }
+    SeiResult<uint32_t> writeConfiguration(const SeiConfiguration& configuration) override;
+    bool queriesClosed() override { return queriesClosed_; }
+    void activateBitRate(uint16_t delayMs, uint64_t nowNs) override;
+
+    uint8_t listObjects(uint8_t type, uint16_t first, SeiMessage& reply) override;
+    uint8_t findObject(uint8_t type, const char* name, uint8_t length, uint32_t& id) override;
+    uint8_t objectInfo(uint32_t id, SeiMessage& reply) override;
+    uint8_t nodeStatistics(SeiMessage& reply) override;
+    uint8_t createTask(const SeiMessage& request, uint32_t& id) override;
+    uint8_t startTask(uint32_t id) override;
+    uint8_t stopTask(uint32_t id) override;
+    uint8_t killTask(uint32_t id) override;
+    uint8_t createObject(const SeiMessage& request, uint32_t& id) override;
+    uint8_t deleteObject(uint32_t id) override;
+    uint8_t addObjects(uint8_t type, uint16_t count) override;
+    uint8_t monitor(const SeiMessage& request, uint64_t nowNs) override;
+
+    /// Whether the node's queries are closed, as the configuration read at
+    /// the start says (then kept by every read and write).
+    void setQueriesClosed(bool closed) { queriesClosed_ = closed; }
+    /// Where Monitor requests go; without one they are refused (NotSupported).
+    void setMonitor(SeiMonitorControl* monitor) { monitor_ = monitor; }
+
+    /// The agent's task calls this whenever it wakes: a bit-rate switch
+    /// that ActivateBitRate asked for is made once its time has come.
+    void poll(uint64_t nowNs);
+    /// When poll() has work next (a pending switch), or UINT64_MAX.
+    uint64_t nextDeadlineNs() const { return switchAtNs_; }
 
 private:
     // Reads the record, lets @p change alter it, writes it as the next one.
@@ -48,6 +77,13 @@ private:
     uint8_t canNode_ = 0xFF;
     // The last record read: GetConfiguration's command line points into it.
     boot::ConfigurationBlock read_;
+    bool queriesClosed_ = false;
+    SeiMonitorControl* monitor_ = nullptr;
+    // ActivateBitRate's switch: when (UINT64_MAX for none) and to what.
+    uint64_t switchAtNs_ = UINT64_MAX;
+    uint32_t switchRate_ = 0;
+    // ListObjects' and ObjectInfo's names: the reply points into these.
+    char names_[kSeiMaxListEntries][kSeiMaxName + 1] = {};
 };
 
 } // namespace sei

@@ -69,6 +69,11 @@ private:
     SeiStatus setNodeId(const SeiMessage& request, SeiMessage& reply);
     SeiStatus setBitRate(const SeiMessage& request, SeiMessage& reply);
     SeiStatus restart();
+    SeiStatus setConfiguration(const SeiMessage& request, SeiMessage& reply);
+    // The object queries and management commands, once admitted.
+    SeiStatus manage(const SeiMessage& request, uint64_t nowNs, SeiMessage& reply);
+    // A query: Ok when it may be answered (its MAC right, or none needed).
+    SeiStatus admitQuery(const SeiMessage& request, const uint8_t* bytes, size_t length, uint64_t nowNs);
     Outcome select(const SeiMessage& request, SeiMessage& reply);
     SeiStatus authenticate(const SeiMessage& request, const uint8_t* bytes, size_t length, uint64_t nowNs);
 

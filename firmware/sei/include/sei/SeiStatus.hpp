@@ -19,10 +19,11 @@ enum class SeiStatus : uint8_t {
     InvalidArgument = 8, ///< A node id outside 1 to 254, a bit rate the controller cannot make exactly.
     CardError = 9,       ///< The card could not be read or written; nothing changed.
     NotPermitted = 10,   ///< A query that needs a MAC on this node (closed queries) came without one.
+    KernelRefused = 11,  ///< The kernel refused the command; the reply carries its dcos::Status.
 };
 
 /// The largest status value: a reply with a greater one does not decode.
-constexpr SeiStatus kSeiLastStatus = SeiStatus::NotPermitted;
+constexpr SeiStatus kSeiLastStatus = SeiStatus::KernelRefused;
 
 /// One line for an engineer.
 const char* seiStatusText(SeiStatus status);

@@ -31,6 +31,8 @@ struct ConfigError {
     Kind kind = Kind::None;
     sei::SeiStatus status = sei::SeiStatus::Ok;
     uint16_t lockoutSecondsLeft = 0;
+    /// For KernelRefused: the node kernel's dcos::Status.
+    uint8_t kernelStatus = 0;
     LinkError link = LinkError::None;
     std::string why; ///< For Silent, Link and Unexpected: what happened, in words.
 
@@ -73,6 +75,19 @@ public:
     /// Restart: never sent twice, since a node that took the first and lost
     /// its reply is already restarting; silence after it is said as such.
     ConfigError restart(const NodeIdentity& node, const ConfigurationKey& key);
+
+    /// Any query (sei::seiCommandIsQuery): with a MAC when @p key is given
+    /// (the node checks it whether or not its queries are closed), else
+    /// without; asked again on silence. @p out's names and text point into
+    /// this client's last reply: valid until its next call.
+    ConfigError query(const NodeIdentity& node, const ConfigurationKey* key, const sei::SeiMessage& request,
+                      sei::SeiMessage& out);
+    /// Any command that changes something, authenticated under a fresh
+    /// challenge. With @p once it is not asked again on silence: a create
+    /// whose reply was lost may have been done, and doing it twice is not
+    /// the same (the caller says so and lets the user look first).
+    ConfigError change(const NodeIdentity& node, const ConfigurationKey& key, const sei::SeiMessage& request,
+                       sei::SeiMessage& out, bool once);
 
     /// Every serial number on the bus (SerialSearch, with the link's probes).
     ConfigError scan(std::vector<uint32_t>& serials);

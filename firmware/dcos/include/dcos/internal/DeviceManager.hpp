@@ -128,6 +128,9 @@ public:
     /// Number of installed devices.
     size_t usedCount() const;
 
+    /// The table as the object directory reads it (ObjectDirectory.hpp).
+    ObjectTableView tableView() const { return table_.view(); }
+
 private:
     size_t slotOf(ObjectId id) const { return table_.slotNumber(id); }
 

@@ -125,6 +125,13 @@ public:
     /// Number of activated slots available to Create.
     constexpr size_t freeCount() const { return core_.active_ - core_.used_; }
 
+    /// The table as the object directory reads it (ObjectDirectory.hpp):
+    /// where its slots' headers are and how many are in use.
+    ObjectTableView view() const
+    {
+        return ObjectTableView{&entries_[0].header, sizeof(Entry), core_.active_, core_.used_, Capacity};
+    }
+
     /// Changes the node id, for boards that learn their logical address at boot.
     ///
     /// Refused with Busy while objects exist, because their ids already carry

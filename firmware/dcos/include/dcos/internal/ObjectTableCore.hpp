@@ -48,6 +48,23 @@ struct ObjectEntryHeader {
     uint16_t index() const { return static_cast<uint16_t>(key & ObjectId::kMaxIndex); }
 };
 
+/// One object table seen from outside its agent, for the configuration
+/// services that list every object of a type (ObjectDirectory.hpp): slot
+/// n's header is @p stride bytes after slot n - 1's.
+struct ObjectTableView {
+    const ObjectEntryHeader* first = nullptr;
+    size_t stride = 0;
+    size_t active = 0;   ///< Slots activated (AddObjects); only these are read.
+    size_t used = 0;     ///< Slots holding an object.
+    size_t capacity = 0; ///< Slots reserved at build time.
+
+    /// Slot @p slot's header (slot below active).
+    const ObjectEntryHeader& header(size_t slot) const
+    {
+        return *reinterpret_cast<const ObjectEntryHeader*>(reinterpret_cast<const uint8_t*>(first) + slot * stride);
+    }
+};
+
 /// A link between slots: a slot number plus one, zero meaning none, so that
 /// every list starts empty in zero-initialised storage.
 ///
