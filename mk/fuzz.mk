@@ -13,7 +13,7 @@
 # caused it is kept in $(FUZZ_BUILD)/artifacts/<target>/.
 
 FUZZ_BUILD := $(BUILD)/fuzz
-# Fuzzing time per target; nineteen targets, so 'make test' spends about 285 s here.
+# Fuzzing time per target; twenty targets, so 'make test' spends about 300 s here.
 FUZZ_SECONDS ?= 15
 FUZZ_TARGETS := frame isotp slcan frametext
 FUZZ_CORPUS := fieldbus/can/fuzz/corpus
@@ -53,6 +53,16 @@ FLASH_FUZZ_REPORT := $(BUILD)/reports/fuzz-flash-tests.xml
 SEI_FUZZ_TARGETS := sei_server
 SEI_FUZZ_CORPUS := firmware/sei/fuzz/corpus
 SEI_FUZZ_REPORT := $(BUILD)/reports/fuzz-sei-tests.xml
+# dcos-mon's reading of the monitoring stream (host_tools/mon/fuzz): every
+# frame of type 0x41 the bus brings, decoded by the node's own frame code.
+MON_FUZZ_TARGETS := monitor_frames
+MON_FUZZ_CORPUS := host_tools/mon/fuzz/corpus
+MON_FUZZ_REPORT := $(BUILD)/reports/fuzz-mon-tests.xml
+# dcos-config's reading of a saved node configuration (host_tools/config/fuzz),
+# the TOML file a user hands to `dcos-config restore`.
+CONFIG_FUZZ_TARGETS := saved_node
+CONFIG_FUZZ_CORPUS := host_tools/config/fuzz/corpus
+CONFIG_FUZZ_REPORT := $(BUILD)/reports/fuzz-config-tests.xml
 
 FUZZ_CXX := clang++
 # toml++ is compiled into the fuzz targets as Debian's shared library, which
@@ -66,8 +76,10 @@ FUZZ_SANITIZERS := address,undefined
 FUZZ_CXXFLAGS := -std=c++20 -O1 -g -fno-omit-frame-pointer -fno-sanitize-recover=all \
 	-Wall -Wextra -Wno-missing-field-initializers -Werror -MMD -MP \
 	-Ifieldbus/can/include -Ifieldbus/modbus/include -Ifirmware/dcos/include \
-	-Ihost_tools/modbus/include -I/usr/include/modbus -Ifirmware/image/include -Ihost_tools/image/include \
+	-Ihost_tools/modbus/include -Ihost_tools/toml/include -I/usr/include/modbus -Ifirmware/image/include -Ihost_tools/image/include \
 	-Ifirmware/flash/include -Ifirmware/boot/include -Ifirmware/runtime/include -Ifirmware/sei/include \
+	-Ihost_tools/config/include -Ihost_tools/can/include \
+	-Ihost_tools/mon/include \
 	$(TOML_RELEASE_ASSERT)
 # Objects are instrumented for coverage without libFuzzer's main; the
 # targets are linked with it.
@@ -103,12 +115,21 @@ FLASH_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(FLASH_FUZZ_TARGETS))
 SEI_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(SEI_PORTABLE_SRCS) firmware/image/src/Sha256.cpp $(CAN_PORTABLE_SRCS))
 SEI_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/sei/fuzz/fuzz_%.cpp.o,$(SEI_FUZZ_TARGETS))
 SEI_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(SEI_FUZZ_TARGETS))
+MON_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,host_tools/mon/src/StreamDecoder.cpp \
+	firmware/sei/src/MonitorFrame.cpp $(CAN_PORTABLE_SRCS))
+MON_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/mon/fuzz/fuzz_%.cpp.o,$(MON_FUZZ_TARGETS))
+MON_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(MON_FUZZ_TARGETS))
+CONFIG_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(filter-out %/CanConfigLink.cpp %/NodeSession.cpp,\
+	$(HOSTCONFIG_SRCS)) $(SEI_PORTABLE_SRCS) firmware/image/src/Sha256.cpp $(IMAGE_SRCS) $(CAN_PORTABLE_SRCS))
+CONFIG_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/config/fuzz/fuzz_%.cpp.o,$(CONFIG_FUZZ_TARGETS))
+CONFIG_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(CONFIG_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as
 # intermediate files and be deleted after every build.
 .SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS) $(MODBUS_FUZZ_LIBRARY_OBJS) $(MODBUS_FUZZ_TARGET_OBJS) \
 	$(HOST_MODBUS_FUZZ_LIBRARY_OBJS) $(HOST_MODBUS_FUZZ_TARGET_OBJS) $(DCOS_FUZZ_LIBRARY_OBJS) $(DCOS_FUZZ_TARGET_OBJS) \
 	$(IMAGE_FUZZ_LIBRARY_OBJS) $(IMAGE_FUZZ_TARGET_OBJS) $(HOST_IMAGE_FUZZ_LIBRARY_OBJS) $(HOST_IMAGE_FUZZ_TARGET_OBJS) \
-	$(FLASH_FUZZ_LIBRARY_OBJS) $(FLASH_FUZZ_TARGET_OBJS) $(SEI_FUZZ_LIBRARY_OBJS) $(SEI_FUZZ_TARGET_OBJS)
+	$(FLASH_FUZZ_LIBRARY_OBJS) $(FLASH_FUZZ_TARGET_OBJS) $(SEI_FUZZ_LIBRARY_OBJS) $(SEI_FUZZ_TARGET_OBJS) \
+	$(MON_FUZZ_LIBRARY_OBJS) $(MON_FUZZ_TARGET_OBJS) $(CONFIG_FUZZ_LIBRARY_OBJS) $(CONFIG_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
@@ -116,7 +137,8 @@ fuzz: deps
 	@$(MAKE) --no-print-directory test-fuzz
 
 fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARIES) $(DCOS_FUZZ_BINARIES) \
-	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES) $(FLASH_FUZZ_BINARIES) $(SEI_FUZZ_BINARIES)
+	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES) $(FLASH_FUZZ_BINARIES) $(SEI_FUZZ_BINARIES) \
+	$(MON_FUZZ_BINARIES) $(CONFIG_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite.
@@ -139,6 +161,10 @@ test-fuzz:
 		--seconds $(FUZZ_SECONDS) --report $(FLASH_FUZZ_REPORT) $(FLASH_FUZZ_TARGETS) || status=1; \
 	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(SEI_FUZZ_CORPUS) \
 		--seconds $(FUZZ_SECONDS) --report $(SEI_FUZZ_REPORT) $(SEI_FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(MON_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(MON_FUZZ_REPORT) $(MON_FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(CONFIG_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(CONFIG_FUZZ_REPORT) $(CONFIG_FUZZ_TARGETS) || status=1; \
 	exit $${status:-0}
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
@@ -183,6 +209,17 @@ $(SEI_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/sei/fuzz/fuzz
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lmbedcrypto
+
+$(MON_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/mon/fuzz/fuzz_%.cpp.o $(MON_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^
+
+$(CONFIG_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/config/fuzz/fuzz_%.cpp.o \
+		$(CONFIG_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lfmt -lmbedcrypto
 
 FUZZ_FLAGS_STAMP := $(FUZZ_BUILD)/flags.stamp
 $(FUZZ_FLAGS_STAMP): FORCE

@@ -4,7 +4,8 @@
 HOST_BUILD := $(BUILD)/host
 HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Wno-missing-field-initializers -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES) \
 	-Ihost_tools/can/include $(HOSTMODBUS_CXXFLAGS) -Ifirmware/image/include -Ihost_tools/image/include \
-	-Ifirmware/flash/include -Ihost_tools/flash/include -Ifirmware/sei/include -Ihost_tools/config/include
+	-Ifirmware/flash/include -Ihost_tools/flash/include -Ifirmware/sei/include -Ihost_tools/config/include \
+	$(HOSTMON_CXXFLAGS)
 
 # Firmware sources with no hardware access of their own (chip drivers go
 # through the mocked port I/O).
@@ -38,7 +39,8 @@ HOST_PORTABLE_SRCS := \
 	$(FLASH_PORTABLE_SRCS) \
 	$(HOSTFLASH_SRCS) \
 	$(SEI_PORTABLE_SRCS) \
-	$(HOSTCONFIG_SRCS)
+	$(HOSTCONFIG_SRCS) \
+	$(HOSTMON_SRCS)
 
 HOST_TEST_SRCS := $(wildcard firmware/*/unit_tests/*.cpp drivers/*/unit_tests/*.cpp fieldbus/*/unit_tests/*.cpp \
 	host_tools/*/unit_tests/*.cpp)
@@ -50,7 +52,7 @@ host-tests: $(HOST_TEST_BINARY)
 $(HOST_TEST_BINARY): $(HOST_OBJS)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
-	$(Q)g++ -o $@ $^ -lgtest -lgtest_main -pthread $(HOST_TOOLS_LIBS)
+	$(Q)g++ -o $@ $^ -lgtest -lgtest_main -pthread $(HOST_TOOLS_LIBS) $(HOSTMON_LIBS)
 
 HOST_FLAGS_STAMP := $(HOST_BUILD)/flags.stamp
 $(HOST_FLAGS_STAMP): FORCE

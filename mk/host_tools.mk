@@ -12,7 +12,7 @@ HOSTCAN_TEST_SRCS := $(wildcard host_tools/can/unit_tests/*.cpp)
 # checks, device identification framing, the simulator's behaviours, on
 # Debian's libmodbus and toml++ (the shared library, hence the defines).
 HOSTMODBUS_SRCS := $(wildcard host_tools/modbus/src/*.cpp)
-HOSTMODBUS_CXXFLAGS := -Ihost_tools/modbus/include -I/usr/include/modbus -DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1
+HOSTMODBUS_CXXFLAGS := -Ihost_tools/modbus/include -Ihost_tools/toml/include -I/usr/include/modbus -DTOML_HEADER_ONLY=0 -DTOML_SHARED_LIB=1
 # Controller images (docs/boot.md): the format and the verifier the stage
 # loader uses (firmware/image), and the host's ELF reader and signer
 # (host_tools/image), on Debian's mbedTLS.
@@ -23,6 +23,13 @@ HOSTFLASH_SRCS := $(wildcard host_tools/flash/src/*.cpp)
 # dcos-config's scan, requests and link to the nodes (host_tools/config), on
 # the configuration protocol's own code (firmware/sei).
 HOSTCONFIG_SRCS := $(wildcard host_tools/config/src/*.cpp)
+# dcos-mon's stream reader, link and trend plot (host_tools/mon), on the
+# monitoring stream's own frame code (firmware/sei) and Debian's cairo,
+# which draws the PNG (pkg-config knows its include path; the fallback is
+# where Debian puts it).
+HOSTMON_SRCS := $(wildcard host_tools/mon/src/*.cpp)
+HOSTMON_CXXFLAGS := -Ihost_tools/mon/include $(shell pkg-config --cflags cairo 2>/dev/null || echo -I/usr/include/cairo)
+HOSTMON_LIBS := -lcairo
 # The card's records, the firmware's own code (firmware/boot), which the
 # host's card tool writes and reads.
 BOOT_RECORD_SRCS := firmware/boot/src/BootState.cpp firmware/boot/src/BootStateStore.cpp firmware/boot/src/ConfigurationStore.cpp \
@@ -36,7 +43,9 @@ DCOS_IMAGE := $(HOST_TOOLS_BIN)/dcos-image
 DCOS_CARD := $(HOST_TOOLS_BIN)/dcos-card
 DCOS_FLASH := $(HOST_TOOLS_BIN)/dcos-flash
 DCOS_CONFIG := $(HOST_TOOLS_BIN)/dcos-config
-HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE) $(DCOS_CARD) $(DCOS_FLASH) $(DCOS_CONFIG)
+DCOS_MON := $(HOST_TOOLS_BIN)/dcos-mon
+HOST_TOOLS := $(DCOS_CAN) $(DCOS_MODBUS) $(DCOS_MODBUS_SIM) $(DCOS_IMAGE) $(DCOS_CARD) $(DCOS_FLASH) $(DCOS_CONFIG) \
+	$(DCOS_MON)
 
 host-tools: $(HOST_TOOLS)
 
@@ -81,3 +90,12 @@ $(DCOS_CONFIG): $(BUILD)/host/host_tools/config/tools/dcos-config.cpp.o \
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto -ltomlplusplus
+
+# dcos-mon: the configuration protocol's client and requests (host_tools/config)
+# to start and renew the stream, its own link and reader (host_tools/mon).
+$(DCOS_MON): $(BUILD)/host/host_tools/mon/tools/dcos-mon.cpp.o \
+	$(patsubst %,$(BUILD)/host/%.o,$(HOSTMON_SRCS) $(HOSTCONFIG_SRCS) $(SEI_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) \
+		$(BOOT_RECORD_SRCS) $(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto -ltomlplusplus $(HOSTMON_LIBS)

@@ -5,12 +5,9 @@ own card (dcos-card with a serial number, a configuration key and the bus's
 bit rate, so that it is on the network from boot), on a 1 Mbit/s lab bus in
 exact time.
 """
-import json
-import os
 import re
-import subprocess
 
-from dcoslab.cards import BIN, new_card, signed, card_state, tool
+from dcoslab.cards import new_card, signed, card_state, config_key, dcos_config
 from dcoslab.configwire import read_wire
 
 BITRATE = 1_000_000
@@ -20,18 +17,8 @@ TIMEOUT = 900
 PROBE_MS = "500"
 
 
-def keygen(directory, name):
-    path = os.path.join(str(directory), f"{name}.key")
-    tool("dcos-config", "keygen", "-o", path)
-    return path
-
-
 def config(lab, *arguments, code=0):
-    """dcos-config on the lab bus with --json; its (parsed output, standard error)."""
-    result = subprocess.run([os.path.join(BIN, "dcos-config"), "-i", f"lab:{lab.socket_path}:can0", "--json",
-                             "--probe-ms", PROBE_MS, *arguments], capture_output=True, text=True, timeout=TIMEOUT)
-    assert result.returncode == code, (result.returncode, result.stdout, result.stderr, lab.hub.log_text()[-4000:])
-    return (json.loads(result.stdout) if code == 0 else None), result.stderr
+    return dcos_config(lab, *arguments, code=code, probe_ms=PROBE_MS, timeout=TIMEOUT)
 
 
 def node_card(tmp_path, name, serial, key=None, append="", options=()):
@@ -44,7 +31,7 @@ def node_card(tmp_path, name, serial, key=None, append="", options=()):
 
 
 def test_two_fresh_nodes_sharing_a_number_are_found_by_serial_and_one_is_renumbered(canlab, tmp_path):
-    keys = {serial: keygen(tmp_path, f"node-{serial}") for serial in (1001, 2002)}
+    keys = {serial: config_key(tmp_path, f"node-{serial}") for serial in (1001, 2002)}
     cards = {serial: node_card(tmp_path, f"n{serial}", serial, keys[serial]) for serial in keys}
     lab = canlab({"can0": BITRATE}, {"board1": {"bus0": "can0", "card": cards[1001]},
                                      "board2": {"bus0": "can0", "card": cards[2002]}})
@@ -97,8 +84,8 @@ def test_two_fresh_nodes_sharing_a_number_are_found_by_serial_and_one_is_renumbe
 
 
 def test_wrong_keys_lock_a_node_out_and_the_lockout_ends(canlab, tmp_path):
-    key = keygen(tmp_path, "right")
-    wrong = keygen(tmp_path, "wrong")
+    key = config_key(tmp_path, "right")
+    wrong = config_key(tmp_path, "wrong")
     card = node_card(tmp_path, "n", 3003, key, append="node=3", options=("--lockout", "3"))
     lab = canlab({"can0": BITRATE}, {"board1": {"bus0": "can0", "card": card}})
     lab.hub.wait_on_bus(["board1.0"], TIMEOUT)
@@ -131,7 +118,7 @@ def test_wrong_keys_lock_a_node_out_and_the_lockout_ends(canlab, tmp_path):
 
 
 def test_a_node_without_a_key_changes_nothing_and_closed_queries_need_the_key(canlab, tmp_path):
-    key = keygen(tmp_path, "k")
+    key = config_key(tmp_path, "k")
     open_card = node_card(tmp_path, "a", 4004, None, append="node=4")
     closed_card = node_card(tmp_path, "b", 5005, key, append="node=5", options=("--closed-queries",))
     lab = canlab({"can0": BITRATE}, {"board4": {"bus0": "can0", "card": open_card},

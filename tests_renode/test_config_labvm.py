@@ -64,6 +64,13 @@ out=$(/tmp/dcos-config {common} --kernel-isotp -K {files}/node.key set-node -n {
 echo "@@SET $out status=$?@@"
 out=$(/tmp/dcos-config {common} --kernel-isotp -K {files}/other.key set-node -n {NODE} 8 2>&1)
 echo "@@WRONG $out status=$?@@"
+out=$(/tmp/dcos-config {common} objects -n {NODE} 2>&1); echo "@@OBJECTS $out status=$?@@"
+out=$(/tmp/dcos-config {common} --kernel-isotp -K {files}/node.key create -n {NODE} semaphore vmlock --initial 0 2>&1)
+echo "@@CREATE $out status=$?@@"
+out=$(/tmp/dcos-config {common} --kernel-isotp show -n {NODE} semaphore:vmlock 2>&1); echo "@@SHOW $out status=$?@@"
+out=$(/tmp/dcos-config {common} -K {files}/node.key delete -n {NODE} semaphore:vmlock 2>&1)
+echo "@@DELETE $out status=$?@@"
+out=$(/tmp/dcos-config {common} find -n {NODE} semaphore vmlock 2>&1); echo "@@GONE $out status=$?@@"
 touch /tmp/stop; wait
 echo "@@FRAMES $(tr '\\n' ';' < /tmp/frames.txt)@@"
 """
@@ -118,6 +125,21 @@ def test_dcos_config_in_the_lab_vm_scans_reads_and_renumbers_the_node_over_socke
     assert status == 0 and json.loads(written)["node_id"] == 7, written
     wrong, status = marked(world, "WRONG")
     assert status == 1 and "refused the key" in wrong, wrong
+    # The node's objects, a semaphore made, shown and deleted over SocketCAN.
+    objects, status = marked(world, "OBJECTS")
+    assert status == 0, objects
+    assert {"idle", "flash", "card"} <= {o["name"] for o in json.loads(objects)}, objects
+    created, status = marked(world, "CREATE")
+    assert status == 0, created
+    shown, status = marked(world, "SHOW")
+    assert status == 0, shown
+    shown = json.loads(shown)
+    assert (shown["id"], shown["type"], shown["count"], shown["owner"]) == (
+        json.loads(created)["id"], "semaphore", 0, "system"), shown
+    deleted, status = marked(world, "DELETE")
+    assert status == 0, deleted
+    gone, status = marked(world, "GONE")
+    assert status == 1 and "kernel refused it: not found" in gone, gone
 
 
 def test_python_can_saw_every_exchange_and_each_decodes_by_the_protocols_page(world):
@@ -136,6 +158,13 @@ def test_python_can_saw_every_exchange_and_each_decodes_by_the_protocols_page(wo
     assert [m["serial"] for m in requests if m["command"] == "Select"] == [SERIAL], requests
     assert [(m["command"], m["status"]) for m in replies if m["command"] in ("SetNodeId",)] == [
         ("SetNodeId", "Ok"), ("SetNodeId", "BadMac")], replies
+    # The object commands, each reply as the page lays it out.
+    assert [m["command"] for m in requests if m["command"] in ("CreateObject", "DeleteObject")] == [
+        "CreateObject", "DeleteObject"], requests
+    listed = [m for m in replies if m["command"] == "ListObjects" and m["status"] == "Ok"]
+    assert listed and any(name == "flash" for m in listed for _, _, name in m["entries"]), listed
+    assert [(m["command"], m["status"], m.get("kernel_status")) for m in replies if m["command"] == "FindObject"][-1] \
+        == ("FindObject", "KernelRefused", 13), replies
     identified = [m for m in replies if m["command"] == "Identify" and m["status"] == "Ok"]
     assert identified and all(m["serial"] == SERIAL and m["node"] == NODE for m in identified), identified
     # The node wrote its card: the next start is node 7's.

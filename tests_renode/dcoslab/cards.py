@@ -3,6 +3,7 @@ cards made with the built host tools (dcos-image, dcos-card), the boot
 sector, the stage loader and the development key (mk/card.mk)."""
 import json
 import os
+import shutil
 import subprocess
 
 from .board import REPOSITORY
@@ -29,6 +30,40 @@ def signed(directory, version, firmware="dcos486.elf", key=DEVELOPMENT_KEY):
     tool("dcos-image", "sign", "-k", key, "--board", "isa486", "--version", version, "-o", path,
          os.path.join(BUILT, firmware))
     return path
+
+
+def signed_application(directory, source, version="1.0.0"):
+    """The application in the folder @p source (one of the repository's, e.g.
+    tests_renode/monitor/ramp_app) built against the staged SDK in
+    @p directory and signed with the development key as @p version."""
+    folder = os.path.join(str(directory), os.path.basename(source))
+    shutil.copytree(os.path.join(REPOSITORY, source), folder)
+    makefile = os.path.join(REPOSITORY, "build", "sdk", "share", "dcos", "application.mk")
+    result = subprocess.run(["make", "--no-print-directory", "-f", makefile, f"APP={folder}", "app"],
+                            capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stdout + result.stderr
+    name = os.path.basename(source)
+    image = os.path.join(folder, f"{name}-{version}.dcos")
+    tool("dcos-image", "sign", "-k", DEVELOPMENT_KEY, "--board", "isa486", "--version", version, "-o", image,
+         os.path.join(folder, "build", f"{name}-486.elf"))
+    return image
+
+
+def config_key(directory, name):
+    """A new configuration key file made by dcos-config keygen."""
+    path = os.path.join(str(directory), f"{name}.key")
+    tool("dcos-config", "keygen", "-o", path)
+    return path
+
+
+def dcos_config(lab, *arguments, code=0, probe_ms="500", timeout=900):
+    """dcos-config on the lab's bus can0 with --json: (its parsed output, or
+    None unless it exits 0, and its standard error). The probe wait is wall
+    time on the host, so it is long enough for a busy machine."""
+    result = subprocess.run([os.path.join(BIN, "dcos-config"), "-i", f"lab:{lab.socket_path}:can0", "--json",
+                             "--probe-ms", probe_ms, *arguments], capture_output=True, text=True, timeout=timeout)
+    assert result.returncode == code, (result.returncode, result.stdout, result.stderr, lab.hub.log_text()[-4000:])
+    return (json.loads(result.stdout) if code == 0 else None), result.stderr
 
 
 def new_card(directory, *slots, append="node=3", options=()):

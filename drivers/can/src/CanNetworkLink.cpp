@@ -32,6 +32,8 @@ static_assert(static_cast<uint8_t>(dcos::SystemMessageType::Flashing) ==
               static_cast<uint8_t>(can::MessageType::Flashing));
 static_assert(static_cast<uint8_t>(dcos::SystemMessageType::Configuration) ==
               static_cast<uint8_t>(can::MessageType::Configuration));
+static_assert(static_cast<uint8_t>(dcos::SystemMessageType::Monitoring) ==
+              static_cast<uint8_t>(can::MessageType::Monitoring));
 
 namespace {
 

@@ -21,7 +21,7 @@ static_assert(MessageIdentifier::kLowestPriority == dcos::kLowestPriority);
 
 constexpr MessageType kAssignedTypes[] = {
     MessageType::TimeSync,       MessageType::RemoteReply, MessageType::RemoteRequest, MessageType::DsmPublication,
-    MessageType::Segmented,      MessageType::Configuration, MessageType::Flashing,
+    MessageType::Segmented,      MessageType::Configuration, MessageType::Monitoring, MessageType::Flashing,
 };
 
 TEST(MessageIdentifier, FieldsAtTheirBitPositions)
@@ -120,7 +120,8 @@ TEST(MessageIdentifier, OnlyTheConfigurationProtocolSendsFromTheBroadcastAddress
     ASSERT_TRUE(answer.ok());
     EXPECT_EQ(answer.value().encode(), 0x1F40FEFFu);
     EXPECT_TRUE(MessageIdentifier::decode(0x1F40FEFF).ok());
-    for (const MessageType type : {MessageType::Flashing, MessageType::RemoteReply, MessageType::NodeStarted}) {
+    for (const MessageType type : {MessageType::Flashing, MessageType::Monitoring, MessageType::RemoteReply,
+                                   MessageType::NodeStarted}) {
         EXPECT_EQ(MessageIdentifier::make(31, type, 254, MessageIdentifier::kBroadcast).error(),
                   LinkError::InvalidNodeNumber);
     }
@@ -131,7 +132,8 @@ TEST(MessageIdentifier, OnlyTheListedTypesAreAssigned)
     int assigned = 0;
     for (unsigned raw = 0; raw <= 0xFF; ++raw) {
         const bool expected = raw == 0x01 || raw == 0x10 || raw == 0x11 || raw == 0x12 || raw == 0x13 || raw == 0x14
-                              || raw == 0x20 || raw == 0x21 || raw == 0x30 || raw == 0x40 || raw == 0x50;
+                              || raw == 0x20 || raw == 0x21 || raw == 0x30 || raw == 0x40 || raw == 0x41
+                              || raw == 0x50;
         EXPECT_EQ(can::isAssignedMessageType(static_cast<uint8_t>(raw)), expected) << raw;
         const uint32_t id = (raw << MessageIdentifier::kTypeShift) | (1u << MessageIdentifier::kDestinationShift) | 2u;
         EXPECT_EQ(MessageIdentifier::decode(id).ok(), expected) << raw;
@@ -141,7 +143,7 @@ TEST(MessageIdentifier, OnlyTheListedTypesAreAssigned)
         }
         assigned += expected ? 1 : 0;
     }
-    EXPECT_EQ(assigned, 11);
+    EXPECT_EQ(assigned, 12);
     EXPECT_STREQ(can::messageTypeName(MessageType::RemoteRequest), "remote request");
     EXPECT_STREQ(can::messageTypeName(MessageType::RelayedPublication), "relayed publication");
 }

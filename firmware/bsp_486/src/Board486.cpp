@@ -33,6 +33,26 @@ constexpr uint16_t rtcPort = 0x70;
 const Rtc146818 rtc(arch_x86::IoWindow::ports(rtcPort, 2));
 Pit8254 pit(arch_x86::IoWindow::ports(pitPort, 4));
 Uart16550 uart(arch_x86::IoWindow::ports(com1Port, 8));
+
+// The console as every caller sees it: COM1, and a copy to a tap when one
+// is set (the monitoring stream's ring, setConsoleTap). The tap pointer is
+// read once per character, an aligned word, so setting it needs no lock.
+runtime::CharacterSink* volatile consoleTap = nullptr;
+
+class TeeConsole final : public runtime::CharacterSink {
+public:
+    void put(char character) override
+    {
+        // The tap first: it never blocks, while the UART may wait for room.
+        runtime::CharacterSink* const tap = consoleTap;
+        if (tap != nullptr) {
+            tap->put(character);
+        }
+        uart.put(character);
+    }
+};
+
+TeeConsole teeConsole;
 Uart16550 rs485(arch_x86::IoWindow::ports(rs485PortAddress, 8));
 Uart16550 secondRs485(arch_x86::IoWindow::ports(secondRs485PortAddress, 8));
 
@@ -316,7 +336,9 @@ void setTaskInterruptLevel(uint8_t level)
 
 uint16_t nodeId() { return node; }
 
-runtime::CharacterSink& console() { return uart; }
+runtime::CharacterSink& console() { return teeConsole; }
+
+void setConsoleTap(runtime::CharacterSink* tap) { consoleTap = tap; }
 
 bool consoleRead(char& character) { return uart.read(character); }
 

@@ -33,6 +33,7 @@ bool objectAt(const ObjectTableView& view, size_t slot, ObjectSummary& out)
     }
     out.id = ObjectId::fromRaw(header.key);
     out.owner = header.owner;
+    out.visibility = header.visibility;
     for (size_t i = 0; i < kObjectNameCapacity; ++i) {
         out.name[i] = header.name[i];
     }

@@ -22,7 +22,8 @@
 // Checks: every reply decodes and answers its request's code (or is the
 // unreadable request's); every frame the CAN server asks to send is an
 // extended Configuration frame to a host, from the node's number, or from
-// 255 only as a scan's single-frame answer or while the node is selected;
+// 255 only as a scan's single-frame answer (or the refusal of a malformed
+// broadcast command: Deselect, ActivateBitRate) or while the node is selected;
 // nothing is written to the card and no restart is asked before a request
 // of kind 7 (no MAC a fuzzer makes up verifies); a lockout never says more
 // seconds than configured; the next deadline never lies in the past after
@@ -71,7 +72,7 @@ public:
         sei::SeiConfiguration configuration;
         configuration.sequence = sequence;
         configuration.nodeId = kNode;
-        configuration.queriesClosed = queriesClosed;
+        configuration.queriesClosed = queriesClosed_;
         configuration.lockoutSeconds = kLockoutSeconds;
         configuration.commandLine = "can0=125000";
         return configuration;
@@ -88,6 +89,90 @@ public:
     }
     bool bitRateValid(uint32_t bitRate) override { return bitRate == 125000 || bitRate == 500000; }
     sei::SeiStatus prepareRestart() override { return failing ? sei::SeiStatus::CardError : sei::SeiStatus::Ok; }
+    sei::SeiResult<uint32_t> writeConfiguration(const sei::SeiConfiguration& configuration) override
+    {
+        FUZZ_CHECK(configuration.nodeId <= sei::SeiServer::kMaxNodeId);
+        FUZZ_CHECK(configuration.bitRate != 0 && bitRateValid(configuration.bitRate));
+        FUZZ_CHECK(configuration.commandLineLength <= sei::kSeiMaxText);
+        return write();
+    }
+    bool queriesClosed() override { return queriesClosed_; }
+    void activateBitRate(uint16_t, uint64_t) override { ++activations; }
+
+    // The management commands: the queries answer with full replies, so
+    // their encoding is exercised at its largest; every change counts as a
+    // write, which only an authenticated request may make.
+    uint8_t listObjects(uint8_t type, uint16_t first, sei::SeiMessage& reply) override
+    {
+        if (type == 0 || type > 13) {
+            return 6; // InvalidArgument
+        }
+        reply.entryCount = sei::kSeiMaxListEntries;
+        for (size_t i = 0; i < reply.entryCount; ++i) {
+            reply.entries[i] = {static_cast<uint32_t>((kNode << 16) | (type << 12) | (first + i)), 0,
+                                "fifteen-letters", static_cast<uint8_t>(i * 2)};
+        }
+        reply.next = first < 64 ? static_cast<uint16_t>(first + sei::kSeiMaxListEntries) : sei::kSeiListEnd;
+        return 0;
+    }
+    uint8_t findObject(uint8_t, const char*, uint8_t length, uint32_t& id) override
+    {
+        id = length;
+        return length % 2 == 0 ? 0 : 13; // NotFound
+    }
+    uint8_t objectInfo(uint32_t id, sei::SeiMessage& reply) override
+    {
+        reply.objectType = static_cast<uint8_t>((id >> 12) & 0xF);
+        reply.name = "fifteen-letters";
+        reply.nameLength = 15;
+        reply.valueCount = sei::kSeiMaxValues;
+        for (size_t i = 0; i < reply.valueCount; ++i) {
+            reply.values[i] = ~uint64_t{0} - i;
+        }
+        return id == 0 ? 1 : 0;
+    }
+    uint8_t nodeStatistics(sei::SeiMessage& reply) override
+    {
+        reply.uptimeNs = ~uint64_t{0};
+        reply.tableCount = sei::kSeiMaxTables;
+        return 0;
+    }
+    uint8_t createTask(const sei::SeiMessage& request, uint32_t& id) override
+    {
+        FUZZ_CHECK(request.textLength <= sei::kSeiMaxName && request.nameLength <= sei::kSeiMaxName);
+        return change(id);
+    }
+    uint8_t startTask(uint32_t id) override { return change(id); }
+    uint8_t stopTask(uint32_t id) override { return change(id); }
+    uint8_t killTask(uint32_t id) override { return change(id); }
+    uint8_t createObject(const sei::SeiMessage& request, uint32_t& id) override
+    {
+        FUZZ_CHECK(request.nameLength <= sei::kSeiMaxName);
+        return change(id);
+    }
+    uint8_t deleteObject(uint32_t id) override { return change(id); }
+    uint8_t addObjects(uint8_t, uint16_t count) override
+    {
+        uint32_t id = count;
+        return change(id);
+    }
+    uint8_t monitor(const sei::SeiMessage& request, uint64_t) override
+    {
+        FUZZ_CHECK(request.channelCount <= sei::kSeiMaxMonitorChannels);
+        for (size_t i = 0; i < request.channelCount; ++i) {
+            FUZZ_CHECK(request.channels[i].offset + sei::seiSampleSize(request.channels[i].format) <=
+                       sei::kSeiPageSize);
+        }
+        return 0;
+    }
+
+    // A change the node would make: a write; odd ids are refused as the
+    // kernel refuses a stale one.
+    uint8_t change(uint32_t& id)
+    {
+        ++writes;
+        return id % 2 == 0 ? 0 : 2;
+    }
 
     sei::SeiResult<uint32_t> write()
     {
@@ -99,7 +184,8 @@ public:
     }
 
     uint32_t serial = kSerial;
-    bool queriesClosed = false;
+    bool queriesClosed_ = false;
+    unsigned activations = 0;
     bool failing = false;
     uint32_t sequence = 1;
     unsigned writes = 0;
@@ -130,7 +216,8 @@ bool isScanAnswer(const can::CanFrame& frame)
     const uint8_t code = frame.data()[1];
     return code == (static_cast<uint8_t>(sei::SeiCommand::ProbeSerial) | sei::kSeiReplyBit) ||
            code == (static_cast<uint8_t>(sei::SeiCommand::Select) | sei::kSeiReplyBit) ||
-           code == (static_cast<uint8_t>(sei::SeiCommand::Deselect) | sei::kSeiReplyBit);
+           code == (static_cast<uint8_t>(sei::SeiCommand::Deselect) | sei::kSeiReplyBit) ||
+           code == (static_cast<uint8_t>(sei::SeiCommand::ActivateBitRate) | sei::kSeiReplyBit);
 }
 
 void checkOutput(const sei::SeiServer& server, const sei::CanSeiServer::Output& output)
@@ -182,7 +269,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     const uint8_t setup = data[0];
     const bool hasKey = (setup & 1) != 0;
     FuzzBackend backend;
-    backend.queriesClosed = (setup & 2) != 0;
+    backend.queriesClosed_ = (setup & 2) != 0;
     backend.failing = (setup & 4) != 0;
     backend.serial = (setup & 8) != 0 ? 0 : kSerial;
     sei::SeiAuthenticator authenticator(hasKey ? kKey : nullptr, kNode, backend.serial, kLockoutSeconds,

@@ -195,6 +195,7 @@ void encodeReply(Writer& w, const SeiMessage& m)
     case SeiCommand::ObjectInfo:
         w.u8(m.objectType);
         w.u8(m.state);
+        w.u8(m.visibility);
         w.u32(m.owner);
         writeName(w, m.name, m.nameLength);
         w.u8(m.valueCount);
@@ -428,6 +429,7 @@ bool decodeReply(Reader& r, SeiMessage& m)
     case SeiCommand::ObjectInfo:
         m.objectType = r.u8();
         m.state = r.u8();
+        m.visibility = r.u8();
         m.owner = r.u32();
         if (!readName(r, m.name, m.nameLength)) {
             return false;

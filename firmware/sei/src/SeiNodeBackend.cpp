@@ -19,6 +19,7 @@
 #include <dcos/internal/ObjectDirectory.hpp>
 #include <dcos/internal/PortManager.hpp>
 #include <dcos/internal/Scheduler.hpp>
+#include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/internal/StackArena.hpp>
 #include <dcos/internal/Task.hpp>
 #include <dcos/internal/TaskManager.hpp>
@@ -44,6 +45,7 @@ SeiResult<SeiConfiguration> SeiNodeBackend::readConfiguration()
     }
     read_ = stored.configuration;
     queriesClosed_ = read_.queriesClosed();
+    queriesKnown_ = true;
     SeiConfiguration configuration;
     configuration.sequence = read_.sequence;
     configuration.nodeId = read_.nodeId;
@@ -138,6 +140,14 @@ bool terminatedName(const char* name, uint8_t length, char (&out)[kSeiMaxName + 
     return true;
 }
 
+// Whether the node already has an object of @p type named @p name: the
+// bus names objects to find them again (FindObject, a restore), so it
+// never makes a second one of a name, though the kernel would.
+bool nameTaken(ObjectType type, const char* name)
+{
+    return name != nullptr && dcos::internal::localNameToObject(type, name, dcos::Visibility::Local).ok();
+}
+
 // Hands an object the agent's task created to the system, so that it lives
 // until it is deleted, not until the agent's task ends.
 template <typename Transfer>
@@ -226,6 +236,7 @@ uint8_t SeiNodeBackend::objectInfo(uint32_t raw, SeiMessage& reply)
         names_[0][i] = summary.name[i];
     }
     reply.objectType = static_cast<uint8_t>(id.type());
+    reply.visibility = static_cast<uint8_t>(summary.visibility);
     reply.owner = summary.owner.raw();
     reply.name = names_[0];
     reply.nameLength = nameLength(names_[0]);
@@ -282,8 +293,10 @@ uint8_t SeiNodeBackend::objectInfo(uint32_t raw, SeiMessage& reply)
         if (!count.ok()) {
             return statusValue(count.status());
         }
+        const dcos::Result<uint32_t> settings = dcos::internal::semaphoreSettings(id);
         value(count.value());
         value(holder.ok() ? holder.value().raw() : 0);
+        value(settings.ok() ? settings.value() : 0);
         break;
     }
     case ObjectType::MessagePort: {
@@ -395,6 +408,9 @@ uint8_t SeiNodeBackend::createTask(const SeiMessage& request, uint32_t& id)
     if (declaration == nullptr) {
         return statusValue(Status::NotFound);
     }
+    if (request.nameLength != 0 && nameTaken(ObjectType::Task, taskName)) {
+        return statusValue(Status::AlreadyExists);
+    }
     dcos::TaskAttributes attributes = declaration->attributes();
     attributes.name = request.nameLength != 0 ? taskName : nullptr;
     attributes.priority = request.priority;
@@ -443,6 +459,10 @@ uint8_t SeiNodeBackend::createObject(const SeiMessage& request, uint32_t& id)
     }
     const char* named = request.nameLength != 0 ? name : nullptr;
     const dcos::Visibility visibility = static_cast<dcos::Visibility>(request.visibility);
+    if (dcos::internal::objectTableOf(static_cast<ObjectType>(request.objectType)).ok() &&
+        nameTaken(static_cast<ObjectType>(request.objectType), named)) {
+        return statusValue(Status::AlreadyExists);
+    }
     switch (static_cast<ObjectType>(request.objectType)) {
     case ObjectType::Semaphore: {
         const uint32_t flags = request.parameters[1];
@@ -539,8 +559,19 @@ SeiResult<uint32_t> SeiNodeBackend::writeConfiguration(const SeiConfiguration& c
     });
     if (written.ok()) {
         queriesClosed_ = configuration.queriesClosed;
+        queriesKnown_ = true;
     }
     return written;
+}
+
+bool SeiNodeBackend::queriesClosed()
+{
+    // The first query reads the card; a card that cannot be read keeps the
+    // queries closed, since nothing says they may be open.
+    if (!queriesKnown_) {
+        (void)readConfiguration();
+    }
+    return queriesClosed_;
 }
 
 void SeiNodeBackend::activateBitRate(uint16_t delayMs, uint64_t nowNs)

@@ -188,9 +188,11 @@ SeiStatus SeiServer::manage(const SeiMessage& request, uint64_t nowNs, SeiMessag
 
 SeiStatus SeiServer::setConfiguration(const SeiMessage& request, SeiMessage& reply)
 {
-    // The same values SetNodeId and SetBitRate take, for the same reasons.
-    if (request.nodeId < kMinNodeId || request.nodeId > kMaxNodeId || request.bitRate == 0 ||
-        !backend_.bitRateValid(request.bitRate)) {
+    // The bit rate SetBitRate takes, for the same reasons; the node ids
+    // SetNodeId takes, and 0, as GetConfiguration says it: none set, so the
+    // kernel command line's or the default is used (a saved configuration
+    // restored as it was).
+    if (request.nodeId > kMaxNodeId || request.bitRate == 0 || !backend_.bitRateValid(request.bitRate)) {
         return SeiStatus::InvalidArgument;
     }
     SeiConfiguration configuration;

@@ -22,18 +22,7 @@ protected:
     {
     }
 
-    SeiHost::Carrier carrier()
-    {
-        return [this](const Bytes& bytes) -> std::optional<Bytes> {
-            Bytes reply(sei::kSeiMaxMessage);
-            const size_t length = node.server.handle(bytes.data(), bytes.size(), reply.data(), reply.size(), now);
-            if (length == 0) {
-                return std::nullopt;
-            }
-            reply.resize(length);
-            return reply;
-        };
-    }
+    SeiHost::Carrier carrier() { return serverCarrier(node.server, now); }
 
     SeiMessage createTask(const char* entry, const char* name, uint8_t priority = 9, uint32_t stack = 4096)
     {
@@ -280,7 +269,7 @@ TEST_F(SeiManagementTest, SetConfigurationRefusesWhatSetNodeIdAndSetBitRateRefus
     SeiMessage m = request(SeiCommand::SetConfiguration);
     m.nodeId = 9;
     m.bitRate = 500000;
-    for (const uint16_t id : {0, 255}) {
+    for (const uint16_t id : {255, 256, 0xFFFF}) {
         m.nodeId = id;
         EXPECT_EQ(host.authenticated(m).status, SeiStatus::InvalidArgument) << id;
     }
@@ -291,6 +280,9 @@ TEST_F(SeiManagementTest, SetConfigurationRefusesWhatSetNodeIdAndSetBitRateRefus
     }
     EXPECT_EQ(node.backend.writes, 0u);
     m.bitRate = 250000;
+    m.nodeId = 0;
+    EXPECT_EQ(host.authenticated(m).status, SeiStatus::Ok) << "0: no node id set, the command line's is used";
+    EXPECT_EQ(node.backend.configuration.nodeId, 0);
     node.backend.failing = true;
     EXPECT_EQ(host.authenticated(m).status, SeiStatus::CardError);
 }

@@ -379,13 +379,14 @@ TEST(SeiMessageTest, ObjectInfoReply)
     SeiMessage m = reply(SeiCommand::ObjectInfo);
     m.objectType = 1;
     m.state = 5;
+    m.visibility = 2;
     m.owner = 0;
     m.name = "pid";
     m.nameLength = 3;
     m.valueCount = 2;
     m.values[0] = 8;
     m.values[1] = 0x0102030405060708ull;
-    roundTrip(m, {0x86, 0x00, 1, 5, 0, 0, 0, 0, 3, 'p', 'i', 'd', 2, 8, 0, 0, 0, 0, 0, 0, 0, 0x08, 0x07, 0x06, 0x05,
+    roundTrip(m, {0x86, 0x00, 1, 5, 2, 0, 0, 0, 0, 3, 'p', 'i', 'd', 2, 8, 0, 0, 0, 0, 0, 0, 0, 0x08, 0x07, 0x06, 0x05,
                   0x04, 0x03, 0x02, 0x01});
 }
 

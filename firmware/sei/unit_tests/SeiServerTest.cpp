@@ -21,18 +21,7 @@ protected:
     {
     }
 
-    SeiHost::Carrier carrier()
-    {
-        return [this](const Bytes& bytes) -> std::optional<Bytes> {
-            Bytes reply(sei::kSeiMaxMessage);
-            const size_t length = node.server.handle(bytes.data(), bytes.size(), reply.data(), reply.size(), now);
-            if (length == 0) {
-                return std::nullopt;
-            }
-            reply.resize(length);
-            return reply;
-        };
-    }
+    SeiHost::Carrier carrier() { return serverCarrier(node.server, now); }
 
     /// The reply to @p bytes, or none.
     std::optional<Bytes> answer(const Bytes& bytes) { return carrier()(bytes); }

@@ -137,6 +137,7 @@ public:
         uint32_t owner = 0;
         std::string name;
         uint8_t state = 2; // dcos::TaskState::Ready
+        uint8_t visibility = 0;
         uint8_t priority = 0;
         uint32_t stackSize = 0;
     };
@@ -190,12 +191,15 @@ public:
         }
         reply.objectType = it->second.type;
         reply.state = it->second.type == kTask ? it->second.state : 0;
+        reply.visibility = it->second.visibility;
         reply.owner = it->second.owner;
         reply.name = it->second.name.c_str();
         reply.nameLength = static_cast<uint8_t>(it->second.name.size());
-        reply.valueCount = it->second.type == kTask ? 2 : 0;
+        // As the node's: base priority, priority, stack size.
+        reply.valueCount = it->second.type == kTask ? 3 : 0;
         reply.values[0] = it->second.priority;
-        reply.values[1] = it->second.stackSize;
+        reply.values[1] = it->second.priority;
+        reply.values[2] = it->second.stackSize;
         return 0;
     }
     uint8_t nodeStatistics(SeiMessage& reply) override
@@ -246,6 +250,7 @@ public:
         Object object;
         object.type = request.objectType;
         object.name.assign(request.name, request.nameLength);
+        object.visibility = request.visibility;
         return add(object, created);
     }
     uint8_t deleteObject(uint32_t object) override
@@ -458,6 +463,21 @@ private:
     std::array<uint8_t, sei::kSeiChallengeSize> challenge_ = {};
     Bytes last_;
 };
+
+/// Carries a host's requests straight to @p server at the time @p now holds
+/// when each is sent.
+inline SeiHost::Carrier serverCarrier(sei::SeiServer& server, const uint64_t& now)
+{
+    return [&server, &now](const Bytes& bytes) -> std::optional<Bytes> {
+        Bytes reply(sei::kSeiMaxMessage);
+        const size_t length = server.handle(bytes.data(), bytes.size(), reply.data(), reply.size(), now);
+        if (length == 0) {
+            return std::nullopt;
+        }
+        reply.resize(length);
+        return reply;
+    };
+}
 
 inline SeiMessage setNodeId(uint16_t nodeId)
 {

@@ -21,6 +21,14 @@ std::unique_ptr<IsoTpRequester> IsoTpRequester::open(const std::string& interfac
     return requester;
 }
 
+std::unique_ptr<IsoTpRequester> IsoTpRequester::over(std::unique_ptr<Transport> transport,
+                                                     const can::IsoTpConfig& config)
+{
+    std::unique_ptr<IsoTpRequester> requester(new IsoTpRequester(config));
+    requester->transport_ = std::move(transport);
+    return requester;
+}
+
 ExchangeOutcome IsoTpRequester::exchange(const std::vector<uint8_t>& request, std::chrono::milliseconds timeout,
                                          const std::function<bool(const std::vector<uint8_t>&)>& accept)
 {

@@ -65,8 +65,10 @@ CanConfigLink::CanConfigLink(const std::string& interface, const CanConfigAddres
 {
 }
 
-std::unique_ptr<CanConfigLink> CanConfigLink::open(const std::string& interface, const CanConfigAddress& address,
-                                                   LinkError& error, std::string& why)
+namespace {
+
+// Addresses no node could answer: said before anything is opened.
+bool addressesRefused(const CanConfigAddress& address, LinkError& error, std::string& why)
 {
     if (address.host > can::MessageIdentifier::kMaxNodeNumber || address.node == address.host ||
         address.priority > can::MessageIdentifier::kLowestPriority) {
@@ -75,6 +77,17 @@ std::unique_ptr<CanConfigLink> CanConfigLink::open(const std::string& interface,
                           "from the node's ({}), and priorities are 0 to {}",
                           can::MessageIdentifier::kMaxNodeNumber, address.host, address.node,
                           can::MessageIdentifier::kLowestPriority);
+        return true;
+    }
+    return false;
+}
+
+} // namespace
+
+std::unique_ptr<CanConfigLink> CanConfigLink::open(const std::string& interface, const CanConfigAddress& address,
+                                                   LinkError& error, std::string& why)
+{
+    if (addressesRefused(address, error, why)) {
         return nullptr;
     }
     std::unique_ptr<CanConfigLink> link(new CanConfigLink(interface, address));
@@ -87,6 +100,19 @@ std::unique_ptr<CanConfigLink> CanConfigLink::open(const std::string& interface,
         why = opened.message;
         return nullptr;
     }
+    return link;
+}
+
+std::unique_ptr<CanConfigLink> CanConfigLink::over(std::unique_ptr<hostcan::Transport> transport,
+                                                   const CanConfigAddress& address, LinkError& error, std::string& why)
+{
+    if (addressesRefused(address, error, why)) {
+        return nullptr;
+    }
+    const std::string name = transport->name();
+    std::unique_ptr<CanConfigLink> link(new CanConfigLink(name, address));
+    link->requester_ = hostcan::IsoTpRequester::over(
+        std::move(transport), sei::canSeiConnection(address.node, address.host, address.priority, true));
     return link;
 }
 
@@ -201,10 +227,9 @@ LinkError CanConfigLink::probe(uint8_t bits, uint32_t value, bool& answered, std
     }
 }
 
-LinkError CanConfigLink::deselect(std::string& why)
+LinkError CanConfigLink::announce(const Bytes& request, std::string& why)
 {
-    const uint8_t deselect[] = {static_cast<uint8_t>(sei::SeiCommand::Deselect)};
-    return sendBroadcast(deselect, sizeof deselect, why);
+    return sendBroadcast(request.data(), request.size(), why);
 }
 
 } // namespace hostconfig

@@ -11,14 +11,6 @@ namespace {
 using sei::SeiCommand;
 using sei::SeiMessage;
 
-SeiMessage requestOf(SeiCommand command)
-{
-    SeiMessage message;
-    message.kind = sei::SeiMessageKind::Request;
-    message.command = command;
-    return message;
-}
-
 ConfigError linkError(LinkError link, const std::string& why)
 {
     ConfigError error;
@@ -107,8 +99,20 @@ ConfigError ConfigClient::select(uint32_t serial, SelectedNode& out)
 
 ConfigError ConfigClient::deselect()
 {
+    return announce(encodeRequest(requestOf(SeiCommand::Deselect)));
+}
+
+ConfigError ConfigClient::activateBitRate(uint16_t delayMs)
+{
+    SeiMessage request = requestOf(SeiCommand::ActivateBitRate);
+    request.delayMs = delayMs;
+    return announce(encodeRequest(request));
+}
+
+ConfigError ConfigClient::announce(const Bytes& request)
+{
     std::string why;
-    const LinkError sent = link_.deselect(why);
+    const LinkError sent = link_.announce(request, why);
     return sent == LinkError::None ? ConfigError{} : linkError(sent, why);
 }
 

@@ -11,6 +11,14 @@
 
 namespace hostconfig {
 
+sei::SeiMessage requestOf(sei::SeiCommand command)
+{
+    sei::SeiMessage message;
+    message.kind = sei::SeiMessageKind::Request;
+    message.command = command;
+    return message;
+}
+
 Bytes encodeRequest(const sei::SeiMessage& request)
 {
     sei::SeiMessage message = request;

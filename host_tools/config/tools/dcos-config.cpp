@@ -7,6 +7,11 @@
 //     dcos-config -i IFACE set-node (-n NODE | --serial S) -K KEYFILE NEWID
 //     dcos-config -i IFACE set-bitrate (-n NODE | --serial S) -K KEYFILE RATE
 //     dcos-config -i IFACE restart (-n NODE | --serial S) -K KEYFILE
+//     dcos-config -i IFACE objects|find|show|stats ... (-n NODE | --serial S) [-K KEYFILE]
+//     dcos-config -i IFACE create|delete|add-objects|task-create|task-start|task-stop|task-kill ... -K KEYFILE
+//     dcos-config -i IFACE save (-n NODE | --serial S) [-K KEYFILE] FILE.toml
+//     dcos-config -i IFACE restore (-n NODE | --serial S) -K KEYFILE FILE.toml
+//     dcos-config -i IFACE switch-bitrate [--delay-ms MS]
 //
 // IFACE is a CAN interface as every DCOS tool takes it (can0,
 // slcan:/dev/ttyACM0, lab:/hub.sock:can0). A node is reached at its CAN
@@ -31,6 +36,9 @@
 #include <hostconfig/CanConfigLink.hpp>
 #include <hostconfig/ConfigClient.hpp>
 #include <hostconfig/ConfigRequest.hpp>
+#include <hostconfig/ConfigurationFile.hpp>
+#include <hostconfig/NodeObjects.hpp>
+#include <hostconfig/NodeSession.hpp>
 
 #include <hostimage/ConfigurationKeyFile.hpp>
 
@@ -46,7 +54,9 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,11 +70,13 @@ using hostconfig::LinkError;
 using hostconfig::NodeConfiguration;
 using hostconfig::NodeIdentity;
 
-constexpr int kExitOk = 0;
-constexpr int kExitRefused = 1;
-constexpr int kExitUsage = 2;
-constexpr int kExitNotAvailable = 3;
-constexpr int kExitNoAnswer = 4;
+using hostconfig::kExitNoAnswer;
+using hostconfig::kExitNotAvailable;
+using hostconfig::kExitOk;
+using hostconfig::kExitRefused;
+using hostconfig::kExitUsage;
+using hostconfig::describe;
+using hostconfig::exitCodeOf;
 
 int fail(int code, const std::string& message)
 {
@@ -91,32 +103,17 @@ struct Options {
     bool force = false;
     uint16_t newNodeId = 0;
     uint32_t bitRate = 0;
+    // The object commands' arguments.
+    std::string kind;
+    std::string name;
+    std::string target;
+    std::string file;
+    hostconfig::ObjectSpec object;
+    std::string visibility = "local";
+    hostconfig::TaskSpec task;
+    uint16_t count = 0;
+    int delayMs = 500;
 };
-
-int exitCodeOf(const ConfigError& error)
-{
-    switch (error.kind) {
-    case ConfigError::Kind::None: return kExitOk;
-    case ConfigError::Kind::Refused:
-    case ConfigError::Kind::Unexpected: return kExitRefused;
-    case ConfigError::Kind::Silent: return kExitNoAnswer;
-    case ConfigError::Kind::Link: return error.link == LinkError::BadArgument ? kExitUsage : kExitNotAvailable;
-    }
-    return kExitRefused;
-}
-
-// The engineer's sentence for @p error about @p who ("node 3").
-std::string describe(const ConfigError& error, const std::string& who)
-{
-    switch (error.kind) {
-    case ConfigError::Kind::None: return fmt::format("{}: done", who);
-    case ConfigError::Kind::Refused: return hostconfig::refusalText(who, error.status, error.lockoutSecondsLeft);
-    case ConfigError::Kind::Silent: return fmt::format("no answer from {}: {}", who, error.why);
-    case ConfigError::Kind::Link: return error.why;
-    case ConfigError::Kind::Unexpected: return fmt::format("{}: {}", who, error.why);
-    }
-    return error.why;
-}
 
 int failWith(const ConfigError& error, const std::string& who) { return fail(exitCodeOf(error), describe(error, who)); }
 
@@ -167,33 +164,6 @@ std::optional<ConfigurationKey> readKey(const Options& options, int& code)
     return key;
 }
 
-// A node reached by its serial number stays selected on the broadcast
-// address until this ends, whichever way the command ends: a selection left
-// behind would make that node take every later request to the broadcast
-// address, another host's too.
-class Selection {
-public:
-    explicit Selection(ConfigClient& client) : client_(client) {}
-    ~Selection()
-    {
-        if (active_) {
-            if (const ConfigError error = client_.deselect()) {
-                warn(fmt::format("could not send Deselect: {} (the node stays selected until another Select or its "
-                                 "restart)",
-                                 error.why));
-            }
-        }
-    }
-    Selection(const Selection&) = delete;
-    Selection& operator=(const Selection&) = delete;
-
-    void begin() { active_ = true; }
-
-private:
-    ConfigClient& client_;
-    bool active_ = false;
-};
-
 std::unique_ptr<hostconfig::CanConfigLink> openLink(const Options& options, uint8_t node, int& code)
 {
     hostconfig::CanConfigAddress address;
@@ -211,46 +181,13 @@ std::unique_ptr<hostconfig::CanConfigLink> openLink(const Options& options, uint
     return link;
 }
 
-// Reaches the node -n or --serial names and identifies it: @p node and the
-// name messages give it (@p who), or the exit code.
-int reach(ConfigClient& client, Selection& selection, const Options& options, NodeIdentity& node, std::string& who)
-{
-    if (options.bySerial) {
-        who = fmt::format("the node with serial {}", options.serial);
-        hostconfig::SelectedNode selected;
-        selection.begin();
-        if (const ConfigError error = client.select(options.serial, selected)) {
-            if (error.kind == ConfigError::Kind::Silent) {
-                return fail(kExitNoAnswer, fmt::format("no node with serial {} answered Select (is it on the bus? "
-                                                       "`dcos-config scan` lists the serial numbers): {}",
-                                                       options.serial, error.why));
-            }
-            return failWith(error, who);
-        }
-    } else {
-        who = fmt::format("node {}", options.node);
-    }
-    if (const ConfigError error = client.identify(node)) {
-        return failWith(error, who);
-    }
-    if (options.bySerial && node.serial != options.serial) {
-        // Another host's Select came in between: do not change that node.
-        return fail(kExitRefused, fmt::format("the selected node has serial {}, not {}: is another host scanning "
-                                              "the bus?",
-                                              node.serial, options.serial));
-    }
-    who = options.bySerial ? fmt::format("node {} (serial {})", node.nodeId, node.serial)
-                           : fmt::format("node {}", node.nodeId);
-    return kExitOk;
-}
-
 // A node reached for one command: the link, the client on it, the
 // selection that ends (Deselect) when this goes, and who the node is.
 // Members go in reverse order, so the Deselect still has its client.
 struct ReachedNode {
     std::unique_ptr<hostconfig::CanConfigLink> link;
     std::unique_ptr<ConfigClient> client;
-    std::unique_ptr<Selection> selection;
+    std::unique_ptr<hostconfig::Selection> selection;
     NodeIdentity node;
     std::string who;
 };
@@ -269,8 +206,11 @@ int reachNode(const Options& options, ReachedNode& reached)
     }
     reached.client = std::make_unique<ConfigClient>(
         *reached.link, hostconfig::ClientOptions{std::chrono::milliseconds(options.timeoutMs), options.retries});
-    reached.selection = std::make_unique<Selection>(*reached.client);
-    return reach(*reached.client, *reached.selection, options, reached.node, reached.who);
+    reached.selection = std::make_unique<hostconfig::Selection>(*reached.client, warn);
+    const hostconfig::ReachOutcome outcome = hostconfig::reachNode(
+        *reached.client, *reached.selection, {options.bySerial, options.serial, options.node}, reached.node,
+        reached.who);
+    return outcome.code == kExitOk ? kExitOk : fail(outcome.code, outcome.message);
 }
 
 int keygen(const Options& options)
@@ -310,7 +250,7 @@ int scan(const Options& options)
     nlohmann::json nodes = nlohmann::json::array();
     bool missing = false;
     {
-        Selection selection(client);
+        hostconfig::Selection selection(client, warn);
         for (const uint32_t serial : serials) {
             const std::string who = fmt::format("serial {}", serial);
             hostconfig::SelectedNode selected;
@@ -457,12 +397,528 @@ int change(const Options& options, Change what)
     return kExitOk;
 }
 
+// The key -K names, when given; @p code is set when it cannot be read.
+std::optional<ConfigurationKey> optionalKey(const Options& options, int& code)
+{
+    return options.keyFile.empty() ? std::nullopt : readKey(options, code);
+}
+
+// Reaches the node for a query: with the key when given, and a clear word
+// when the node's queries are closed and no key was given.
+int reachForQuery(const Options& options, ReachedNode& reached, const std::optional<ConfigurationKey>& key)
+{
+    if (const int status = reachNode(options, reached); status != kExitOk) {
+        return status;
+    }
+    if (!key && reached.node.queriesClosed()) {
+        return fail(kExitUsage, fmt::format("{} has closed queries (dcos-card create --closed-queries): give its "
+                                            "configuration key with -K KEYFILE",
+                                            reached.who));
+    }
+    return kExitOk;
+}
+
+// A node reached for queries: its key when -K gave one, and its objects.
+// Members go in reverse order, so the objects go before their client.
+struct QueriedNode {
+    std::optional<ConfigurationKey> key;
+    ReachedNode reached;
+    std::unique_ptr<hostconfig::NodeObjects> objects;
+};
+
+int queryNode(const Options& options, QueriedNode& queried)
+{
+    int code = kExitOk;
+    queried.key = optionalKey(options, code);
+    if (code != kExitOk) {
+        return code;
+    }
+    if (const int status = reachForQuery(options, queried.reached, queried.key); status != kExitOk) {
+        return status;
+    }
+    queried.objects = std::make_unique<hostconfig::NodeObjects>(*queried.reached.client, queried.reached.node,
+                                                                queried.key ? &*queried.key : nullptr);
+    return kExitOk;
+}
+
+std::optional<hostconfig::ObjectKind> kindArgument(const std::string& word)
+{
+    const std::optional<hostconfig::ObjectKind> kind = hostconfig::kindFromName(word);
+    if (!kind) {
+        std::string known;
+        for (const hostconfig::ObjectKind k : hostconfig::listedKinds()) {
+            known += (known.empty() ? "" : ", ") + hostconfig::kindName(static_cast<uint8_t>(k));
+        }
+        fail(kExitUsage, fmt::format("'{}' is no object type; the types are {}", word, known));
+    }
+    return kind;
+}
+
+// The object @p text names: an id (0x0005a001 or decimal), or KIND:NAME, or
+// (with @p fallback) a name of that kind, as the node finds it.
+int resolveObject(hostconfig::NodeObjects& objects, const std::string& text,
+                  std::optional<hostconfig::ObjectKind> fallback, const std::string& who, uint32_t& id)
+{
+    if (const std::optional<uint32_t> parsed = hostconfig::parseId(text)) {
+        id = *parsed;
+        return kExitOk;
+    }
+    std::optional<hostconfig::ObjectKind> kind = fallback;
+    std::string name = text;
+    if (const size_t colon = text.find(':'); colon != std::string::npos) {
+        kind = kindArgument(text.substr(0, colon));
+        if (!kind) {
+            return kExitUsage;
+        }
+        name = text.substr(colon + 1);
+    }
+    if (!kind || name.empty() || name.size() > sei::kSeiMaxName) {
+        return fail(kExitUsage, fmt::format("'{}' is neither an id (0x0005a001) nor TYPE:NAME with a name of 1 to {} "
+                                            "characters",
+                                            text, sei::kSeiMaxName));
+    }
+    if (const ConfigError error = objects.find(*kind, name, id)) {
+        return failWith(error, who);
+    }
+    return kExitOk;
+}
+
+nlohmann::json entryJson(const hostconfig::ObjectEntry& entry)
+{
+    return {{"id", hostconfig::idText(entry.id)},
+            {"type", hostconfig::kindName(entry.type)},
+            {"name", entry.name},
+            {"owner", entry.owner == 0 ? std::string("system") : hostconfig::idText(entry.owner)}};
+}
+
+int listObjects(const Options& options)
+{
+    std::vector<hostconfig::ObjectKind> kinds = hostconfig::listedKinds();
+    if (!options.kind.empty()) {
+        const std::optional<hostconfig::ObjectKind> kind = kindArgument(options.kind);
+        if (!kind) {
+            return kExitUsage;
+        }
+        kinds = {*kind};
+    }
+    QueriedNode queried;
+    if (const int status = queryNode(options, queried); status != kExitOk) {
+        return status;
+    }
+    hostconfig::NodeObjects& objects = *queried.objects;
+    const ReachedNode& reached = queried.reached;
+    nlohmann::json out = nlohmann::json::array();
+    if (!options.json) {
+        fmt::print("{:<12} {:<10} {:<16} {}\n", "id", "type", "name", "owner");
+    }
+    for (const hostconfig::ObjectKind kind : kinds) {
+        std::vector<hostconfig::ObjectEntry> entries;
+        if (const ConfigError error = objects.list(kind, entries)) {
+            return failWith(error, reached.who);
+        }
+        for (const hostconfig::ObjectEntry& entry : entries) {
+            if (options.json) {
+                out.push_back(entryJson(entry));
+            } else {
+                fmt::print("{:<12} {:<10} {:<16} {}\n", hostconfig::idText(entry.id), hostconfig::kindName(entry.type),
+                           entry.name.empty() ? "-" : entry.name,
+                           entry.owner == 0 ? std::string("system") : hostconfig::idText(entry.owner));
+            }
+        }
+    }
+    if (options.json) {
+        fmt::print("{}\n", out.dump());
+    }
+    return kExitOk;
+}
+
+int findObject(const Options& options)
+{
+    const std::optional<hostconfig::ObjectKind> kind = kindArgument(options.kind);
+    if (!kind) {
+        return kExitUsage;
+    }
+    QueriedNode queried;
+    if (const int status = queryNode(options, queried); status != kExitOk) {
+        return status;
+    }
+    uint32_t id = 0;
+    if (const ConfigError error = queried.objects->find(*kind, options.name, id)) {
+        return failWith(error, queried.reached.who);
+    }
+    if (options.json) {
+        fmt::print("{}\n", nlohmann::json{{"id", hostconfig::idText(id)}, {"type", options.kind},
+                                          {"name", options.name}}.dump());
+    } else {
+        fmt::print("{}\n", hostconfig::idText(id));
+    }
+    return kExitOk;
+}
+
+int showObject(const Options& options)
+{
+    QueriedNode queried;
+    if (const int status = queryNode(options, queried); status != kExitOk) {
+        return status;
+    }
+    hostconfig::NodeObjects& objects = *queried.objects;
+    const ReachedNode& reached = queried.reached;
+    uint32_t id = 0;
+    if (const int status = resolveObject(objects, options.target, std::nullopt, reached.who, id); status != kExitOk) {
+        return status;
+    }
+    hostconfig::ObjectDetails details;
+    if (const ConfigError error = objects.info(id, details)) {
+        return failWith(error, reached.who);
+    }
+    static const char* const visibilities[] = {"local", "regional", "global"};
+    const std::string visibility = details.visibility < 3 ? visibilities[details.visibility] : "?";
+    const bool task = details.type == static_cast<uint8_t>(hostconfig::ObjectKind::Task);
+    if (options.json) {
+        nlohmann::json out{{"id", hostconfig::idText(details.id)},
+                           {"type", hostconfig::kindName(details.type)},
+                           {"name", details.name},
+                           {"visibility", visibility},
+                           {"owner", details.owner == 0 ? std::string("system") : hostconfig::idText(details.owner)}};
+        if (task) {
+            out["state"] = hostconfig::taskStateName(details.state);
+        }
+        for (const auto& [name, value] : details.figures) {
+            out[name] = value;
+        }
+        fmt::print("{}\n", out.dump());
+        return kExitOk;
+    }
+    fmt::print("{:<22} {}\n", "id", hostconfig::idText(details.id));
+    fmt::print("{:<22} {}\n", "type", hostconfig::kindName(details.type));
+    fmt::print("{:<22} {}\n", "name", details.name.empty() ? "-" : details.name);
+    fmt::print("{:<22} {}\n", "visibility", visibility);
+    fmt::print("{:<22} {}\n", "owner", details.owner == 0 ? std::string("system") : hostconfig::idText(details.owner));
+    if (task) {
+        fmt::print("{:<22} {}\n", "state", hostconfig::taskStateName(details.state));
+    }
+    for (const auto& [name, value] : details.figures) {
+        fmt::print("{:<22} {}\n", name, value);
+    }
+    return kExitOk;
+}
+
+int statistics(const Options& options)
+{
+    QueriedNode queried;
+    if (const int status = queryNode(options, queried); status != kExitOk) {
+        return status;
+    }
+    hostconfig::NodeStatistics stats;
+    if (const ConfigError error = queried.objects->statistics(stats)) {
+        return failWith(error, queried.reached.who);
+    }
+    if (options.json) {
+        nlohmann::json tables = nlohmann::json::object();
+        for (const hostconfig::NodeStatistics::Table& table : stats.tables) {
+            tables[hostconfig::kindName(table.type)] = {{"used", table.used}, {"active", table.active}};
+        }
+        fmt::print("{}\n", nlohmann::json{{"uptime_ns", stats.uptimeNs},
+                                          {"task_switches", stats.taskSwitches},
+                                          {"stack_free", stats.stackFree},
+                                          {"tables", tables}}
+                               .dump());
+        return kExitOk;
+    }
+    fmt::print("uptime          {}.{:03} s\n", stats.uptimeNs / 1000000000u, (stats.uptimeNs / 1000000u) % 1000u);
+    fmt::print("task switches   {}\n", stats.taskSwitches);
+    fmt::print("stack free      {} bytes\n", stats.stackFree);
+    for (const hostconfig::NodeStatistics::Table& table : stats.tables) {
+        fmt::print("{:<15} {} of {} slots used\n", hostconfig::kindName(table.type), table.used, table.active);
+    }
+    return kExitOk;
+}
+
+// The object and task commands that change something.
+enum class Manage { Create, Delete, AddObjects, TaskCreate, TaskStart, TaskStop, TaskKill };
+
+int manage(const Options& options, Manage what)
+{
+    int code = kExitOk;
+    const std::optional<ConfigurationKey> key = readKey(options, code);
+    if (!key) {
+        return code;
+    }
+    std::optional<hostconfig::ObjectKind> kind;
+    if (what == Manage::Create || what == Manage::AddObjects) {
+        kind = kindArgument(options.kind);
+        if (!kind) {
+            return kExitUsage;
+        }
+    }
+    hostconfig::ObjectSpec object = options.object;
+    if (what == Manage::Create) {
+        object.kind = *kind;
+        object.name = options.name;
+        static const char* const visibilities[] = {"local", "regional", "global"};
+        object.visibility = 0xFF;
+        for (uint8_t v = 0; v < 3; ++v) {
+            object.visibility = options.visibility == visibilities[v] ? v : object.visibility;
+        }
+        if (object.visibility == 0xFF) {
+            return fail(kExitUsage, fmt::format("visibility '{}' is none of local, regional, global", options.visibility));
+        }
+    }
+    ReachedNode reached;
+    if (const int status = reachNode(options, reached); status != kExitOk) {
+        return status;
+    }
+    hostconfig::NodeChanges changes(*reached.client, reached.node, *key);
+    hostconfig::NodeObjects objects(*reached.client, reached.node, &*key);
+    uint32_t id = 0;
+    ConfigError error;
+    std::string done;
+    switch (what) {
+    case Manage::Create:
+        error = changes.createObject(object, id);
+        done = fmt::format("{} {} created", hostconfig::kindName(static_cast<uint8_t>(object.kind)), object.name);
+        break;
+    case Manage::AddObjects:
+        error = changes.addObjects(*kind, options.count);
+        done = fmt::format("{} more {} slots", options.count, hostconfig::kindName(static_cast<uint8_t>(*kind)));
+        break;
+    case Manage::TaskCreate:
+        error = changes.createTask(options.task, id);
+        done = fmt::format("task {} created, running {}", options.task.name, options.task.entry);
+        break;
+    case Manage::Delete:
+    case Manage::TaskStart:
+    case Manage::TaskStop:
+    case Manage::TaskKill: {
+        const std::optional<hostconfig::ObjectKind> fallback =
+            what == Manage::Delete ? std::nullopt : std::optional<hostconfig::ObjectKind>(hostconfig::ObjectKind::Task);
+        if (const int status = resolveObject(objects, options.target, fallback, reached.who, id); status != kExitOk) {
+            return status;
+        }
+        const sei::SeiCommand command = what == Manage::Delete      ? sei::SeiCommand::DeleteObject
+                                        : what == Manage::TaskStart ? sei::SeiCommand::StartTask
+                                        : what == Manage::TaskStop  ? sei::SeiCommand::StopTask
+                                                                    : sei::SeiCommand::KillTask;
+        error = changes.onObject(command, id);
+        done = fmt::format("{} {}", hostconfig::idText(id),
+                           what == Manage::Delete      ? "deleted"
+                           : what == Manage::TaskStart ? "started"
+                           : what == Manage::TaskStop  ? "stopped"
+                                                       : "killed");
+        break;
+    }
+    }
+    if (error) {
+        if (error.kind == ConfigError::Kind::Silent &&
+            (what == Manage::Create || what == Manage::TaskCreate || what == Manage::AddObjects)) {
+            return fail(kExitNoAnswer, fmt::format("no reply from {}: it may have done it all the same, so it was not "
+                                                   "asked again; look with `dcos-config objects` ({})",
+                                                   reached.who, error.why));
+        }
+        return failWith(error, reached.who);
+    }
+    if (options.json) {
+        nlohmann::json out{{"node", reached.node.nodeId}, {"serial", reached.node.serial}};
+        if (id != 0) {
+            out["id"] = hostconfig::idText(id);
+        }
+        fmt::print("{}\n", out.dump());
+    } else {
+        fmt::print("{}: {}{}\n", reached.who, done, id != 0 && what != Manage::Delete && what != Manage::TaskStart &&
+                                                            what != Manage::TaskStop && what != Manage::TaskKill
+                                                        ? fmt::format(" as {}", hostconfig::idText(id))
+                                                        : std::string());
+    }
+    return kExitOk;
+}
+
+int save(const Options& options)
+{
+    QueriedNode queried;
+    if (const int status = queryNode(options, queried); status != kExitOk) {
+        return status;
+    }
+    const std::optional<ConfigurationKey>& key = queried.key;
+    const ReachedNode& reached = queried.reached;
+    ConfigClient& client = *reached.client;
+    hostconfig::SavedNode saved;
+    saved.serial = reached.node.serial;
+    if (const ConfigError error = client.getConfiguration(reached.node, key ? &*key : nullptr, saved.configuration)) {
+        return failWith(error, reached.who);
+    }
+    hostconfig::NodeObjects& objects = *queried.objects;
+    // The named objects a host can make again: semaphores, ports and
+    // publishers, each as it was created.
+    for (const hostconfig::ObjectKind kind :
+         {hostconfig::ObjectKind::Semaphore, hostconfig::ObjectKind::MessagePort, hostconfig::ObjectKind::Publisher}) {
+        std::vector<hostconfig::ObjectEntry> entries;
+        if (const ConfigError error = objects.list(kind, entries)) {
+            return failWith(error, reached.who);
+        }
+        for (const hostconfig::ObjectEntry& entry : entries) {
+            if (entry.name.empty()) {
+                continue; // Nothing could find it again by name.
+            }
+            hostconfig::ObjectDetails details;
+            if (const ConfigError error = objects.info(entry.id, details)) {
+                return failWith(error, reached.who);
+            }
+            hostconfig::ObjectSpec spec;
+            spec.kind = kind;
+            spec.name = entry.name;
+            spec.visibility = details.visibility;
+            if (kind == hostconfig::ObjectKind::Semaphore) {
+                const uint64_t settings = details.figure("settings");
+                spec.counting = (settings & sei::kSeiSemaphoreCounting) != 0;
+                spec.inheritance = (settings & sei::kSeiSemaphoreInheritance) != 0;
+                spec.fifo = (settings & sei::kSeiSemaphoreFifo) != 0;
+                spec.initialCount = static_cast<uint32_t>(details.figure("count"));
+            } else if (kind == hostconfig::ObjectKind::MessagePort) {
+                spec.fifo = details.figure("order_fifo") != 0;
+            }
+            saved.objects.push_back(spec);
+        }
+    }
+    const std::string header = fmt::format(
+        "A DCOS node's configuration, saved by dcos-config {} from {}, board {}, firmware {}.\n"
+        "dcos-config restore -K KEYFILE writes [node] into the node's card (it takes effect at the next start) and\n"
+        "creates every object and task below that the node has not got by its name. Semaphores, ports and publishers\n"
+        "are the node's named ones at the time of saving (its application's too: restore leaves those present as\n"
+        "they are); a semaphore's initial_count is its count then. Tasks are not saved, since a node does not say\n"
+        "which entry point a task runs: add a [[task]] with name, entry (a task the image's application declares),\n"
+        "priority, stack_size and argument for each one restore should start.",
+        dcos::versionString, reached.who, hostconfig::boardText(reached.node.board), reached.node.version);
+    const std::string text = hostconfig::writeSavedNode(saved, header);
+    std::ofstream out(options.file, std::ios::binary | std::ios::trunc);
+    if (!out || !(out << text) || !out.flush()) {
+        return fail(kExitNotAvailable, fmt::format("cannot write {}", options.file));
+    }
+    if (options.json) {
+        fmt::print("{}\n", nlohmann::json{{"file", options.file},
+                                          {"node", reached.node.nodeId},
+                                          {"serial", reached.node.serial},
+                                          {"objects", saved.objects.size()}}
+                               .dump());
+    } else {
+        fmt::print("{}: configuration and {} named objects saved to {}\n", reached.who, saved.objects.size(),
+                   options.file);
+    }
+    return kExitOk;
+}
+
+int restore(const Options& options)
+{
+    int code = kExitOk;
+    const std::optional<ConfigurationKey> key = readKey(options, code);
+    if (!key) {
+        return code;
+    }
+    std::ifstream in(options.file, std::ios::binary);
+    if (!in) {
+        return fail(kExitNotAvailable, fmt::format("cannot read {}", options.file));
+    }
+    std::ostringstream text;
+    text << in.rdbuf();
+    hostconfig::SavedNode saved;
+    if (const std::optional<std::string> error = hostconfig::readSavedNode(text.str(), options.file, saved)) {
+        return fail(kExitUsage, *error);
+    }
+    ReachedNode reached;
+    if (const int status = reachNode(options, reached); status != kExitOk) {
+        return status;
+    }
+    if (saved.serial != 0 && saved.serial != reached.node.serial) {
+        warn(fmt::format("{} was saved from serial {}; restoring it to serial {}", options.file, saved.serial,
+                         reached.node.serial));
+    }
+    hostconfig::NodeChanges changes(*reached.client, reached.node, *key);
+    hostconfig::NodeObjects objects(*reached.client, reached.node, &*key);
+    uint32_t sequence = 0;
+    if (const ConfigError error = changes.setConfiguration(saved.configuration, sequence)) {
+        return failWith(error, reached.who);
+    }
+    nlohmann::json created = nlohmann::json::array();
+    nlohmann::json present = nlohmann::json::array();
+    // Each object and task by its name: one the node has is left as it is,
+    // so that a restore done twice creates nothing the second time.
+    const auto ensure = [&](hostconfig::ObjectKind kind, const std::string& name, auto make) -> int {
+        const std::string label = fmt::format("{} {}", hostconfig::kindName(static_cast<uint8_t>(kind)), name);
+        uint32_t id = 0;
+        const ConfigError found = objects.find(kind, name, id);
+        if (!found) {
+            present.push_back(label);
+            return kExitOk;
+        }
+        if (found.kind != ConfigError::Kind::Refused || found.status != sei::SeiStatus::KernelRefused ||
+            found.kernelStatus != static_cast<uint8_t>(dcos::Status::NotFound)) {
+            return failWith(found, reached.who);
+        }
+        if (const ConfigError error = make(id)) {
+            warn(fmt::format("{} not restored: {}", label, describe(error, reached.who)));
+            return exitCodeOf(error);
+        }
+        created.push_back({{"object", label}, {"id", hostconfig::idText(id)}});
+        return kExitOk;
+    };
+    int worst = kExitOk;
+    for (const hostconfig::ObjectSpec& spec : saved.objects) {
+        const int status =
+            ensure(spec.kind, spec.name, [&](uint32_t& id) { return changes.createObject(spec, id); });
+        worst = worst == kExitOk ? status : worst;
+    }
+    for (const hostconfig::TaskSpec& spec : saved.tasks) {
+        const int status =
+            ensure(hostconfig::ObjectKind::Task, spec.name, [&](uint32_t& id) { return changes.createTask(spec, id); });
+        worst = worst == kExitOk ? status : worst;
+    }
+    if (options.json) {
+        fmt::print("{}\n", nlohmann::json{{"node", reached.node.nodeId},
+                                          {"serial", reached.node.serial},
+                                          {"sequence", sequence},
+                                          {"created", created},
+                                          {"present", present}}
+                               .dump());
+    } else {
+        fmt::print("{}: configuration written (sequence {}; node id {} and bit rate {} from the next start)\n",
+                   reached.who, sequence, saved.configuration.nodeId, saved.configuration.bitRate);
+        for (const nlohmann::json& item : created) {
+            fmt::print("  created {} as {}\n", item["object"].get<std::string>(), item["id"].get<std::string>());
+        }
+        for (const nlohmann::json& item : present) {
+            fmt::print("  present {}\n", item.get<std::string>());
+        }
+    }
+    return worst;
+}
+
+int switchBitRate(const Options& options)
+{
+    int code = kExitOk;
+    std::unique_ptr<hostconfig::CanConfigLink> link = openLink(options, can::MessageIdentifier::kBroadcast, code);
+    if (!link) {
+        return code;
+    }
+    ConfigClient client(*link, {std::chrono::milliseconds(options.timeoutMs), options.retries});
+    if (const ConfigError error = client.activateBitRate(static_cast<uint16_t>(options.delayMs))) {
+        return failWith(error, "the bus");
+    }
+    if (options.json) {
+        fmt::print("{}\n", nlohmann::json{{"delay_ms", options.delayMs}}.dump());
+    } else {
+        fmt::print("ActivateBitRate sent: in {} ms every node switches to the bit rate its configuration names "
+                   "(dcos-config set-bitrate); switch this interface too (SocketCAN: ip link set {} type can bitrate "
+                   "RATE)\n",
+                   options.delayMs, options.interface);
+    }
+    return kExitOk;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
 {
-    CLI::App app{"dcos-config: find the controllers on a CAN bus, read what they are, and change their node id and "
-                 "CAN bit rate",
+    CLI::App app{"dcos-config: find the controllers on a CAN bus, read what they are, change their node id and CAN "
+                 "bit rate, and manage their objects and tasks",
                  "dcos-config"};
     app.set_version_flag("--version", std::string("dcos-config ") + dcos::versionString);
     app.footer("exit status: 0 done, 1 refused by the node (its status: wrong key, locked out, no key, a value it "
@@ -523,6 +979,67 @@ int main(int argc, char** argv)
     CLI::App* restartCommand = app.add_subcommand("restart", "restart a node, so a written node id or bit rate "
                                                              "takes effect (-K)");
 
+    const std::string kinds = "task, timer, device, pool, heap, port, publisher or semaphore";
+    CLI::App* objectsCommand = app.add_subcommand("objects", "list a node's objects: id, type, name, owner");
+    objectsCommand->add_option("type", options.kind, "only objects of this type: " + kinds);
+    CLI::App* findCommand = app.add_subcommand("find", "print the id of a node's object of a type by its name");
+    findCommand->add_option("type", options.kind, kinds)->required();
+    findCommand->add_option("name", options.name, "the object's name")->required();
+    CLI::App* showCommand =
+        app.add_subcommand("show", "show an object: owner, visibility, a task's state, and the figures of its type");
+    showCommand->add_option("object", options.target, "an id (0x0005a001) or TYPE:NAME (semaphore:lock)")->required();
+    CLI::App* statsCommand =
+        app.add_subcommand("stats", "show a node's uptime, task switches, free stack memory and tables' use");
+    CLI::App* createCommand =
+        app.add_subcommand("create", "create a named semaphore, port or publisher, owned by the system (-K)");
+    createCommand->add_option("type", options.kind, "semaphore, port or publisher")->required();
+    createCommand->add_option("name", options.name, "its name, 1 to 15 characters")
+        ->required()
+        ->check(CLI::Validator([](std::string& name) { return name.size() <= sei::kSeiMaxName ? std::string()
+                                                                                              : std::string("at most 15 characters"); },
+                               "NAME", "name length"));
+    createCommand->add_option("--initial", options.object.initialCount, "semaphores: the units available at first")
+        ->default_val(1);
+    createCommand->add_flag("--counting", options.object.counting, "semaphores: counting rather than binary");
+    createCommand->add_flag("--inherit", options.object.inheritance, "binary semaphores: priority inheritance");
+    createCommand->add_flag("--fifo", options.object.fifo,
+                            "semaphores: waiters first come first served; ports: messages first in first out");
+    createCommand->add_option("--visibility", options.visibility, "local, regional or global (NameToObject's reach)")
+        ->default_val("local");
+    CLI::App* deleteCommand = app.add_subcommand("delete", "delete an object; a task is killed (-K)");
+    deleteCommand->add_option("object", options.target, "an id or TYPE:NAME")->required();
+    CLI::App* addObjectsCommand =
+        app.add_subcommand("add-objects", "activate more slots of a table, up to its reserve (AddObjects; -K)");
+    addObjectsCommand->add_option("type", options.kind, kinds)->required();
+    addObjectsCommand->add_option("count", options.count, "how many slots")->required()->check(CLI::Range(1, 4096));
+    CLI::App* taskCreateCommand = app.add_subcommand(
+        "task-create", "start a task running an entry point of the node's image: a task its application declares (-K)");
+    taskCreateCommand->add_option("entry", options.task.entry, "the declared task whose code the new task runs")
+        ->required();
+    taskCreateCommand->add_option("name", options.task.name, "the new task's name, 1 to 15 characters")->required();
+    taskCreateCommand->add_option("--prio", options.task.priority, "the task's priority, 0 (most urgent) to 31")
+        ->default_val(16)
+        ->check(CLI::Range(0, 31));
+    taskCreateCommand->add_option("--stack", options.task.stackSize, "stack bytes")->default_val(4096);
+    taskCreateCommand->add_option("--arg", options.task.argument, "the entry point's argument")->default_val(0);
+    CLI::App* taskStartCommand = app.add_subcommand("task-start", "resume a stopped task (-K)");
+    CLI::App* taskStopCommand = app.add_subcommand("task-stop", "suspend a task (-K)");
+    CLI::App* taskKillCommand = app.add_subcommand("task-kill", "end a task; what it held is recovered (-K)");
+    for (CLI::App* command : {taskStartCommand, taskStopCommand, taskKillCommand}) {
+        command->add_option("task", options.target, "the task's id or name")->required();
+    }
+    CLI::App* saveCommand = app.add_subcommand(
+        "save", "write a node's configuration and named objects to a TOML file (-K when its queries are closed)");
+    saveCommand->add_option("file", options.file, "the TOML file to write")->required();
+    CLI::App* restoreCommand = app.add_subcommand(
+        "restore", "write a saved configuration into a node's card and create the objects and tasks it lacks (-K)");
+    restoreCommand->add_option("file", options.file, "the TOML file dcos-config save wrote")->required();
+    CLI::App* switchCommand = app.add_subcommand(
+        "switch-bitrate", "make every node on the bus switch to its configured bit rate at once (set-bitrate each first)");
+    switchCommand->add_option("--delay-ms", options.delayMs, "how long every node waits before it switches")
+        ->default_val(500)
+        ->check(CLI::Range(0, 65535));
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {
@@ -540,6 +1057,9 @@ int main(int argc, char** argv)
     if (*scanCommand) {
         return scan(options);
     }
+    if (*switchCommand) {
+        return switchBitRate(options);
+    }
     if (options.node < 0 && !options.bySerial) {
         return fail(kExitUsage, "say which node: -n NODE (its CAN node number) or --serial S (its serial number)");
     }
@@ -553,6 +1073,21 @@ int main(int argc, char** argv)
     if (*infoCommand) {
         return info(options);
     }
+    if (*objectsCommand) {
+        return listObjects(options);
+    }
+    if (*findCommand) {
+        return findObject(options);
+    }
+    if (*showCommand) {
+        return showObject(options);
+    }
+    if (*statsCommand) {
+        return statistics(options);
+    }
+    if (*saveCommand) {
+        return save(options);
+    }
     if (options.keyFile.empty()) {
         return fail(kExitUsage, "changes need the node's configuration key: -K KEYFILE");
     }
@@ -564,6 +1099,30 @@ int main(int argc, char** argv)
     }
     if (*restartCommand) {
         return change(options, Change::Restart);
+    }
+    if (*createCommand) {
+        return manage(options, Manage::Create);
+    }
+    if (*deleteCommand) {
+        return manage(options, Manage::Delete);
+    }
+    if (*addObjectsCommand) {
+        return manage(options, Manage::AddObjects);
+    }
+    if (*taskCreateCommand) {
+        return manage(options, Manage::TaskCreate);
+    }
+    if (*taskStartCommand) {
+        return manage(options, Manage::TaskStart);
+    }
+    if (*taskStopCommand) {
+        return manage(options, Manage::TaskStop);
+    }
+    if (*taskKillCommand) {
+        return manage(options, Manage::TaskKill);
+    }
+    if (*restoreCommand) {
+        return restore(options);
     }
     return fail(kExitUsage, "no command");
 }

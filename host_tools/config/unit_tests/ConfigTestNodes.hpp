@@ -144,12 +144,10 @@ public:
         return LinkError::None;
     }
 
-    LinkError deselect(std::string&) override
+    LinkError announce(const Bytes& bytes, std::string&) override
     {
-        ++deselects;
-        sei::SeiMessage request;
-        request.command = sei::SeiCommand::Deselect;
-        const Bytes bytes = hostconfig::encodeRequest(request);
+        deselects += !bytes.empty() && bytes[0] == static_cast<uint8_t>(sei::SeiCommand::Deselect);
+        announced.push_back(bytes);
         for (MemoryNode* node : nodes_) {
             node->take(bytes, nowNs);
         }
@@ -173,6 +171,7 @@ public:
     std::vector<Bytes> requests;
     unsigned probes = 0;
     unsigned deselects = 0;
+    std::vector<Bytes> announced;
 
 private:
     std::vector<MemoryNode*> nodes_;

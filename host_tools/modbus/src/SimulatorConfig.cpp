@@ -1,5 +1,7 @@
 #include <hostmodbus/SimulatorConfig.hpp>
 
+#include <hosttoml/TomlChecker.hpp>
+
 #include <fmt/core.h>
 #include <toml++/toml.h>
 
@@ -28,117 +30,7 @@ constexpr double kMaxMagnitude = 1e9;
 
 const char* const kTableKeys[kTableCount] = {"coil", "discrete_input", "holding_register", "input_register"};
 
-// The first error stops the check: one clear message with a line number
-// serves better than a cascade that follows from it.
-class Checker {
-public:
-    explicit Checker(std::string_view fileName) : fileName_(fileName) {}
-
-    bool failed() const { return !message_.empty(); }
-    const std::string& message() const { return message_; }
-
-    void fail(const toml::node& node, const std::string& text) { failAt(node.source().begin.line, text); }
-
-    void failAt(int64_t line, const std::string& text)
-    {
-        if (message_.empty()) {
-            message_ = fmt::format("{}:{}: {}", fileName_, line, text);
-        }
-    }
-
-    // Rejects keys other than @p allowed, so a misspelt key is an error
-    // rather than a setting that silently does nothing.
-    void onlyKeys(const toml::table& table, std::initializer_list<std::string_view> allowed, const std::string& where)
-    {
-        for (auto&& [key, node] : table) {
-            if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end()) {
-                std::string list;
-                for (std::string_view a : allowed) {
-                    list += (list.empty() ? "" : ", ") + std::string(a);
-                }
-                fail(node, fmt::format("{}: unknown key '{}' (known: {})", where, key.str(), list));
-                return;
-            }
-        }
-    }
-
-    std::optional<int64_t> integer(const toml::table& table, std::string_view key, int64_t min, int64_t max,
-                                   const std::string& where)
-    {
-        const toml::node* node = table.get(key);
-        if (node == nullptr) {
-            return std::nullopt;
-        }
-        const std::optional<int64_t> value = node->value_exact<int64_t>();
-        if (!value || *value < min || *value > max) {
-            fail(*node, fmt::format("{}: '{}' must be an integer from {} to {}", where, key, min, max));
-            return std::nullopt;
-        }
-        return value;
-    }
-
-    std::optional<double> number(const toml::table& table, std::string_view key, double min, double max,
-                                 const std::string& where)
-    {
-        const toml::node* node = table.get(key);
-        if (node == nullptr) {
-            return std::nullopt;
-        }
-        // An integer is a number too: "per_second = 500" must not be refused for lacking ".0".
-        std::optional<double> value;
-        if (node->is_integer()) {
-            value = static_cast<double>(node->as_integer()->get());
-        } else if (node->is_floating_point()) {
-            value = node->as_floating_point()->get();
-        }
-        if (!value || !std::isfinite(*value) || *value < min || *value > max) {
-            fail(*node, fmt::format("{}: '{}' must be a number from {} to {}", where, key, min, max));
-            return std::nullopt;
-        }
-        return value;
-    }
-
-    std::optional<std::string> string(const toml::table& table, std::string_view key, size_t maxLength,
-                                      const std::string& where)
-    {
-        const toml::node* node = table.get(key);
-        if (node == nullptr) {
-            return std::nullopt;
-        }
-        const std::optional<std::string> value = node->value_exact<std::string>();
-        if (!value || value->size() > maxLength) {
-            fail(*node, fmt::format("{}: '{}' must be a string of at most {} bytes", where, key, maxLength));
-            return std::nullopt;
-        }
-        return value;
-    }
-
-    const toml::table* subtable(const toml::table& table, std::string_view key, const std::string& where)
-    {
-        const toml::node* node = table.get(key);
-        if (node == nullptr) {
-            return nullptr;
-        }
-        if (!node->is_table()) {
-            fail(*node, fmt::format("{}: '{}' must be a table, e.g. {} = {{ ... }}", where, key, key));
-            return nullptr;
-        }
-        return node->as_table();
-    }
-
-    // A missing key is reported only if nothing else was: a key that is
-    // present but wrong has said so already.
-    void require(const toml::node& at, bool present, std::string_view key, const std::string& where)
-    {
-        if (!present && !failed()) {
-            fail(at, fmt::format("{}: '{}' is required", where, key));
-        }
-    }
-
-private:
-    std::string fileName_;
-    std::string message_;
-};
+using Checker = hosttoml::TomlChecker;
 
 bool validName(const std::string& name)
 {
@@ -379,23 +271,9 @@ Result<SimulatorConfig> parseSimulatorConfig(std::string_view text, std::string_
     // them, is_non_ascii_horizontal_whitespace): undefined behaviour on a
     // hostile or merely accented file, found by fuzz_modbus_sim_config. The
     // file is therefore ASCII, and a byte outside it is refused with its line.
-    unsigned line = 1;
-    for (const char c : text) {
-        if (static_cast<unsigned char>(c) >= 0x80) {
-            return R::failure(fmt::format("{}:{}: only ASCII characters are accepted (the TOML library fails on "
-                                          "some others)",
-                                          fileName, line));
-        }
-        line += c == '\n' ? 1 : 0;
-    }
     toml::table root;
-    // toml++ in Debian is built with exceptions; its parse error ends here,
-    // as a value like every other error.
-    try {
-        root = toml::parse(text, fileName);
-    } catch (const toml::parse_error& error) {
-        return R::failure(fmt::format("{}:{}:{}: not TOML: {}", fileName, error.source().begin.line,
-                                      error.source().begin.column, error.description()));
+    if (const std::optional<std::string> error = hosttoml::parseAscii(text, fileName, root)) {
+        return R::failure(*error);
     }
     Checker check(fileName);
     SimulatorConfig config;

@@ -46,6 +46,13 @@ enum class MessageType : uint8_t {
     Segmented = 0x30,
     /// Configuration by the system engineering interface agent (seed 7.14).
     Configuration = 0x40,
+    /// The stream a node sends the host that asked for it with the
+    /// configuration protocol's Monitor command: samples of publications
+    /// and console output, unacknowledged (seed 7.14, 8.3;
+    /// docs/protocols/monitor.md). Next to Configuration, whose command
+    /// starts it, and ahead of Flashing: a few frames a period that a
+    /// control engineer watches live.
+    Monitoring = 0x41,
     /// Program download into a node: the SEI agent's file transfer (seed 7.14).
     Flashing = 0x50,
 };
@@ -64,6 +71,7 @@ constexpr bool isAssignedMessageType(uint8_t raw)
     case MessageType::RelayedPublication:
     case MessageType::Segmented:
     case MessageType::Configuration:
+    case MessageType::Monitoring:
     case MessageType::Flashing:
         return true;
     }
@@ -84,6 +92,7 @@ constexpr const char* messageTypeName(MessageType type)
     case MessageType::RelayedPublication: return "relayed publication";
     case MessageType::Segmented: return "segmented";
     case MessageType::Configuration: return "configuration";
+    case MessageType::Monitoring: return "monitoring";
     case MessageType::Flashing: return "flashing";
     }
     return "unassigned";

@@ -198,6 +198,14 @@ uint16_t nodeId();
 
 /// The console: output (waits while its buffer is full) and input.
 runtime::CharacterSink& console();
+
+/// Sends a copy of every character written to console() to @p tap too, or
+/// (null) to nobody. The tap is called from whatever context writes, an
+/// interrupt handler included, before the character is queued for the
+/// UART: it must not block and must guard its own state. The system
+/// engineering interface agent's monitoring stream sets it while a host
+/// follows the console (docs/protocols/monitor.md).
+void setConsoleTap(runtime::CharacterSink* tap);
 bool consoleRead(char& character);
 bool consoleHasInput();
 

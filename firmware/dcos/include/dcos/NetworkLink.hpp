@@ -36,6 +36,7 @@ enum class SystemMessageType : uint8_t {
     DsmPublication = 0x20, ///< A part of a publication, to the broadcast address (docs/protocols/publications.md).
     RelayedPublication = 0x21, ///< A relay header or a publication's frame, from a gateway (publications.md, "Across a gateway").
     Configuration = 0x40, ///< A frame of the configuration protocol (docs/protocols/config.md, "On CAN"), for the system engineering interface agent.
+    Monitoring = 0x41, ///< A frame of the stream of samples and console output the agent sends to a host (docs/protocols/monitor.md); nodes send it, never take it.
     Flashing = 0x50, ///< A frame of the flash protocol's ISO-TP connection (docs/protocols/flash.md, "On CAN"), for the system engineering interface agent.
 };
 

@@ -1732,6 +1732,10 @@ void receiverEntry(uintptr_t)
                 case SystemMessageType::TimeSync: onTimeSyncMessage(interface, message); break;
                 case SystemMessageType::Flashing:
                 case SystemMessageType::Configuration: onEngineeringFrame(interface, message); break;
+                case SystemMessageType::Monitoring:
+                    // A stream goes from a node to a host; the link never
+                    // passes one up, and another node's is nothing to act on.
+                    break;
                 }
             }
         }

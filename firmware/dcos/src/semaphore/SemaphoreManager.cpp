@@ -178,6 +178,18 @@ Result<bool> isBinarySemaphore(ObjectId id)
     return semaphore.value()->kind == SemaphoreKind::Binary;
 }
 
+Result<uint32_t> semaphoreSettings(ObjectId id)
+{
+    arch_x86::InterruptGuard guard;
+    const Result<Semaphore*> semaphore = resolve(id);
+    if (!semaphore.ok()) {
+        return semaphore.status();
+    }
+    const Semaphore& s = *semaphore.value();
+    return (s.kind == SemaphoreKind::Counting ? 1u : 0u) | (s.inheritance ? 2u : 0u) |
+           (s.waiters.order() == WaitQueue::Order::Fifo ? 4u : 0u);
+}
+
 ObjectId remoteHolderOf(ObjectId id)
 {
     arch_x86::InterruptGuard guard;

@@ -258,7 +258,8 @@ struct SeiMessage {
     uint8_t priority = 0;
     uint32_t stackSize = 0;
     uint32_t argument = 0;
-    /// CreateObject request: dcos::Visibility and the type's two parameters.
+    /// CreateObject request and ObjectInfo reply: dcos::Visibility;
+    /// CreateObject request: the type's two parameters.
     uint8_t visibility = 0;
     uint32_t parameters[kSeiObjectParameters] = {};
     /// AddObjects request: how many slots to add.

@@ -38,7 +38,7 @@ public:
     bool bitRateValid(uint32_t bitRate) override;
     SeiStatus prepareRestart() override { return SeiStatus::Ok; }
     SeiResult<uint32_t> writeConfiguration(const SeiConfiguration& configuration) override;
-    bool queriesClosed() override { return queriesClosed_; }
+    bool queriesClosed() override;
     void activateBitRate(uint16_t delayMs, uint64_t nowNs) override;
 
     uint8_t listObjects(uint8_t type, uint16_t first, SeiMessage& reply) override;
@@ -54,9 +54,6 @@ public:
     uint8_t addObjects(uint8_t type, uint16_t count) override;
     uint8_t monitor(const SeiMessage& request, uint64_t nowNs) override;
 
-    /// Whether the node's queries are closed, as the configuration read at
-    /// the start says (then kept by every read and write).
-    void setQueriesClosed(bool closed) { queriesClosed_ = closed; }
     /// Where Monitor requests go; without one they are refused (NotSupported).
     void setMonitor(SeiMonitorControl* monitor) { monitor_ = monitor; }
 
@@ -77,7 +74,10 @@ private:
     uint8_t canNode_ = 0xFF;
     // The last record read: GetConfiguration's command line points into it.
     boot::ConfigurationBlock read_;
-    bool queriesClosed_ = false;
+    // Whether the queries are closed, as the record last read or written
+    // says; until the first read, unknown.
+    bool queriesClosed_ = true;
+    bool queriesKnown_ = false;
     SeiMonitorControl* monitor_ = nullptr;
     // ActivateBitRate's switch: when (UINT64_MAX for none) and to what.
     uint64_t switchAtNs_ = UINT64_MAX;

@@ -39,6 +39,10 @@ public:
     /// @p config (the host's side); null, with @p error, when it cannot.
     static std::unique_ptr<IsoTpRequester> open(const std::string& interface, const can::IsoTpConfig& config,
                                                 bool kernelIsoTp, TransportError& error);
+    /// Over a transport already open: a tool that also reads other frames
+    /// on the same interface (dcos-mon's stream) passes every frame through
+    /// a transport of its own that sees them first.
+    static std::unique_ptr<IsoTpRequester> over(std::unique_ptr<Transport> transport, const can::IsoTpConfig& config);
 
     /// Sends @p request and waits up to @p timeout for a reply @p accept
     /// takes (a reply to another request, left from an earlier exchange,

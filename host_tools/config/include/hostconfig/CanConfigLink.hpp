@@ -53,11 +53,19 @@ public:
     /// slcan:/dev/ttyACM0, lab:/hub.sock:can0); null with @p error and @p why.
     static std::unique_ptr<CanConfigLink> open(const std::string& interface, const CanConfigAddress& address,
                                                LinkError& error, std::string& why);
+    /// Over a transport already open (address.kernelIsoTp is not taken
+    /// then); null with BadArgument for addresses no node could answer.
+    static std::unique_ptr<CanConfigLink> over(std::unique_ptr<hostcan::Transport> transport,
+                                               const CanConfigAddress& address, LinkError& error, std::string& why);
+
+    /// The frame transport under the connection; null on the kernel's
+    /// can-isotp socket.
+    hostcan::Transport* transport() { return requester_->transport(); }
 
     LinkError exchange(const Bytes& request, sei::SeiCommand command, Bytes& reply, std::chrono::milliseconds timeout,
                        std::string& why) override;
     LinkError probe(uint8_t bits, uint32_t value, bool& answered, std::string& why) override;
-    LinkError deselect(std::string& why) override;
+    LinkError announce(const Bytes& request, std::string& why) override;
 
 private:
     CanConfigLink(const std::string& interface, const CanConfigAddress& address);

@@ -62,6 +62,9 @@ public:
     ConfigError select(uint32_t serial, SelectedNode& out);
     /// No node is selected any more.
     ConfigError deselect();
+    /// Every node on the bus switches its CAN controller to its configured
+    /// bit rate @p delayMs after this (ActivateBitRate; none answers).
+    ConfigError activateBitRate(uint16_t delayMs);
 
     /// The card's configuration of @p node (as its Identify gave it): with a
     /// MAC when @p key is given (checked by the node whether or not its
@@ -104,6 +107,7 @@ private:
     ConfigError ask(const Bytes& request, sei::SeiCommand command, sei::SeiMessage& out, bool retry = true);
     /// A fresh challenge, then @p request signed under it; both again on
     /// silence, as a lost reply used the challenge up (unless @p once).
+    ConfigError announce(const Bytes& request);
     ConfigError authenticated(const NodeIdentity& node, const ConfigurationKey& key, const sei::SeiMessage& request,
                               sei::SeiMessage& out, bool once = false);
 

@@ -40,8 +40,9 @@ public:
     /// came.
     virtual LinkError probe(uint8_t bits, uint32_t value, bool& answered, std::string& why) = 0;
 
-    /// Sends Deselect to every node on the bus; no node answers it.
-    virtual LinkError deselect(std::string& why) = 0;
+    /// Sends @p request to every node on the bus, for the commands no node
+    /// answers there (Deselect, ActivateBitRate): returns once it has gone.
+    virtual LinkError announce(const Bytes& request, std::string& why) = 0;
 };
 
 } // namespace hostconfig

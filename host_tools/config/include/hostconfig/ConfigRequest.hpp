@@ -22,6 +22,9 @@ using Bytes = std::vector<uint8_t>;
 using hostimage::ConfigurationKey;
 using Challenge = std::array<uint8_t, sei::kSeiChallengeSize>;
 
+/// An empty request of @p command, its fields to be filled in.
+sei::SeiMessage requestOf(sei::SeiCommand command);
+
 /// A request without a MAC (Identify, Challenge, GetConfiguration without
 /// one, the scanning commands): its bytes, empty when it does not encode.
 Bytes encodeRequest(const sei::SeiMessage& request);

@@ -22,6 +22,7 @@ namespace dcos::internal {
 struct ObjectSummary {
     ObjectId id;
     ObjectId owner; ///< Null for the system.
+    Visibility visibility = Visibility::Local;
     char name[kObjectNameCapacity] = {};
 };
 

@@ -20,6 +20,12 @@ size_t semaphoreCount();
 /// the held forms, which name the task. O(1).
 Result<bool> isBinarySemaphore(ObjectId id);
 
+/// How the local semaphore @p id was created, for the system engineering
+/// interface agent's ObjectInfo (a host saving a node's configuration
+/// makes the same again). Bit 0 counting, bit 1 priority inheritance, bit 2
+/// waiters first come first served; or why the id names none. O(1).
+Result<uint32_t> semaphoreSettings(ObjectId id);
+
 // ---- binary semaphores held by tasks of other nodes ------------------------
 //
 // A binary semaphore of this node may be held by a task of another node
