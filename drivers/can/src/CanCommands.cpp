@@ -971,7 +971,9 @@ void networkBootStart()
 void switchCanBitRate(uint32_t rate)
 {
     for (unsigned channel = 0; channel < sja1000::kChannels; ++channel) {
-        if (!sja1000::consoleChannels[channel].installed()) {
+        // A channel already at the rate is left alone: resetting its chip
+        // would only drop the frames under way.
+        if (!sja1000::consoleChannels[channel].installed() || sja1000::stateOf(channel).bitRate == rate) {
             continue;
         }
         runtime::format(bsp::console(), "%s: switching to %lu bit/s, as a configuration host asked\r\n",

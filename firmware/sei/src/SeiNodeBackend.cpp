@@ -169,9 +169,9 @@ uint8_t SeiNodeBackend::listObjects(uint8_t type, uint16_t first, SeiMessage& re
     if (!table.ok()) {
         return statusValue(table.status());
     }
-    // The slots are walked in order from the first one whose object's index
-    // is at least @p first... indices and slots differ, so the page is by
-    // slot: the reply's "next" is the slot to ask for next.
+    // A page is a run of table slots from @p first (slots, not ids: an id's
+    // index names a slot only while its object lives); the reply's "next" is
+    // the slot to ask from for the rest.
     reply.entryCount = 0;
     reply.next = kSeiListEnd;
     for (size_t slot = first; slot < table.value().active; ++slot) {
@@ -254,27 +254,31 @@ uint8_t SeiNodeBackend::objectInfo(uint32_t raw, SeiMessage& reply)
             return statusValue(state.status());
         }
         reply.state = static_cast<uint8_t>(state.value());
-        // The figures are copied whole: the task runs on while they are read.
-        dcos::internal::Task copy;
-        size_t highWater = 0;
+        // The figures are copied whole, with interrupts held off: the task
+        // runs on while they are read. Its stack's high-water mark is a scan
+        // of the stack, too long to hold interrupts off for; it is taken
+        // after, from the same task table entry (static memory), and is a
+        // diagnostic figure should the task end in between.
+        struct {
+            uint8_t basePriority, priority;
+            size_t stackSize;
+            uint64_t executionPeriodNs, deadlinePeriodNs;
+            uint32_t profileSamples;
+            uint64_t profileMinimumNs, profileMaximumNs, profileTotalNs;
+        } copy{};
+        const dcos::internal::Task* entry = nullptr;
         {
             arch_x86::InterruptGuard guard;
             const dcos::Result<dcos::internal::Task*> task = dcos::internal::TaskManager::resolve(id);
             if (!task.ok()) {
                 return statusValue(task.status());
             }
-            const dcos::internal::Task& t = *task.value();
-            copy.basePriority = t.basePriority;
-            copy.priority = t.priority;
-            copy.stackSize = t.stackSize;
-            copy.executionPeriodNs = t.executionPeriodNs;
-            copy.deadlinePeriodNs = t.deadlinePeriodNs;
-            copy.profileSamples = t.profileSamples;
-            copy.profileMinimumNs = t.profileMinimumNs;
-            copy.profileMaximumNs = t.profileMaximumNs;
-            copy.profileTotalNs = t.profileTotalNs;
-            highWater = dcos::internal::TaskManager::stackHighWater(t);
+            entry = task.value();
+            copy = {entry->basePriority,      entry->priority,         entry->stackSize,
+                    entry->executionPeriodNs, entry->deadlinePeriodNs, entry->profileSamples,
+                    entry->profileMinimumNs,  entry->profileMaximumNs, entry->profileTotalNs};
         }
+        const size_t highWater = dcos::internal::TaskManager::stackHighWater(*entry);
         value(copy.basePriority);
         value(copy.priority);
         value(copy.stackSize);

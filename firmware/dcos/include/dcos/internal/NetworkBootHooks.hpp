@@ -16,7 +16,8 @@ namespace dcos::internal {
 /// start is reported on the console and left down; the node runs on.
 void networkBootStart() __attribute__((weak));
 
-/// Switches every CAN channel that is up to @p rate bit/s at once, as the
+/// Switches every CAN channel that is up, and not at @p rate bit/s already,
+/// to @p rate at once, as the
 /// configuration protocol's ActivateBitRate asks (docs/protocols/config.md,
 /// "Switching the bus's bit rate"); says so on the console. A channel the
 /// chip cannot run at @p rate is left as it was, and said so too.
