@@ -508,76 +508,69 @@ bool decodeReply(Reader& r, SeiMessage& m)
 
 } // namespace
 
+namespace {
+
+// What each command is, in one place: which need a MAC, which are queries
+// (a MAC when the node's queries are closed), which every node takes from
+// the broadcast address, and which are always open.
+enum class CommandClass : uint8_t { Open, Query, Change, Broadcast };
+
+struct CommandTraits {
+    SeiCommand command;
+    CommandClass kind;
+};
+
+constexpr CommandTraits kCommands[] = {
+    {SeiCommand::Identify, CommandClass::Open},         {SeiCommand::Challenge, CommandClass::Open},
+    {SeiCommand::GetConfiguration, CommandClass::Query}, {SeiCommand::ListObjects, CommandClass::Query},
+    {SeiCommand::FindObject, CommandClass::Query},       {SeiCommand::ObjectInfo, CommandClass::Query},
+    {SeiCommand::NodeStatistics, CommandClass::Query},   {SeiCommand::Monitor, CommandClass::Query},
+    {SeiCommand::SetNodeId, CommandClass::Change},       {SeiCommand::SetBitRate, CommandClass::Change},
+    {SeiCommand::Restart, CommandClass::Change},         {SeiCommand::SetConfiguration, CommandClass::Change},
+    {SeiCommand::CreateTask, CommandClass::Change},      {SeiCommand::StartTask, CommandClass::Change},
+    {SeiCommand::StopTask, CommandClass::Change},        {SeiCommand::KillTask, CommandClass::Change},
+    {SeiCommand::CreateObject, CommandClass::Change},    {SeiCommand::DeleteObject, CommandClass::Change},
+    {SeiCommand::AddObjects, CommandClass::Change},      {SeiCommand::ProbeSerial, CommandClass::Broadcast},
+    {SeiCommand::Select, CommandClass::Broadcast},       {SeiCommand::Deselect, CommandClass::Broadcast},
+    {SeiCommand::ActivateBitRate, CommandClass::Broadcast},
+};
+
+const CommandTraits* traitsOf(uint8_t code)
+{
+    for (const CommandTraits& traits : kCommands) {
+        if (static_cast<uint8_t>(traits.command) == code) {
+            return &traits;
+        }
+    }
+    return nullptr;
+}
+
+bool isOfClass(SeiCommand command, CommandClass kind)
+{
+    const CommandTraits* traits = traitsOf(static_cast<uint8_t>(command));
+    return traits != nullptr && traits->kind == kind;
+}
+
+} // namespace
+
 bool isSeiCommand(uint8_t code)
 {
-    switch (static_cast<SeiCommand>(code)) {
-    case SeiCommand::Identify:
-    case SeiCommand::Challenge:
-    case SeiCommand::GetConfiguration:
-    case SeiCommand::SetNodeId:
-    case SeiCommand::SetBitRate:
-    case SeiCommand::Restart:
-    case SeiCommand::ProbeSerial:
-    case SeiCommand::Select:
-    case SeiCommand::Deselect:
-    case SeiCommand::ActivateBitRate:
-    case SeiCommand::ListObjects:
-    case SeiCommand::FindObject:
-    case SeiCommand::ObjectInfo:
-    case SeiCommand::NodeStatistics:
-    case SeiCommand::Monitor:
-    case SeiCommand::SetConfiguration:
-    case SeiCommand::CreateTask:
-    case SeiCommand::StartTask:
-    case SeiCommand::StopTask:
-    case SeiCommand::KillTask:
-    case SeiCommand::CreateObject:
-    case SeiCommand::DeleteObject:
-    case SeiCommand::AddObjects:
-        return true;
-    }
-    return false;
+    return traitsOf(code) != nullptr;
 }
 
 bool seiCommandNeedsMac(SeiCommand command)
 {
-    switch (command) {
-    case SeiCommand::SetNodeId:
-    case SeiCommand::SetBitRate:
-    case SeiCommand::Restart:
-    case SeiCommand::SetConfiguration:
-    case SeiCommand::CreateTask:
-    case SeiCommand::StartTask:
-    case SeiCommand::StopTask:
-    case SeiCommand::KillTask:
-    case SeiCommand::CreateObject:
-    case SeiCommand::DeleteObject:
-    case SeiCommand::AddObjects:
-        return true;
-    default:
-        return false;
-    }
+    return isOfClass(command, CommandClass::Change);
 }
 
 bool seiCommandIsQuery(SeiCommand command)
 {
-    switch (command) {
-    case SeiCommand::GetConfiguration:
-    case SeiCommand::ListObjects:
-    case SeiCommand::FindObject:
-    case SeiCommand::ObjectInfo:
-    case SeiCommand::NodeStatistics:
-    case SeiCommand::Monitor:
-        return true;
-    default:
-        return false;
-    }
+    return isOfClass(command, CommandClass::Query);
 }
 
 bool seiCommandIsBroadcast(SeiCommand command)
 {
-    return command == SeiCommand::ProbeSerial || command == SeiCommand::Select || command == SeiCommand::Deselect ||
-           command == SeiCommand::ActivateBitRate;
+    return isOfClass(command, CommandClass::Broadcast);
 }
 
 size_t SeiMessage::encode(uint8_t* out, size_t capacity) const
