@@ -17,9 +17,11 @@ SEI_PORTABLE_SRCS := \
 	firmware/sei/src/SeiStatus.cpp
 
 # The node's side in the kernel: the backend on the card's configuration
-# record and the console command. The agent's task that runs the server is
+# record and the kernel's objects, the monitoring stream's console copy,
+# publications and sender, and the console command. The agent's task that runs the server is
 # the flash service's (firmware/flash/src/FlashService.cpp): one task serves
 # both of the agent's protocols.
 SEI_TARGET_SRCS := \
 	firmware/sei/src/SeiNodeBackend.cpp \
+	firmware/sei/src/SeiNodeMonitor.cpp \
 	firmware/sei/src/SeiCommands.cpp

@@ -4,11 +4,10 @@
 #include <flash/FlashSession.hpp>
 
 #include <sei/CanSeiServer.hpp>
-#include <sei/LogRing.hpp>
 #include <sei/SeiAuthenticator.hpp>
 #include <sei/SeiMonitor.hpp>
-#include <sei/SeiMonitorControl.hpp>
 #include <sei/SeiNodeBackend.hpp>
+#include <sei/SeiNodeMonitor.hpp>
 #include <sei/SeiServer.hpp>
 #include <sei/SeiService.hpp>
 
@@ -19,9 +18,7 @@
 #include <boot/ConfigurationStore.hpp>
 #include <bsp/Board.hpp>
 #include <bsp/BoardReset.hpp>
-#include <arch_x86/Cpu.hpp>
 #include <can/MessageIdentifier.hpp>
-#include <dcos/DsmAgent.hpp>
 #include <dcos/NetworkInterfacesManager.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
@@ -58,154 +55,6 @@ volatile uint32_t head = 0;
 volatile uint32_t tail = 0;
 
 constexpr uint32_t kFrameEvent = 1u << 0;
-// The monitoring stream (docs/protocols/monitor.md), which a host starts
-// with the configuration protocol's Monitor command: samples of this
-// node's publications and a copy of its console, sent to that host.
-
-// The console's copy. Static, not on the task's stack: the console writes
-// into it from every context while the task runs or waits. 2 KiB holds
-// about a second of a console at 19200 baud, more than the stream's Log
-// frames need between two of the task's wakes.
-sei::LogRing<2048> consoleRing;
-
-// The console's tap (bsp::setConsoleTap): every character it writes, with
-// interrupts off around the ring, since a handler's output may interrupt a
-// task's in the middle of a put. A few instructions; it never waits.
-class ConsoleRingTap final : public runtime::CharacterSink {
-public:
-    void put(char character) override
-    {
-        arch_x86::InterruptGuard guard;
-        (void)consoleRing.put(static_cast<uint8_t>(character));
-    }
-};
-ConsoleRingTap consoleRingTap;
-
-// The ring as the stream reads it, each call with interrupts off for the
-// few bytes of one frame.
-class NodeMonitorLog final : public sei::MonitorLog {
-public:
-    void capture(bool on) override
-    {
-        if (!on) {
-            bsp::setConsoleTap(nullptr);
-        }
-        {
-            arch_x86::InterruptGuard guard;
-            consoleRing.clear();
-        }
-        if (on) {
-            bsp::setConsoleTap(&consoleRingTap);
-        }
-    }
-    size_t peek(uint8_t* out, size_t max) override
-    {
-        arch_x86::InterruptGuard guard;
-        return consoleRing.peek(out, max);
-    }
-    void consume(size_t count) override
-    {
-        arch_x86::InterruptGuard guard;
-        consoleRing.consume(count);
-    }
-    uint32_t takeLost(uint32_t max) override
-    {
-        arch_x86::InterruptGuard guard;
-        return consoleRing.takeLost(max);
-    }
-    bool pending() override
-    {
-        arch_x86::InterruptGuard guard;
-        return consoleRing.pending();
-    }
-};
-
-// This node's publications through the DSM agent's public interface, as
-// any task reads them; the agent's task is a super user, so it may read
-// every publisher. Only this node's: another node's publisher would be a
-// remote transaction on every renewal, and its page is that node's to
-// stream.
-class NodeMonitorPages final : public sei::MonitorPages {
-public:
-    uint8_t open(uint32_t publisher, uint32_t& subscription) override
-    {
-        const ObjectId id = ObjectId::fromRaw(publisher);
-        if (id.node() != dcos::internal::localNode()) {
-            return static_cast<uint8_t>(Status::InvalidId);
-        }
-        if (id.type() != dcos::ObjectType::DsmPublisher) {
-            return static_cast<uint8_t>(Status::WrongType);
-        }
-        const Result<ObjectId> opened = dcos::DsmAgent::Open(id);
-        if (!opened.ok()) {
-            return static_cast<uint8_t>(opened.status());
-        }
-        subscription = opened.value().raw();
-        return static_cast<uint8_t>(Status::Ok);
-    }
-    void close(uint32_t subscription) override
-    {
-        // A subscription whose publisher was deleted closes the same way;
-        // nothing else can refuse the owner.
-        (void)dcos::DsmAgent::Close(ObjectId::fromRaw(subscription));
-    }
-    bool read(uint32_t subscription, uint8_t (&page)[sei::kSeiPageSize]) override
-    {
-        // The last seen id kNoDsmData with no wait: the current page at
-        // once, or WouldBlock for a publisher never written.
-        dcos::DsmPage current;
-        const Result<uint32_t> read =
-            dcos::DsmAgent::Read(ObjectId::fromRaw(subscription), dcos::kNoDsmData, current, dcos::kPoll);
-        if (!read.ok()) {
-            return false;
-        }
-        for (size_t i = 0; i < sei::kSeiPageSize; ++i) {
-            page[i] = current.bytes[i];
-        }
-        return true;
-    }
-};
-
-// The stream's frames go out as single frames of type Monitoring on the
-// interface the Monitor request came from, without an echo: nothing
-// confirms them, and the transmit path's queue refusing one is counted.
-class NodeMonitorSender final : public sei::MonitorSender {
-public:
-    bool send(const sei::MonitorTarget& target, const uint8_t* data, uint8_t length) override
-    {
-        SystemMessage message;
-        message.priority = target.priority;
-        message.type = SystemMessageType::Monitoring;
-        message.destination = target.host;
-        message.length = length;
-        for (uint8_t i = 0; i < length && i < sizeof message.data; ++i) {
-            message.data[i] = data[i];
-        }
-        message.echo = false;
-        return dcos::internal::sendOnLink(target.interface, message);
-    }
-};
-
-// What SeiNodeBackend hands Monitor requests to: the stream, told where
-// the request being served came from (the task sets that before it hands
-// a frame to the configuration protocol's server, whose request completes
-// on that frame).
-class NodeMonitorControl final : public sei::SeiMonitorControl {
-public:
-    explicit NodeMonitorControl(sei::SeiMonitor& monitor) : monitor_(monitor) {}
-
-    void setRequestSource(const sei::MonitorTarget& from) { from_ = from; }
-
-    uint8_t configure(const sei::SeiMessage& request, uint64_t nowNs) override
-    {
-        return monitor_.configure(request, from_, nowNs);
-    }
-
-private:
-    sei::SeiMonitor& monitor_;
-    sei::MonitorTarget from_;
-};
-
 // The task keeps both protocols' servers and the monitoring stream on its
 // stack (the servers' buffers are a whole message each way), and the image
 // checks and card calls run below them.
@@ -213,8 +62,8 @@ constexpr size_t kStackBytes = 16384;
 constexpr size_t kServersBytes = sizeof(CanFlashServer) + sizeof(FlashSession) + sizeof(sei::CanSeiServer) +
                                  sizeof(sei::SeiServer) + sizeof(sei::SeiAuthenticator) +
                                  sizeof(sei::SeiNodeBackend) + sizeof(ata::AtaPioDisk) + sizeof(boot::AtaSectorStore) +
-                                 sizeof(sei::SeiMonitor) + sizeof(NodeMonitorLog) + sizeof(NodeMonitorPages) +
-                                 sizeof(NodeMonitorSender) + sizeof(NodeMonitorControl);
+                                 sizeof(sei::SeiMonitor) + sizeof(sei::NodeMonitorLog) + sizeof(sei::NodeMonitorPages) +
+                                 sizeof(sei::NodeMonitorSender) + sizeof(sei::NodeMonitorControl);
 static_assert(kServersBytes <= kStackBytes / 2, "the servers leave half the agent's stack to the calls they make");
 
 ObjectId serviceTask;
@@ -396,11 +245,11 @@ void serviceEntry(uintptr_t)
     liveAuthenticator = &authenticator;
     liveSeiProtocol = &seiServer;
 
-    NodeMonitorLog monitorLog;
-    NodeMonitorPages monitorPages;
-    NodeMonitorSender monitorSender;
+    sei::NodeMonitorLog monitorLog;
+    sei::NodeMonitorPages monitorPages;
+    sei::NodeMonitorSender monitorSender;
     sei::SeiMonitor monitor(monitorPages, monitorLog, monitorSender);
-    NodeMonitorControl monitorControl(monitor);
+    sei::NodeMonitorControl monitorControl(monitor);
     backend.setMonitor(&monitorControl);
 
     uint8_t interface = 0xFF;
