@@ -6,6 +6,7 @@
 #include <sja1000/BitTiming.hpp>
 
 #include <arch_x86/Cpu.hpp>
+#include <runtime/Text.hpp>
 #include <dcos/BufferPoolAgent.hpp>
 #include <dcos/DsmAgent.hpp>
 #include <dcos/HeapAgent.hpp>
@@ -400,11 +401,7 @@ uint8_t SeiNodeBackend::createTask(const SeiMessage& request, uint32_t& id)
     const dcos::app::TaskDeclaration* declaration = nullptr;
     for (size_t i = 0; application != nullptr && i < application->tasks.count; ++i) {
         const char* name = application->tasks.items[i].name;
-        size_t n = 0;
-        while (name != nullptr && name[n] != '\0' && name[n] == entryName[n]) {
-            ++n;
-        }
-        if (name != nullptr && name[n] == '\0' && entryName[n] == '\0') {
+        if (name != nullptr && runtime::textEquals(name, entryName)) {
             declaration = &application->tasks.items[i];
             break;
         }

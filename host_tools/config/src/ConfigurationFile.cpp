@@ -18,8 +18,6 @@ namespace {
 
 using hosttoml::TomlChecker;
 
-const char* const kVisibilities[] = {"local", "regional", "global"};
-
 std::string quoted(const std::string& text)
 {
     // toml++ writes a string with every escape TOML needs.
@@ -34,10 +32,8 @@ std::optional<uint8_t> visibilityOf(TomlChecker& check, const toml::table& table
     if (!word) {
         return uint8_t{0};
     }
-    for (uint8_t v = 0; v < 3; ++v) {
-        if (*word == kVisibilities[v]) {
-            return v;
-        }
+    if (const std::optional<uint8_t> visibility = visibilityFromName(*word)) {
+        return visibility;
     }
     check.fail(*table.get("visibility"), fmt::format("{}: 'visibility' must be \"local\", \"regional\" or \"global\"",
                                                      where));
@@ -89,7 +85,7 @@ std::string writeSavedNode(const SavedNode& node, const std::string& header)
     out += fmt::format("command_line = {}\n", quoted(c.commandLine));
     for (const ObjectSpec& object : node.objects) {
         switch (object.kind) {
-        case ObjectKind::Semaphore:
+        case ObjectType::Semaphore:
             out += "\n[[semaphore]]\n";
             out += fmt::format("name = {}\n", quoted(object.name));
             out += fmt::format("initial_count = {}\n", object.initialCount);
@@ -97,18 +93,19 @@ std::string writeSavedNode(const SavedNode& node, const std::string& header)
             out += fmt::format("inheritance = {}\n", object.inheritance);
             out += fmt::format("fifo = {}\n", object.fifo);
             break;
-        case ObjectKind::MessagePort:
+        case ObjectType::MessagePort:
             out += "\n[[port]]\n";
             out += fmt::format("name = {}\n", quoted(object.name));
             out += fmt::format("fifo = {}\n", object.fifo);
             break;
-        case ObjectKind::Publisher:
+        case ObjectType::DsmPublisher:
             out += "\n[[publisher]]\n";
             out += fmt::format("name = {}\n", quoted(object.name));
             break;
         default: continue;
         }
-        out += fmt::format("visibility = \"{}\"\n", kVisibilities[object.visibility < 3 ? object.visibility : 0]);
+        const char* visibility = visibilityName(object.visibility);
+        out += fmt::format("visibility = \"{}\"\n", visibility != nullptr ? visibility : visibilityName(0));
     }
     for (const TaskSpec& task : node.tasks) {
         out += "\n[[task]]\n";
@@ -156,8 +153,8 @@ std::optional<std::string> readSavedNode(const std::string& text, const std::str
         node.configuration.lockoutSeconds = static_cast<uint16_t>(lockout.value_or(0));
         node.configuration.commandLine = commandLine.value_or("");
     }
-    std::set<std::pair<ObjectKind, std::string>> names;
-    const auto named = [&](const toml::table& entry, const std::string& where, ObjectKind kind) {
+    std::set<std::pair<ObjectType, std::string>> names;
+    const auto named = [&](const toml::table& entry, const std::string& where, ObjectType kind) {
         const std::optional<std::string> name = check.string(entry, "name", sei::kSeiMaxName, where);
         check.require(entry, name.has_value() && !name->empty(), "name", where);
         if (name && !name->empty() && !names.insert({kind, *name}).second) {
@@ -169,7 +166,7 @@ std::optional<std::string> readSavedNode(const std::string& text, const std::str
     eachEntry(check, root, "semaphore", [&](const toml::table& entry, const std::string& where) {
         check.onlyKeys(entry, {"name", "initial_count", "counting", "inheritance", "fifo", "visibility"}, where);
         ObjectSpec spec;
-        spec.kind = ObjectKind::Semaphore;
+        spec.kind = ObjectType::Semaphore;
         spec.name = named(entry, where, spec.kind);
         spec.initialCount = static_cast<uint32_t>(check.integer(entry, "initial_count", 0, 0xFFFFFFFFll, where).value_or(1));
         spec.counting = check.boolean(entry, "counting", where).value_or(false);
@@ -181,7 +178,7 @@ std::optional<std::string> readSavedNode(const std::string& text, const std::str
     eachEntry(check, root, "port", [&](const toml::table& entry, const std::string& where) {
         check.onlyKeys(entry, {"name", "fifo", "visibility"}, where);
         ObjectSpec spec;
-        spec.kind = ObjectKind::MessagePort;
+        spec.kind = ObjectType::MessagePort;
         spec.name = named(entry, where, spec.kind);
         spec.fifo = check.boolean(entry, "fifo", where).value_or(false);
         spec.visibility = visibilityOf(check, entry, where).value_or(0);
@@ -190,7 +187,7 @@ std::optional<std::string> readSavedNode(const std::string& text, const std::str
     eachEntry(check, root, "publisher", [&](const toml::table& entry, const std::string& where) {
         check.onlyKeys(entry, {"name", "visibility"}, where);
         ObjectSpec spec;
-        spec.kind = ObjectKind::Publisher;
+        spec.kind = ObjectType::DsmPublisher;
         spec.name = named(entry, where, spec.kind);
         spec.visibility = visibilityOf(check, entry, where).value_or(0);
         node.objects.push_back(spec);
@@ -198,7 +195,7 @@ std::optional<std::string> readSavedNode(const std::string& text, const std::str
     eachEntry(check, root, "task", [&](const toml::table& entry, const std::string& where) {
         check.onlyKeys(entry, {"name", "entry", "priority", "stack_size", "argument"}, where);
         TaskSpec spec;
-        spec.name = named(entry, where, ObjectKind::Task);
+        spec.name = named(entry, where, ObjectType::Task);
         const std::optional<std::string> entryPoint = check.string(entry, "entry", sei::kSeiMaxName, where);
         check.require(entry, entryPoint.has_value() && !entryPoint->empty(), "entry", where);
         spec.entry = entryPoint.value_or("");

@@ -14,22 +14,22 @@ using sei::SeiCommand;
 using sei::SeiMessage;
 
 struct KindWord {
-    ObjectKind kind;
+    ObjectType kind;
     const char* word;
 };
 
 constexpr KindWord kKindWords[] = {
-    {ObjectKind::Task, "task"},   {ObjectKind::Timer, "timer"},        {ObjectKind::Device, "device"},
-    {ObjectKind::BufferPool, "pool"}, {ObjectKind::Heap, "heap"},      {ObjectKind::MessagePort, "port"},
-    {ObjectKind::Publisher, "publisher"}, {ObjectKind::Semaphore, "semaphore"},
+    {ObjectType::Task, "task"},   {ObjectType::Timer, "timer"},        {ObjectType::Device, "device"},
+    {ObjectType::BufferPool, "pool"}, {ObjectType::Heap, "heap"},      {ObjectType::MessagePort, "port"},
+    {ObjectType::DsmPublisher, "publisher"}, {ObjectType::Semaphore, "semaphore"},
 };
 
 } // namespace
 
-const std::vector<ObjectKind>& listedKinds()
+const std::vector<ObjectType>& listedKinds()
 {
-    static const std::vector<ObjectKind> kinds = [] {
-        std::vector<ObjectKind> all;
+    static const std::vector<ObjectType> kinds = [] {
+        std::vector<ObjectType> all;
         for (const KindWord& word : kKindWords) {
             all.push_back(word.kind);
         }
@@ -48,11 +48,32 @@ std::string kindName(uint8_t type)
     return fmt::format("type-{}", type);
 }
 
-std::optional<ObjectKind> kindFromName(const std::string& name)
+std::optional<ObjectType> kindFromName(const std::string& name)
 {
     for (const KindWord& word : kKindWords) {
         if (name == word.word) {
             return word.kind;
+        }
+    }
+    return std::nullopt;
+}
+
+namespace {
+
+const char* const kVisibilityWords[] = {"local", "regional", "global"};
+
+} // namespace
+
+const char* visibilityName(uint8_t visibility)
+{
+    return visibility < sizeof kVisibilityWords / sizeof kVisibilityWords[0] ? kVisibilityWords[visibility] : nullptr;
+}
+
+std::optional<uint8_t> visibilityFromName(const std::string& name)
+{
+    for (uint8_t v = 0; v < sizeof kVisibilityWords / sizeof kVisibilityWords[0]; ++v) {
+        if (name == kVisibilityWords[v]) {
+            return v;
         }
     }
     return std::nullopt;
@@ -106,13 +127,13 @@ const std::vector<std::string>& figureNames(uint8_t type)
     static const std::vector<std::string> heap = {"heap_bytes", "free_bytes", "used_bytes", "allocated_segments",
                                                   "free_segments", "largest_free_segment"};
     static const std::vector<std::string> publisher = {"data_id", "page_low", "page_high"};
-    switch (static_cast<ObjectKind>(type)) {
-    case ObjectKind::Task: return task;
-    case ObjectKind::Semaphore: return semaphore;
-    case ObjectKind::MessagePort: return port;
-    case ObjectKind::BufferPool: return pool;
-    case ObjectKind::Heap: return heap;
-    case ObjectKind::Publisher: return publisher;
+    switch (static_cast<ObjectType>(type)) {
+    case ObjectType::Task: return task;
+    case ObjectType::Semaphore: return semaphore;
+    case ObjectType::MessagePort: return port;
+    case ObjectType::BufferPool: return pool;
+    case ObjectType::Heap: return heap;
+    case ObjectType::DsmPublisher: return publisher;
     default: return none;
     }
 }
@@ -127,7 +148,7 @@ uint64_t ObjectDetails::figure(const std::string& wanted) const
     return 0;
 }
 
-ConfigError NodeObjects::list(ObjectKind kind, std::vector<ObjectEntry>& out)
+ConfigError NodeObjects::list(ObjectType kind, std::vector<ObjectEntry>& out)
 {
     out.clear();
     SeiMessage request = requestOf(SeiCommand::ListObjects);
@@ -165,7 +186,7 @@ ConfigError NodeObjects::list(ObjectKind kind, std::vector<ObjectEntry>& out)
     return error;
 }
 
-ConfigError NodeObjects::find(ObjectKind kind, const std::string& name, uint32_t& id)
+ConfigError NodeObjects::find(ObjectType kind, const std::string& name, uint32_t& id)
 {
     SeiMessage request = requestOf(SeiCommand::FindObject);
     request.objectType = static_cast<uint8_t>(kind);
@@ -252,12 +273,12 @@ ConfigError NodeChanges::createObject(const ObjectSpec& spec, uint32_t& id)
     request.name = spec.name.data();
     request.nameLength = static_cast<uint8_t>(spec.name.size());
     request.visibility = spec.visibility;
-    if (spec.kind == ObjectKind::Semaphore) {
+    if (spec.kind == ObjectType::Semaphore) {
         request.parameters[0] = spec.initialCount;
         request.parameters[1] = (spec.counting ? sei::kSeiSemaphoreCounting : 0) |
                                 (spec.inheritance ? sei::kSeiSemaphoreInheritance : 0) |
                                 (spec.fifo ? sei::kSeiSemaphoreFifo : 0);
-    } else if (spec.kind == ObjectKind::MessagePort) {
+    } else if (spec.kind == ObjectType::MessagePort) {
         request.parameters[0] = spec.fifo ? 1 : 0;
     }
     SeiMessage reply;
@@ -268,7 +289,7 @@ ConfigError NodeChanges::createObject(const ObjectSpec& spec, uint32_t& id)
     return error;
 }
 
-ConfigError NodeChanges::addObjects(ObjectKind kind, uint16_t count)
+ConfigError NodeChanges::addObjects(ObjectType kind, uint16_t count)
 {
     SeiMessage request = requestOf(SeiCommand::AddObjects);
     request.objectType = static_cast<uint8_t>(kind);

@@ -441,12 +441,12 @@ int queryNode(const Options& options, QueriedNode& queried)
     return kExitOk;
 }
 
-std::optional<hostconfig::ObjectKind> kindArgument(const std::string& word)
+std::optional<dcos::ObjectType> kindArgument(const std::string& word)
 {
-    const std::optional<hostconfig::ObjectKind> kind = hostconfig::kindFromName(word);
+    const std::optional<dcos::ObjectType> kind = hostconfig::kindFromName(word);
     if (!kind) {
         std::string known;
-        for (const hostconfig::ObjectKind k : hostconfig::listedKinds()) {
+        for (const dcos::ObjectType k : hostconfig::listedKinds()) {
             known += (known.empty() ? "" : ", ") + hostconfig::kindName(static_cast<uint8_t>(k));
         }
         fail(kExitUsage, fmt::format("'{}' is no object type; the types are {}", word, known));
@@ -457,13 +457,13 @@ std::optional<hostconfig::ObjectKind> kindArgument(const std::string& word)
 // The object @p text names: an id (0x0005a001 or decimal), or KIND:NAME, or
 // (with @p fallback) a name of that kind, as the node finds it.
 int resolveObject(hostconfig::NodeObjects& objects, const std::string& text,
-                  std::optional<hostconfig::ObjectKind> fallback, const std::string& who, uint32_t& id)
+                  std::optional<dcos::ObjectType> fallback, const std::string& who, uint32_t& id)
 {
     if (const std::optional<uint32_t> parsed = hostconfig::parseId(text)) {
         id = *parsed;
         return kExitOk;
     }
-    std::optional<hostconfig::ObjectKind> kind = fallback;
+    std::optional<dcos::ObjectType> kind = fallback;
     std::string name = text;
     if (const size_t colon = text.find(':'); colon != std::string::npos) {
         kind = kindArgument(text.substr(0, colon));
@@ -493,9 +493,9 @@ nlohmann::json entryJson(const hostconfig::ObjectEntry& entry)
 
 int listObjects(const Options& options)
 {
-    std::vector<hostconfig::ObjectKind> kinds = hostconfig::listedKinds();
+    std::vector<dcos::ObjectType> kinds = hostconfig::listedKinds();
     if (!options.kind.empty()) {
-        const std::optional<hostconfig::ObjectKind> kind = kindArgument(options.kind);
+        const std::optional<dcos::ObjectType> kind = kindArgument(options.kind);
         if (!kind) {
             return kExitUsage;
         }
@@ -511,7 +511,7 @@ int listObjects(const Options& options)
     if (!options.json) {
         fmt::print("{:<12} {:<10} {:<16} {}\n", "id", "type", "name", "owner");
     }
-    for (const hostconfig::ObjectKind kind : kinds) {
+    for (const dcos::ObjectType kind : kinds) {
         std::vector<hostconfig::ObjectEntry> entries;
         if (const ConfigError error = objects.list(kind, entries)) {
             return failWith(error, reached.who);
@@ -534,7 +534,7 @@ int listObjects(const Options& options)
 
 int findObject(const Options& options)
 {
-    const std::optional<hostconfig::ObjectKind> kind = kindArgument(options.kind);
+    const std::optional<dcos::ObjectType> kind = kindArgument(options.kind);
     if (!kind) {
         return kExitUsage;
     }
@@ -571,9 +571,9 @@ int showObject(const Options& options)
     if (const ConfigError error = objects.info(id, details)) {
         return failWith(error, reached.who);
     }
-    static const char* const visibilities[] = {"local", "regional", "global"};
-    const std::string visibility = details.visibility < 3 ? visibilities[details.visibility] : "?";
-    const bool task = details.type == static_cast<uint8_t>(hostconfig::ObjectKind::Task);
+    const char* known = hostconfig::visibilityName(details.visibility);
+    const std::string visibility = known != nullptr ? known : "?";
+    const bool task = details.type == static_cast<uint8_t>(dcos::ObjectType::Task);
     if (options.json) {
         nlohmann::json out{{"id", hostconfig::idText(details.id)},
                            {"type", hostconfig::kindName(details.type)},
@@ -644,7 +644,7 @@ int manage(const Options& options, Manage what)
     if (!key) {
         return code;
     }
-    std::optional<hostconfig::ObjectKind> kind;
+    std::optional<dcos::ObjectType> kind;
     if (what == Manage::Create || what == Manage::AddObjects) {
         kind = kindArgument(options.kind);
         if (!kind) {
@@ -655,14 +655,11 @@ int manage(const Options& options, Manage what)
     if (what == Manage::Create) {
         object.kind = *kind;
         object.name = options.name;
-        static const char* const visibilities[] = {"local", "regional", "global"};
-        object.visibility = 0xFF;
-        for (uint8_t v = 0; v < 3; ++v) {
-            object.visibility = options.visibility == visibilities[v] ? v : object.visibility;
-        }
-        if (object.visibility == 0xFF) {
+        const std::optional<uint8_t> visibility = hostconfig::visibilityFromName(options.visibility);
+        if (!visibility) {
             return fail(kExitUsage, fmt::format("visibility '{}' is none of local, regional, global", options.visibility));
         }
+        object.visibility = *visibility;
     }
     ReachedNode reached;
     if (const int status = reachNode(options, reached); status != kExitOk) {
@@ -690,8 +687,8 @@ int manage(const Options& options, Manage what)
     case Manage::TaskStart:
     case Manage::TaskStop:
     case Manage::TaskKill: {
-        const std::optional<hostconfig::ObjectKind> fallback =
-            what == Manage::Delete ? std::nullopt : std::optional<hostconfig::ObjectKind>(hostconfig::ObjectKind::Task);
+        const std::optional<dcos::ObjectType> fallback =
+            what == Manage::Delete ? std::nullopt : std::optional<dcos::ObjectType>(dcos::ObjectType::Task);
         if (const int status = resolveObject(objects, options.target, fallback, reached.who, id); status != kExitOk) {
             return status;
         }
@@ -749,8 +746,8 @@ int save(const Options& options)
     hostconfig::NodeObjects& objects = *queried.objects;
     // The named objects a host can make again: semaphores, ports and
     // publishers, each as it was created.
-    for (const hostconfig::ObjectKind kind :
-         {hostconfig::ObjectKind::Semaphore, hostconfig::ObjectKind::MessagePort, hostconfig::ObjectKind::Publisher}) {
+    for (const dcos::ObjectType kind :
+         {dcos::ObjectType::Semaphore, dcos::ObjectType::MessagePort, dcos::ObjectType::DsmPublisher}) {
         std::vector<hostconfig::ObjectEntry> entries;
         if (const ConfigError error = objects.list(kind, entries)) {
             return failWith(error, reached.who);
@@ -767,13 +764,13 @@ int save(const Options& options)
             spec.kind = kind;
             spec.name = entry.name;
             spec.visibility = details.visibility;
-            if (kind == hostconfig::ObjectKind::Semaphore) {
+            if (kind == dcos::ObjectType::Semaphore) {
                 const uint64_t settings = details.figure("settings");
                 spec.counting = (settings & sei::kSeiSemaphoreCounting) != 0;
                 spec.inheritance = (settings & sei::kSeiSemaphoreInheritance) != 0;
                 spec.fifo = (settings & sei::kSeiSemaphoreFifo) != 0;
                 spec.initialCount = static_cast<uint32_t>(details.figure("count"));
-            } else if (kind == hostconfig::ObjectKind::MessagePort) {
+            } else if (kind == dcos::ObjectType::MessagePort) {
                 spec.fifo = details.figure("order_fifo") != 0;
             }
             saved.objects.push_back(spec);
@@ -841,7 +838,7 @@ int restore(const Options& options)
     nlohmann::json present = nlohmann::json::array();
     // Each object and task by its name: one the node has is left as it is,
     // so that a restore done twice creates nothing the second time.
-    const auto ensure = [&](hostconfig::ObjectKind kind, const std::string& name, auto make) -> int {
+    const auto ensure = [&](dcos::ObjectType kind, const std::string& name, auto make) -> int {
         const std::string label = fmt::format("{} {}", hostconfig::kindName(static_cast<uint8_t>(kind)), name);
         uint32_t id = 0;
         const ConfigError found = objects.find(kind, name, id);
@@ -868,7 +865,7 @@ int restore(const Options& options)
     }
     for (const hostconfig::TaskSpec& spec : saved.tasks) {
         const int status =
-            ensure(hostconfig::ObjectKind::Task, spec.name, [&](uint32_t& id) { return changes.createTask(spec, id); });
+            ensure(dcos::ObjectType::Task, spec.name, [&](uint32_t& id) { return changes.createTask(spec, id); });
         worst = worst == kExitOk ? status : worst;
     }
     if (options.json) {

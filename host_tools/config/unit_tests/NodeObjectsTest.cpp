@@ -19,12 +19,12 @@
 namespace {
 
 using config_test::keyOf;
+using dcos::ObjectType;
 using config_test::MemoryBus;
 using config_test::MemoryNode;
 using hostconfig::ConfigClient;
 using hostconfig::ConfigError;
 using hostconfig::NodeIdentity;
-using hostconfig::ObjectKind;
 using sei::SeiCommand;
 using sei::SeiStatus;
 
@@ -53,7 +53,7 @@ TEST(NodeObjectsTest, AListingIsPutTogetherFromItsPages)
         uint32_t id = 0;
         ASSERT_FALSE(changes.createObject(spec, id));
     }
-    ASSERT_FALSE(changes.addObjects(ObjectKind::Semaphore, 16));
+    ASSERT_FALSE(changes.addObjects(ObjectType::Semaphore, 16));
     for (int i = 8; i < 19; ++i) {
         hostconfig::ObjectSpec spec;
         spec.name = "s" + std::to_string(i);
@@ -62,7 +62,7 @@ TEST(NodeObjectsTest, AListingIsPutTogetherFromItsPages)
     }
     hostconfig::NodeObjects objects(f.client, f.identity, nullptr);
     std::vector<hostconfig::ObjectEntry> entries;
-    ASSERT_FALSE(objects.list(ObjectKind::Semaphore, entries));
+    ASSERT_FALSE(objects.list(ObjectType::Semaphore, entries));
     ASSERT_EQ(entries.size(), 19u);
     EXPECT_EQ(entries.front().name, "s0");
     EXPECT_EQ(entries.back().name, "s18");
@@ -81,7 +81,7 @@ TEST(NodeObjectsTest, FindInfoAndTheKernelsRefusals)
     ASSERT_FALSE(changes.createTask(task, id));
     hostconfig::NodeObjects objects(f.client, f.identity, nullptr);
     uint32_t found = 0;
-    ASSERT_FALSE(objects.find(ObjectKind::Task, "s2", found));
+    ASSERT_FALSE(objects.find(ObjectType::Task, "s2", found));
     EXPECT_EQ(found, id);
     hostconfig::ObjectDetails details;
     ASSERT_FALSE(objects.info(id, details));
@@ -90,7 +90,7 @@ TEST(NodeObjectsTest, FindInfoAndTheKernelsRefusals)
     EXPECT_EQ(details.figure("stack_size"), 4096u);
     EXPECT_EQ(details.figures.front().first, "base_priority");
 
-    const ConfigError missing = objects.find(ObjectKind::Task, "nosuch", found);
+    const ConfigError missing = objects.find(ObjectType::Task, "nosuch", found);
     EXPECT_EQ(missing.kind, ConfigError::Kind::Refused);
     EXPECT_EQ(missing.status, SeiStatus::KernelRefused);
     EXPECT_EQ(hostconfig::describe(missing, "node 3"), "node 3's kernel refused it: not found");
@@ -98,7 +98,7 @@ TEST(NodeObjectsTest, FindInfoAndTheKernelsRefusals)
     task.entry = "nosuch";
     EXPECT_EQ(hostconfig::describe(changes.createTask(task, id), "node 3"), "node 3's kernel refused it: not found");
     hostconfig::ObjectSpec pool;
-    pool.kind = ObjectKind::BufferPool;
+    pool.kind = ObjectType::BufferPool;
     pool.name = "p";
     EXPECT_EQ(hostconfig::describe(changes.createObject(pool, id), "node 3"),
               "node 3's kernel refused it: not supported");
@@ -124,7 +124,7 @@ TEST(NodeObjectsTest, WordsForKindsStatesAndIds)
 {
     EXPECT_EQ(hostconfig::kindName(10), "semaphore");
     EXPECT_EQ(hostconfig::kindName(2), "type-2");
-    EXPECT_EQ(hostconfig::kindFromName("port"), ObjectKind::MessagePort);
+    EXPECT_EQ(hostconfig::kindFromName("port"), ObjectType::MessagePort);
     EXPECT_FALSE(hostconfig::kindFromName("process"));
     EXPECT_EQ(hostconfig::taskStateName(5), "suspended");
     EXPECT_EQ(hostconfig::kernelStatusText(4), "object table full");
@@ -152,11 +152,11 @@ hostconfig::SavedNode sample()
     semaphore.counting = true;
     semaphore.visibility = 1;
     hostconfig::ObjectSpec port;
-    port.kind = ObjectKind::MessagePort;
+    port.kind = ObjectType::MessagePort;
     port.name = "inbox";
     port.fifo = true;
     hostconfig::ObjectSpec publisher;
-    publisher.kind = ObjectKind::Publisher;
+    publisher.kind = ObjectType::DsmPublisher;
     publisher.name = "level";
     publisher.visibility = 2;
     node.objects = {semaphore, port, publisher};
@@ -185,11 +185,11 @@ TEST(ConfigurationFileTest, AWrittenFileReadsBackTheSame)
     EXPECT_EQ(back.configuration.lockoutSeconds, 90);
     EXPECT_EQ(back.configuration.commandLine, node.configuration.commandLine);
     ASSERT_EQ(back.objects.size(), 3u);
-    EXPECT_EQ(back.objects[0].kind, ObjectKind::Semaphore);
+    EXPECT_EQ(back.objects[0].kind, ObjectType::Semaphore);
     EXPECT_EQ(back.objects[0].initialCount, 3u);
     EXPECT_TRUE(back.objects[0].counting);
     EXPECT_EQ(back.objects[0].visibility, 1);
-    EXPECT_EQ(back.objects[1].kind, ObjectKind::MessagePort);
+    EXPECT_EQ(back.objects[1].kind, ObjectType::MessagePort);
     EXPECT_TRUE(back.objects[1].fifo);
     EXPECT_EQ(back.objects[2].visibility, 2);
     ASSERT_EQ(back.tasks.size(), 1u);

@@ -315,7 +315,7 @@ int resolvePublishers(ConfigClient& client, const NodeIdentity& node, const Conf
         }
         hostconfig::NodeObjects objects(client, node, key);
         if (const ConfigError error =
-                objects.find(hostconfig::ObjectKind::Publisher, channel.spec.publisherName, channel.publisher)) {
+                objects.find(dcos::ObjectType::DsmPublisher, channel.spec.publisherName, channel.publisher)) {
             return failWith(error, who, fmt::format("to find publisher '{}'", channel.spec.publisherName));
         }
     }

@@ -10,6 +10,8 @@
 
 #include <sei/SeiMessage.hpp>
 
+#include <dcos/ObjectId.hpp>
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -17,25 +19,20 @@
 
 namespace hostconfig {
 
-/// The object types a node lists (dcos::ObjectType's values).
-enum class ObjectKind : uint8_t {
-    Task = 1,
-    Timer = 3,
-    Device = 4,
-    BufferPool = 5,
-    Heap = 6,
-    MessagePort = 7,
-    Publisher = 8,
-    Semaphore = 10,
-};
+/// The object types, as the node numbers them in every id.
+using dcos::ObjectType;
 
 /// Every listed kind, in the order `dcos-config objects` prints them.
-const std::vector<ObjectKind>& listedKinds();
+const std::vector<ObjectType>& listedKinds();
 /// "task", "timer", "device", "pool", "heap", "port", "publisher", "semaphore";
 /// "type-N" for a number this tool does not know.
 std::string kindName(uint8_t type);
 /// The kind a word names (the names above), or nothing.
-std::optional<ObjectKind> kindFromName(const std::string& name);
+std::optional<ObjectType> kindFromName(const std::string& name);
+/// "local", "regional" or "global" (dcos::Visibility); null for another value.
+const char* visibilityName(uint8_t visibility);
+/// The visibility a word names (the names above), or nothing.
+std::optional<uint8_t> visibilityFromName(const std::string& name);
 /// "ready", "suspended", ... (dcos::TaskState).
 std::string taskStateName(uint8_t state);
 /// The kernel's words for its status (dcos::statusName).
@@ -94,8 +91,8 @@ public:
     }
 
     /// Every object of @p kind, a page at a time.
-    ConfigError list(ObjectKind kind, std::vector<ObjectEntry>& out);
-    ConfigError find(ObjectKind kind, const std::string& name, uint32_t& id);
+    ConfigError list(ObjectType kind, std::vector<ObjectEntry>& out);
+    ConfigError find(ObjectType kind, const std::string& name, uint32_t& id);
     ConfigError info(uint32_t id, ObjectDetails& out);
     ConfigError statistics(NodeStatistics& out);
 
@@ -107,7 +104,7 @@ private:
 
 /// What CreateObject makes; the fields its kind does not use stay as they are.
 struct ObjectSpec {
-    ObjectKind kind = ObjectKind::Semaphore;
+    ObjectType kind = ObjectType::Semaphore;
     std::string name;
     uint8_t visibility = 0;      ///< 0 local, 1 regional, 2 global.
     uint32_t initialCount = 1;   ///< Semaphores.
@@ -140,7 +137,7 @@ public:
     /// Not asked again on silence.
     ConfigError createObject(const ObjectSpec& spec, uint32_t& id);
     /// Not asked again on silence (the slots would be added twice).
-    ConfigError addObjects(ObjectKind kind, uint16_t count);
+    ConfigError addObjects(ObjectType kind, uint16_t count);
     /// The whole configuration record: the sequence written.
     ConfigError setConfiguration(const NodeConfiguration& configuration, uint32_t& sequence);
 
