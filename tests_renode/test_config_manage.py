@@ -160,6 +160,13 @@ def test_a_bit_rate_switch_takes_the_whole_bus_at_once(canlab, tmp_path):
     cards = {node: node_card(tmp_path, f"n{node}", image, 8000 + node, keys[node], node) for node in (1, 2)}
     lab = canlab({"can0": BITRATE}, {f"board{node}": {"bus0": "can0", "card": cards[node]} for node in (1, 2)})
     lab.hub.wait_on_bus(["board1.0", "board2.0"], TIMEOUT)
+    # A switch to the rate the nodes already run at changes nothing: no chip
+    # is reset, and both still answer.
+    config(lab, "switch-bitrate", "--delay-ms", "0")
+    lab.hub.wait_until(lab.hub.now_ns + 50_000_000, TIMEOUT)
+    for node in (1, 2):
+        assert "switching to" not in lab.board(f"board{node}").emulator.transcript
+        assert config(lab, "info", "-n", str(node))[0]["node"] == node
     for node in (1, 2):
         written, _ = config(lab, "set-bitrate", "-n", str(node), "-K", keys[node], "500000")
         assert written["bit_rate"] == 500000, written
@@ -173,7 +180,8 @@ def test_a_bit_rate_switch_takes_the_whole_bus_at_once(canlab, tmp_path):
     # bit, at one moment, 200 ms after the announcement left.
     announced = [r for r in lab.hub.frames() if r.outcome == "ok" and r.frame.extended
                  and (r.frame.id >> 16) & 0xFF == 0x40 and list(r.frame.data[:2]) == [0x03, 0x23]]
-    assert len(announced) == 1, announced
+    assert len(announced) == 2 and announced[0].frame.data[2:4] == b"\x00\x00", announced
+    announced = announced[1:]
     # A wait's condition runs under the hub's lock, so the log is read after it.
     start = announced[0].end
     lab.hub.wait_until(start + 400_000_000, TIMEOUT)
