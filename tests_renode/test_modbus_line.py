@@ -461,10 +461,16 @@ def test_the_controller_as_master_reads_dcos_modbus_sim_over_the_line(master_on_
     # Two answers of 7 characters, each paced back to back from a boundary, heard by the board.
     assert len(answers) == 14 and all(r.rx == ("board1.rs485",) for r in answers), lab.hub.log_text()
     assert host_gaps(answers[:7]) == [0] * 6 and host_gaps(answers[7:]) == [0] * 6
-    # Each answer starts t3.5 or later after the request's last stop bit.
+    # Each answer starts t3.5 or later after the last stop bit of the request it answers, the last
+    # request character before it (a retry, below, comes between).
     requests = from_port(records, "board1.rs485")
-    assert answers[0].start - requests[7].end >= T35_NS and answers[7].start - requests[15].end >= T35_NS
-    assert modbus_state(board)["master.timeouts"] == 0
+    for answer in (answers[0], answers[7]):
+        assert answer.start - max(r.end for r in requests if r.end <= answer.start) >= T35_NS
+    # Both reads ended well. A time-out followed by a good retry is allowed, as in the every-function
+    # test below: dcos-modbus-sim frames requests by silences of the host's wall clock, which a loaded
+    # host stretches inside a request (a fresh CI run saw it once here).
+    seen = modbus_state(board)
+    assert seen["master.failures"] == 0, (seen, lab.hub.log_text())
 
 
 EVERY_TABLE_SIM = """\
