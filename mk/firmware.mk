@@ -64,6 +64,8 @@ include drivers/iobus/iobus.mk
 include fieldbus/can/can.mk
 include fieldbus/modbus/modbus.mk
 include drivers/can/can.mk
+include drivers/pci/pci.mk
+include firmware/bsp_p5smp/p5smp.mk
 include drivers/modbus/modbus.mk
 include drivers/ata/ata.mk
 include firmware/flash/flash.mk

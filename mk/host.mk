@@ -3,6 +3,7 @@
 
 HOST_BUILD := $(BUILD)/host
 HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Wno-missing-field-initializers -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES) \
+	-Ifirmware/bsp_p5smp/include -Idrivers/pci/include \
 	-Ihost_tools/can/include $(HOSTMODBUS_CXXFLAGS) -Ifirmware/image/include -Ihost_tools/image/include \
 	-Ifirmware/flash/include -Ihost_tools/flash/include -Ifirmware/sei/include -Ihost_tools/config/include \
 	$(HOSTMON_CXXFLAGS)
@@ -26,6 +27,8 @@ HOST_PORTABLE_SRCS := \
 	firmware/bsp_486/src/Pit8254.cpp \
 	firmware/bsp_486/src/Rtc146818.cpp \
 	firmware/bsp_486/src/Uart16550.cpp \
+	$(P5SMP_PORTABLE_SRCS) \
+	$(PCI_DRIVER_PORTABLE_SRCS) \
 	$(IOBUS_PORTABLE_SRCS) \
 	$(CAN_PORTABLE_SRCS) \
 	$(MODBUS_PORTABLE_SRCS) \

@@ -51,13 +51,13 @@ private:
 
     struct CommandPorts final : port_io_mock::Responder {
         FakeAtaDisk* disk;
-        uint16_t read(uint16_t offset, int width) override { return disk->readCommand(offset, width); }
-        void write(uint16_t offset, uint16_t value, int width) override { disk->writeCommand(offset, value, width); }
+        uint32_t read(uint16_t offset, int width) override { return disk->readCommand(offset, width); }
+        void write(uint16_t offset, uint32_t value, int width) override { disk->writeCommand(offset, static_cast<uint16_t>(value), width); }
     } commandPorts_;
     struct ControlPorts final : port_io_mock::Responder {
         FakeAtaDisk* disk;
-        uint16_t read(uint16_t, int) override { return disk->status(); }
-        void write(uint16_t, uint16_t value, int) override { disk->deviceControl = static_cast<uint8_t>(value); }
+        uint32_t read(uint16_t, int) override { return disk->status(); }
+        void write(uint16_t, uint32_t value, int) override { disk->deviceControl = static_cast<uint8_t>(value); }
     } controlPorts_;
 
     uint32_t sectors_;

@@ -36,7 +36,7 @@ void FakeSja1000::raise(uint8_t bits)
     interrupt = static_cast<uint8_t>(interrupt | (bits & interruptEnable));
 }
 
-uint16_t FakeSja1000::read(uint16_t offset, int)
+uint32_t FakeSja1000::read(uint16_t offset, int)
 {
     const bool reset = (mode & reg::kModeReset) != 0;
     switch (offset) {
@@ -74,7 +74,7 @@ uint16_t FakeSja1000::read(uint16_t offset, int)
     return 0;
 }
 
-void FakeSja1000::write(uint16_t offset, uint16_t value16, int)
+void FakeSja1000::write(uint16_t offset, uint32_t value16, int)
 {
     const uint8_t value = static_cast<uint8_t>(value16);
     const bool reset = (mode & reg::kModeReset) != 0;

@@ -29,8 +29,8 @@ class FakeSja1000 final : public port_io_mock::Responder {
 public:
     FakeSja1000() { port_io_mock::attach(kBase, sja1000::reg::kWindowSize, this); }
 
-    uint16_t read(uint16_t offset, int width) override;
-    void write(uint16_t offset, uint16_t value, int width) override;
+    uint32_t read(uint16_t offset, int width) override;
+    void write(uint16_t offset, uint32_t value, int width) override;
 
     // -- the bus, as the test plays it --------------------------------------
 

@@ -10,8 +10,8 @@ namespace port_io_mock {
 
 namespace {
 std::vector<Access> log;
-std::map<uint16_t, std::deque<uint16_t>> queued;
-std::map<uint16_t, uint16_t> defaults;
+std::map<uint16_t, std::deque<uint32_t>> queued;
+std::map<uint16_t, uint32_t> defaults;
 
 struct Attached {
     uint16_t first;
@@ -30,11 +30,11 @@ const Attached* responderFor(uint16_t port)
     return nullptr;
 }
 
-uint16_t nextRead(uint16_t port, int width)
+uint32_t nextRead(uint16_t port, int width)
 {
     auto& queue = queued[port];
     if (!queue.empty()) {
-        const uint16_t value = queue.front();
+        const uint32_t value = queue.front();
         queue.pop_front();
         return value;
     }
@@ -45,7 +45,7 @@ uint16_t nextRead(uint16_t port, int width)
     return found != defaults.end() ? found->second : 0xFF;
 }
 
-void written(uint16_t port, uint16_t value, int width)
+void written(uint16_t port, uint32_t value, int width)
 {
     if (const Attached* a = responderFor(port)) {
         a->responder->write(static_cast<uint16_t>(port - a->first), value, width);
@@ -70,17 +70,17 @@ std::vector<Access> takeLog()
     return out;
 }
 
-void queueRead(uint16_t port, uint16_t value) { queued[port].push_back(value); }
+void queueRead(uint16_t port, uint32_t value) { queued[port].push_back(value); }
 
-void setDefaultRead(uint16_t port, uint16_t value) { defaults[port] = value; }
+void setDefaultRead(uint16_t port, uint32_t value) { defaults[port] = value; }
 
 std::string describe(const std::vector<Access>& accesses)
 {
     std::string text;
     char line[64];
     for (const Access& a : accesses) {
-        std::snprintf(line, sizeof line, "%s%d 0x%03x %s 0x%02x\n", a.write ? "out" : "in", a.width, a.port,
-                      a.write ? "<-" : "->", a.value);
+        std::snprintf(line, sizeof line, "%s%d 0x%03x %s 0x%02lx\n", a.write ? "out" : "in", a.width, a.port,
+                      a.write ? "<-" : "->", static_cast<unsigned long>(a.value));
         text += line;
     }
     return text;
@@ -99,8 +99,15 @@ uint8_t portRead8(uint16_t port)
 
 uint16_t portRead16(uint16_t port)
 {
-    const uint16_t value = port_io_mock::nextRead(port, 16);
+    const uint16_t value = static_cast<uint16_t>(port_io_mock::nextRead(port, 16));
     port_io_mock::log.push_back({false, port, value, 16});
+    return value;
+}
+
+uint32_t portRead32(uint16_t port)
+{
+    const uint32_t value = port_io_mock::nextRead(port, 32);
+    port_io_mock::log.push_back({false, port, value, 32});
     return value;
 }
 
@@ -114,6 +121,12 @@ void portWrite16(uint16_t port, uint16_t value)
 {
     port_io_mock::log.push_back({true, port, value, 16});
     port_io_mock::written(port, value, 16);
+}
+
+void portWrite32(uint16_t port, uint32_t value)
+{
+    port_io_mock::log.push_back({true, port, value, 32});
+    port_io_mock::written(port, value, 32);
 }
 
 } // namespace arch_x86

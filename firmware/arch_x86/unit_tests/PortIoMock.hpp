@@ -16,7 +16,7 @@ namespace port_io_mock {
 struct Access {
     bool write;
     uint16_t port;
-    uint16_t value;
+    uint32_t value;
     int width;
 
     bool operator==(const Access&) const = default;
@@ -28,8 +28,8 @@ struct Access {
 /// instead of a script of values. Offsets are from the first port.
 class Responder {
 public:
-    virtual uint16_t read(uint16_t offset, int width) = 0;
-    virtual void write(uint16_t offset, uint16_t value, int width) = 0;
+    virtual uint32_t read(uint16_t offset, int width) = 0;
+    virtual void write(uint16_t offset, uint32_t value, int width) = 0;
 
 protected:
     ~Responder() = default;
@@ -46,11 +46,11 @@ void reset();
 std::vector<Access> takeLog();
 
 /// Queues a value for the next read of port.
-void queueRead(uint16_t port, uint16_t value);
+void queueRead(uint16_t port, uint32_t value);
 
 /// The value a read of port returns when nothing is queued (initially 0xFF,
 /// an empty ISA bus).
-void setDefaultRead(uint16_t port, uint16_t value);
+void setDefaultRead(uint16_t port, uint32_t value);
 
 /// Writes a readable log line per access, for failure messages.
 std::string describe(const std::vector<Access>& log);

@@ -66,6 +66,25 @@ public:
         }
     }
 
+    uint32_t read32(size_t offset) const
+    {
+        check(offset, 4);
+        if (space_ == Space::Port) {
+            return portRead32(static_cast<uint16_t>(base_ + offset));
+        }
+        return *reinterpret_cast<volatile uint32_t*>(base_ + offset);
+    }
+
+    void write32(size_t offset, uint32_t value) const
+    {
+        check(offset, 4);
+        if (space_ == Space::Port) {
+            portWrite32(static_cast<uint16_t>(base_ + offset), value);
+        } else {
+            *reinterpret_cast<volatile uint32_t*>(base_ + offset) = value;
+        }
+    }
+
     Space space() const { return space_; }
     uintptr_t base() const { return base_; }
     size_t size() const { return size_; }

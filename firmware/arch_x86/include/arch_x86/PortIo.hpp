@@ -15,6 +15,8 @@ uint8_t portRead8(uint16_t port);
 uint16_t portRead16(uint16_t port);
 void portWrite8(uint16_t port, uint8_t value);
 void portWrite16(uint16_t port, uint16_t value);
+uint32_t portRead32(uint16_t port);
+void portWrite32(uint16_t port, uint32_t value);
 #else
 inline uint8_t portRead8(uint16_t port)
 {
@@ -38,6 +40,21 @@ inline void portWrite8(uint16_t port, uint8_t value)
 inline void portWrite16(uint16_t port, uint16_t value)
 {
     asm volatile("outw %0, %1" : : "a"(value), "Nd"(port) : "memory");
+}
+
+// The doubleword forms are what PCI configuration mechanism #1 needs (PCI
+// Local Bus Specification 3.0, 3.2.2.3.2): its address and data ports take
+// 32-bit accesses.
+inline uint32_t portRead32(uint16_t port)
+{
+    uint32_t value;
+    asm volatile("inl %1, %0" : "=a"(value) : "Nd"(port) : "memory");
+    return value;
+}
+
+inline void portWrite32(uint16_t port, uint32_t value)
+{
+    asm volatile("outl %0, %1" : : "a"(value), "Nd"(port) : "memory");
 }
 #endif
 
