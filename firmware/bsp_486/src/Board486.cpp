@@ -190,6 +190,7 @@ uint16_t crystalModel(const boot::BootInfo& bootInfo, uint16_t divisor)
 
 } // namespace
 
+static_assert(systemTickLine == 0, "BoardTick.hpp reads the tick's request as bit 0 of the master 8259");
 static_assert(Pit8254::minimumRateHz == minimumTickRateHz && Pit8254::maximumRateHz == maximumTickRateHz);
 
 void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
