@@ -10,6 +10,10 @@ namespace {
 // tasks their own rings.
 constexpr uint32_t entryPresent = 1u << 0;
 constexpr uint32_t entryWritable = 1u << 1;
+// Page-level write-through and cache disable (SDM Vol. 3, 4.9 and 11.12):
+// a device register is never served from the cache.
+constexpr uint32_t entryWriteThrough = 1u << 3;
+constexpr uint32_t entryCacheDisable = 1u << 4;
 constexpr uint32_t entryFrameMask = 0xFFFFF000u;
 
 constexpr uintptr_t entriesPerTable = 1024;
@@ -68,6 +72,38 @@ uintptr_t Paging::enable(uintptr_t memoryEnd, uintptr_t tablesStart)
                  : "r"(cr0 | cr0Paging)
                  : "memory");
     return tablesStart + kPageSize + tableCount * kPageSize;
+}
+
+bool Paging::mapDevice(uintptr_t physical, size_t bytes)
+{
+    // The one table of device pages, and the 4 MiB region it serves once
+    // the first device is mapped.
+    alignas(kPageSize) static uint32_t deviceTable[entriesPerTable];
+    static uintptr_t deviceRegion = 0;
+
+    if (directoryTable == nullptr || bytes == 0 || physical < mappedLimit || physical + (bytes - 1) < physical) {
+        return false;
+    }
+    const uintptr_t first = pageBase(physical);
+    const uintptr_t last = pageBase(physical + (bytes - 1));
+    const uintptr_t region = first / bytesPerTable;
+    if (last / bytesPerTable != region || (deviceRegion != 0 && deviceRegion != region)) {
+        return false;
+    }
+    if (deviceRegion == 0) {
+        if ((directoryTable[region] & entryPresent) != 0) {
+            return false; // The memory's own tables reach that far.
+        }
+        deviceRegion = region;
+        directoryTable[region] =
+            static_cast<uint32_t>(reinterpret_cast<uintptr_t>(deviceTable)) | entryPresent | entryWritable;
+    }
+    for (uintptr_t page = first; page <= last; page += kPageSize) {
+        deviceTable[(page / kPageSize) % entriesPerTable] =
+            static_cast<uint32_t>(page) | entryPresent | entryWritable | entryWriteThrough | entryCacheDisable;
+        asm volatile("invlpg (%0)" : : "r"(page) : "memory");
+    }
+    return true;
 }
 
 void Paging::setPresent(uintptr_t page, bool present)

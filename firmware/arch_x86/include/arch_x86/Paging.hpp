@@ -46,6 +46,16 @@ public:
     /// Whether the page holding address is mapped and present.
     static bool isPresent(uintptr_t address);
 
+    /// Maps the device registers at [physical, physical + bytes) above the
+    /// memory, identity, writable and uncached (PCD and PWT: a register read
+    /// must reach the device every time). The local and I/O APICs of the
+    /// dual-Pentium board live there. Every device page must lie in one
+    /// 4 MiB region above mappedEnd(), served by one page table in static
+    /// storage: false (nothing changed) for a range outside it, inside the
+    /// memory, or before paging is on. The ISA board never calls it, and the
+    /// linker leaves its table out of that image.
+    static bool mapDevice(uintptr_t physical, size_t bytes);
+
     /// Whether paging has been turned on.
     static bool enabled();
 

@@ -1,0 +1,44 @@
+// The PC/AT peripherals both boards carry at the same addresses: the console
+// on COM1, the two RS-485 ports on COM2 and COM3, the CMOS real-time clock,
+// and the command-line options every board reads.
+//
+// Board.hpp declares what the kernel calls (console(), rs485Uart(),
+// readRealTimeClock(), ...); PcPeripherals.cpp defines those for both
+// boards. This header is the part each board's own file needs: bringing
+// the console up on its interrupt line and reading the options that shape
+// its tick.
+#pragma once
+
+#include <stdint.h>
+
+#include <boot/BootInfo.hpp>
+#include <bsp/Uart16550.hpp>
+
+namespace bsp::pc {
+
+/// The console's UART (COM1), for a board's own messages at boot.
+Uart16550& consoleUart();
+
+/// Brings the console up at consoleBaud and attaches its interrupt line;
+/// panics when the UART does not answer (nothing could be reported then).
+void initialiseConsole();
+
+/// "node=N" on the command line, or @p defaultNode; a value that is not a
+/// node id is reported on the console and @p defaultNode kept.
+uint16_t nodeFromCommandLine(const boot::BootInfo& bootInfo, uint16_t defaultNode);
+
+/// The tick rate: "tick_hz=N" when it names a rate from minimumTickRateHz to
+/// maximumTickRateHz, else @p requested (the application's rate), itself
+/// replaced by defaultTickRateHz when it is out of that range. A bad option
+/// is reported on the console.
+uint32_t tickRateFromCommandLine(const boot::BootInfo& bootInfo, uint32_t requested);
+
+/// "crystal_ppm=N" (0 to 1000): the lab's model of a crystal N parts per
+/// million fast, for the global time base's tests (docs/protocols/time.md).
+/// An emulated timer counts at exactly its nominal rate, so the model makes
+/// the tick timer count fewer per tick than the @p countsPerTick the kernel
+/// believes: the tick comes early and the clock gains. Returns the counts
+/// to take off, the nearest to N ppm, and says on the console what that gives.
+uint32_t crystalShortening(const boot::BootInfo& bootInfo, uint32_t countsPerTick);
+
+} // namespace bsp::pc
