@@ -63,6 +63,12 @@ MON_FUZZ_REPORT := $(BUILD)/reports/fuzz-mon-tests.xml
 CONFIG_FUZZ_TARGETS := saved_node
 CONFIG_FUZZ_CORPUS := host_tools/config/fuzz/corpus
 CONFIG_FUZZ_REPORT := $(BUILD)/reports/fuzz-config-tests.xml
+# The dual-Pentium board's reader of the BIOS's MultiProcessor Specification
+# tables (firmware/bsp_p5smp/fuzz), which it believes about its processors
+# and interrupt wiring.
+P5SMP_FUZZ_TARGETS := mp_table
+P5SMP_FUZZ_CORPUS := firmware/bsp_p5smp/fuzz/corpus
+P5SMP_FUZZ_REPORT := $(BUILD)/reports/fuzz-p5smp-tests.xml
 
 FUZZ_CXX := clang++
 # toml++ is compiled into the fuzz targets as Debian's shared library, which
@@ -123,6 +129,9 @@ CONFIG_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(filter-out %/CanCon
 	$(HOSTCONFIG_SRCS)) $(SEI_PORTABLE_SRCS) firmware/image/src/Sha256.cpp $(IMAGE_SRCS) $(CAN_PORTABLE_SRCS))
 CONFIG_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/config/fuzz/fuzz_%.cpp.o,$(CONFIG_FUZZ_TARGETS))
 CONFIG_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(CONFIG_FUZZ_TARGETS))
+P5SMP_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/bsp_p5smp/src/MpTable.cpp.o
+P5SMP_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/bsp_p5smp/fuzz/fuzz_%.cpp.o,$(P5SMP_FUZZ_TARGETS))
+P5SMP_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(P5SMP_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as
 # intermediate files and be deleted after every build.
 .SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS) $(MODBUS_FUZZ_LIBRARY_OBJS) $(MODBUS_FUZZ_TARGET_OBJS) \
@@ -130,6 +139,7 @@ CONFIG_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(CONFIG_FUZZ_TARGETS)
 	$(IMAGE_FUZZ_LIBRARY_OBJS) $(IMAGE_FUZZ_TARGET_OBJS) $(HOST_IMAGE_FUZZ_LIBRARY_OBJS) $(HOST_IMAGE_FUZZ_TARGET_OBJS) \
 	$(FLASH_FUZZ_LIBRARY_OBJS) $(FLASH_FUZZ_TARGET_OBJS) $(SEI_FUZZ_LIBRARY_OBJS) $(SEI_FUZZ_TARGET_OBJS) \
 	$(MON_FUZZ_LIBRARY_OBJS) $(MON_FUZZ_TARGET_OBJS) $(CONFIG_FUZZ_LIBRARY_OBJS) $(CONFIG_FUZZ_TARGET_OBJS)
+.SECONDARY: $(P5SMP_FUZZ_LIBRARY_OBJS) $(P5SMP_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
@@ -139,6 +149,7 @@ fuzz: deps
 fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARIES) $(DCOS_FUZZ_BINARIES) \
 	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES) $(FLASH_FUZZ_BINARIES) $(SEI_FUZZ_BINARIES) \
 	$(MON_FUZZ_BINARIES) $(CONFIG_FUZZ_BINARIES)
+fuzz-targets: $(P5SMP_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite.
@@ -165,6 +176,8 @@ test-fuzz:
 		--seconds $(FUZZ_SECONDS) --report $(MON_FUZZ_REPORT) $(MON_FUZZ_TARGETS) || status=1; \
 	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(CONFIG_FUZZ_CORPUS) \
 		--seconds $(FUZZ_SECONDS) --report $(CONFIG_FUZZ_REPORT) $(CONFIG_FUZZ_TARGETS) || status=1; \
+	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(P5SMP_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $(P5SMP_FUZZ_REPORT) $(P5SMP_FUZZ_TARGETS) || status=1; \
 	exit $${status:-0}
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
@@ -220,6 +233,18 @@ $(CONFIG_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/config/f
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lfmt -lmbedcrypto
+
+$(P5SMP_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/bsp_p5smp/fuzz/fuzz_%.cpp.o $(P5SMP_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^
+
+# The board's headers are found only by its own objects, so the flags every
+# other object is built with stay as they were.
+$(P5SMP_FUZZ_LIBRARY_OBJS) $(P5SMP_FUZZ_TARGET_OBJS): $(FUZZ_BUILD)/%.cpp.o: %.cpp $(FUZZ_FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_COMPILE_FLAGS) -Ifirmware/bsp_p5smp/include -c $< -o $@
 
 FUZZ_FLAGS_STAMP := $(FUZZ_BUILD)/flags.stamp
 $(FUZZ_FLAGS_STAMP): FORCE

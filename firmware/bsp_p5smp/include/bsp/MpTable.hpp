@@ -73,7 +73,7 @@ struct MpIoApic {
     uint32_t address;
 };
 
-/// What a bus entry's type string names (MP spec 4.3.2, table 4-8); the rest are Other.
+/// What a bus entry's type string names (MP spec 4.3.2); the rest are Other.
 enum class MpBusKind : uint8_t { Isa, Eisa, Pci, Other };
 
 /// A bus entry (MP spec 4.3.2).
@@ -82,9 +82,9 @@ struct MpBus {
     MpBusKind kind;
 };
 
-/// The PO field of an interrupt entry (MP spec 4.3.4, table 4-10).
+/// The PO field of an interrupt entry (MP spec 4.3.4).
 enum class MpPolarity : uint8_t { Conforming, High, Low };
-/// The EL field of an interrupt entry (MP spec 4.3.4, table 4-10).
+/// The EL field of an interrupt entry (MP spec 4.3.4).
 enum class MpTrigger : uint8_t { Conforming, Edge, Level };
 
 /// An I/O interrupt entry (MP spec 4.3.4) or a local interrupt entry (4.3.5).
@@ -114,7 +114,7 @@ public:
     static constexpr unsigned kMaximumProcessors = 8, kMaximumBuses = 16, kMaximumIoApics = 2, kMaximumInterrupts = 48;
     /// Room for local interrupt entries: two LINTIN wires for each processor.
     static constexpr unsigned kMaximumLocalInterrupts = 2 * kMaximumProcessors;
-    /// Interrupt entry types (MP spec 4.3.4, table 4-9).
+    /// Interrupt entry types (MP spec 4.3.4).
     static constexpr uint8_t kInterruptInt = 0, kInterruptNmi = 1, kInterruptSmi = 2, kInterruptExtInt = 3;
     /// An interrupt entry's destination that means every I/O APIC or every local APIC (MP spec 4.3.4, 4.3.5).
     static constexpr uint8_t kAllApics = 0xFF;
@@ -123,8 +123,6 @@ public:
     uint32_t tableAddress = 0;
     uint8_t specRevision = 0;
     bool imcrPresent = false;
-    /// MP feature byte 1 when it names a default configuration (MpError::DefaultConfiguration), else 0.
-    uint8_t defaultConfiguration = 0;
     uint32_t localApicAddress = 0;
     /// The OEM and product strings, trailing blanks removed, anything unprintable as '?'.
     char oemId[9] = {};
@@ -141,6 +139,8 @@ public:
     /// The local interrupt entries (type 4), in table order; they count against TooManyInterrupts too.
     MpInterrupt localInterrupts[kMaximumLocalInterrupts] = {};
     unsigned localInterruptCount = 0;
+    /// MP feature byte 1 when it names a default configuration (MpError::DefaultConfiguration), else 0.
+    uint8_t defaultConfiguration = 0;
 
     /// The bootstrap processor's entry, or null.
     const MpProcessor* bootstrapProcessor() const;
@@ -148,9 +148,9 @@ public:
     bool isaRoute(uint8_t irq, IoApicRoute& route) const;
     /// The route of PCI bus @p bus, device @p device, interrupt pin @p pin (0 = INTA# .. 3 = INTD#): source IRQ encodes (device << 2) | pin (MP spec D.3); false when none.
     bool pciRoute(uint8_t bus, uint8_t device, uint8_t pin, IoApicRoute& route) const;
-    /// The I/O APIC entry with id @p id, or null.
+    /// The I/O APIC entry with id @p id (the first, should the table list an id twice), or null.
     const MpIoApic* ioApic(uint8_t id) const;
-    /// The bus entry with id @p id, or null.
+    /// The bus entry with id @p id (the first, should the table list an id twice), or null.
     const MpBus* bus(uint8_t id) const;
 
 private:
