@@ -17,6 +17,7 @@ FW_INCLUDES := \
 	-Ifieldbus/can/include \
 	-Ifieldbus/modbus/include \
 	-Idrivers/can/include \
+	-Idrivers/pci/include \
 	-Idrivers/modbus/include \
 	-Idrivers/ata/include
 
@@ -98,6 +99,7 @@ FW_SRCS := \
 	$(MODBUS_PORTABLE_SRCS) \
 	$(CAN_DRIVER_PORTABLE_SRCS) \
 	$(CAN_DRIVER_TARGET_SRCS) \
+	$(PCI_DRIVER_PORTABLE_SRCS) \
 	$(MODBUS_DRIVER_PORTABLE_SRCS) \
 	$(MODBUS_DRIVER_TARGET_SRCS) \
 	$(ATA_DRIVER_PORTABLE_SRCS)

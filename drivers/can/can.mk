@@ -5,6 +5,8 @@
 CAN_DRIVER_PORTABLE_SRCS := \
 	drivers/can/src/BitTiming.cpp \
 	drivers/can/src/IsaSja1000Channel.cpp \
+	drivers/can/src/KvaserPciCard.cpp \
+	drivers/can/src/PciSja1000Channel.cpp \
 	drivers/can/src/Sja1000Chip.cpp \
 	drivers/can/src/Sja1000Controller.cpp
 
