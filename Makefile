@@ -2,6 +2,7 @@
 #
 #   make          firmware images and host tools
 #   make run      boot the ISA 486 controller in the emulator, console on this terminal
+#                 (BOARD=p5smp: the dual-Pentium controller's node 2 instead)
 #                 (KERNEL_CONFIG=minimal: the minimal kernel's image, its self-check;
 #                 with APP=<dir>, the application built with that configuration)
 #                 (APP=<dir>: with the application in <dir>; ARGS="...": launcher options,
@@ -17,6 +18,8 @@
 # 'make run' and 'make test' install the Debian packages they lack first.
 
 BUILD      := build
+# The board `make run` boots: isa486 (the default) or p5smp.
+BOARD      ?= isa486
 # V=1 shows the full compiler command lines.
 Q          := $(if $(filter 1,$(V)),,@)
 PYTHON     := /usr/bin/python3
@@ -46,7 +49,11 @@ ifneq ($(CARD),)
 	@$(PYTHON) tests_renode/launch.py --board isa486 --card $(CARD_486) $(ARGS)
 else ifeq ($(APP),)
 	@$(MAKE) --no-print-directory firmware
+ifeq ($(BOARD),p5smp)
+	@$(PYTHON) tests_renode/launch.py --board p5smp --image $(IMAGE_P5SMP) $(ARGS)
+else
 	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(if $(filter minimal,$(KERNEL_CONFIG)),$(IMAGE_486_MINIMAL),$(IMAGE_486)) $(ARGS)
+endif
 else
 	@$(MAKE) --no-print-directory sdk
 	@$(call app_make,$(APP),run)

@@ -175,10 +175,13 @@ IMAGE_486 := $(BUILD)/486/dcos486.elf
 IMAGE_486_TEST := $(BUILD)/486/dcos486-test.elf
 IMAGE_486_MINIMAL := $(BUILD)/486/dcos486-minimal.elf
 IMAGE_486_MINIMAL_TEST := $(BUILD)/486/dcos486-minimal-test.elf
+# The dual-Pentium board's images (mk/board_p5smp.mk).
+IMAGE_P5SMP := $(BUILD)/p5smp/dcos-p5smp.elf
+IMAGE_P5SMP_TEST := $(BUILD)/p5smp/dcos-p5smp-test.elf
 
 FW_IMAGES_STAMP := $(FW_BUILD)/images.stamp
 
-firmware: $(IMAGE_486) $(IMAGE_486_TEST) $(IMAGE_486_MINIMAL) $(IMAGE_486_MINIMAL_TEST)
+firmware: $(IMAGE_486) $(IMAGE_486_TEST) $(IMAGE_486_MINIMAL) $(IMAGE_486_MINIMAL_TEST) $(IMAGE_P5SMP) $(IMAGE_P5SMP_TEST)
 
 $(IMAGE_486): $(FW_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld $(FW_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
@@ -244,3 +247,5 @@ $(FW_BUILD)/generated/BuildRevision.cpp.o: $(FW_BUILD)/generated/BuildRevision.c
 	$(Q)g++ $(FW_CXXFLAGS) -c $< -o $@
 
 -include $(shell find $(FW_BUILD) -name '*.d' 2>/dev/null)
+
+include mk/board_p5smp.mk

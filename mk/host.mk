@@ -3,7 +3,7 @@
 
 HOST_BUILD := $(BUILD)/host
 HOST_CXXFLAGS := -std=c++20 -O1 -g -Wall -Wextra -Wno-missing-field-initializers -Werror -DDCOS_HOST_BUILD -MMD -MP $(FW_INCLUDES) \
-	-Ifirmware/bsp_p5smp/include -Idrivers/pci/include \
+	-Ifirmware/bsp_p5smp/include \
 	-Ihost_tools/can/include $(HOSTMODBUS_CXXFLAGS) -Ifirmware/image/include -Ihost_tools/image/include \
 	-Ifirmware/flash/include -Ihost_tools/flash/include -Ifirmware/sei/include -Ihost_tools/config/include \
 	$(HOSTMON_CXXFLAGS)

@@ -82,3 +82,25 @@ def test_unreadable_image_is_an_error_not_a_pass(tmp_path):
     result = run_checker(str(bogus))
     assert result.returncode == 2
     assert "cannot disassemble" in result.stderr
+
+
+@pytest.mark.parametrize("kind", ["production", "test"])
+def test_the_dual_pentium_images_hold_only_pentium_instructions(kind):
+    """The p5smp images may use what the Pentium adds (CPUID for its APIC), nothing later."""
+    result = subprocess.run([sys.executable, CHECKER, "--cpu", "pentium", load_board("p5smp").image(kind)],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "pentium clean" in result.stdout
+
+
+@pytest.mark.parametrize("instruction, allowed", [("cpuid", True), ("rdtsc", True), ("cmpxchg8b (%esi)", True),
+                                                  ("wrmsr", True), ("cmovne %eax, %ebx", False),
+                                                  ("rdtscp", False), ("nopl 0x0(%eax)", False),
+                                                  ("movq %mm0, %mm1", False), ("sysenter", False)])
+def test_the_pentium_check_allows_exactly_the_pentium_additions(tmp_path, instruction, allowed):
+    obj = assemble(tmp_path, "crafted", f"    movl %eax, %ebx\n    {instruction}")
+    pentium = subprocess.run([sys.executable, CHECKER, "--cpu", "pentium", obj], capture_output=True, text=True,
+                             timeout=120)
+    assert pentium.returncode == (0 if allowed else 1), pentium.stdout + pentium.stderr
+    # The same instruction is never one the i486 check lets through.
+    assert run_checker(obj).returncode == 1

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks that an ELF image holds no instruction an Intel 486 lacks.
+"""Checks that an ELF image holds no instruction its board's processor lacks.
 
 The 486 board's firmware is compiled with -march=i486, but one stray object
 (a library built for i686, an inline asm, a multi-byte NOP from the
@@ -12,6 +12,9 @@ executable section with objdump and rejects:
   486DX-33 of the seed's controller node), RSM;
 - every MMX, SSE and AVX instruction, recognised by its mnemonic or by an
   MMX/XMM/YMM register operand.
+
+With --cpu pentium (the dual-Pentium board's images) the Pentium additions
+are allowed and everything else above is still rejected.
 
 It prints each offending instruction with its address and function, and
 exits 1 if there is any, 2 if the image cannot be read, 0 if it is clean.
@@ -27,6 +30,8 @@ FORBIDDEN_MNEMONICS = re.compile(
     r"|cmpxchg8b|cmpxchg16b|cpuid|rsm|emms|femms|fxsave\w*|fxrstor\w*|ldmxcsr|stmxcsr|[slm]fence|clflush\w*"
     r"|prefetch\w*|movnti|xsave\w*|xrstor\w*|popcnt|lzcnt|tzcnt|movbe|crc32\w*|v\w+)$"
 )
+# What the Pentium (P54C) adds to the i486: allowed with --cpu pentium.
+PENTIUM_ADDITIONS = re.compile(r"^(rdtsc|rdmsr|wrmsr|cmpxchg8b|cpuid|rsm)$")
 # Long NOPs (0F 1F /0) appear as "nopl"/"nopw" with a memory operand.
 LONG_NOP = re.compile(r"^nop[lwq]?$")
 SIMD_REGISTER = re.compile(r"%(x|y|z)mm\d+|%mm\d")
@@ -35,8 +40,8 @@ INSTRUCTION = re.compile(r"^\s*([0-9a-f]+):\s+(?:[0-9a-f]{2} )+\s*(\S.*)$")
 FUNCTION = re.compile(r"^[0-9a-f]+ <(.+)>:$")
 
 
-def violations(path, objdump="objdump"):
-    """Yields (address, function, instruction text) for each post-486 instruction."""
+def violations(path, objdump="objdump", cpu="i486"):
+    """Yields (address, function, instruction text) for each instruction @p cpu lacks (i486 or pentium)."""
     try:
         listing = subprocess.run(
             [objdump, "-d", "-w", path],
@@ -64,7 +69,7 @@ def violations(path, objdump="objdump"):
             mnemonic, _, operands = operands.strip().partition(" ")
         if mnemonic == "(bad)":
             yield address, function, "undecodable bytes in an executable section"
-        elif FORBIDDEN_MNEMONICS.match(mnemonic):
+        elif FORBIDDEN_MNEMONICS.match(mnemonic) and not (cpu == "pentium" and PENTIUM_ADDITIONS.match(mnemonic)):
             yield address, function, text.strip()
         elif LONG_NOP.match(mnemonic) and operands.strip():
             yield address, function, text.strip() + " (long NOP, 0F 1F)"
@@ -73,20 +78,22 @@ def violations(path, objdump="objdump"):
 
 
 def main():
-    parser = argparse.ArgumentParser(description="Reject instructions an i486 does not have.")
+    parser = argparse.ArgumentParser(description="Reject instructions the board's processor does not have.")
     parser.add_argument("images", nargs="+", help="ELF images or object files")
     parser.add_argument("--objdump", default="objdump")
+    parser.add_argument("--cpu", choices=("i486", "pentium"), default="i486",
+                        help="the processor the images run on (default i486)")
     arguments = parser.parse_args()
     failed = False
     for image in arguments.images:
-        found = list(violations(image, arguments.objdump))
+        found = list(violations(image, arguments.objdump, arguments.cpu))
         for address, function, text in found:
             print(f"{image}: 0x{address} in {function}: {text}")
         if found:
-            print(f"{image}: {len(found)} instruction(s) an i486 does not have", file=sys.stderr)
+            print(f"{image}: {len(found)} instruction(s) an {arguments.cpu} does not have", file=sys.stderr)
             failed = True
         else:
-            print(f"{image}: i486 clean")
+            print(f"{image}: {arguments.cpu} clean")
     sys.exit(1 if failed else 0)
 
 

@@ -33,6 +33,8 @@ class Board:
     machine: str
     cpu: str
     memory_mib: int
+    # Processors (-smp), one per socket: the dual-Pentium board has two, each its own node.
+    smp: int = 1
     devices: list = field(default_factory=list)
     serial_ports: list = field(default_factory=list)
     images: dict = field(default_factory=dict)
@@ -117,6 +119,11 @@ class Board:
         if cpu or not accel:
             command += ["-cpu", cpu or self.cpu]
         command += ["-m", str(memory_mib or self.memory_mib)]
+        if self.smp > 1:
+            # One processor per socket, as on the board: a single package
+            # of several cores would set CPUID's HT flag, and the BIOS then
+            # lists only the first processor of each package in its MP table.
+            command += ["-smp", f"{self.smp},sockets={self.smp},cores=1,threads=1"]
         if card:
             if append:
                 raise ValueError("a card carries its own command line (dcos-card create --append), not -append")

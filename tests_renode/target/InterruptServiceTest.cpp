@@ -2,11 +2,11 @@
 // refused in handlers, interrupt levels per task and the legal limit
 // (seed 7.3.3).
 #include "KernelTestSupport.hpp"
+#include <bsp/Board.hpp>
 
 #include <dcos/SystemAgent.hpp>
 #include <dcos/TimerAgent.hpp>
 
-#include <arch_x86/PortIo.hpp>
 
 namespace target_test {
 
@@ -71,10 +71,9 @@ bool blockingInIsr(shell::Shell& shell)
 DCOS_TARGET_TEST(isrBlockingTest, "isrblock", "blocking services are refused in interrupt handlers", blockingInIsr);
 
 // The 8259A pair's interrupt masks (OCW1), read back directly.
-uint16_t interruptMask()
-{
-    return static_cast<uint16_t>(arch_x86::portRead8(0x21) | (arch_x86::portRead8(0xA1) << 8));
-}
+// The lines the interrupt controller holds off, read from the controller
+// (the 8259A pair's mask registers, or the I/O APIC's entries).
+uint16_t interruptMask() { return bsp::interruptLinesHeldOff(); }
 
 volatile uint16_t maskSeenByOtherTask = 0;
 

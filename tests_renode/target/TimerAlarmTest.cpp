@@ -2,6 +2,8 @@
 // event and by signal, the system clock, and their errors (seed 7.5).
 #include "KernelTestSupport.hpp"
 
+#include <bsp/Board.hpp>
+
 #include <dcos/TimerAgent.hpp>
 
 namespace target_test {
@@ -136,7 +138,7 @@ bool alarms(shell::Shell& shell)
     invalid.day = 29;
     ok = checkStatus(shell, timerAgent.SetDayClockAlarm(timer, invalid, AlarmNotification::event(1)),
                      Status::InvalidArgument, "29 February 2026") && ok;
-    ok = checkStatus(shell, timerAgent.XferOwnership(timer, ObjectId(1, dcos::ObjectType::Task, 0x0F0)),
+    ok = checkStatus(shell, timerAgent.XferOwnership(timer, ObjectId(bsp::nodeId(), dcos::ObjectType::Task, 0x0F0)),
                      Status::InvalidId, "XferOwnership to no task") && ok;
     ok = checkStatus(shell, timerAgent.XferOwnership(timer, taskAgent.NameToObject("idle").value()), Status::Ok,
                      "XferOwnership to another task") && ok;

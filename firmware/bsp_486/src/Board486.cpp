@@ -176,6 +176,12 @@ bool isInterruptRequested(unsigned line)
     return line < interruptLineCount && (pic.readRequestRegister() & (1u << line)) != 0;
 }
 
+uint16_t interruptLinesHeldOff()
+{
+    arch_x86::InterruptGuard guard;
+    return pic.readMaskRegisters();
+}
+
 bool interruptCutShort(unsigned& line)
 {
     arch_x86::InterruptGuard guard;

@@ -72,6 +72,11 @@ uint16_t Pic8259::readInServiceRegister() const
     return static_cast<uint16_t>(master_.read8(commandRegister) | (slave_.read8(commandRegister) << 8));
 }
 
+uint16_t Pic8259::readMaskRegisters() const
+{
+    return static_cast<uint16_t>(master_.read8(dataRegister) | (slave_.read8(dataRegister) << 8));
+}
+
 bool Pic8259::isGenuineLowestLine(unsigned line) const
 {
     return (readInServiceRegister() & (1u << line)) != 0;

@@ -82,6 +82,12 @@ bool isInterruptMasked(unsigned line);
 /// True when the interrupt controller holds a request on line (IRR).
 bool isInterruptRequested(unsigned line);
 
+/// The lines that cannot interrupt now, one bit per line, read from the
+/// interrupt controller itself: masked for lack of a handler, by
+/// maskInterrupt(), or by the running task's interrupt level
+/// (setTaskInterruptLevel()). For tests and diagnostics.
+uint16_t interruptLinesHeldOff();
+
 /// Finds the interrupt whose delivery a fault cut short: called with no
 /// handler running, a line the interrupt controller still has in service
 /// was acknowledged by the processor, whose push of the interrupt frame then

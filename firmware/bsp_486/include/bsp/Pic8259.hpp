@@ -61,6 +61,9 @@ public:
     uint16_t readRequestRegister() const;
     /// The 16-bit in-service register: lines being serviced.
     uint16_t readInServiceRegister() const;
+    /// The 16-bit interrupt mask register (OCW1) as the chips hold it: what
+    /// mask() recorded and the overlay together.
+    uint16_t readMaskRegisters() const;
 
     /// isGenuine() for line 7 or 15: whether its in-service bit is set.
     bool isGenuineLowestLine(unsigned line) const;

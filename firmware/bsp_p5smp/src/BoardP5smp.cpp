@@ -1,0 +1,566 @@
+// Board support for the dual-Pentium controller (seed 9.2, controller nodes
+// 2 and 3; Fig. 9.2): two Pentium processors with their local APICs, an I/O
+// APIC, the MultiProcessor Specification 1.4 tables the BIOS leaves, and the
+// PC/AT peripherals (PcPeripherals.cpp) on its ISA bus.
+//
+// This node runs on the bootstrap processor. Its tick is its own local
+// APIC's timer, calibrated against the 8254; the ISA lines reach it through
+// the I/O APIC, routed as the MP table says, while the 8259A pair is masked
+// and, where the board has the IMCR, cut off (MP spec 3.6.2.1). Lines keep
+// their PC/AT numbers, so the kernel, the drivers and the applications see
+// the same lines on both boards; line 0 is the local APIC timer instead of
+// the 8254, and line 2, the 8259A's cascade input on a PC/AT, is the
+// inter-processor interrupt the other node of the board raises.
+#include <bsp/Board.hpp>
+#include <bsp/IoApic.hpp>
+#include <bsp/LocalApic.hpp>
+#include <bsp/MpTable.hpp>
+#include <bsp/P5smpBoard.hpp>
+#include <bsp/PcPeripherals.hpp>
+#include <bsp/Pic8259.hpp>
+
+#include <arch_x86/Cpu.hpp>
+#include <arch_x86/Gdt.hpp>
+#include <arch_x86/Idt.hpp>
+#include <arch_x86/Paging.hpp>
+#include <arch_x86/PortIo.hpp>
+#include <boot/Panic.hpp>
+
+#include <string.h>
+
+extern "C" {
+// ApicSpurious.S: the local APIC's spurious vector, which takes no EOI.
+void apicSpuriousEntry();
+uint32_t apicSpuriousCount = 0;
+}
+
+namespace bsp {
+
+uint32_t apicTickCounts = 0;
+uint32_t apicNanosecondsPerCountQ24 = 0;
+
+namespace {
+
+// PC/AT ports the board still uses: the 8259A pair (to mask it), the 8254's
+// counter 2 and its gate and output on port 0x61 (to calibrate the APIC
+// timer), and the IMCR (MP spec 3.6.2.1).
+constexpr uint16_t masterPicPort = 0x20;
+constexpr uint16_t slavePicPort = 0xA0;
+constexpr uint16_t pitCounter2Port = 0x42;
+constexpr uint16_t pitControlPort = 0x43;
+constexpr uint16_t systemControlPortB = 0x61;
+constexpr uint16_t imcrSelectPort = 0x22;
+constexpr uint16_t imcrDataPort = 0x23;
+// Port B (PC/AT technical reference): bit 0 gates counter 2, bit 1 drives
+// the speaker from it, bit 5 reads counter 2's output.
+constexpr uint8_t portBCounter2Gate = 1u << 0;
+constexpr uint8_t portBSpeakerData = 1u << 1;
+constexpr uint8_t portBCounter2Output = 1u << 5;
+// 8254 control word (Intel 8254 datasheet, "Control Word Format"): counter
+// 2, low byte then high byte, mode 0 (interrupt on terminal count), binary.
+constexpr uint8_t pitCounter2Mode0 = 0xB0;
+// The IMCR's register and its value that routes the 8259A's INTR to the
+// APIC instead of the processor (MP spec 3.6.2.1).
+constexpr uint8_t imcrRegister = 0x70;
+constexpr uint8_t imcrApicMode = 0x01;
+
+constexpr uint32_t pitHz = 1'193'182;
+// 50 ms of the 8254: short at boot, long enough that the poll's few
+// instructions and the 8254's own step (838 ns) are under 20 ppm.
+constexpr uint16_t calibrationCounts = 59'659;
+// At least ten times as many reads of port B as 50 ms can take on a 150 MHz
+// Pentium, so only an 8254 that never counts ends the wait.
+constexpr uint32_t calibrationPolls = 50'000'000;
+constexpr LocalApic::TimerDivide timerDivide = LocalApic::TimerDivide::By16;
+
+// The vectors: the lines from firstIrqVector, as on the ISA board, and the
+// spurious vector, whose low four bits must be set on the Pentium's APIC
+// (SDM Vol. 3A, 11.9).
+constexpr uint8_t spuriousVector = 0xFF;
+constexpr uint8_t vectorOf(unsigned line) { return static_cast<uint8_t>(arch_x86::firstIrqVector + line); }
+static_assert(systemTickLine == 0 && interProcessorLine == 2);
+static_assert(vectorOf(systemTickLine) == 32, "BoardTick.hpp reads the tick's request as bit 0 of IRR 32-63");
+
+// A start-up IPI's wait for its delivery status, in reads.
+constexpr uint32_t deliverySpins = 100'000;
+
+LocalApic localApic(arch_x86::IoWindow::memory(LocalApic::kDefaultBase, LocalApic::kWindowBytes));
+IoApic ioApic(arch_x86::IoWindow::memory(IoApic::kDefaultBase, IoApic::kWindowBytes));
+Pic8259 pic(arch_x86::IoWindow::ports(masterPicPort, 2), arch_x86::IoWindow::ports(slavePicPort, 2));
+
+MpConfiguration mp;
+bool mpValid = false;
+MpResult mpResult{MpError::NotFound, 0};
+
+struct Attachment {
+    InterruptHandler handler;
+    void* context;
+};
+// What each line's owner attached, and what the dispatch calls: the same,
+// but for the tick while the kernel masks it (see applyMask()).
+Attachment registered[interruptLineCount];
+Attachment attachments[interruptLineCount];
+// A tick that came while its line was masked, delivered on the unmask.
+bool tickDeferred = false;
+
+// Where each ISA line arrives at the I/O APIC; line 0 and line 2 are the
+// local APIC's own (timer and inter-processor interrupt), never routed.
+struct LineRoute {
+    bool routed;
+    uint8_t pin;
+    bool activeLow;
+    bool levelTriggered;
+};
+LineRoute routes[interruptLineCount];
+
+uint32_t unexpected[interruptLineCount];
+uint16_t maskedLines = 0xFFFF; // Lines without a handler, or masked by the kernel.
+uint16_t overlayLines = 0;     // Lines held off by the running task's interrupt level.
+uint16_t node = 2;
+uint32_t tickRate = defaultTickRateHz;
+uint64_t tickPeriodNs = 0;
+uint64_t apicTimerHz = 0;
+
+// The same priority order as the ISA board's 8259A pair in fully nested
+// mode, so a line's level means the same on both boards; line 2 (the
+// inter-processor interrupt) has none, as the cascade had none.
+constexpr uint8_t levelOfLine[interruptLineCount] = {0, 1, 0xFF, 10, 11, 12, 13, 14, 2, 3, 4, 5, 6, 7, 8, 9};
+
+const BoardIdentity board{"p5smp", "Pentium"};
+
+// Low memory for the MP table search. Page 0 is not mapped (Paging.hpp),
+// so the BIOS data area's two words the search reads are answered from
+// what the loader reported: no EBDA pointer, which sends the search to the
+// last KiB of base memory (where a BIOS keeps its EBDA), and the base
+// memory size. Everything else below 1 MiB is read where it lies.
+class LowMemory final : public PhysicalMemory {
+public:
+    explicit LowMemory(uint32_t baseMemoryKib) : baseMemoryKib_(baseMemoryKib) {}
+
+    bool read(uint32_t address, void* into, uint32_t bytes) const override
+    {
+        constexpr uint32_t ebdaSegmentWord = 0x40E;
+        constexpr uint32_t baseMemoryWord = 0x413;
+        constexpr uint32_t lowMemoryEnd = 0x100000;
+        if (bytes == 2 && (address == ebdaSegmentWord || address == baseMemoryWord)) {
+            const uint16_t value = address == ebdaSegmentWord ? 0 : static_cast<uint16_t>(baseMemoryKib_);
+            memcpy(into, &value, sizeof value);
+            return true;
+        }
+        if (address < arch_x86::Paging::kPageSize || address >= lowMemoryEnd || bytes > lowMemoryEnd - address) {
+            return false;
+        }
+        memcpy(into, reinterpret_cast<const void*>(static_cast<uintptr_t>(address)), bytes);
+        return true;
+    }
+
+private:
+    uint32_t baseMemoryKib_;
+};
+
+uint8_t bootstrapApicId() { return localApic.id(); }
+
+// The tick's line is the timer's LVT entry: its mask bit holds the tick off.
+void setTimerMasked(bool masked)
+{
+    const arch_x86::IoWindow& registers = localApic.window();
+    const uint32_t entry = registers.read32(LocalApic::kLvtTimer);
+    registers.write32(LocalApic::kLvtTimer, masked ? entry | LocalApic::kLvtMask : entry & ~LocalApic::kLvtMask);
+}
+
+// The tick raised again, as the timer would, by an interrupt to this
+// processor itself on the tick's vector.
+void raiseTick() { (void)localApic.sendFixed(bootstrapApicId(), vectorOf(systemTickLine), deliverySpins); }
+
+// Applies the mask of @p line: masked without a handler, by the kernel, or
+// by the running task's level. An ISA line is masked at the I/O APIC. The
+// tick is not: a masked LVT entry drops the timer's interrupts (SDM Vol. 3A,
+// 11.5.1), where the 8259A holds a masked request until the unmask, and the
+// kernel counts on that. So while its owner is attached the timer keeps
+// interrupting, a tick that comes while the line is masked is only noted,
+// and the unmask raises it again. Line 2, the other processor's
+// interrupts, cannot be held off at its source and keeps no mask.
+void applyMask(unsigned line)
+{
+    const bool masked = ((maskedLines | overlayLines) >> line & 1u) != 0;
+    if (line == systemTickLine) {
+        const bool attached = registered[line].handler != nullptr;
+        setTimerMasked(!attached);
+        attachments[line] = masked ? Attachment{nullptr, nullptr} : registered[line];
+        if (attached && !masked && tickDeferred) {
+            tickDeferred = false;
+            raiseTick();
+        }
+    } else if (routes[line].routed) {
+        (void)ioApic.setMasked(routes[line].pin, masked);
+    }
+}
+
+[[gnu::noinline]] void dispatchUncommon(unsigned line)
+{
+    if (line == systemTickLine && registered[line].handler != nullptr) {
+        tickDeferred = true; // Masked by the kernel: delivered on the unmask.
+        localApic.endOfInterrupt();
+        return;
+    }
+    // Nobody owns this line: mask it so it cannot storm, and count it.
+    ++unexpected[line];
+    maskedLines = static_cast<uint16_t>(maskedLines | (1u << line));
+    applyMask(line);
+    localApic.endOfInterrupt();
+}
+
+void dispatchInterrupt(unsigned line)
+{
+    const Attachment& attachment = attachments[line];
+    if (attachment.handler == nullptr) [[unlikely]] {
+        dispatchUncommon(line);
+        return;
+    }
+    // The local APIC holds back this vector's priority class and every
+    // lower one until the EOI below (SDM Vol. 3A, 11.8.3): enabling
+    // interrupts lets only more urgent classes nest.
+    arch_x86::enableInterrupts();
+    attachment.handler(attachment.context);
+    arch_x86::disableInterrupts();
+    localApic.endOfInterrupt();
+}
+
+// The processor must have a local APIC (CPUID.1:EDX bit 9): the board's
+// interrupts all pass through it.
+bool processorHasApic()
+{
+    uint32_t eax = 1;
+    uint32_t ebx;
+    uint32_t ecx = 0;
+    uint32_t edx;
+    asm volatile("cpuid" : "+a"(eax), "=b"(ebx), "+c"(ecx), "=d"(edx));
+    constexpr uint32_t cpuidApic = 1u << 9;
+    return (edx & cpuidApic) != 0;
+}
+
+// Counts of the APIC timer in calibrationCounts of the 8254's counter 2,
+// as Hz; 0 when the 8254 never reached its terminal count.
+uint64_t measureApicTimerHz()
+{
+    const uint8_t portB = arch_x86::portRead8(systemControlPortB);
+    // The gate high and the speaker off; in mode 0 the count starts with
+    // the write of its high byte, which comes right after the APIC's start.
+    arch_x86::portWrite8(systemControlPortB,
+                         static_cast<uint8_t>((portB & ~portBSpeakerData) | portBCounter2Gate));
+    arch_x86::portWrite8(pitControlPort, pitCounter2Mode0);
+    arch_x86::portWrite8(pitCounter2Port, static_cast<uint8_t>(calibrationCounts & 0xFF));
+    // A one-shot from the largest count ends after minutes: it raises
+    // nothing before stopTimer() below, and interrupts are off anyway.
+    (void)localApic.startOneShot(vectorOf(systemTickLine), 0xFFFFFFFFu, timerDivide);
+    arch_x86::portWrite8(pitCounter2Port, static_cast<uint8_t>(calibrationCounts >> 8));
+    uint32_t polls = 0;
+    while ((arch_x86::portRead8(systemControlPortB) & portBCounter2Output) == 0 && ++polls < calibrationPolls) {
+    }
+    const uint32_t elapsed = 0xFFFFFFFFu - localApic.currentCount();
+    localApic.stopTimer();
+    arch_x86::portWrite8(systemControlPortB, portB);
+    if (polls >= calibrationPolls) {
+        return 0;
+    }
+    return (uint64_t{elapsed} * pitHz + calibrationCounts / 2) / calibrationCounts;
+}
+
+// Masks the 8259A pair for good (vectors remapped above the exceptions
+// first, so a stray request cannot pass for one) and, where the board has
+// the IMCR, disconnects it from the processor.
+void retirePics()
+{
+    pic.initialise(static_cast<uint8_t>(arch_x86::firstIrqVector));
+    for (unsigned line = 0; line < Pic8259::lineCount; ++line) {
+        pic.mask(line);
+    }
+    if (mpValid && mp.imcrPresent) {
+        arch_x86::portWrite8(imcrSelectPort, imcrRegister);
+        arch_x86::portWrite8(imcrDataPort, imcrApicMode);
+    }
+}
+
+// The MP table's routes of the ISA lines, or the MP spec's default
+// configuration's (5.3: IRQ 0 on INTIN2, the others on their own pin).
+void routeIsaLines()
+{
+    for (unsigned line = 0; line < interruptLineCount; ++line) {
+        routes[line] = LineRoute{};
+        if (line == systemTickLine || line == interProcessorLine) {
+            continue;
+        }
+        IoApicRoute route{};
+        if (mpValid && mp.isaRoute(static_cast<uint8_t>(line), route)) {
+            if (route.pin < ioApic.pinCount()) {
+                routes[line] = {true, route.pin, route.activeLow, route.levelTriggered};
+            }
+        } else {
+            // A line the table does not name is on its own pin, edge
+            // triggered and active high, as in the default configurations.
+            // A BIOS leaves out the IRQs it keeps for PCI (SeaBIOS leaves
+            // out 5, 9, 10 and 11), yet an ISA card set to one of them
+            // drives that pin all the same; pciInterruptLine() switches a
+            // pin a PCI device shares to the PCI polarity and trigger.
+            routes[line] = {true, static_cast<uint8_t>(line), false, false};
+        }
+    }
+    ioApic.maskAll();
+    const uint8_t destination = bootstrapApicId();
+    for (unsigned line = 0; line < interruptLineCount; ++line) {
+        const LineRoute& route = routes[line];
+        if (route.routed) {
+            (void)ioApic.route(route.pin, vectorOf(line), destination, route.activeLow, route.levelTriggered, true);
+        }
+    }
+}
+
+void reportConfiguration()
+{
+    runtime::CharacterSink& out = pc::consoleUart();
+    if (!mpValid) {
+        runtime::format(out,
+                        "warning: MP configuration not used: %s (at 0x%lx); the default configuration is assumed "
+                        "(local APIC at 0x%lx, I/O APIC at 0x%lx, ISA IRQ 0 on pin 2, the others on their own), "
+                        "and no second processor is started\r\n",
+                        mpErrorText(mpResult.error), static_cast<unsigned long>(mpResult.address),
+                        static_cast<unsigned long>(LocalApic::kDefaultBase),
+                        static_cast<unsigned long>(IoApic::kDefaultBase));
+        return;
+    }
+    const MpProcessor* bootstrap = mp.bootstrapProcessor();
+    runtime::format(out, "MP 1.%u table at 0x%lx (%s %s): %u processors, bootstrap APIC %u;",
+                    unsigned(mp.specRevision), static_cast<unsigned long>(mp.tableAddress), mp.oemId,
+                    mp.productId, mp.processorCount, unsigned(bootstrap->apicId));
+    for (unsigned i = 0; i < mp.ioApicCount; ++i) {
+        runtime::format(out, " I/O APIC %u at 0x%lx%s", unsigned(mp.ioApics[i].id),
+                        static_cast<unsigned long>(mp.ioApics[i].address), mp.ioApics[i].enabled ? "" : " (disabled)");
+    }
+    runtime::format(out, " (%u pins)\r\n", ioApic.pinCount());
+}
+
+} // namespace
+
+const BoardIdentity& identity() { return board; }
+
+void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
+{
+    node = pc::nodeFromCommandLine(bootInfo, 2);
+    if (!processorHasApic()) {
+        dcosPanic("the processor has no local APIC: this image is for the dual-Pentium board (p5smp)");
+    }
+    const LowMemory lowMemory(bootInfo.lowerMemoryKib);
+    mpResult = findMpConfiguration(lowMemory, mp);
+    mpValid = mpResult.error == MpError::None;
+    const uint32_t localApicBase = mpValid ? mp.localApicAddress : LocalApic::kDefaultBase;
+    // The first enabled I/O APIC: the parser requires one, not that it comes first.
+    const MpIoApic* firstIoApic = nullptr;
+    for (unsigned i = 0; mpValid && i < mp.ioApicCount && firstIoApic == nullptr; ++i) {
+        firstIoApic = mp.ioApics[i].enabled ? &mp.ioApics[i] : nullptr;
+    }
+    const uint32_t ioApicBase = firstIoApic != nullptr ? firstIoApic->address : IoApic::kDefaultBase;
+    // BoardTick.hpp and the windows above read the APICs at their default
+    // bases, which every board of this design keeps; a table saying
+    // otherwise describes another board.
+    if (localApicBase != LocalApic::kDefaultBase || ioApicBase != IoApic::kDefaultBase) {
+        dcosPanic("the MP table puts the local APIC at 0x%lx and the I/O APIC at 0x%lx, not at 0x%lx and 0x%lx "
+                  "where this board keeps them",
+                  static_cast<unsigned long>(localApicBase), static_cast<unsigned long>(ioApicBase),
+                  static_cast<unsigned long>(LocalApic::kDefaultBase), static_cast<unsigned long>(IoApic::kDefaultBase));
+    }
+    if (!arch_x86::Paging::mapDevice(LocalApic::kDefaultBase, LocalApic::kWindowBytes) ||
+        !arch_x86::Paging::mapDevice(IoApic::kDefaultBase, IoApic::kWindowBytes)) {
+        dcosPanic("cannot map the APICs' registers");
+    }
+
+    retirePics();
+    arch_x86::Idt::setInterruptHandler(dispatchInterrupt);
+    arch_x86::Idt::setGate(spuriousVector, arch_x86::Gdt::kernelCode,
+                           static_cast<uint32_t>(reinterpret_cast<uintptr_t>(&apicSpuriousEntry)), 0x8E);
+    if (!localApic.enable(spuriousVector)) {
+        dcosPanic("the local APIC refused spurious vector 0x%x", unsigned(spuriousVector));
+    }
+    routeIsaLines();
+    pc::initialiseConsole();
+    reportConfiguration();
+
+    tickRate = pc::tickRateFromCommandLine(bootInfo, tickRateHz);
+    apicTimerHz = measureApicTimerHz();
+    if (apicTimerHz == 0) {
+        dcosPanic("the 8254's counter 2 never reached its terminal count: the local APIC timer cannot be calibrated");
+    }
+    const uint32_t counts = static_cast<uint32_t>((apicTimerHz + tickRate / 2) / tickRate);
+    tickPeriodNs = (uint64_t{counts} * 1'000'000'000u + apicTimerHz / 2) / apicTimerHz;
+    apicNanosecondsPerCountQ24 =
+        static_cast<uint32_t>(((uint64_t{1'000'000'000u} << 24) + apicTimerHz / 2) / apicTimerHz);
+    const uint32_t shortenBy = pc::crystalShortening(bootInfo, counts);
+    runtime::format(pc::consoleUart(), "local APIC timer %lu Hz (against the 8254), %lu counts per tick\r\n",
+                    static_cast<unsigned long>(apicTimerHz), static_cast<unsigned long>(counts));
+    // The timer counts counts - shortenBy per period: with a crystal model
+    // the clock's reading within a tick runs over those, and the tick itself
+    // still counts as the nominal period, so the clock runs fast.
+    apicTickCounts = counts - shortenBy;
+    // Started masked: attachInterrupt(systemTickLine) unmasks it.
+    if (apicTickCounts < 2 || !localApic.startPeriodic(vectorOf(systemTickLine), apicTickCounts - 1, timerDivide)) {
+        dcosPanic("the local APIC timer cannot tick at %lu Hz from %lu Hz", static_cast<unsigned long>(tickRate),
+                  static_cast<unsigned long>(apicTimerHz));
+    }
+    setTimerMasked(true);
+}
+
+dcos::Status attachInterrupt(unsigned line, InterruptHandler handler, void* context)
+{
+    if (line >= interruptLineCount || handler == nullptr) {
+        return dcos::Status::InvalidArgument;
+    }
+    if (line != systemTickLine && line != interProcessorLine && !routes[line].routed) {
+        return dcos::Status::InvalidArgument; // The MP table routes this ISA line nowhere.
+    }
+    arch_x86::InterruptGuard guard;
+    if (registered[line].handler != nullptr) {
+        return dcos::Status::Busy;
+    }
+    registered[line] = {handler, context};
+    attachments[line] = registered[line];
+    maskedLines = static_cast<uint16_t>(maskedLines & ~(1u << line));
+    applyMask(line);
+    return dcos::Status::Ok;
+}
+
+dcos::Status detachInterrupt(unsigned line)
+{
+    if (line >= interruptLineCount) {
+        return dcos::Status::InvalidArgument;
+    }
+    arch_x86::InterruptGuard guard;
+    maskedLines = static_cast<uint16_t>(maskedLines | (1u << line));
+    registered[line] = {nullptr, nullptr};
+    attachments[line] = {nullptr, nullptr};
+    if (line == systemTickLine) {
+        tickDeferred = false;
+    }
+    applyMask(line);
+    return dcos::Status::Ok;
+}
+
+void maskInterrupt(unsigned line)
+{
+    if (line >= interruptLineCount) {
+        return;
+    }
+    arch_x86::InterruptGuard guard;
+    maskedLines = static_cast<uint16_t>(maskedLines | (1u << line));
+    applyMask(line);
+}
+
+void unmaskInterrupt(unsigned line)
+{
+    if (line >= interruptLineCount) {
+        return;
+    }
+    arch_x86::InterruptGuard guard;
+    maskedLines = static_cast<uint16_t>(maskedLines & ~(1u << line));
+    applyMask(line);
+}
+
+bool isInterruptMasked(unsigned line) { return line < interruptLineCount && ((maskedLines >> line) & 1u) != 0; }
+
+bool isInterruptRequested(unsigned line)
+{
+    arch_x86::InterruptGuard guard;
+    return line < interruptLineCount &&
+           (localApic.isRequested(vectorOf(line)) || (line == systemTickLine && tickDeferred));
+}
+
+uint16_t interruptLinesHeldOff()
+{
+    arch_x86::InterruptGuard guard;
+    uint16_t held = 0;
+    for (unsigned line = 0; line < interruptLineCount; ++line) {
+        bool off = false;
+        if (line == systemTickLine) {
+            off = attachments[line].handler == nullptr;
+        } else if (routes[line].routed) {
+            off = ioApic.isMasked(routes[line].pin);
+        }
+        held = static_cast<uint16_t>(held | (off ? 1u << line : 0u));
+    }
+    return held;
+}
+
+bool interruptCutShort(unsigned& line)
+{
+    arch_x86::InterruptGuard guard;
+    for (unsigned candidate = 0; candidate < interruptLineCount; ++candidate) {
+        if (localApic.isInService(vectorOf(candidate))) {
+            line = candidate;
+            return true;
+        }
+    }
+    return false;
+}
+
+uint32_t unexpectedInterruptCount(unsigned line) { return line < interruptLineCount ? unexpected[line] : 0; }
+
+uint32_t spuriousInterruptCount() { return apicSpuriousCount; }
+
+uint32_t tickRateHz() { return tickRate; }
+
+uint64_t tickPeriodNanoseconds() { return tickPeriodNs; }
+
+uint8_t interruptLevelOf(unsigned line) { return line < interruptLineCount ? levelOfLine[line] : 0xFF; }
+
+void setTaskInterruptLevel(uint8_t level)
+{
+    uint16_t overlay = 0;
+    for (unsigned line = 0; line < interruptLineCount; ++line) {
+        const uint8_t lineLevel = levelOfLine[line];
+        if (lineLevel != 0 && lineLevel != 0xFF && lineLevel >= level) {
+            overlay = static_cast<uint16_t>(overlay | (1u << line));
+        }
+    }
+    if (overlay == overlayLines) {
+        return; // The common case: the same level as the task before.
+    }
+    const uint16_t changed = static_cast<uint16_t>(overlay ^ overlayLines);
+    overlayLines = overlay;
+    for (unsigned line = 0; line < interruptLineCount; ++line) {
+        if ((changed >> line & 1u) != 0) {
+            applyMask(line);
+        }
+    }
+}
+
+uint16_t nodeId() { return node; }
+
+// The dual-Pentium board's own interface (P5smpBoard.hpp).
+
+const MpConfiguration* mpConfiguration() { return mpValid ? &mp : nullptr; }
+
+uint64_t apicTimerFrequencyHz() { return apicTimerHz; }
+
+bool pciInterruptLine(uint8_t bus, uint8_t device, uint8_t pin, unsigned& line)
+{
+    IoApicRoute route{};
+    if (!mpValid || !mp.pciRoute(bus, device, pin, route)) {
+        return false;
+    }
+    // A PCI interrupt shares the pin of an ISA line (the BIOS steers the
+    // PIIX's PIRQ lines onto free ISA IRQs); the line takes the PCI
+    // polarity and trigger, since that is what drives the pin now.
+    for (unsigned candidate = 0; candidate < interruptLineCount; ++candidate) {
+        LineRoute& lineRoute = routes[candidate];
+        if (lineRoute.routed && lineRoute.pin == route.pin) {
+            arch_x86::InterruptGuard guard;
+            lineRoute.activeLow = route.activeLow;
+            lineRoute.levelTriggered = route.levelTriggered;
+            (void)ioApic.route(route.pin, vectorOf(candidate), bootstrapApicId(), route.activeLow,
+                               route.levelTriggered, ((maskedLines | overlayLines) >> candidate & 1u) != 0);
+            line = candidate;
+            return true;
+        }
+    }
+    return false;
+}
+
+} // namespace bsp

@@ -1,0 +1,151 @@
+"""The dual-Pentium board (seed 9.2, controller nodes 2 and 3) on the emulated pc machine.
+
+Node 2 runs on the bootstrap processor: its tick is its local APIC's
+timer, calibrated against the 8254; the ISA lines reach it through the I/O
+APIC as the BIOS's MP table routes them. The same on-target API suite the
+ISA 486 board runs is run here on the same kernel, under -icount with both
+processors present, so every timing it checks is exact.
+"""
+
+import dataclasses
+import re
+
+import pytest
+
+from dcoslab import gdbstub
+from dcoslab.board import load_board
+from dcoslab.target import run_target_test
+
+import test_board_486_interrupts as board_486
+import test_iobus_driver as iobus
+import test_kernel_core as kernel_core
+import test_memory_agents as memory_agents
+import test_object_ids as object_ids
+import test_port_dsm as port_dsm
+import test_runtime_486 as runtime_486
+import test_semaphores as semaphores
+import test_timing_bounds as timing_bounds
+
+# 62.5 MHz: QEMU's APIC timer counts its 1 GHz bus clock, divided by 16.
+APIC_TIMER_HZ = 62_500_000
+
+
+def calibrated_hz(transcript):
+    """The APIC timer's rate the board measured against the 8254, and its counts per tick."""
+    match = re.search(r"local APIC timer (\d+) Hz \(against the 8254\), (\d+) counts per tick", transcript)
+    assert match, transcript
+    return int(match.group(1)), int(match.group(2))
+
+# The API suite both boards run: every kernel, memory, communication and
+# timing test, the I/O board's driver (its interrupt now through the I/O
+# APIC) and the board's own tick and masking tests.
+API_SUITE = (kernel_core.KERNEL_TARGET_TESTS + memory_agents.MEMORY_TARGET_TESTS + semaphores.SEMAPHORE_TARGET_TESTS
+             + port_dsm.PORT_DSM_TARGET_TESTS + object_ids.OBJECT_ID_TARGET_TESTS
+             + timing_bounds.TIMING_TARGET_TESTS + runtime_486.RUNTIME_TARGET_TESTS
+             + [name for name in iobus.IOBUS_TARGET_TESTS if name not in iobus.BOOT_OPTIONS]
+             + board_486.BOARD_TARGET_TESTS)
+
+
+@pytest.fixture
+def p5smp():
+    return load_board("p5smp")
+
+
+def test_the_board_reports_both_processors_its_mp_table_and_the_calibrated_tick(boot, p5smp):
+    emulator = boot(p5smp, icount=True)
+    emulator.expect(r"dcos> ")
+    transcript = emulator.transcript
+    assert re.search(r"MP 1\.4 table at 0x[0-9a-f]+ \(BOCHSCPU 0\.1\): 2 processors, bootstrap APIC 0; "
+                     r"I/O APIC \d+ at 0xfec00000 \(24 pins\)", transcript), transcript
+    # The calibration's 50 ms window of the 8254 measures the rate to a few counts in 3 million.
+    hz, counts = calibrated_hz(transcript)
+    assert abs(hz - APIC_TIMER_HZ) <= APIC_TIMER_HZ * 2e-6, transcript
+    assert counts == 62_500
+    assert "board p5smp (Pentium), node 2," in transcript, transcript
+    assert "tick 1000 Hz" in transcript
+
+
+def test_the_console_answers_through_the_io_apic(boot, p5smp):
+    """COM1's interrupt (IRQ 4) reaches node 2 through the I/O APIC: the shell reads a command."""
+    emulator = boot(p5smp)
+    emulator.expect(r"dcos> ")
+    output = emulator.command("version")
+    assert "p5smp" in output, output
+
+
+def test_one_processor_is_reported_and_the_node_runs(boot, p5smp):
+    emulator = boot(dataclasses.replace(p5smp, smp=1), icount=True)
+    emulator.expect(r"dcos> ")
+    assert re.search(r"MP 1\.4 table at 0x[0-9a-f]+ \(BOCHSCPU 0\.1\): 1 processors", emulator.transcript), \
+        emulator.transcript
+
+
+@pytest.mark.parametrize("name", API_SUITE)
+def test_api_suite(boot, p5smp, name):
+    run_target_test(boot(p5smp, "test", icount=True), name)
+
+
+@pytest.mark.parametrize("rate", [None, 19, 100, 2000])
+def test_the_tick_follows_the_apic_timer(boot, p5smp, rate):
+    append = f"tick_hz={rate}" if rate else ""
+    emulator = run_target_test(boot(p5smp, "test", append=append, icount=True), "tick")
+    configured = rate or 1000
+    hz, counts = calibrated_hz(emulator.transcript)
+    assert counts == (hz + configured // 2) // configured
+    match = re.search(r"tick rate: (\d+) ticks in 2 s of emulator time; configured (\d+) Hz", emulator.transcript)
+    assert match, "the tick test printed no measurement"
+    assert int(match.group(2)) == configured
+    assert abs(int(match.group(1)) - 2 * APIC_TIMER_HZ / counts) <= 1.5
+
+
+def test_the_crystal_model_shortens_the_apic_period(boot, p5smp):
+    emulator = run_target_test(boot(p5smp, "test", append="tick_hz=100 crystal_ppm=100", icount=True), "tick")
+    # 625,000 counts per tick at 100 Hz: 100 ppm is 62.49 counts, so 62 come off (99.2 ppm).
+    hz, counts = calibrated_hz(emulator.transcript)
+    assert counts == 625_000
+    match = re.search(r"crystal model: the tick timer counts (\d+) of 625000, the clock runs ([\d.]+) ppm fast",
+                      emulator.transcript)
+    assert match, emulator.transcript
+    assert 625_000 - int(match.group(1)) == 62
+    assert abs(float(match.group(2)) - 100) < 1.0
+    ticks = int(re.search(r"tick rate: (\d+) ticks in 2 s", emulator.transcript).group(1))
+    assert abs(ticks - 2 * APIC_TIMER_HZ / int(match.group(1))) <= 1.5
+
+
+def find_mp_table(stub):
+    """The floating pointer's and the configuration table's addresses in the BIOS ROM area."""
+    rom = stub.read_memory(0xF0000, 0x10000)
+    for offset in range(0, len(rom), 16):
+        if rom[offset:offset + 4] == b"_MP_" and sum(rom[offset:offset + 16]) & 0xFF == 0:
+            return 0xF0000 + offset, int.from_bytes(rom[offset + 4:offset + 8], "little")
+    raise AssertionError("no MP floating pointer in the BIOS ROM area")
+
+
+@pytest.mark.parametrize("damage, reported", [
+    ("checksum", "the MP configuration table's checksum is wrong"),
+    ("signature", "the MP floating pointer does not point at a PCMP configuration table"),
+])
+def test_a_corrupt_mp_table_is_reported_and_the_node_runs_on_defaults(boot, p5smp, tmp_path, damage, reported):
+    """The BIOS's table damaged before the kernel starts: a clear report, and node 2 runs on the defaults."""
+    socket_path = tmp_path / "gdb.sock"
+    emulator = boot(p5smp, icount=True, extra_args=gdbstub.paused_boot_args(socket_path))
+    stub = gdbstub.GdbStub(str(socket_path))
+    try:
+        stub.run_to(gdbstub.elf_entry(p5smp.image()))
+        _, table = find_mp_table(stub)
+        if damage == "checksum":
+            byte = stub.read_memory(table + 7, 1)[0]
+            stub.write_memory(table + 7, bytes([byte ^ 0x5A]))
+        else:
+            stub.write_memory(table, b"XCMP")
+    finally:
+        stub.detach()
+    emulator.expect(r"dcos> ")
+    transcript = emulator.transcript
+    match = re.search(r"warning: MP configuration not used: ([^(]+) \(at 0x([0-9a-f]+)\); the default configuration "
+                      r"is assumed .* and no second processor is started", transcript)
+    assert match, transcript
+    assert match.group(1).strip() == reported
+    assert int(match.group(2), 16) == table
+    # The defaults route the console's line as the table did: the shell answers.
+    assert "p5smp" in emulator.command("version")
