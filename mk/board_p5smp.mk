@@ -28,17 +28,57 @@ FWP5_OWN_OBJS := $(call fwp5_objects,$(P5SMP_BOARD_SRCS) $(FWP5_KERNEL_SRCS))
 FWP5_REPLACED_OBJS := $(call fw_objects,$(wildcard firmware/bsp_486/src/Board486.cpp) $(FWP5_KERNEL_SRCS))
 FWP5_OBJS := $(filter-out $(FWP5_REPLACED_OBJS),$(FW_OBJS)) $(FWP5_OWN_OBJS)
 
-$(IMAGE_P5SMP): $(FWP5_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld $(FWP5_IMAGES_STAMP)
+# Node 3's images: the production and test images' objects linked at
+# 16 MiB, the upper half of the board's memory (bsp/SecondProcessor.hpp).
+# Node 2's production image carries node 3's production image, and its test
+# image node 3's test image, stripped, as data (node3-image.o, whose symbols
+# _binary_node3_stripped_elf_start and _end BoardP5smp.cpp names: objcopy
+# names them after the input file, hence one folder per kind), and loads it
+# when it starts the second processor. The --defsym comes before the linker
+# script, whose DEFINED() sees only what is defined by then.
+IMAGE_P5SMP_NODE3 := $(BUILD)/p5smp/dcos-p5smp-node3.elf
+IMAGE_P5SMP_NODE3_TEST := $(BUILD)/p5smp/dcos-p5smp-node3-test.elf
+FWP5_NODE3_LOAD_ADDRESS := 0x1000000
+FWP5_NODE3_BLOB := $(FWP5_BUILD)/node3/node3-image.o
+FWP5_NODE3_TEST_BLOB := $(FWP5_BUILD)/node3-test/node3-image.o
+
+$(IMAGE_P5SMP_NODE3): $(FWP5_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld \
+		$(FWP5_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)ld $(FW_LDFLAGS) -o $@ $(FWP5_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY)
+	$(Q)ld --defsym=__image_load_address=$(FWP5_NODE3_LOAD_ADDRESS) $(FW_LDFLAGS) -o $@ $(FWP5_OBJS) \
+		$(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY)
 
-# The same on-target test suite as the ISA board's test image.
-$(IMAGE_P5SMP_TEST): $(FWP5_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) \
+$(IMAGE_P5SMP_NODE3_TEST): $(FWP5_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) \
 		firmware/boot/link.ld $(FWP5_IMAGES_STAMP)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)ld $(FW_LDFLAGS) -o $@ $(FWP5_OBJS) $(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY)
+	$(Q)ld --defsym=__image_load_address=$(FWP5_NODE3_LOAD_ADDRESS) $(FW_LDFLAGS) -o $@ $(FWP5_OBJS) \
+		$(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY)
+
+$(FWP5_NODE3_BLOB): $(IMAGE_P5SMP_NODE3)
+$(FWP5_NODE3_TEST_BLOB): $(IMAGE_P5SMP_NODE3_TEST)
+$(FWP5_NODE3_BLOB) $(FWP5_NODE3_TEST_BLOB):
+	@mkdir -p $(dir $@)
+	@echo "  BLOB    $@"
+	$(Q)objcopy --strip-all $< $(dir $@)node3-stripped.elf
+	$(Q)cd $(dir $@) && objcopy -I binary -O elf32-i386 -B i386 \
+		--rename-section .data=.rodata.node3_image,alloc,load,readonly,data,contents \
+		--add-section .note.GNU-stack=/dev/null node3-stripped.elf node3-image.o
+
+$(IMAGE_P5SMP): $(FWP5_OBJS) $(FWP5_NODE3_BLOB) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld \
+		$(FWP5_IMAGES_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FWP5_OBJS) $(FWP5_NODE3_BLOB) $(FW_FLASH_SERVICE_OBJS) $(MBEDTLS_FW_LIBRARY)
+
+# The same on-target test suite as the ISA board's test image, on both nodes.
+$(IMAGE_P5SMP_TEST): $(FWP5_OBJS) $(FWP5_NODE3_TEST_BLOB) $(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) \
+		$(MBEDTLS_FW_LIBRARY) firmware/boot/link.ld $(FWP5_IMAGES_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)ld $(FW_LDFLAGS) -o $@ $(FWP5_OBJS) $(FWP5_NODE3_TEST_BLOB) $(FW_TARGET_TEST_OBJS) $(FW_FLASH_SERVICE_OBJS) \
+		$(MBEDTLS_FW_LIBRARY)
 
 $(FWP5_IMAGES_STAMP): FORCE
 	@mkdir -p $(dir $@)

@@ -9,10 +9,13 @@ processors present, so every timing it checks is exact.
 
 import dataclasses
 import re
+import time
 
 import pytest
 
 from dcoslab import gdbstub
+from dcoslab.board import EXIT_PASS
+from dcoslab.node_console import NodeConsole
 from dcoslab.board import load_board
 from dcoslab.target import run_target_test
 
@@ -78,6 +81,44 @@ def test_one_processor_is_reported_and_the_node_runs(boot, p5smp):
     emulator.expect(r"dcos> ")
     assert re.search(r"MP 1\.4 table at 0x[0-9a-f]+ \(BOCHSCPU 0\.1\): 1 processors", emulator.transcript), \
         emulator.transcript
+    assert "one processor: node 3 is not started" in emulator.transcript
+
+
+def boot_both_nodes(boot, p5smp, kind="production", append=""):
+    """Boots the board with node 3's console on a socket; returns the emulator and node 3's console."""
+    emulator = boot(p5smp, kind, append=append, icount=True, serial_sockets=("node3",))
+    emulator.expect(r"node 3 started on the processor with APIC id 1 \(image at 0x1000000, \d+ bytes; console COM4\)")
+    emulator.expect(r"dcos> ")
+    node3 = NodeConsole(emulator, "node3")
+    node3.prompt()
+    return emulator, node3
+
+
+def test_node_3_runs_on_the_second_processor_with_its_own_console(boot, p5smp):
+    emulator, node3 = boot_both_nodes(boot, p5smp)
+    version = node3.command("version")
+    assert "board p5smp" in version and "loaded by node 2 (second processor start)" in version, version
+    # Both consoles answer, each through its own line of the I/O APIC: IRQ 4 to node 2, IRQ 7 to node 3.
+    assert "loaded by node 2" not in emulator.command("version")
+    assert "up 0 d" in node3.command("uptime")
+
+
+def uptime_rate(output):
+    """Ticks per second of an `uptime` answer, and the rate it names."""
+    match = re.search(r"up (\d+) d (\d+):(\d+):(\d+)\.(\d+) \((\d+) ticks at (\d+) Hz\)", output)
+    assert match, output
+    days, hours, minutes, seconds, millis, ticks, rate = (int(group) for group in match.groups())
+    elapsed = ((days * 24 + hours) * 60 + minutes) * 60 + seconds + millis / 1000
+    return ticks / elapsed, rate
+
+
+def test_each_node_ticks_at_its_own_rate(boot, p5smp):
+    emulator, node3 = boot_both_nodes(boot, p5smp, append="tick_hz=250 node3.tick_hz=100")
+    time.sleep(1.0)  # Emulated seconds pass while the test waits: both clocks run on.
+    node2_measured, node2_rate = uptime_rate(emulator.command("uptime"))
+    node3_measured, node3_rate = uptime_rate(node3.command("uptime"))
+    assert (node2_rate, node3_rate) == (250, 100)
+    assert abs(node2_measured - 250) < 2 and abs(node3_measured - 100) < 2, (node2_measured, node3_measured)
 
 
 @pytest.mark.parametrize("name", API_SUITE)
@@ -149,3 +190,21 @@ def test_a_corrupt_mp_table_is_reported_and_the_node_runs_on_defaults(boot, p5sm
     assert int(match.group(2), 16) == table
     # The defaults route the console's line as the table did: the shell answers.
     assert "p5smp" in emulator.command("version")
+
+
+# The same suite on node 3, whose spare lines are 12 and 13
+# (bsp::spareInterruptLine), but for "intlevel", which checks the levels of
+# the console's line 4 and its neighbours 5-7: node 2's lines, which node 3
+# reports held off for good (they cannot reach it), and the I/O board's
+# driver, whose line 5 is node 2's.
+NODE3_SUITE = [name for name in kernel_core.KERNEL_TARGET_TESTS + memory_agents.MEMORY_TARGET_TESTS
+               + semaphores.SEMAPHORE_TARGET_TESTS + port_dsm.PORT_DSM_TARGET_TESTS
+               + timing_bounds.TIMING_TARGET_TESTS + board_486.BOARD_TARGET_TESTS if name != "intlevel"]
+
+
+@pytest.mark.parametrize("name", NODE3_SUITE)
+def test_api_suite_on_node_3(boot, p5smp, name):
+    emulator, node3 = boot_both_nodes(boot, p5smp, kind="test")
+    node3.send(f"test {name} --exit\r")
+    node3.expect(rf"TEST {name}: (PASS|FAIL)", timeout=120)
+    emulator.expect_exit(EXIT_PASS, timeout=120)

@@ -84,9 +84,12 @@ def test_unreadable_image_is_an_error_not_a_pass(tmp_path):
     assert "cannot disassemble" in result.stderr
 
 
-@pytest.mark.parametrize("kind", ["production", "test"])
+@pytest.mark.parametrize("kind", ["production", "test", "node3", "node3-test"])
 def test_the_dual_pentium_images_hold_only_pentium_instructions(kind):
-    """The p5smp images may use what the Pentium adds (CPUID for its APIC), nothing later."""
+    """The p5smp images may use what the Pentium adds (CPUID for its APIC), nothing later.
+
+    Node 2's images carry node 3's as data, which a disassembly of their
+    code does not read: node 3's images are checked as they are linked."""
     result = subprocess.run([sys.executable, CHECKER, "--cpu", "pentium", load_board("p5smp").image(kind)],
                             capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stdout + result.stderr

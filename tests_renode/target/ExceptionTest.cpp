@@ -3,6 +3,7 @@
 // A divide error in a task is that task's exception (the task agent's
 // tests cover it); in an interrupt handler it is a kernel fault, which must
 // stop the node with a full report.
+#include "SpareLine.hpp"
 #include "TargetTest.hpp"
 
 #include <dcos/SystemAgent.hpp>
@@ -11,7 +12,6 @@ namespace {
 
 // An interrupt line no device uses on the emulated board; the test raises
 // its vector with a software interrupt.
-constexpr unsigned spareLine = 5;
 
 // Divides by zero with known values in the general registers, so the test
 // can check that the report shows the state at the faulting instruction.
@@ -31,12 +31,12 @@ void divideByZeroInInterrupt(void*)
 
 bool divideByZero(shell::Shell& shell)
 {
-    const dcos::Status status = dcos::systemAgent.InstallISR(spareLine, divideByZeroInInterrupt, nullptr);
+    const dcos::Status status = dcos::systemAgent.InstallISR(target_test::spareLine(), divideByZeroInInterrupt, nullptr);
     if (status != dcos::Status::Ok) {
         shell.print("cannot install the test ISR: %s\r\n", dcos::statusName(status));
         return false;
     }
-    asm volatile("int $0x25" ::: "memory"); // IRQ 5's vector: 0x20 + 5.
+    target_test::raiseSpareLine();
     return false; // Not reached: #DE in a handler ends in the panic report.
 }
 

@@ -1,6 +1,7 @@
 // The system agent's interrupt services on the target: blocking services
 // refused in handlers, interrupt levels per task and the legal limit
 // (seed 7.3.3).
+#include "SpareLine.hpp"
 #include "KernelTestSupport.hpp"
 #include <bsp/Board.hpp>
 
@@ -17,7 +18,6 @@ using dcos::Status;
 using dcos::systemAgent;
 using dcos::taskAgent;
 
-constexpr unsigned spareLine = 5;
 
 struct IsrResults {
     Status sleep;
@@ -45,14 +45,14 @@ void tryBlockingInIsr(void*)
 bool blockingInIsr(shell::Shell& shell)
 {
     isrRan = false;
-    bool ok = checkStatus(shell, systemAgent.InstallISR(spareLine, tryBlockingInIsr, nullptr), Status::Ok, "InstallISR");
-    ok = checkStatus(shell, systemAgent.InstallISR(spareLine, tryBlockingInIsr, nullptr), Status::Busy,
+    bool ok = checkStatus(shell, systemAgent.InstallISR(target_test::spareLine(), tryBlockingInIsr, nullptr), Status::Ok, "InstallISR");
+    ok = checkStatus(shell, systemAgent.InstallISR(target_test::spareLine(), tryBlockingInIsr, nullptr), Status::Busy,
                      "a second routine on the same line") && ok;
     // The routine waits for events 0 and 25 with the shell task as the
     // running task; an earlier test may have left them posted, and a present
     // event is taken without blocking, so clear them first.
     (void)taskAgent.ReceiveEvent(1u | (1u << 25), dcos::EventWait::Any, dcos::kPoll);
-    asm volatile("int $0x25" ::: "memory");
+    target_test::raiseSpareLine();
     ok = check(shell, isrRan, "the routine ran") && ok;
     ok = checkStatus(shell, isrResults.sleep, Status::InInterrupt, "SleepFor in an ISR") && ok;
     ok = checkStatus(shell, isrResults.receiveWithTimeout, Status::InInterrupt, "ReceiveEvent with time-out in an ISR") && ok;
@@ -61,7 +61,7 @@ bool blockingInIsr(shell::Shell& shell)
     ok = checkStatus(shell, isrResults.postEvent, Status::Ok, "PostEvent is allowed in an ISR") && ok;
     ok = check(shell, taskAgent.ReceiveEvent(1u << 26, dcos::EventWait::Any, dcos::kPoll).ok(),
                "the event posted from the ISR arrived") && ok;
-    ok = checkStatus(shell, systemAgent.RemoveISR(spareLine), Status::Ok, "RemoveISR") && ok;
+    ok = checkStatus(shell, systemAgent.RemoveISR(target_test::spareLine()), Status::Ok, "RemoveISR") && ok;
     ok = checkStatus(shell, systemAgent.RemoveISR(0), Status::InvalidArgument, "the tick cannot be removed") && ok;
     ok = checkStatus(shell, systemAgent.InstallISR(16, tryBlockingInIsr, nullptr), Status::InvalidArgument,
                      "line 16") && ok;

@@ -5,6 +5,7 @@
 // agent from a user task. The board is the emulator's isa-mfio at 0x300,
 // IRQ 5, in loopback (DAC n drives ADC n, DO drives DI); the tests that need
 // it absent or faulty are booted so by tests_renode/test_iobus_driver.py.
+#include "SpareLine.hpp"
 #include "KernelTestSupport.hpp"
 
 #include <iobus/AnalogScaling.hpp>
@@ -102,7 +103,8 @@ bool probePresent(shell::Shell& shell)
     ok = check(shell, info.id == 0x4D46 && info.revision == 0x0100 && info.present == 1, "identity") && ok;
     ok = uninstallBoard(shell) && ok;
     // No board decodes 0x280 on this machine: the bus floats high.
-    ok = installBoard(shell, 0x280, 7, false) && ok;
+    // On a spare line: line 7 is node 3's console on the dual-Pentium board.
+    ok = installBoard(shell, 0x280, static_cast<uint8_t>(target_test::spareLine(1)), false) && ok;
     ok = checkStatus(shell, systemAgent.Probe(testBoard.id()), Status::NotFound, "Probe of an empty slot") && ok;
     ok = checkStatus(shell, systemAgent.Open(testBoard.id()), Status::NotFound, "Open of an empty slot") && ok;
     ok = uninstallBoard(shell) && ok;

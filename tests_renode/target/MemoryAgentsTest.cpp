@@ -3,6 +3,7 @@
 // tasks, calls from an interrupt handler, corrupted pools and heaps refusing
 // service, full tables, and resource recovery when a task dies holding a
 // buffer and a segment.
+#include "SpareLine.hpp"
 #include "KernelTestSupport.hpp"
 
 #include <dcos/BufferPoolAgent.hpp>
@@ -33,7 +34,6 @@ using dcos::internal::HeapManager;
 
 // An interrupt line no device uses on the emulated board; the test raises
 // its vector (0x20 + line) by software.
-constexpr unsigned kSpareLine = 5;
 
 // The messages below state the heap's figures: a 16-byte header, so that
 // one byte takes 24.
@@ -588,8 +588,8 @@ bool memoryInInterrupts(shell::Shell& shell)
     isrResults.heap = heapAgent.Create(heapArea, sizeof heapArea, "isr-heap", Visibility::Local).value();
     isrResults.taskBuffer = bufferPoolAgent.Allocate(isrResults.pool).value();
     isrRan = false;
-    bool ok = checkStatus(shell, dcos::systemAgent.InstallISR(kSpareLine, memoryIsr, nullptr), Status::Ok, "InstallISR");
-    asm volatile("int $0x25" ::: "memory");
+    bool ok = checkStatus(shell, dcos::systemAgent.InstallISR(target_test::spareLine(), memoryIsr, nullptr), Status::Ok, "InstallISR");
+    target_test::raiseSpareLine();
     ok = check(shell, isrRan, "the routine ran") && ok;
     ok = checkStatus(shell, isrResults.allocateBuffer, Status::Ok, "Allocate a buffer in an ISR") && ok;
     ok = checkStatus(shell, isrResults.allocateSegment, Status::Ok, "Allocate a segment in an ISR") && ok;
@@ -597,7 +597,7 @@ bool memoryInInterrupts(shell::Shell& shell)
     ok = checkStatus(shell, isrResults.create, Status::InInterrupt, "Create in an ISR") && ok;
     ok = checkStatus(shell, isrResults.nameToObject, Status::InInterrupt, "NameToObject in an ISR") && ok;
     ok = checkStatus(shell, isrResults.statistics, Status::Ok, "GetStatistics in an ISR") && ok;
-    ok = checkStatus(shell, dcos::systemAgent.RemoveISR(kSpareLine), Status::Ok, "RemoveISR") && ok;
+    ok = checkStatus(shell, dcos::systemAgent.RemoveISR(target_test::spareLine()), Status::Ok, "RemoveISR") && ok;
     // What an ISR allocates is held by the system: any task may return it.
     spawn("returner", 10, returnSystemEntry);
     ok = check(shell, waitForDone(shell, 1), "the returning task finished") && ok;

@@ -3,6 +3,7 @@
 // port order, time-outs, receivers woken by tasks and interrupt handlers,
 // readers racing a writer, and recovery of a dead task's ports, publishers
 // and subscriptions.
+#include "SpareLine.hpp"
 #include "KernelTestSupport.hpp"
 
 #include <dcos/DsmAgent.hpp>
@@ -37,9 +38,6 @@ using dcos::internal::DsmManager;
 using dcos::internal::PortManager;
 
 constexpr uint64_t kMillisecond = 1000000;
-// Lines no device uses; the tests raise their vectors (0x20 + line) by software.
-constexpr unsigned kSpareLine = 5;
-constexpr unsigned kOtherSpareLine = 10;
 
 // --- Shared helpers ---------------------------------------------------------
 
@@ -240,10 +238,10 @@ bool portPrimitives(shell::Shell& shell)
     ok = checkStatus(shell, newOwnerGiveBack, Status::Ok, "the new owner gives the port back") && ok;
 
     // Interrupt handlers may send and poll, but not wait or create.
-    ok = checkStatus(shell, systemAgent.InstallISR(kSpareLine, portIsrRoutine, nullptr), Status::Ok,
+    ok = checkStatus(shell, systemAgent.InstallISR(target_test::spareLine(), portIsrRoutine, nullptr), Status::Ok,
                      "InstallISR") && ok;
-    asm volatile("int $0x25" ::: "memory");
-    ok = checkStatus(shell, systemAgent.RemoveISR(kSpareLine), Status::Ok, "RemoveISR") && ok;
+    target_test::raiseSpareLine();
+    ok = checkStatus(shell, systemAgent.RemoveISR(target_test::spareLine()), Status::Ok, "RemoveISR") && ok;
     ok = checkStatus(shell, portIsr.receivePoll, Status::WouldBlock, "Receive polls in an ISR") && ok;
     ok = checkStatus(shell, portIsr.receiveWait, Status::InInterrupt, "Receive may not wait in an ISR") && ok;
     ok = checkStatus(shell, portIsr.send, Status::Ok, "Send in an ISR") && ok;
@@ -541,11 +539,11 @@ bool portWake(shell::Shell& shell)
     ok = waitForDone(shell, 1) && ok;
     ok = check(shell, wokenWith[0] == 0x7A5C, "woken by a task with its message") && ok;
     // An ISR sends: the receiver runs at the outermost exit, before the test task goes on.
-    ok = checkStatus(shell, systemAgent.InstallISR(kOtherSpareLine, wakeIsr, nullptr), Status::Ok, "InstallISR") && ok;
+    ok = checkStatus(shell, systemAgent.InstallISR(target_test::spareLine(), wakeIsr, nullptr), Status::Ok, "InstallISR") && ok;
     Trace::record('s');
-    asm volatile("int $0x2A" ::: "memory");
+    target_test::raiseSpareLine();
     Trace::record('S');
-    ok = checkStatus(shell, systemAgent.RemoveISR(kOtherSpareLine), Status::Ok, "RemoveISR") && ok;
+    ok = checkStatus(shell, systemAgent.RemoveISR(target_test::spareLine()), Status::Ok, "RemoveISR") && ok;
     ok = waitForDone(shell, 1) && ok;
     ok = check(shell, wokenWith[1] == 0x15F, "woken by an ISR with its message") && ok;
     ok = check(shell, freeBuffers() == freeBefore, "a waiting receiver's messages took no buffer") && ok;
@@ -721,9 +719,9 @@ bool dsmPrimitives(shell::Shell& shell)
     ok = check(shell, afterTransfer.ok() && wordOf(page, 0) == 77, "the new owner's page is read") && ok;
 
     // Interrupt handlers may write and poll, but not wait, create or open.
-    ok = checkStatus(shell, systemAgent.InstallISR(kSpareLine, dsmIsrRoutine, nullptr), Status::Ok, "InstallISR") && ok;
-    asm volatile("int $0x25" ::: "memory");
-    ok = checkStatus(shell, systemAgent.RemoveISR(kSpareLine), Status::Ok, "RemoveISR") && ok;
+    ok = checkStatus(shell, systemAgent.InstallISR(target_test::spareLine(), dsmIsrRoutine, nullptr), Status::Ok, "InstallISR") && ok;
+    target_test::raiseSpareLine();
+    ok = checkStatus(shell, systemAgent.RemoveISR(target_test::spareLine()), Status::Ok, "RemoveISR") && ok;
     ok = checkStatus(shell, dsmIsr.write, Status::Ok, "Write in an ISR") && ok;
     ok = checkStatus(shell, dsmIsr.readPoll, Status::Ok, "Read polls in an ISR") && ok;
     ok = check(shell, dsmIsr.readId != 0, "the ISR read its own page") && ok;
@@ -910,7 +908,7 @@ void writerEntry(uintptr_t)
             (void)dcos::schedulerAgent.Yield();
         }
         if (i % 50 == 0) {
-            asm volatile("int $0x25" ::: "memory");
+            target_test::raiseSpareLine();
         }
         if (i % 50 == 0) {
             (void)taskAgent.SleepFor(kMillisecond); // Lets the less urgent reader run.
@@ -945,7 +943,7 @@ void readerEntry(uintptr_t index)
             if (index == 1) {
                 ++emptyPolls;
                 if (emptyPolls % 4 == 0) {
-                    asm volatile("int $0x25" ::: "memory");
+                    target_test::raiseSpareLine();
                 }
                 if (emptyPolls % 8 == 0) {
                     (void)taskAgent.SleepFor(kMillisecond);
@@ -980,7 +978,7 @@ bool dsmRace(shell::Shell& shell)
 {
     race::publisher = dsmAgent.Create("race", Visibility::Local).value();
     bool ok = check(shell, !race::publisher.isNull(), "create the publisher");
-    ok = checkStatus(shell, systemAgent.InstallISR(kSpareLine, race::writingIsr, nullptr), Status::Ok,
+    ok = checkStatus(shell, systemAgent.InstallISR(target_test::spareLine(), race::writingIsr, nullptr), Status::Ok,
                      "InstallISR") && ok;
     const size_t subscriptionsBefore = DsmManager::subscriptionCount();
     {
@@ -1002,7 +1000,7 @@ bool dsmRace(shell::Shell& shell)
         }
     }
     ok = waitForDone(shell, 1 + race::kReaders, 20000 * kMillisecond) && ok;
-    ok = checkStatus(shell, systemAgent.RemoveISR(kSpareLine), Status::Ok, "RemoveISR") && ok;
+    ok = checkStatus(shell, systemAgent.RemoveISR(target_test::spareLine()), Status::Ok, "RemoveISR") && ok;
     shell.print("writes: %u by the task, %u by the ISR; reads: %u, %u, %u; torn %u, not newer %u, unexpected %u\r\n",
                 race::kWrites, race::isrWrites, race::reads[0], race::reads[1], race::reads[2], race::tornPages,
                 race::notNewer, race::unexpected);

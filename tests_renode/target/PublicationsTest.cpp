@@ -19,6 +19,7 @@
 // the writes skipped between two pages read; a subscriber slower than the
 // publisher skips some by design (it reads the latest page), so the tests
 // bound them only where the reader keeps up.
+#include "SpareLine.hpp"
 #include "KernelTestSupport.hpp"
 
 #include <dcos/DsmAgent.hpp>
@@ -110,8 +111,7 @@ void publisherEntry(uintptr_t)
 }
 
 // An interrupt handler's Write: the routine on the spare line (5, vector
-// 0x25) writes the page of isrCounter to the publishing task's publisher.
-constexpr unsigned kSpareLine = 5;
+// 0x20 + the spare line) writes the page of isrCounter to the publishing task's publisher.
 volatile uint32_t isrCounter = 0;
 volatile Status isrWrite = Status::Ok;
 
@@ -236,14 +236,14 @@ CommandResult pubsub(shell::Shell& shell, int argc, char** argv)
         if (!shell::Shell::parseUnsigned(argv[2], counter) || counter == 0) {
             return CommandResult::UsageError;
         }
-        const Status installed = dcos::systemAgent.InstallISR(kSpareLine, writingIsr, nullptr);
+        const Status installed = dcos::systemAgent.InstallISR(target_test::spareLine(), writingIsr, nullptr);
         if (installed != Status::Ok) {
             shell.print("error: InstallISR: %s\r\n", dcos::statusName(installed));
             return CommandResult::Failed;
         }
         isrCounter = static_cast<uint32_t>(counter);
-        asm volatile("int $0x25" ::: "memory");
-        (void)dcos::systemAgent.RemoveISR(kSpareLine);
+        target_test::raiseSpareLine();
+        (void)dcos::systemAgent.RemoveISR(target_test::spareLine());
         shell.print("RRES %s 0 0\r\n", dcos::statusName(isrWrite));
         return CommandResult::Ok;
     }

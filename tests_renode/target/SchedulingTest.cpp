@@ -1,6 +1,7 @@
 // The scheduler agent on the target: preemption from interrupts with the
 // dispatch deferred to the outermost exit, round robin, time slicing,
 // priorities and deadline scheduling (seed 7.3.3, 7.4).
+#include "SpareLine.hpp"
 #include "KernelTestSupport.hpp"
 
 #include <dcos/SchedulerAgent.hpp>
@@ -24,9 +25,9 @@ constexpr uint64_t kMillisecond = 1000000;
 
 // --- Preemption from a nested interrupt ------------------------------------
 
-// Two lines no device uses; the test raises their vectors by software.
-constexpr unsigned outerLine = 10;
-constexpr unsigned innerLine = 11;
+// The node's two spare lines; the test raises their vectors by software.
+unsigned outerLine() { return target_test::spareLine(0); }
+unsigned innerLine() { return target_test::spareLine(1); }
 ObjectId urgentTask;
 
 void innerIsr(void*)
@@ -39,7 +40,7 @@ void innerIsr(void*)
 void outerIsr(void*)
 {
     Trace::record('o');
-    asm volatile("int $0x2B" ::: "memory"); // Nest: IRQ 11's vector.
+    target_test::raiseSpareLine(1); // Nest: the inner line's vector.
     Trace::record('O');
 }
 
@@ -55,16 +56,16 @@ bool preemptionFromInterrupt(shell::Shell& shell)
     Trace::clear();
     urgentTask = spawn("urgent", 2, urgentEntry);
     bool ok = check(shell, !urgentTask.isNull(), "create the urgent task");
-    ok = ok && checkStatus(shell, systemAgent.InstallISR(outerLine, outerIsr, nullptr), Status::Ok, "InstallISR outer");
-    ok = ok && checkStatus(shell, systemAgent.InstallISR(innerLine, innerIsr, nullptr), Status::Ok, "InstallISR inner");
+    ok = ok && checkStatus(shell, systemAgent.InstallISR(outerLine(), outerIsr, nullptr), Status::Ok, "InstallISR outer");
+    ok = ok && checkStatus(shell, systemAgent.InstallISR(innerLine(), innerIsr, nullptr), Status::Ok, "InstallISR inner");
     // The urgent task has run up to its wait. Now: test task 's', outer
     // handler, nested inner handler readying the urgent task, back out.
     Trace::record('s');
-    asm volatile("int $0x2A" ::: "memory"); // IRQ 10's vector.
+    target_test::raiseSpareLine(0); // The outer line's vector.
     Trace::record('S');
     ok = ok && waitForDone(shell, 1);
-    (void)systemAgent.RemoveISR(outerLine);
-    (void)systemAgent.RemoveISR(innerLine);
+    (void)systemAgent.RemoveISR(outerLine());
+    (void)systemAgent.RemoveISR(innerLine());
     // The urgent task runs after the outer handler ends ('O'), before the
     // interrupted test task continues ('S'), and not at the inner exit.
     return Trace::expect(shell, "soiIOHS") && ok;

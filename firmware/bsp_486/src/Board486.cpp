@@ -201,6 +201,8 @@ bool interruptCutShort(unsigned& line)
     return false;
 }
 
+unsigned spareInterruptLine(unsigned which) { return which == 0 ? 5 : 11; }
+
 uint32_t unexpectedInterruptCount(unsigned line) { return line < interruptLineCount ? unexpected[line] : 0; }
 
 uint32_t spuriousInterruptCount() { return spurious; }

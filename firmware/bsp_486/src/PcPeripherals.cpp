@@ -45,6 +45,7 @@ public:
 };
 
 TeeConsole teeConsole;
+bool realTimeClockOwned = true;
 
 // Writes straight to the UART, for the panic path.
 class PolledConsole final : public runtime::CharacterSink {
@@ -56,8 +57,10 @@ PolledConsole polledConsole;
 
 void consoleInterrupt(void*) { uart.handleInterrupt(); }
 
-// A decimal option of at most @p digits digits; false when it has other
-// characters, none or more, so the accumulation cannot overflow.
+} // namespace
+
+namespace pc {
+
 bool decimalOption(const char* text, unsigned digits, uint32_t& value)
 {
     value = 0;
@@ -73,23 +76,26 @@ bool decimalOption(const char* text, unsigned digits, uint32_t& value)
     return true;
 }
 
-} // namespace
-
-namespace pc {
-
 Uart16550& consoleUart() { return uart; }
 
-void initialiseConsole()
+static_assert(consoleLine == 4, "PcPeripherals.hpp's default console line");
+
+void initialiseConsole(uint16_t port, unsigned line)
 {
+    if (port != com1Port) {
+        uart = Uart16550(arch_x86::IoWindow::ports(port, 8));
+    }
     if (uart.initialise(consoleBaud) != dcos::Status::Ok) {
         // No console means no way to report anything; the panic path still
         // tries the polled port in case the chip merely failed the probe.
-        dcosPanic("console UART not found at port 0x%x", com1Port);
+        dcosPanic("console UART not found at port 0x%x", unsigned(port));
     }
-    if (attachInterrupt(consoleLine, consoleInterrupt, nullptr) != dcos::Status::Ok) {
-        dcosPanic("cannot attach the console's interrupt line %u", consoleLine);
+    if (attachInterrupt(line, consoleInterrupt, nullptr) != dcos::Status::Ok) {
+        dcosPanic("cannot attach the console's interrupt line %u", line);
     }
 }
+
+void leaveRealTimeClock() { realTimeClockOwned = false; }
 
 uint16_t nodeFromCommandLine(const boot::BootInfo& bootInfo, uint16_t defaultNode)
 {
@@ -150,7 +156,13 @@ uint32_t crystalShortening(const boot::BootInfo& bootInfo, uint32_t countsPerTic
 
 } // namespace pc
 
-dcos::Result<dcos::DateTime> readRealTimeClock() { return rtc.read(); }
+dcos::Result<dcos::DateTime> readRealTimeClock()
+{
+    if (!realTimeClockOwned) {
+        return dcos::Status::NotSupported; // Another node of the board reads it (leaveRealTimeClock()).
+    }
+    return rtc.read();
+}
 
 runtime::CharacterSink& console() { return teeConsole; }
 

@@ -18,6 +18,8 @@
 #include <bsp/P5smpBoard.hpp>
 #include <bsp/PcPeripherals.hpp>
 #include <bsp/Pic8259.hpp>
+#include <bsp/ApTrampoline.h>
+#include <bsp/SecondProcessor.hpp>
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/Gdt.hpp>
@@ -26,12 +28,18 @@
 #include <arch_x86/PortIo.hpp>
 #include <boot/Panic.hpp>
 
+#include <runtime/Format.hpp>
+
 #include <string.h>
 
 extern "C" {
 // ApicSpurious.S: the local APIC's spurious vector, which takes no EOI.
 void apicSpuriousEntry();
 uint32_t apicSpuriousCount = 0;
+// Node 3's kernel image, stripped, which node 2's images carry as data
+// (mk/board_p5smp.mk). Weak: node 3's own image carries none.
+[[gnu::weak]] extern const uint8_t _binary_node3_stripped_elf_start[];
+[[gnu::weak]] extern const uint8_t _binary_node3_stripped_elf_end[];
 }
 
 namespace bsp {
@@ -81,8 +89,26 @@ constexpr uint8_t vectorOf(unsigned line) { return static_cast<uint8_t>(arch_x86
 static_assert(systemTickLine == 0 && interProcessorLine == 2);
 static_assert(vectorOf(systemTickLine) == 32, "BoardTick.hpp reads the tick's request as bit 0 of IRR 32-63");
 
-// A start-up IPI's wait for its delivery status, in reads.
+// An inter-processor interrupt's wait for its delivery status, in reads.
 constexpr uint32_t deliverySpins = 100'000;
+
+// What node 3 owns when it runs (seed 9.2: devices are assigned to the
+// nodes asymmetrically): its console, COM4 at 0x2E8 on IRQ 7, and IRQs 12
+// and 13, which nothing on the board drives (the PS/2 mouse port is unused,
+// and the FPU reports its errors as exceptions, CR0.NE), as its spare
+// lines, besides its own tick and the inter-processor interrupt line every
+// node has. Node 2
+// owns every other ISA line, and it alone programs the I/O APIC: its
+// select and window registers are one pair that two processors cannot
+// share without a lock, so node 3's lines are routed to it once, at its
+// start, unmasked, and node 3 masks them in software.
+constexpr uint16_t node3ConsolePort = 0x2E8;
+constexpr unsigned node3ConsoleLine = 7;
+constexpr unsigned node3SpareLines[2] = {12, 13};
+constexpr unsigned node2SpareLines[2] = {5, 11};
+constexpr uint16_t node3Lines = (1u << node3ConsoleLine) | (1u << node3SpareLines[0]) | (1u << node3SpareLines[1]);
+// How long node 2 waits for the second processor to report from protected mode.
+constexpr uint32_t answerMicroseconds = 100'000;
 
 LocalApic localApic(arch_x86::IoWindow::memory(LocalApic::kDefaultBase, LocalApic::kWindowBytes));
 IoApic ioApic(arch_x86::IoWindow::memory(IoApic::kDefaultBase, IoApic::kWindowBytes));
@@ -100,8 +126,6 @@ struct Attachment {
 // but for the tick while the kernel masks it (see applyMask()).
 Attachment registered[interruptLineCount];
 Attachment attachments[interruptLineCount];
-// A tick that came while its line was masked, delivered on the unmask.
-bool tickDeferred = false;
 
 // Where each ISA line arrives at the I/O APIC; line 0 and line 2 are the
 // local APIC's own (timer and inter-processor interrupt), never routed.
@@ -116,6 +140,15 @@ LineRoute routes[interruptLineCount];
 uint32_t unexpected[interruptLineCount];
 uint16_t maskedLines = 0xFFFF; // Lines without a handler, or masked by the kernel.
 uint16_t overlayLines = 0;     // Lines held off by the running task's interrupt level.
+// Lines masked here rather than at their source (see applyMask()), and
+// those of them that interrupted while masked.
+uint16_t softwareMaskedLines = 1u << systemTickLine;
+uint16_t pendingLines = 0;
+// The lines this node may attach: every one but another node's.
+uint16_t ownedLines = 0xFFFF;
+bool isNode3 = false;
+uint8_t node3ApicId = 0xFF;
+SecondProcessor::Outcome node3Outcome = SecondProcessor::Outcome::NoImage;
 uint16_t node = 2;
 uint32_t tickRate = defaultTickRateHz;
 uint64_t tickPeriodNs = 0;
@@ -168,38 +201,41 @@ void setTimerMasked(bool masked)
     registers.write32(LocalApic::kLvtTimer, masked ? entry | LocalApic::kLvtMask : entry & ~LocalApic::kLvtMask);
 }
 
-// The tick raised again, as the timer would, by an interrupt to this
-// processor itself on the tick's vector.
-void raiseTick() { (void)localApic.sendFixed(bootstrapApicId(), vectorOf(systemTickLine), deliverySpins); }
+// An interrupt raised again on @p line's vector, by this processor to itself.
+void raiseAgain(unsigned line) { (void)localApic.sendFixed(localApic.id(), vectorOf(line), deliverySpins); }
 
 // Applies the mask of @p line: masked without a handler, by the kernel, or
-// by the running task's level. An ISA line is masked at the I/O APIC. The
-// tick is not: a masked LVT entry drops the timer's interrupts (SDM Vol. 3A,
-// 11.5.1), where the 8259A holds a masked request until the unmask, and the
-// kernel counts on that. So while its owner is attached the timer keeps
-// interrupting, a tick that comes while the line is masked is only noted,
-// and the unmask raises it again. Line 2, the other processor's
-// interrupts, cannot be held off at its source and keeps no mask.
+// by the running task's level. An ISA line of node 2 is masked at the I/O
+// APIC. The tick is not: a masked LVT entry drops the timer's interrupts
+// (SDM Vol. 3A, 11.5.1), where the 8259A holds a masked request until the
+// unmask, and the kernel counts on that. Nor are node 3's lines, which only
+// node 2 programs. Those are masked in software: while the line's owner is
+// attached its interrupts keep coming, one that comes while the line is
+// masked is only noted, and the unmask raises it again. Line 2, the other
+// processor's interrupts, cannot be held off at its source and keeps no mask.
 void applyMask(unsigned line)
 {
     const bool masked = ((maskedLines | overlayLines) >> line & 1u) != 0;
-    if (line == systemTickLine) {
+    if ((softwareMaskedLines >> line & 1u) != 0) {
         const bool attached = registered[line].handler != nullptr;
-        setTimerMasked(!attached);
-        attachments[line] = masked ? Attachment{nullptr, nullptr} : registered[line];
-        if (attached && !masked && tickDeferred) {
-            tickDeferred = false;
-            raiseTick();
+        if (line == systemTickLine) {
+            setTimerMasked(!attached);
         }
-    } else if (routes[line].routed) {
+        attachments[line] = masked ? Attachment{nullptr, nullptr} : registered[line];
+        const uint16_t bit = static_cast<uint16_t>(1u << line);
+        if (attached && !masked && (pendingLines & bit) != 0) {
+            pendingLines = static_cast<uint16_t>(pendingLines & ~bit);
+            raiseAgain(line);
+        }
+    } else if ((ownedLines >> line & 1u) != 0 && routes[line].routed) {
         (void)ioApic.setMasked(routes[line].pin, masked);
     }
 }
 
 [[gnu::noinline]] void dispatchUncommon(unsigned line)
 {
-    if (line == systemTickLine && registered[line].handler != nullptr) {
-        tickDeferred = true; // Masked by the kernel: delivered on the unmask.
+    if ((softwareMaskedLines >> line & 1u) != 0 && registered[line].handler != nullptr) {
+        pendingLines = static_cast<uint16_t>(pendingLines | (1u << line)); // Delivered on the unmask.
         localApic.endOfInterrupt();
         return;
     }
@@ -283,7 +319,9 @@ void retirePics()
 
 // The MP table's routes of the ISA lines, or the MP spec's default
 // configuration's (5.3: IRQ 0 on INTIN2, the others on their own pin).
-void routeIsaLines()
+// Where each ISA line arrives: the MP table's route, or the MP spec's
+// default configuration's (5.3: IRQ 0 on INTIN2, the others on their own pin).
+void findRoutes()
 {
     for (unsigned line = 0; line < interruptLineCount; ++line) {
         routes[line] = LineRoute{};
@@ -305,14 +343,118 @@ void routeIsaLines()
             routes[line] = {true, static_cast<uint8_t>(line), false, false};
         }
     }
-    ioApic.maskAll();
-    const uint8_t destination = bootstrapApicId();
+}
+
+// Node 2 routes every line with an I/O APIC pin: @p lines to the processor
+// with APIC id @p destination, the others masked to itself.
+void routeLines(uint16_t lines, uint8_t destination, bool masked)
+{
     for (unsigned line = 0; line < interruptLineCount; ++line) {
         const LineRoute& route = routes[line];
-        if (route.routed) {
-            (void)ioApic.route(route.pin, vectorOf(line), destination, route.activeLow, route.levelTriggered, true);
+        if (route.routed && (lines >> line & 1u) != 0) {
+            (void)ioApic.route(route.pin, vectorOf(line), destination, route.activeLow, route.levelTriggered, masked);
         }
     }
+}
+
+// The second processor of the MP table: the first enabled one that is not
+// the bootstrap processor; 0xFF when there is none.
+uint8_t secondProcessorApicId()
+{
+    if (!mpValid) {
+        return 0xFF;
+    }
+    const uint8_t bootstrap = mp.bootstrapProcessor()->apicId;
+    for (unsigned i = 0; i < mp.processorCount; ++i) {
+        if (mp.processors[i].enabled && mp.processors[i].apicId != bootstrap) {
+            return mp.processors[i].apicId;
+        }
+    }
+    return 0xFF;
+}
+
+// A busy wait on the local APIC timer, before the tick starts: a one-shot
+// count, masked so that its end raises nothing, and polled.
+void delayMicroseconds(uint32_t microseconds)
+{
+    const uint32_t counts = static_cast<uint32_t>(apicTimerHz * microseconds / 1'000'000u) + 1;
+    (void)localApic.startOneShot(vectorOf(systemTickLine), counts, timerDivide);
+    setTimerMasked(true);
+    // Each poll takes at least one count; the bound only guards a dead timer.
+    for (uint32_t polls = 0; localApic.currentCount() != 0 && polls <= counts; ++polls) {
+    }
+}
+
+// Node 3's command line: its node id, the APIC timer's rate node 2 measured
+// (it cannot use the 8254, which is node 2's), and every option of node 2's
+// command line written "node3.<option>", without that prefix.
+char node3CommandLine[AP_TRAMPOLINE_COMMAND_LINE_BYTES];
+
+void composeNode3CommandLine(const char* node2CommandLine)
+{
+    runtime::BufferSink out(node3CommandLine, sizeof node3CommandLine);
+    runtime::format(out, "node=3 apic_hz=%lu", static_cast<unsigned long>(apicTimerHz));
+    constexpr char prefix[] = "node3.";
+    constexpr size_t prefixLength = sizeof prefix - 1;
+    for (const char* word = node2CommandLine; *word != '\0';) {
+        while (*word == ' ') {
+            ++word;
+        }
+        const char* end = word;
+        while (*end != '\0' && *end != ' ') {
+            ++end;
+        }
+        if (static_cast<size_t>(end - word) > prefixLength && memcmp(word, prefix, prefixLength) == 0) {
+            out.put(' ');
+            for (const char* c = word + prefixLength; c != end; ++c) {
+                out.put(*c);
+            }
+        }
+        word = end;
+    }
+}
+
+// Starts node 3 on the second processor, its lines routed to it first so
+// that none of its interrupts can reach node 2 once it runs; if it does not
+// start they come back, masked, to node 2.
+void startNode3(const boot::BootInfo& bootInfo)
+{
+    node3ApicId = secondProcessorApicId();
+    runtime::CharacterSink& out = pc::consoleUart();
+    if (node3ApicId == 0xFF) {
+        runtime::format(out, "one processor: node 3 is not started\r\n");
+        return;
+    }
+    const uint8_t* image = _binary_node3_stripped_elf_start;
+    const size_t bytes = image != nullptr ? static_cast<size_t>(_binary_node3_stripped_elf_end - image) : 0;
+    const uint32_t memoryEnd = 0x100000u + bootInfo.upperMemoryKib * 1024u;
+    // Node 2's image and the page tables after it (a page per 4 MiB mapped,
+    // and the directory) must end below node 3's half.
+    const uintptr_t node2End = boot::imageLayout().end + (memoryEnd / 0x400000u + 2) * arch_x86::Paging::kPageSize;
+    if (node2End > SecondProcessor::kNodeBase) {
+        runtime::format(out, "node 3 is not started: node 2's image ends at 0x%lx, above node 3's half at 0x%lx\r\n",
+                        static_cast<unsigned long>(node2End), static_cast<unsigned long>(SecondProcessor::kNodeBase));
+        return;
+    }
+    uint32_t entry = 0;
+    node3Outcome = SecondProcessor::load(image, bytes, memoryEnd, entry);
+    if (node3Outcome == SecondProcessor::Outcome::Started) {
+        composeNode3CommandLine(bootInfo.commandLine);
+        routeLines(node3Lines, node3ApicId, false);
+        const SecondProcessor::Launch launch{entry, node3ApicId, bootInfo.lowerMemoryKib, bootInfo.upperMemoryKib,
+                                             node3CommandLine, delayMicroseconds};
+        node3Outcome = SecondProcessor::start(localApic, launch, answerMicroseconds);
+    }
+    if (node3Outcome != SecondProcessor::Outcome::Started) {
+        routeLines(node3Lines, bootstrapApicId(), true);
+        runtime::format(out, "node 3 is not started on the processor with APIC id %u: %s\r\n", unsigned(node3ApicId),
+                        SecondProcessor::describe(node3Outcome));
+        return;
+    }
+    ownedLines = static_cast<uint16_t>(ownedLines & ~node3Lines);
+    runtime::format(out, "node 3 started on the processor with APIC id %u (image at 0x%lx, %lu bytes; console COM4)\r\n",
+                    unsigned(node3ApicId), static_cast<unsigned long>(SecondProcessor::kNodeBase),
+                    static_cast<unsigned long>(bytes));
 }
 
 void reportConfiguration()
@@ -345,13 +487,22 @@ const BoardIdentity& identity() { return board; }
 
 void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
 {
-    node = pc::nodeFromCommandLine(bootInfo, 2);
     if (!processorHasApic()) {
         dcosPanic("the processor has no local APIC: this image is for the dual-Pentium board (p5smp)");
+    }
+    // BoardTick.hpp and the windows above read the APICs at their default
+    // bases, which every board of this design keeps; a table saying
+    // otherwise (checked below) describes another board.
+    if (!arch_x86::Paging::mapDevice(LocalApic::kDefaultBase, LocalApic::kWindowBytes) ||
+        !arch_x86::Paging::mapDevice(IoApic::kDefaultBase, IoApic::kWindowBytes)) {
+        dcosPanic("cannot map the APICs' registers");
     }
     const LowMemory lowMemory(bootInfo.lowerMemoryKib);
     mpResult = findMpConfiguration(lowMemory, mp);
     mpValid = mpResult.error == MpError::None;
+    // Node 3 is the node that does not run on the bootstrap processor.
+    isNode3 = mpValid && localApic.id() != mp.bootstrapProcessor()->apicId;
+    node = pc::nodeFromCommandLine(bootInfo, isNode3 ? 3 : 2);
     const uint32_t localApicBase = mpValid ? mp.localApicAddress : LocalApic::kDefaultBase;
     // The first enabled I/O APIC: the parser requires one, not that it comes first.
     const MpIoApic* firstIoApic = nullptr;
@@ -359,43 +510,62 @@ void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
         firstIoApic = mp.ioApics[i].enabled ? &mp.ioApics[i] : nullptr;
     }
     const uint32_t ioApicBase = firstIoApic != nullptr ? firstIoApic->address : IoApic::kDefaultBase;
-    // BoardTick.hpp and the windows above read the APICs at their default
-    // bases, which every board of this design keeps; a table saying
-    // otherwise describes another board.
     if (localApicBase != LocalApic::kDefaultBase || ioApicBase != IoApic::kDefaultBase) {
         dcosPanic("the MP table puts the local APIC at 0x%lx and the I/O APIC at 0x%lx, not at 0x%lx and 0x%lx "
                   "where this board keeps them",
                   static_cast<unsigned long>(localApicBase), static_cast<unsigned long>(ioApicBase),
                   static_cast<unsigned long>(LocalApic::kDefaultBase), static_cast<unsigned long>(IoApic::kDefaultBase));
     }
-    if (!arch_x86::Paging::mapDevice(LocalApic::kDefaultBase, LocalApic::kWindowBytes) ||
-        !arch_x86::Paging::mapDevice(IoApic::kDefaultBase, IoApic::kWindowBytes)) {
-        dcosPanic("cannot map the APICs' registers");
-    }
 
-    retirePics();
     arch_x86::Idt::setInterruptHandler(dispatchInterrupt);
     arch_x86::Idt::setGate(spuriousVector, arch_x86::Gdt::kernelCode,
                            static_cast<uint32_t>(reinterpret_cast<uintptr_t>(&apicSpuriousEntry)), 0x8E);
     if (!localApic.enable(spuriousVector)) {
         dcosPanic("the local APIC refused spurious vector 0x%x", unsigned(spuriousVector));
     }
-    routeIsaLines();
-    pc::initialiseConsole();
-    reportConfiguration();
-
+    findRoutes();
     tickRate = pc::tickRateFromCommandLine(bootInfo, tickRateHz);
-    apicTimerHz = measureApicTimerHz();
-    if (apicTimerHz == 0) {
-        dcosPanic("the 8254's counter 2 never reached its terminal count: the local APIC timer cannot be calibrated");
+    if (isNode3) {
+        // Node 2 routed node 3's lines to it and keeps the rest, the 8254
+        // and the real-time clock: node 3 masks its lines in software and
+        // takes the APIC timer's rate from node 2.
+        ownedLines = static_cast<uint16_t>(node3Lines | (1u << systemTickLine) | (1u << interProcessorLine));
+        softwareMaskedLines = static_cast<uint16_t>(softwareMaskedLines | node3Lines);
+        pc::leaveRealTimeClock();
+        pc::initialiseConsole(node3ConsolePort, node3ConsoleLine);
+        char text[16];
+        uint32_t hz = 0;
+        if (!boot::findCommandLineOption(bootInfo.commandLine, "apic_hz", text, sizeof text) ||
+            !pc::decimalOption(text, 10, hz) || hz == 0) {
+            dcosPanic("node 3 needs the APIC timer's rate from node 2 (apic_hz= on its command line)");
+        }
+        apicTimerHz = hz;
+        runtime::format(pc::consoleUart(), "node 3 on the processor with APIC id %u; local APIC timer %lu Hz (from node 2)\r\n",
+                        unsigned(localApic.id()), static_cast<unsigned long>(apicTimerHz));
+    } else {
+        retirePics();
+        ioApic.maskAll();
+        routeLines(0xFFFF, bootstrapApicId(), true);
+        pc::initialiseConsole();
+        reportConfiguration();
+        apicTimerHz = measureApicTimerHz();
+        if (apicTimerHz == 0) {
+            dcosPanic("the 8254's counter 2 never reached its terminal count: the local APIC timer cannot be "
+                      "calibrated");
+        }
     }
     const uint32_t counts = static_cast<uint32_t>((apicTimerHz + tickRate / 2) / tickRate);
     tickPeriodNs = (uint64_t{counts} * 1'000'000'000u + apicTimerHz / 2) / apicTimerHz;
     apicNanosecondsPerCountQ24 =
         static_cast<uint32_t>(((uint64_t{1'000'000'000u} << 24) + apicTimerHz / 2) / apicTimerHz);
     const uint32_t shortenBy = pc::crystalShortening(bootInfo, counts);
-    runtime::format(pc::consoleUart(), "local APIC timer %lu Hz (against the 8254), %lu counts per tick\r\n",
-                    static_cast<unsigned long>(apicTimerHz), static_cast<unsigned long>(counts));
+    if (!isNode3) {
+        runtime::format(pc::consoleUart(), "local APIC timer %lu Hz (against the 8254), %lu counts per tick\r\n",
+                        static_cast<unsigned long>(apicTimerHz), static_cast<unsigned long>(counts));
+        if (mpValid) {
+            startNode3(bootInfo);
+        }
+    }
     // The timer counts counts - shortenBy per period: with a crystal model
     // the clock's reading within a tick runs over those, and the tick itself
     // still counts as the nominal period, so the clock runs fast.
@@ -412,6 +582,9 @@ dcos::Status attachInterrupt(unsigned line, InterruptHandler handler, void* cont
 {
     if (line >= interruptLineCount || handler == nullptr) {
         return dcos::Status::InvalidArgument;
+    }
+    if ((ownedLines >> line & 1u) == 0) {
+        return dcos::Status::InvalidArgument; // The other node of the board owns this line.
     }
     if (line != systemTickLine && line != interProcessorLine && !routes[line].routed) {
         return dcos::Status::InvalidArgument; // The MP table routes this ISA line nowhere.
@@ -436,9 +609,7 @@ dcos::Status detachInterrupt(unsigned line)
     maskedLines = static_cast<uint16_t>(maskedLines | (1u << line));
     registered[line] = {nullptr, nullptr};
     attachments[line] = {nullptr, nullptr};
-    if (line == systemTickLine) {
-        tickDeferred = false;
-    }
+    pendingLines = static_cast<uint16_t>(pendingLines & ~(1u << line));
     applyMask(line);
     return dcos::Status::Ok;
 }
@@ -468,8 +639,7 @@ bool isInterruptMasked(unsigned line) { return line < interruptLineCount && ((ma
 bool isInterruptRequested(unsigned line)
 {
     arch_x86::InterruptGuard guard;
-    return line < interruptLineCount &&
-           (localApic.isRequested(vectorOf(line)) || (line == systemTickLine && tickDeferred));
+    return line < interruptLineCount && (localApic.isRequested(vectorOf(line)) || (pendingLines >> line & 1u) != 0);
 }
 
 uint16_t interruptLinesHeldOff()
@@ -477,11 +647,16 @@ uint16_t interruptLinesHeldOff()
     arch_x86::InterruptGuard guard;
     uint16_t held = 0;
     for (unsigned line = 0; line < interruptLineCount; ++line) {
-        bool off = false;
-        if (line == systemTickLine) {
+        // Another node's line cannot interrupt this one at all.
+        bool off = true;
+        if ((ownedLines >> line & 1u) == 0) {
+            off = true;
+        } else if ((softwareMaskedLines >> line & 1u) != 0) {
             off = attachments[line].handler == nullptr;
         } else if (routes[line].routed) {
             off = ioApic.isMasked(routes[line].pin);
+        } else {
+            off = false; // Line 2: nothing holds it off.
         }
         held = static_cast<uint16_t>(held | (off ? 1u << line : 0u));
     }
@@ -498,6 +673,11 @@ bool interruptCutShort(unsigned& line)
         }
     }
     return false;
+}
+
+unsigned spareInterruptLine(unsigned which)
+{
+    return (isNode3 ? node3SpareLines : node2SpareLines)[which != 0 ? 1 : 0];
 }
 
 uint32_t unexpectedInterruptCount(unsigned line) { return line < interruptLineCount ? unexpected[line] : 0; }

@@ -100,6 +100,12 @@ bool interruptCutShort(unsigned& line);
 /// right from power-on. Corrupted when the clock was never set.
 dcos::Result<dcos::DateTime> readRealTimeClock();
 
+/// Two lines this node owns that no driver claims at boot (@p which 0 or
+/// 1), for on-target tests that run routines in interrupt context, raised
+/// by software interrupts on their vectors: 5 and 11 on the ISA board and on
+/// node 2 of the dual-Pentium board, 12 and 13 on its node 3.
+unsigned spareInterruptLine(unsigned which);
+
 /// Interrupts that arrived on a line with no handler (and were masked).
 uint32_t unexpectedInterruptCount(unsigned line);
 

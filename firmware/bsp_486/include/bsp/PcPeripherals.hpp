@@ -21,7 +21,19 @@ Uart16550& consoleUart();
 
 /// Brings the console up at consoleBaud and attaches its interrupt line;
 /// panics when the UART does not answer (nothing could be reported then).
-void initialiseConsole();
+/// The console is COM1 on consoleLine unless a board node has its own
+/// (@p port, @p line): the dual-Pentium board's node 3.
+void initialiseConsole(uint16_t port = 0x3F8, unsigned line = 4);
+
+/// Leaves the CMOS real-time clock to another node of the board: its index
+/// and data ports are one pair that two processors cannot share without a
+/// lock, so only one node reads it, and readRealTimeClock() answers
+/// NotSupported on the others.
+void leaveRealTimeClock();
+
+/// A decimal option of at most @p digits digits (so that it cannot
+/// overflow); false when it is empty or has anything else.
+bool decimalOption(const char* text, unsigned digits, uint32_t& value);
 
 /// "node=N" on the command line, or @p defaultNode; a value that is not a
 /// node id is reported on the console and @p defaultNode kept.
