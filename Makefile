@@ -2,7 +2,7 @@
 #
 #   make          firmware images and host tools
 #   make run      boot the ISA 486 controller in the emulator, console on this terminal
-#                 (BOARD=p5smp: the dual-Pentium controller's node 2 instead)
+#                 (BOARD=p5smp: the dual-Pentium controller, node 2's console here, node 3's on a pty)
 #                 (KERNEL_CONFIG=minimal: the minimal kernel's image, its self-check;
 #                 with APP=<dir>, the application built with that configuration)
 #                 (APP=<dir>: with the application in <dir>; ARGS="...": launcher options,
@@ -50,7 +50,7 @@ ifneq ($(CARD),)
 else ifeq ($(APP),)
 	@$(MAKE) --no-print-directory firmware
 ifeq ($(BOARD),p5smp)
-	@$(PYTHON) tests_renode/launch.py --board p5smp --image $(IMAGE_P5SMP) $(ARGS)
+	@$(PYTHON) tests_renode/launch.py --board p5smp --image $(IMAGE_P5SMP) --serial node3=pty $(ARGS)
 else
 	@$(PYTHON) tests_renode/launch.py --board isa486 --image $(if $(filter minimal,$(KERNEL_CONFIG)),$(IMAGE_486_MINIMAL),$(IMAGE_486)) $(ARGS)
 endif

@@ -208,3 +208,30 @@ def test_api_suite_on_node_3(boot, p5smp, name):
     node3.send(f"test {name} --exit\r")
     node3.expect(rf"TEST {name}: (PASS|FAIL)", timeout=120)
     emulator.expect_exit(EXIT_PASS, timeout=120)
+
+
+def test_a_second_processor_that_never_answers_is_reported_and_node_2_runs_on(boot, p5smp, tmp_path):
+    """The MP table names a second processor at an APIC id nothing answers: STARTUP goes unanswered."""
+    socket_path = tmp_path / "gdb.sock"
+    emulator = boot(p5smp, icount=True, extra_args=gdbstub.paused_boot_args(socket_path))
+    stub = gdbstub.GdbStub(str(socket_path))
+    try:
+        stub.run_to(gdbstub.elf_entry(p5smp.image()))
+        _, table = find_mp_table(stub)
+        header = stub.read_memory(table, 44)
+        length = int.from_bytes(header[4:6], "little")
+        entries = stub.read_memory(table + 44, length - 44)
+        offset = 0
+        while entries[offset] != 0 or not entries[offset + 3] & 1 or entries[offset + 3] & 2:
+            offset += 20 if entries[offset] == 0 else 8  # the enabled processor that is not the bootstrap one
+        old_id = entries[offset + 1]
+        assert old_id == 1
+        # APIC id 5 instead of 1, and the checksum moved by as much the other way.
+        stub.write_memory(table + 44 + offset + 1, bytes([5]))
+        stub.write_memory(table + 7, bytes([(header[7] - (5 - old_id)) & 0xFF]))
+    finally:
+        stub.detach()
+    emulator.expect(r"dcos> ")
+    assert "node 3 is not started on the processor with APIC id 5: the second processor did not answer STARTUP" \
+        in emulator.transcript, emulator.transcript
+    assert "p5smp" in emulator.command("version")
