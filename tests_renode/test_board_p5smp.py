@@ -162,18 +162,30 @@ def find_mp_table(stub):
     raise AssertionError("no MP floating pointer in the BIOS ROM area")
 
 
-@pytest.mark.parametrize("damage, reported", [
-    ("checksum", "the MP configuration table's checksum is wrong"),
-    ("signature", "the MP floating pointer does not point at a PCMP configuration table"),
-])
-def test_a_corrupt_mp_table_is_reported_and_the_node_runs_on_defaults(boot, p5smp, tmp_path, damage, reported):
-    """The BIOS's table damaged before the kernel starts: a clear report, and node 2 runs on the defaults."""
+def boot_at_the_kernel_entry(boot, p5smp, tmp_path):
+    """Boots the board paused, runs it to node 2's kernel entry (the BIOS's tables are built by then).
+
+    Returns the emulator, the GDB stub (detach it to let the kernel run) and the MP table's address."""
     socket_path = tmp_path / "gdb.sock"
     emulator = boot(p5smp, icount=True, extra_args=gdbstub.paused_boot_args(socket_path))
     stub = gdbstub.GdbStub(str(socket_path))
     try:
         stub.run_to(gdbstub.elf_entry(p5smp.image()))
         _, table = find_mp_table(stub)
+    except BaseException:
+        stub.detach()
+        raise
+    return emulator, stub, table
+
+
+@pytest.mark.parametrize("damage, reported", [
+    ("checksum", "the MP configuration table's checksum is wrong"),
+    ("signature", "the MP floating pointer does not point at a PCMP configuration table"),
+])
+def test_a_corrupt_mp_table_is_reported_and_the_node_runs_on_defaults(boot, p5smp, tmp_path, damage, reported):
+    """The BIOS's table damaged before the kernel starts: a clear report, and node 2 runs on the defaults."""
+    emulator, stub, table = boot_at_the_kernel_entry(boot, p5smp, tmp_path)
+    try:
         if damage == "checksum":
             byte = stub.read_memory(table + 7, 1)[0]
             stub.write_memory(table + 7, bytes([byte ^ 0x5A]))
@@ -212,12 +224,8 @@ def test_api_suite_on_node_3(boot, p5smp, name):
 
 def test_a_second_processor_that_never_answers_is_reported_and_node_2_runs_on(boot, p5smp, tmp_path):
     """The MP table names a second processor at an APIC id nothing answers: STARTUP goes unanswered."""
-    socket_path = tmp_path / "gdb.sock"
-    emulator = boot(p5smp, icount=True, extra_args=gdbstub.paused_boot_args(socket_path))
-    stub = gdbstub.GdbStub(str(socket_path))
+    emulator, stub, table = boot_at_the_kernel_entry(boot, p5smp, tmp_path)
     try:
-        stub.run_to(gdbstub.elf_entry(p5smp.image()))
-        _, table = find_mp_table(stub)
         header = stub.read_memory(table, 44)
         length = int.from_bytes(header[4:6], "little")
         entries = stub.read_memory(table + 44, length - 44)

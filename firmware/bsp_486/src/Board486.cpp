@@ -49,11 +49,6 @@ uint32_t unexpected[interruptLineCount];
 uint32_t spurious;
 uint16_t node = 1;
 
-// Interrupt level of each line: the 8259A pair's fixed priority order in
-// fully nested mode, IRQ 0, 1, then the slave's 8-15 (through IR2), then 3-7.
-// The cascade line 2 has no level of its own.
-constexpr uint8_t levelOfLine[interruptLineCount] = {0, 1, 0xFF, 10, 11, 12, 13, 14, 2, 3, 4, 5, 6, 7, 8, 9};
-
 const BoardIdentity board{"isa486", "i486DX"};
 
 // The interrupt controller's vectors are exactly the board's lines, so the
@@ -211,17 +206,9 @@ uint32_t tickRateHz() { return pit.requestedRateHz(); }
 
 uint64_t tickPeriodNanoseconds() { return pit.tickPeriodNanoseconds(); }
 
-uint8_t interruptLevelOf(unsigned line) { return line < interruptLineCount ? levelOfLine[line] : 0xFF; }
-
 void setTaskInterruptLevel(uint8_t level)
 {
-    uint16_t overlay = 0;
-    for (unsigned line = 0; line < interruptLineCount; ++line) {
-        const uint8_t lineLevel = levelOfLine[line];
-        if (lineLevel != 0 && lineLevel != 0xFF && lineLevel >= level) {
-            overlay = static_cast<uint16_t>(overlay | (1u << line));
-        }
-    }
+    const uint16_t overlay = pc::linesAtOrBelowLevel(level);
     pic.setOverlayMask(overlay);
 }
 

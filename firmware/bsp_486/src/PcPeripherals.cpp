@@ -57,6 +57,12 @@ PolledConsole polledConsole;
 
 void consoleInterrupt(void*) { uart.handleInterrupt(); }
 
+// Interrupt level of each line: the 8259A pair's fixed priority order in
+// fully nested mode, IRQ 0, 1, then the slave's 8-15 (through IR2), then 3-7.
+// Line 2 (the cascade on the ISA board, the other node's interrupts on the
+// dual-Pentium board) has no level of its own.
+constexpr uint8_t levelOfLine[interruptLineCount] = {0, 1, 0xFF, 10, 11, 12, 13, 14, 2, 3, 4, 5, 6, 7, 8, 9};
+
 } // namespace
 
 namespace pc {
@@ -74,6 +80,18 @@ bool decimalOption(const char* text, unsigned digits, uint32_t& value)
         value = value * 10 + static_cast<uint32_t>(*p - '0');
     }
     return true;
+}
+
+uint16_t linesAtOrBelowLevel(uint8_t level)
+{
+    uint16_t lines = 0;
+    for (unsigned line = 0; line < interruptLineCount; ++line) {
+        const uint8_t lineLevel = levelOfLine[line];
+        if (lineLevel != 0 && lineLevel != 0xFF && lineLevel >= level) {
+            lines = static_cast<uint16_t>(lines | (1u << line));
+        }
+    }
+    return lines;
 }
 
 Uart16550& consoleUart() { return uart; }
@@ -155,6 +173,8 @@ uint32_t crystalShortening(const boot::BootInfo& bootInfo, uint32_t countsPerTic
 }
 
 } // namespace pc
+
+uint8_t interruptLevelOf(unsigned line) { return line < interruptLineCount ? levelOfLine[line] : 0xFF; }
 
 dcos::Result<dcos::DateTime> readRealTimeClock()
 {

@@ -154,11 +154,6 @@ uint32_t tickRate = defaultTickRateHz;
 uint64_t tickPeriodNs = 0;
 uint64_t apicTimerHz = 0;
 
-// The same priority order as the ISA board's 8259A pair in fully nested
-// mode, so a line's level means the same on both boards; line 2 (the
-// inter-processor interrupt) has none, as the cascade had none.
-constexpr uint8_t levelOfLine[interruptLineCount] = {0, 1, 0xFF, 10, 11, 12, 13, 14, 2, 3, 4, 5, 6, 7, 8, 9};
-
 const BoardIdentity board{"p5smp", "Pentium"};
 
 // Low memory for the MP table search. Page 0 is not mapped (Paging.hpp),
@@ -338,8 +333,9 @@ void findRoutes()
             // triggered and active high, as in the default configurations.
             // A BIOS leaves out the IRQs it keeps for PCI (SeaBIOS leaves
             // out 5, 9, 10 and 11), yet an ISA card set to one of them
-            // drives that pin all the same; pciInterruptLine() switches a
-            // pin a PCI device shares to the PCI polarity and trigger.
+            // drives that pin all the same. (A PCI device steered onto one
+            // of them would drive it low and level: its MP table entry,
+            // MpConfiguration::pciRoute, says so.)
             routes[line] = {true, static_cast<uint8_t>(line), false, false};
         }
     }
@@ -688,17 +684,9 @@ uint32_t tickRateHz() { return tickRate; }
 
 uint64_t tickPeriodNanoseconds() { return tickPeriodNs; }
 
-uint8_t interruptLevelOf(unsigned line) { return line < interruptLineCount ? levelOfLine[line] : 0xFF; }
-
 void setTaskInterruptLevel(uint8_t level)
 {
-    uint16_t overlay = 0;
-    for (unsigned line = 0; line < interruptLineCount; ++line) {
-        const uint8_t lineLevel = levelOfLine[line];
-        if (lineLevel != 0 && lineLevel != 0xFF && lineLevel >= level) {
-            overlay = static_cast<uint16_t>(overlay | (1u << line));
-        }
-    }
+    const uint16_t overlay = pc::linesAtOrBelowLevel(level);
     if (overlay == overlayLines) {
         return; // The common case: the same level as the task before.
     }
@@ -712,35 +700,5 @@ void setTaskInterruptLevel(uint8_t level)
 }
 
 uint16_t nodeId() { return node; }
-
-// The dual-Pentium board's own interface (P5smpBoard.hpp).
-
-const MpConfiguration* mpConfiguration() { return mpValid ? &mp : nullptr; }
-
-uint64_t apicTimerFrequencyHz() { return apicTimerHz; }
-
-bool pciInterruptLine(uint8_t bus, uint8_t device, uint8_t pin, unsigned& line)
-{
-    IoApicRoute route{};
-    if (!mpValid || !mp.pciRoute(bus, device, pin, route)) {
-        return false;
-    }
-    // A PCI interrupt shares the pin of an ISA line (the BIOS steers the
-    // PIIX's PIRQ lines onto free ISA IRQs); the line takes the PCI
-    // polarity and trigger, since that is what drives the pin now.
-    for (unsigned candidate = 0; candidate < interruptLineCount; ++candidate) {
-        LineRoute& lineRoute = routes[candidate];
-        if (lineRoute.routed && lineRoute.pin == route.pin) {
-            arch_x86::InterruptGuard guard;
-            lineRoute.activeLow = route.activeLow;
-            lineRoute.levelTriggered = route.levelTriggered;
-            (void)ioApic.route(route.pin, vectorOf(candidate), bootstrapApicId(), route.activeLow,
-                               route.levelTriggered, ((maskedLines | overlayLines) >> candidate & 1u) != 0);
-            line = candidate;
-            return true;
-        }
-    }
-    return false;
-}
 
 } // namespace bsp

@@ -31,6 +31,12 @@ void initialiseConsole(uint16_t port = 0x3F8, unsigned line = 4);
 /// NotSupported on the others.
 void leaveRealTimeClock();
 
+/// The lines held off by a task at interrupt @p level: every line of that
+/// level or a lower priority (a larger number), never the tick (level 0)
+/// nor a line without a level. Both boards order their lines as the PC/AT's
+/// 8259A pair does in fully nested mode (interruptLevelOf()).
+uint16_t linesAtOrBelowLevel(uint8_t level);
+
 /// A decimal option of at most @p digits digits (so that it cannot
 /// overflow); false when it is empty or has anything else.
 bool decimalOption(const char* text, unsigned digits, uint32_t& value);
