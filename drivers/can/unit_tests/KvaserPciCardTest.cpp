@@ -13,12 +13,12 @@
 
 #include "../../../firmware/dcos/unit_tests/FakeKernelContext.hpp"
 #include "../../iobus/unit_tests/FakeAgents.hpp"
+#include "../../pci/unit_tests/FakeConfigSpace.hpp"
 #include "FakeSja1000.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <vector>
 
@@ -28,6 +28,7 @@ using dcos::ObjectId;
 using dcos::Result;
 using dcos::Status;
 using dcos::systemAgent;
+using pci_test::FakeConfigSpace;
 using sja1000::KvaserPciCard;
 using sja1000::KvaserPciFault;
 using sja1000::KvaserPciProblem;
@@ -41,119 +42,6 @@ constexpr uint16_t kChipPorts = 0xC080;
 constexpr uint16_t kXilinxPorts = 0xC100;
 constexpr uint8_t kLine = 11;
 constexpr pci::Address kCard{0, 4, 0};
-
-// A host bridge's configuration mechanism #1 holding the functions a test
-// adds: CONFIG_ADDRESS reads back, an absent function reads all ones, a
-// BAR keeps only its writable address bits and its type bits, and the
-// command register its writable bits.
-class FakeHostBridge final : public port_io_mock::Responder {
-public:
-    struct Function {
-        uint8_t bytes[pcireg::kConfigSpaceSize] = {};
-        uint32_t barWritable[pcireg::kDeviceBarCount] = {};
-
-        uint32_t read(unsigned offset, unsigned width) const
-        {
-            uint32_t value = 0;
-            for (unsigned i = 0; i < width; ++i) {
-                value |= static_cast<uint32_t>(bytes[offset + i]) << (8 * i);
-            }
-            return value;
-        }
-        void store(unsigned offset, unsigned width, uint32_t value)
-        {
-            for (unsigned i = 0; i < width; ++i) {
-                bytes[offset + i] = static_cast<uint8_t>(value >> (8 * i));
-            }
-        }
-        uint16_t command() const { return static_cast<uint16_t>(read(pcireg::kCommand, 2)); }
-        uint32_t bar(unsigned index) const { return read(pcireg::kBar0 + 4 * index, 4); }
-        void ioBar(unsigned index, uint32_t base, uint32_t size)
-        {
-            barWritable[index] = ~(size - 1) & pcireg::kBarIoAddressMask;
-            store(pcireg::kBar0 + 4 * index, 4, base | pcireg::kBarSpaceIo);
-        }
-        void memoryBar(unsigned index, uint32_t base, uint32_t size)
-        {
-            barWritable[index] = ~(size - 1) & pcireg::kBarMemoryAddressMask;
-            store(pcireg::kBar0 + 4 * index, 4, base);
-        }
-    };
-
-    FakeHostBridge() { port_io_mock::attach(pcireg::kConfigAddressPort, pcireg::kConfigPortCount, this); }
-
-    Function& add(pci::Address address, uint16_t vendor, uint16_t device, uint32_t classCode)
-    {
-        Function& f = functions[key(address)];
-        f.store(pcireg::kVendorId, 2, vendor);
-        f.store(pcireg::kDeviceId, 2, device);
-        f.store(pcireg::kRevisionAndClass, 4, classCode << 8);
-        f.store(pcireg::kInterruptLine, 1, pcireg::kInterruptLineUnknown);
-        return f;
-    }
-
-    Function& at(pci::Address address) { return functions.at(key(address)); }
-
-    uint32_t read(uint16_t offset, int width) override
-    {
-        if (offset < pcireg::kConfigDataOffset) {
-            return offset == 0 && width == 32 ? configAddress : 0xFFFFFFFF;
-        }
-        const unsigned bytes = static_cast<unsigned>(width) / 8;
-        const Function* f = selected();
-        if (f == nullptr) {
-            return bytes == 4 ? 0xFFFFFFFF : (1u << (8 * bytes)) - 1;
-        }
-        return f->read(registerOffset(offset), bytes);
-    }
-
-    void write(uint16_t offset, uint32_t value, int width) override
-    {
-        if (offset < pcireg::kConfigDataOffset) {
-            if (offset == 0 && width == 32) {
-                configAddress = value;
-            }
-            return;
-        }
-        Function* f = selected();
-        if (f == nullptr) {
-            return;
-        }
-        const unsigned at = registerOffset(offset);
-        if (at >= pcireg::kBar0 && at < pcireg::kBar0 + 4 * pcireg::kDeviceBarCount && width == 32) {
-            const uint32_t writable = f->barWritable[(at - pcireg::kBar0) / 4];
-            f->store(at, 4, (value & writable) | (f->read(at, 4) & ~writable));
-        } else if (at == pcireg::kCommand && width == 16) {
-            const uint16_t writable =
-                pcireg::kCommandDecode | pcireg::kCommandBusMaster | pcireg::kCommandInterruptDisable;
-            f->store(at, 2, (value & writable) | (f->command() & ~writable));
-        }
-    }
-
-    uint32_t configAddress = 0;
-
-private:
-    static uint32_t key(pci::Address a) { return uint32_t{a.bus} << 16 | uint32_t{a.device} << 8 | a.function; }
-
-    unsigned registerOffset(uint16_t dataOffset) const
-    {
-        return (configAddress & pcireg::kConfigAddressRegisterMask) + (dataOffset - pcireg::kConfigDataOffset);
-    }
-
-    Function* selected()
-    {
-        if ((configAddress & pcireg::kConfigAddressEnable) == 0) {
-            return nullptr;
-        }
-        const pci::Address a{static_cast<uint8_t>(configAddress >> 16),
-                             static_cast<uint8_t>((configAddress >> 11) & 0x1F),
-                             static_cast<uint8_t>((configAddress >> 8) & 0x7)};
-        const auto found = functions.find(key(a));
-        return found == functions.end() ? nullptr : &found->second;
-    }
-
-    std::map<uint32_t, Function> functions;
-};
 
 // The S5920's operation registers as QEMU models them: INTCSR and PTCR,
 // doubleword accesses only (the model's minimum access size is 4).
@@ -229,9 +117,10 @@ protected:
     void SetUp() override
     {
         port_io_mock::reset();
-        host = std::make_unique<FakeHostBridge>();
+        host = std::make_unique<FakeConfigSpace>();
         host->add({0, 0, 0}, 0x8086, 0x1237, 0x060000);
-        FakeHostBridge::Function& card = host->add(kCard, KvaserPciCard::kVendorId, KvaserPciCard::kDeviceId, 0xFF0000);
+        FakeConfigSpace::Function& card =
+            host->add(kCard, KvaserPciCard::kVendorId, KvaserPciCard::kDeviceId, 0xFF0000);
         card.ioBar(0, kBridgePorts, 0x80);
         card.ioBar(1, kChipPorts, 0x80);
         card.ioBar(2, kXilinxPorts, 0x08);
@@ -251,7 +140,7 @@ protected:
         return *slots->chips.back();
     }
 
-    FakeHostBridge::Function& cardFunction() { return host->at(kCard); }
+    FakeConfigSpace::Function& cardFunction() { return host->at(kCard); }
 
     // Whether any access since the last takeLog() reached a port outside
     // the configuration ports.
@@ -267,7 +156,7 @@ protected:
     }
 
     pci::ConfigSpace config;
-    std::unique_ptr<FakeHostBridge> host;
+    std::unique_ptr<FakeConfigSpace> host;
     std::unique_ptr<FakeS5920> bridge;
     std::unique_ptr<FakeChipSlots> slots;
     std::unique_ptr<FakeXilinx> xilinx;
@@ -344,7 +233,7 @@ TEST_F(KvaserPciCardTest, NoCardIsNotFound)
     EXPECT_EQ(problem.fault, KvaserPciFault::NoCard);
 
     port_io_mock::reset();
-    host = std::make_unique<FakeHostBridge>();
+    host = std::make_unique<FakeConfigSpace>();
     host->add({0, 0, 0}, 0x8086, 0x1237, 0x060000);
     EXPECT_EQ(KvaserPciCard::probe(config, 0, &problem).status(), Status::NotFound);
     EXPECT_EQ(problem.fault, KvaserPciFault::NoCard);

@@ -10,11 +10,11 @@
 #include <pci/FunctionConfig.hpp>
 
 #include "../../../firmware/arch_x86/unit_tests/PortIoMock.hpp"
+#include "FakeConfigSpace.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <vector>
 
@@ -28,156 +28,7 @@ using pci::ConfigSpace;
 using pci::Device;
 using pci::Enumerator;
 namespace reg = pci::reg;
-
-// A host bridge's configuration mechanism #1 with the functions a test
-// adds. It follows the specification where the driver depends on it:
-// CONFIG_ADDRESS reads back what was written, CONFIG_DATA answers only
-// with the enable bit set, an absent function reads all ones, a BAR keeps
-// only its writable address bits (so all ones read back give its size) and
-// its read-only type bits, and the command register keeps its writable bits.
-class FakeConfigSpace final : public port_io_mock::Responder {
-public:
-    struct Function {
-        uint8_t bytes[reg::kConfigSpaceSize] = {};
-        uint32_t barWritable[reg::kDeviceBarCount] = {}; ///< 0: not implemented.
-        /// The command register when all ones were last written to a BAR.
-        uint16_t commandWhenSized = 0xFFFF;
-        unsigned sizings = 0;
-
-        uint32_t read(unsigned offset, unsigned width) const
-        {
-            uint32_t value = 0;
-            for (unsigned i = 0; i < width; ++i) {
-                value |= static_cast<uint32_t>(bytes[offset + i]) << (8 * i);
-            }
-            return value;
-        }
-        void store(unsigned offset, unsigned width, uint32_t value)
-        {
-            for (unsigned i = 0; i < width; ++i) {
-                bytes[offset + i] = static_cast<uint8_t>(value >> (8 * i));
-            }
-        }
-        uint16_t command() const { return static_cast<uint16_t>(read(reg::kCommand, 2)); }
-        uint32_t bar(unsigned index) const { return read(reg::kBar0 + 4 * index, 4); }
-    };
-
-    FakeConfigSpace() { port_io_mock::attach(reg::kConfigAddressPort, reg::kConfigPortCount, this); }
-
-    Function& add(Address address, uint16_t vendor, uint16_t device, uint32_t classCode, uint8_t headerType = 0)
-    {
-        Function& f = functions[key(address)];
-        f.store(reg::kVendorId, 2, vendor);
-        f.store(reg::kDeviceId, 2, device);
-        f.store(reg::kRevisionAndClass, 4, classCode << 8 | 0x02);
-        f.store(reg::kHeaderType, 1, headerType);
-        f.store(reg::kInterruptLine, 1, reg::kInterruptLineUnknown);
-        return f;
-    }
-
-    static void ioBar(Function& f, unsigned index, uint32_t base, uint32_t size, uint32_t decoded = 0xFFFFFFFF)
-    {
-        f.barWritable[index] = ~(size - 1) & reg::kBarIoAddressMask & decoded;
-        f.store(reg::kBar0 + 4 * index, 4, base | reg::kBarSpaceIo);
-    }
-
-    static void memoryBar(Function& f, unsigned index, uint32_t base, uint32_t size, bool prefetchable)
-    {
-        f.barWritable[index] = ~(size - 1) & reg::kBarMemoryAddressMask;
-        f.store(reg::kBar0 + 4 * index, 4, base | (prefetchable ? reg::kBarMemoryPrefetchable : 0));
-    }
-
-    static void memory64Bar(Function& f, unsigned index, uint64_t base, uint64_t size, bool prefetchable)
-    {
-        const uint64_t writable = ~(size - 1);
-        f.barWritable[index] = static_cast<uint32_t>(writable) & reg::kBarMemoryAddressMask;
-        f.store(reg::kBar0 + 4 * index, 4,
-                static_cast<uint32_t>(base) | reg::kBarMemoryType64 |
-                    (prefetchable ? reg::kBarMemoryPrefetchable : 0));
-        if (index + 1 < reg::kDeviceBarCount) {
-            f.barWritable[index + 1] = static_cast<uint32_t>(writable >> 32);
-            f.store(reg::kBar0 + 4 * (index + 1), 4, static_cast<uint32_t>(base >> 32));
-        }
-    }
-
-    Function& at(Address address) { return functions.at(key(address)); }
-
-    uint32_t read(uint16_t offset, int width) override
-    {
-        if (offset < reg::kConfigDataOffset) {
-            return width == 32 && offset == 0 ? configAddress : 0xFFFFFFFF;
-        }
-        const unsigned bytes = static_cast<unsigned>(width) / 8;
-        const uint32_t none = bytes == 4 ? 0xFFFFFFFF : (1u << (8 * bytes)) - 1;
-        Function* f = selected();
-        if (f == nullptr) {
-            return none;
-        }
-        return f->read(registerOffset(offset), bytes);
-    }
-
-    void write(uint16_t offset, uint32_t value, int width) override
-    {
-        if (offset < reg::kConfigDataOffset) {
-            if (offset == 0 && width == 32) {
-                configAddress = value;
-            }
-            return;
-        }
-        Function* f = selected();
-        if (f == nullptr) {
-            return;
-        }
-        const unsigned at = registerOffset(offset);
-        const unsigned bytes = static_cast<unsigned>(width) / 8;
-        if (at >= reg::kBar0 && at < reg::kBar0 + 4 * reg::kDeviceBarCount) {
-            ASSERT_EQ(bytes, 4u) << "BARs are written whole";
-            const unsigned index = (at - reg::kBar0) / 4;
-            if (value == 0xFFFFFFFF) {
-                f->commandWhenSized = f->command();
-                ++f->sizings;
-            }
-            const uint32_t writable = f->barWritable[index];
-            f->store(at, 4, (value & writable) | (f->bar(index) & ~writable));
-        } else if (at == reg::kCommand && bytes == 2) {
-            const uint16_t writable = reg::kCommandDecode | reg::kCommandBusMaster | reg::kCommandInterruptDisable;
-            f->store(at, 2, (value & writable) | (f->command() & ~writable));
-        } else if (at == reg::kInterruptLine && bytes == 1) {
-            f->store(at, 1, value);
-        }
-    }
-
-    uint32_t configAddress = 0;
-    /// Functions that answer every function number of their device, as a
-    /// single-function device that ignores the function number does.
-    std::vector<Address> aliased;
-
-private:
-    static uint32_t key(Address a) { return uint32_t{a.bus} << 16 | uint32_t{a.device} << 8 | a.function; }
-
-    unsigned registerOffset(uint16_t dataOffset) const
-    {
-        return (configAddress & reg::kConfigAddressRegisterMask) + (dataOffset - reg::kConfigDataOffset);
-    }
-
-    Function* selected()
-    {
-        if ((configAddress & reg::kConfigAddressEnable) == 0) {
-            return nullptr;
-        }
-        Address a{static_cast<uint8_t>(configAddress >> 16), static_cast<uint8_t>((configAddress >> 11) & 0x1F),
-                  static_cast<uint8_t>((configAddress >> 8) & 0x7)};
-        for (const Address& alias : aliased) {
-            if (alias.bus == a.bus && alias.device == a.device) {
-                a.function = 0;
-            }
-        }
-        const auto found = functions.find(key(a));
-        return found == functions.end() ? nullptr : &found->second;
-    }
-
-    std::map<uint32_t, Function> functions;
-};
+using pci_test::FakeConfigSpace;
 
 constexpr Address kHostBridge{0, 0, 0};
 constexpr Address kIsaBridge{0, 1, 0};
@@ -200,23 +51,23 @@ protected:
         fake = std::make_unique<FakeConfigSpace>();
         fake->add(kHostBridge, 0x8086, 0x1237, 0x060000);
         fake->add(kIsaBridge, 0x8086, 0x7000, 0x060100, reg::kHeaderTypeMultiFunction);
-        FakeConfigSpace::ioBar(fake->add(kIde, 0x8086, 0x7010, 0x010180), 4, 0xC140, 16, 0x0000FFFF);
+        fake->add(kIde, 0x8086, 0x7010, 0x010180).ioBar(4, 0xC140, 16, 0x0000FFFF);
         FakeConfigSpace::Function& acpi = fake->add(kAcpi, 0x8086, 0x7113, 0x068000);
         acpi.store(reg::kInterruptLine, 1, 9);
         acpi.store(reg::kInterruptPin, 1, reg::kInterruptPinA);
         FakeConfigSpace::Function& vga = fake->add(kVga, 0x1234, 0x1111, 0x030000);
-        FakeConfigSpace::memoryBar(vga, 0, 0xFD000000, 16u << 20, true);
-        FakeConfigSpace::memoryBar(vga, 2, 0xFEBF0000, 4096, false);
+        vga.memoryBar(0, 0xFD000000, 16u << 20, true);
+        vga.memoryBar(2, 0xFEBF0000, 4096, false);
         vga.store(reg::kCommand, 2, reg::kCommandIoSpace | reg::kCommandMemorySpace | reg::kCommandBusMaster);
         FakeConfigSpace::Function& nvme = fake->add(kNvme, 0x1B36, 0x0010, 0x010802);
-        FakeConfigSpace::memory64Bar(nvme, 0, 0xFEBF4000, 16 * 1024, false);
-        FakeConfigSpace::memory64Bar(nvme, 2, 0x800000000ull, 1u << 20, true);
-        FakeConfigSpace::memory64Bar(nvme, 5, 0xFEC00000, 4096, false); // Its upper half would be BAR6.
+        nvme.memory64Bar(0, 0xFEBF4000, 16 * 1024, false);
+        nvme.memory64Bar(2, 0x800000000ull, 1u << 20, true);
+        nvme.memory64Bar(5, 0xFEC00000, 4096, false); // Its upper half would be BAR6.
         nvme.store(reg::kCommand, 2, reg::kCommandMemorySpace);
         FakeConfigSpace::Function& kvaser = fake->add(kKvaser, 0x10E8, 0x8406, 0xFF0000);
-        FakeConfigSpace::ioBar(kvaser, 0, 0xC000, 0x80);
-        FakeConfigSpace::ioBar(kvaser, 1, 0xC080, 0x80);
-        FakeConfigSpace::ioBar(kvaser, 2, 0xC100, 0x08);
+        kvaser.ioBar(0, 0xC000, 0x80);
+        kvaser.ioBar(1, 0xC080, 0x80);
+        kvaser.ioBar(2, 0xC100, 0x08);
         kvaser.store(reg::kInterruptLine, 1, 11);
         kvaser.store(reg::kInterruptPin, 1, reg::kInterruptPinA);
         kvaser.store(reg::kSubsystemVendorId, 2, 0x10E8);
