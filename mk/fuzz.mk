@@ -66,7 +66,7 @@ CONFIG_FUZZ_REPORT := $(BUILD)/reports/fuzz-config-tests.xml
 # The dual-Pentium board's reader of the BIOS's MultiProcessor Specification
 # tables (firmware/bsp_p5smp/fuzz), which it believes about its processors
 # and interrupt wiring.
-P5SMP_FUZZ_TARGETS := mp_table
+P5SMP_FUZZ_TARGETS := mp_table shared_memory_ring
 P5SMP_FUZZ_CORPUS := firmware/bsp_p5smp/fuzz/corpus
 P5SMP_FUZZ_REPORT := $(BUILD)/reports/fuzz-p5smp-tests.xml
 
@@ -129,7 +129,8 @@ CONFIG_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(filter-out %/CanCon
 	$(HOSTCONFIG_SRCS)) $(SEI_PORTABLE_SRCS) firmware/image/src/Sha256.cpp $(IMAGE_SRCS) $(CAN_PORTABLE_SRCS))
 CONFIG_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/config/fuzz/fuzz_%.cpp.o,$(CONFIG_FUZZ_TARGETS))
 CONFIG_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(CONFIG_FUZZ_TARGETS))
-P5SMP_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/bsp_p5smp/src/MpTable.cpp.o
+P5SMP_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/bsp_p5smp/src/MpTable.cpp.o \
+	$(FUZZ_BUILD)/firmware/bsp_p5smp/src/SharedMemoryRing.cpp.o
 P5SMP_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/bsp_p5smp/fuzz/fuzz_%.cpp.o,$(P5SMP_FUZZ_TARGETS))
 P5SMP_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(P5SMP_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as

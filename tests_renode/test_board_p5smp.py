@@ -13,7 +13,7 @@ import time
 
 import pytest
 
-from dcoslab import gdbstub
+from dcoslab import gdbstub, remote
 from dcoslab.board import EXIT_PASS
 from dcoslab.node_console import NodeConsole
 from dcoslab.board import load_board
@@ -25,6 +25,7 @@ import test_kernel_core as kernel_core
 import test_memory_agents as memory_agents
 import test_object_ids as object_ids
 import test_port_dsm as port_dsm
+import test_remote_transactions as remote_transactions
 import test_runtime_486 as runtime_486
 import test_semaphores as semaphores
 import test_timing_bounds as timing_bounds
@@ -243,3 +244,25 @@ def test_a_second_processor_that_never_answers_is_reported_and_node_2_runs_on(bo
     assert "node 3 is not started on the processor with APIC id 5: the second processor did not answer STARTUP" \
         in emulator.transcript, emulator.transcript
     assert "p5smp" in emulator.command("version")
+
+
+def test_node_3_uses_a_semaphore_on_node_2_over_shared_memory(boot, p5smp):
+    """The remote primitives run between the board's two nodes as over CAN: the same answers as a local call."""
+    emulator, node3 = boot_both_nodes(boot, p5smp, kind="test")
+    assert "shared-memory network: interface 0, 130.3.0.2/16, physical 0; node 3 at physical 1" \
+        in emulator.transcript, emulator.transcript
+    interfaces = node3.command("net")
+    assert "130.3.0.3/16" in interfaces, interfaces
+    far_semaphore = remote.created(emulator, "remote sem 1 2", "RSEM")
+    near_semaphore = remote.created(emulator, "remote sem 1 2", "RSEM")
+    assert far_semaphore.startswith("0x0002")
+    far = [remote.call(node3, step.format(far_semaphore)) for step in remote_transactions.SEMAPHORE_SEQUENCE]
+    near = [remote.call(emulator, step.format(near_semaphore)) for step in remote_transactions.SEMAPHORE_SEQUENCE]
+    assert [(status, value) for status, value, _ in far] == [(status, value) for status, value, _ in near]
+    assert [status for status, _, _ in far] == [
+        "ok", "ok", "ok", "would block", "timed out", "ok", "ok", "invalid argument", "ok"]
+    # Node 3's 200 ms wait was node 2's, and the answer came after it.
+    assert 200_000 <= far[4][2] < 1_000_000
+    served = remote.net_counters(emulator)
+    assert served["served"] == len(remote_transactions.SEMAPHORE_SEQUENCE), served
+    assert remote.net_counters(node3)["unreachable"] == 0

@@ -20,6 +20,7 @@
 #include <bsp/Pic8259.hpp>
 #include <bsp/ApTrampoline.h>
 #include <bsp/SecondProcessor.hpp>
+#include <bsp/SharedMemoryLink.hpp>
 
 #include <arch_x86/Cpu.hpp>
 #include <arch_x86/Gdt.hpp>
@@ -148,6 +149,10 @@ uint16_t pendingLines = 0;
 uint16_t ownedLines = 0xFFFF;
 bool isNode3 = false;
 uint8_t node3ApicId = 0xFF;
+bool node3Running = false;
+// The other node's APIC id and node id (node 3 has them from the MP table and node 2).
+uint8_t otherApicId = 0xFF;
+uint16_t otherNode = 3;
 SecondProcessor::Outcome node3Outcome = SecondProcessor::Outcome::NoImage;
 uint16_t node = 2;
 uint32_t tickRate = defaultTickRateHz;
@@ -389,7 +394,7 @@ char node3CommandLine[AP_TRAMPOLINE_COMMAND_LINE_BYTES];
 void composeNode3CommandLine(const char* node2CommandLine)
 {
     runtime::BufferSink out(node3CommandLine, sizeof node3CommandLine);
-    runtime::format(out, "node=3 apic_hz=%lu", static_cast<unsigned long>(apicTimerHz));
+    runtime::format(out, "node=3 peer=%u apic_hz=%lu", unsigned(node), static_cast<unsigned long>(apicTimerHz));
     constexpr char prefix[] = "node3.";
     constexpr size_t prefixLength = sizeof prefix - 1;
     for (const char* word = node2CommandLine; *word != '\0';) {
@@ -436,6 +441,7 @@ void startNode3(const boot::BootInfo& bootInfo)
     node3Outcome = SecondProcessor::load(image, bytes, memoryEnd, entry);
     if (node3Outcome == SecondProcessor::Outcome::Started) {
         composeNode3CommandLine(bootInfo.commandLine);
+        SharedMemoryArea::at().layOut();
         routeLines(node3Lines, node3ApicId, false);
         const SecondProcessor::Launch launch{entry, node3ApicId, bootInfo.lowerMemoryKib, bootInfo.upperMemoryKib,
                                              node3CommandLine, delayMicroseconds};
@@ -448,6 +454,8 @@ void startNode3(const boot::BootInfo& bootInfo)
         return;
     }
     ownedLines = static_cast<uint16_t>(ownedLines & ~node3Lines);
+    node3Running = true;
+    otherApicId = node3ApicId;
     runtime::format(out, "node 3 started on the processor with APIC id %u (image at 0x%lx, %lu bytes; console COM4)\r\n",
                     unsigned(node3ApicId), static_cast<unsigned long>(SecondProcessor::kNodeBase),
                     static_cast<unsigned long>(bytes));
@@ -536,6 +544,12 @@ void initialise(const boot::BootInfo& bootInfo, uint32_t tickRateHz)
             dcosPanic("node 3 needs the APIC timer's rate from node 2 (apic_hz= on its command line)");
         }
         apicTimerHz = hz;
+        otherApicId = mp.bootstrapProcessor()->apicId;
+        uint32_t peer = 0;
+        otherNode = boot::findCommandLineOption(bootInfo.commandLine, "peer", text, sizeof text) &&
+                            pc::decimalOption(text, 5, peer) && peer >= 1 && peer <= 0xFFFE
+                        ? static_cast<uint16_t>(peer)
+                        : 2;
         runtime::format(pc::consoleUart(), "node 3 on the processor with APIC id %u; local APIC timer %lu Hz (from node 2)\r\n",
                         unsigned(localApic.id()), static_cast<unsigned long>(apicTimerHz));
     } else {
@@ -700,5 +714,16 @@ void setTaskInterruptLevel(uint8_t level)
 }
 
 uint16_t nodeId() { return node; }
+
+unsigned processorIndex() { return isNode3 ? 1 : 0; }
+
+bool otherNodeRunning() { return isNode3 || node3Running; }
+
+uint16_t otherNodeId() { return otherNode; }
+
+bool signalOtherNode()
+{
+    return otherNodeRunning() && localApic.sendFixed(otherApicId, vectorOf(interProcessorLine), deliverySpins);
+}
 
 } // namespace bsp

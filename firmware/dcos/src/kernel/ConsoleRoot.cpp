@@ -86,6 +86,9 @@ void rootTaskEntry(uintptr_t)
     if (networkBootStart != nullptr) {
         networkBootStart();
     }
+    if (boardNetworkStart != nullptr) {
+        boardNetworkStart();
+    }
     ApplicationLoader::startLinked();
     SemaphoreAttributes life;
     life.name = "shell-life";

@@ -16,6 +16,12 @@ namespace dcos::internal {
 /// start is reported on the console and left down; the node runs on.
 void networkBootStart() __attribute__((weak));
 
+/// Brings up the network the board itself has between its nodes (the
+/// dual-Pentium board's shared memory, firmware/bsp_p5smp) and attaches it
+/// as an interface; called by the root task right after networkBootStart.
+/// Null on a board without one.
+void boardNetworkStart() __attribute__((weak));
+
 /// Switches every CAN channel that is up, and not at @p rate bit/s already,
 /// to @p rate at once, as the
 /// configuration protocol's ActivateBitRate asks (docs/protocols/config.md,
