@@ -18,8 +18,6 @@
 # 'make run' and 'make test' install the Debian packages they lack first.
 
 BUILD      := build
-# The board `make run` boots: isa486 (the default) or p5smp.
-BOARD      ?= isa486
 # V=1 shows the full compiler command lines.
 Q          := $(if $(filter 1,$(V)),,@)
 PYTHON     := /usr/bin/python3

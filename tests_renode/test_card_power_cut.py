@@ -101,8 +101,8 @@ def assert_cut(cut):
     so nothing answered (exit 4). On a busy host the board's ATA driver may
     give up on the write first (its wait is a count of polls, and this
     board runs in host time), and the node answers that its card failed
-    (exit 1); the write did not reach the card either way, and the board
-    stops at it all the same (wait_power_cut)."""
+    (exit 1); the write did not reach the card either way. After exit 4 the
+    board stops at it (wait_power_cut); after exit 1 it may never issue it."""
     assert (cut.returncode == 4 and "no answer" in cut.stderr) or \
         (cut.returncode == 1 and "the node's card cannot be read or written" in cut.stderr), cut.stdout + cut.stderr
 
@@ -124,7 +124,12 @@ def test_a_power_cut_during_a_download_leaves_the_card_as_it_was_and_the_downloa
                           "-k", DEVELOPMENT_KEY, "--timeout-ms", "4000", "--retries", "0", image],
                          capture_output=True, text=True, timeout=300)
     assert_cut(cut)
-    emulator.wait_power_cut()
+    if cut.returncode == 4:
+        emulator.wait_power_cut()
+    # Exit 1: the board's driver gave up on a write first (a busy host, see
+    # assert_cut) and abandoned the download, so the write after the cut may
+    # never be issued and the board need not stop; the card holds at most
+    # the first N writes either way, which is what the rest checks.
     emulator.close()
     assert card_state(card)["boot_state"]["trial"] == "none", "nothing half-written is pending"
     again = boot(isa486, card=card)

@@ -381,8 +381,11 @@ void delayMicroseconds(uint32_t microseconds)
     const uint32_t counts = static_cast<uint32_t>(apicTimerHz * microseconds / 1'000'000u) + 1;
     (void)localApic.startOneShot(vectorOf(systemTickLine), counts, timerDivide);
     setTimerMasked(true);
-    // Each poll takes at least one count; the bound only guards a dead timer.
-    for (uint32_t polls = 0; localApic.currentCount() != 0 && polls <= counts; ++polls) {
+    // A count is 16 bus clocks (timerDivide), and a poll takes at least one
+    // processor clock, never shorter than a bus clock: a live timer ends
+    // within 16 polls a count. The bound only guards a dead timer.
+    const uint64_t pollLimit = uint64_t{counts} * 16 + 16;
+    for (uint64_t polls = 0; localApic.currentCount() != 0 && polls <= pollLimit; ++polls) {
     }
 }
 
