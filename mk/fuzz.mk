@@ -153,33 +153,23 @@ fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARI
 fuzz-targets: $(P5SMP_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
-# summary shows it instead of a missing suite.
+# summary shows it instead of a missing suite. The groups run side by side,
+# $(JOBS) at a time (each libFuzzer run takes one core), and every group
+# runs even when another fails (-k): the exit status says whether any did.
+FUZZ_RUN_GROUPS := CAN MODBUS HOST_MODBUS DCOS IMAGE HOST_IMAGE FLASH SEI MON CONFIG P5SMP
+CAN_FUZZ_CORPUS = $(FUZZ_CORPUS)
+CAN_FUZZ_REPORT = $(FUZZ_REPORT)
+CAN_FUZZ_TARGETS = $(FUZZ_TARGETS)
+
 test-fuzz:
 	@mkdir -p $(dir $(FUZZ_REPORT))
 	@if $(MAKE) --no-print-directory fuzz-targets; then built=; else built=--build-failed; fi; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(FUZZ_REPORT) $(FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(MODBUS_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(MODBUS_FUZZ_REPORT) $(MODBUS_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(HOST_MODBUS_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(HOST_MODBUS_FUZZ_REPORT) $(HOST_MODBUS_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(DCOS_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(DCOS_FUZZ_REPORT) $(DCOS_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(IMAGE_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(IMAGE_FUZZ_REPORT) $(IMAGE_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(HOST_IMAGE_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(HOST_IMAGE_FUZZ_REPORT) $(HOST_IMAGE_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(FLASH_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(FLASH_FUZZ_REPORT) $(FLASH_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(SEI_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(SEI_FUZZ_REPORT) $(SEI_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(MON_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(MON_FUZZ_REPORT) $(MON_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(CONFIG_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(CONFIG_FUZZ_REPORT) $(CONFIG_FUZZ_TARGETS) || status=1; \
-	$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $$built --build $(FUZZ_BUILD) --corpus $(P5SMP_FUZZ_CORPUS) \
-		--seconds $(FUZZ_SECONDS) --report $(P5SMP_FUZZ_REPORT) $(P5SMP_FUZZ_TARGETS) || status=1; \
-	exit $${status:-0}
+	$(MAKE) --no-print-directory -k -j$(JOBS) FUZZ_BUILT=$$built $(addprefix fuzz-run-,$(FUZZ_RUN_GROUPS))
+
+.PHONY: $(addprefix fuzz-run-,$(FUZZ_RUN_GROUPS))
+$(addprefix fuzz-run-,$(FUZZ_RUN_GROUPS)): fuzz-run-%:
+	@$(PYTHON) fieldbus/can/fuzz/run_fuzzers.py $(FUZZ_BUILT) --build $(FUZZ_BUILD) --corpus $($*_FUZZ_CORPUS) \
+		--seconds $(FUZZ_SECONDS) --report $($*_FUZZ_REPORT) $($*_FUZZ_TARGETS)
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/fieldbus/can/fuzz/fuzz_%.cpp.o $(FUZZ_LIBRARY_OBJS)
 	@mkdir -p $(dir $@)
