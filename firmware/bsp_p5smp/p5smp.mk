@@ -5,4 +5,4 @@
 # checked windows, memory through readers the host tests supply): built
 # for the host tests and the firmware.
 P5SMP_PORTABLE_SRCS := firmware/bsp_p5smp/src/MpTable.cpp firmware/bsp_p5smp/src/LocalApic.cpp firmware/bsp_p5smp/src/IoApic.cpp \
-	firmware/bsp_p5smp/src/SharedMemoryRing.cpp
+	firmware/bsp_p5smp/src/SharedMemoryRing.cpp firmware/bsp_p5smp/src/ElfImage.cpp

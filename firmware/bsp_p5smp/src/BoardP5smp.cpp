@@ -148,12 +148,10 @@ uint16_t pendingLines = 0;
 // The lines this node may attach: every one but another node's.
 uint16_t ownedLines = 0xFFFF;
 bool isNode3 = false;
-uint8_t node3ApicId = 0xFF;
 bool node3Running = false;
 // The other node's APIC id and node id (node 3 has them from the MP table and node 2).
 uint8_t otherApicId = 0xFF;
 uint16_t otherNode = 3;
-SecondProcessor::Outcome node3Outcome = SecondProcessor::Outcome::NoImage;
 uint16_t node = 2;
 uint32_t tickRate = defaultTickRateHz;
 uint64_t tickPeriodNs = 0;
@@ -423,7 +421,7 @@ void composeNode3CommandLine(const char* node2CommandLine)
 // start they come back, masked, to node 2.
 void startNode3(const boot::BootInfo& bootInfo)
 {
-    node3ApicId = secondProcessorApicId();
+    const uint8_t node3ApicId = secondProcessorApicId();
     runtime::CharacterSink& out = pc::consoleUart();
     if (node3ApicId == 0xFF) {
         runtime::format(out, "one processor: node 3 is not started\r\n");
@@ -441,7 +439,7 @@ void startNode3(const boot::BootInfo& bootInfo)
         return;
     }
     uint32_t entry = 0;
-    node3Outcome = SecondProcessor::load(image, bytes, memoryEnd, entry);
+    SecondProcessor::Outcome node3Outcome = SecondProcessor::load(image, bytes, memoryEnd, entry);
     if (node3Outcome == SecondProcessor::Outcome::Started) {
         composeNode3CommandLine(bootInfo.commandLine);
         SharedMemoryArea::at().layOut();

@@ -1,4 +1,5 @@
 #include <bsp/ApTrampoline.h>
+#include <bsp/ElfImage.hpp>
 #include <bsp/SecondProcessor.hpp>
 
 #include <boot/Multiboot.hpp>
@@ -9,75 +10,6 @@ extern "C" const uint8_t apTrampolineStart[];
 extern "C" const uint8_t apTrampolineEnd[];
 
 namespace bsp {
-
-namespace {
-
-// ELF (System V ABI, "Object Files", and its i386 supplement): the fields
-// the loader reads, at their offsets in a 32-bit file.
-constexpr uint8_t kElfMagic[4] = {0x7F, 'E', 'L', 'F'};
-constexpr size_t kClassOffset = 4;
-constexpr uint8_t kClass32 = 1;
-constexpr size_t kDataOffset = 5;
-constexpr uint8_t kLittleEndian = 1;
-constexpr size_t kTypeOffset = 16;
-constexpr uint16_t kTypeExecutable = 2;
-constexpr size_t kMachineOffset = 18;
-constexpr uint16_t kMachine386 = 3;
-constexpr size_t kEntryOffset = 24;
-constexpr size_t kProgramHeaderOffset = 28;
-constexpr size_t kProgramHeaderSizeOffset = 42;
-constexpr size_t kProgramHeaderCountOffset = 44;
-constexpr size_t kHeaderBytes = 52;
-constexpr uint16_t kProgramHeaderBytes = 32;
-constexpr uint32_t kSegmentLoad = 1;
-// Program header fields.
-constexpr size_t kSegmentType = 0;
-constexpr size_t kSegmentFileOffset = 4;
-constexpr size_t kSegmentPhysical = 12;
-constexpr size_t kSegmentFileBytes = 16;
-constexpr size_t kSegmentMemoryBytes = 20;
-// An image has a handful of segments; more is not an image of ours.
-constexpr uint16_t kMaximumSegments = 16;
-
-uint16_t read16(const uint8_t* at)
-{
-    uint16_t value;
-    memcpy(&value, at, sizeof value);
-    return value;
-}
-
-uint32_t read32(const uint8_t* at)
-{
-    uint32_t value;
-    memcpy(&value, at, sizeof value);
-    return value;
-}
-
-struct Segment {
-    uint32_t fileOffset;
-    uint32_t physical;
-    uint32_t fileBytes;
-    uint32_t memoryBytes;
-};
-
-// The segment at @p index, checked against the file and node 3's memory;
-// false for a loadable segment that does not fit. @p load says whether it is one.
-bool segmentAt(const uint8_t* image, size_t bytes, uint32_t headers, uint16_t index, uint32_t memoryEnd,
-               Segment& segment, bool& load)
-{
-    const uint8_t* header = image + headers + uint32_t{index} * kProgramHeaderBytes;
-    load = read32(header + kSegmentType) == kSegmentLoad;
-    segment = {read32(header + kSegmentFileOffset), read32(header + kSegmentPhysical),
-               read32(header + kSegmentFileBytes), read32(header + kSegmentMemoryBytes)};
-    if (!load) {
-        return true;
-    }
-    return segment.fileBytes <= segment.memoryBytes && segment.fileOffset <= bytes &&
-           segment.fileBytes <= bytes - segment.fileOffset && segment.physical >= SecondProcessor::kNodeBase &&
-           segment.physical < memoryEnd && segment.memoryBytes <= memoryEnd - segment.physical;
-}
-
-} // namespace
 
 const char* SecondProcessor::describe(Outcome outcome)
 {
@@ -100,45 +32,15 @@ SecondProcessor::Outcome SecondProcessor::load(const uint8_t* image, size_t byte
     if (memoryEnd < kMinimumMemoryEnd) {
         return Outcome::NoMemory;
     }
-    if (bytes < kHeaderBytes || memcmp(image, kElfMagic, sizeof kElfMagic) != 0 || image[kClassOffset] != kClass32 ||
-        image[kDataOffset] != kLittleEndian || read16(image + kTypeOffset) != kTypeExecutable ||
-        read16(image + kMachineOffset) != kMachine386 ||
-        read16(image + kProgramHeaderSizeOffset) != kProgramHeaderBytes) {
-        return Outcome::BadImage;
-    }
-    const uint32_t headers = read32(image + kProgramHeaderOffset);
-    const uint16_t count = read16(image + kProgramHeaderCountOffset);
-    if (count == 0 || count > kMaximumSegments || headers > bytes ||
-        uint32_t{count} * kProgramHeaderBytes > bytes - headers) {
-        return Outcome::BadImage;
-    }
     // Every check first, so that a bad image writes nothing.
-    entry = read32(image + kEntryOffset);
-    bool entryInside = false;
-    for (uint16_t i = 0; i < count; ++i) {
-        Segment segment{};
-        bool loadable = false;
-        if (!segmentAt(image, bytes, headers, i, memoryEnd, segment, loadable)) {
-            return Outcome::BadImage;
-        }
-        if (loadable && entry >= segment.physical && entry - segment.physical < segment.fileBytes) {
-            entryInside = true;
-        }
-    }
-    if (!entryInside) {
+    if (!ElfImage::check(image, bytes, kNodeBase, memoryEnd, entry)) {
         return Outcome::BadImage;
     }
-    for (uint16_t i = 0; i < count; ++i) {
-        Segment segment{};
-        bool loadable = false;
-        (void)segmentAt(image, bytes, headers, i, memoryEnd, segment, loadable);
-        if (!loadable) {
-            continue;
-        }
+    ElfImage::forEachLoadable(image, [image](const ElfImage::Segment& segment) {
         auto* to = reinterpret_cast<uint8_t*>(static_cast<uintptr_t>(segment.physical));
         memcpy(to, image + segment.fileOffset, segment.fileBytes);
         memset(to + segment.fileBytes, 0, segment.memoryBytes - segment.fileBytes);
-    }
+    });
     return Outcome::Started;
 }
 
