@@ -4,6 +4,7 @@
 # mocked port I/O on the host): built for the host tests and the firmware.
 CAN_DRIVER_PORTABLE_SRCS := \
 	drivers/can/src/BitTiming.cpp \
+	drivers/can/src/BoardCanChannel.cpp \
 	drivers/can/src/IsaSja1000Channel.cpp \
 	drivers/can/src/KvaserPciCard.cpp \
 	drivers/can/src/PciSja1000Channel.cpp \

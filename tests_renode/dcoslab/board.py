@@ -50,6 +50,9 @@ class Board:
     # port name -> {"driver": ..., "properties": {...}}, the device that then
     # takes the port's place (the isa486's RS-485 port: isa-rs485-uart).
     line_ports: dict = field(default_factory=dict)
+    # The board's CAN card, the device whose channels a lab bus wires
+    # (dcoslab/canlab.py): the isa486's ISA card, the p5smp's PCI card.
+    can_card: str = "isa-sja1000"
 
     def image(self, kind="production"):
         """Absolute path of the board's firmware image of the given kind."""

@@ -236,6 +236,10 @@ class CanLab:
         wiring gives that board its own (e.g. "node=2"), the key "devices"
         more device properties ({"isa-mfio": {"wiring": "plant", ...}}) and
         the key "args" more emulator arguments (a -chardev for them), the
+        key "board" another board definition than board_definition for that
+        board (its CAN card, Board.can_card, is the one wired), the
+        key "serial_sockets" serial ports of the board to join to Unix
+        sockets (the p5smp's node 3 console, dcoslab/node_console.py), the
         key "card" a CompactFlash card image the board boots from instead of
         the image kind (docs/boot.md), and the key "expect" what its console
         shows once it is up, instead of the shell's prompt. cpu
@@ -257,8 +261,14 @@ class CanLab:
                 board_args = []
                 card = None
                 prompt = r"dcos> "
+                definition = board_definition
+                serial_sockets = ()
                 for key, value in channels.items():
-                    if key == "append":
+                    if key == "board":
+                        definition = value
+                    elif key == "serial_sockets":
+                        serial_sockets = tuple(value)
+                    elif key == "append":
                         board_append = value
                     elif key == "card":
                         card = value
@@ -281,8 +291,10 @@ class CanLab:
                     options["cpu"] = cpu
                 if card:
                     options["card"] = card
-                emulator = boot(board_definition, kind, icount=True, name=name,
-                                device_properties={"isa-sja1000": properties, **devices},
+                if serial_sockets:
+                    options["serial_sockets"] = serial_sockets
+                emulator = boot(definition, kind, icount=True, name=name,
+                                device_properties={definition.can_card: properties, **devices},
                                 extra_args=["-rtc", f"base={RTC_BASE}", *board_args], **options)
                 self.boards[name] = LabBoard(name, emulator, self.hub)
                 prompts[name] = prompt

@@ -12,6 +12,7 @@
 //     RGOT <events> <signals>     what the listener has received so far
 //     RHOG <ms>                   the busy task ran that long
 //     RKILL <status>              KillTask's status
+//     RHALT                       the node stops for good (halt)
 //     RPORT <id>                  the porter's port was created
 //     RPGOT <count> <priorities> <last message>
 //                                 what the porter has received: how many
@@ -31,6 +32,9 @@
 #include <dcos/GregorianCalendar.hpp>
 #include <dcos/TimerAgent.hpp>
 #include <dcos/internal/IdText.hpp>
+
+#include <arch_x86/Cpu.hpp>
+#include <bsp/Board.hpp>
 
 #include <runtime/Text.hpp>
 #include <shell/ShellCommand.hpp>
@@ -205,6 +209,18 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
         }
         printResult(shell, found.status(), found.ok() ? found.value().raw() : 0, start);
         return CommandResult::Ok;
+    }
+    if (textEquals(verb, "halt") && argc == 2) {
+        // A node that dies without a word, as a processor that hangs does:
+        // interrupts off and halted for good, so it answers nothing, sends
+        // nothing and tells no peer. The other node of a dual-processor board
+        // runs on; its requests to this node meet the remote watchdog.
+        shell.print("RHALT\r\n");
+        bsp::consoleFlush();
+        arch_x86::disableInterrupts();
+        for (;;) {
+            arch_x86::haltUntilInterrupt();
+        }
     }
     if (textEquals(verb, "self") && argc == 2) {
         shell.print("RTASK %s\r\n", dcos::internal::IdText(taskAgent.IdOfSelf()).c_str());
@@ -425,7 +441,7 @@ DCOS_SHELL_COMMAND_DETAILED(
     "post [at=P] [tick] <id> <events> | signal [at=P] [tick] <id> <n> | state [at=P] [tick] <task> | "
     "priority [at=P] [tick] <task> | holder [at=P] [tick] <semaphore> | port | portgot | "
     "send [at=P] [tick] <port> <priority*256+first byte> | receive [tick] <port> | self | timer | "
-    "give <timer> <task> | alarm <timer> watchdog|periodic|day <ms> <events> | cancel <timer> | events <ms>",
+    "give <timer> <task> | alarm <timer> watchdog|periodic|day <ms> <events> | cancel <timer> | events <ms> | halt",
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
     "  hog: a task that keeps the processor busy at a priority for a time\r\n"
     "  waiter: a task that acquires the semaphore for ever; kill: KillTask\r\n"
@@ -433,6 +449,7 @@ DCOS_SHELL_COMMAND_DETAILED(
     "  port: a task that owns the global port \"inbox\" and receives from it (portgot shows what came)\r\n"
     "  send: sixteen bytes counting up from the argument's low byte, at the priority in its second byte\r\n"
     "  timer: a global timer of the console; give: XferOwnership; alarm: its events to the owner; events: the console's\r\n"
+    "  halt: this node stops for good, interrupts off, as a hung processor does\r\n"
     "  prints RRES <status> <value> <microseconds taken>",
     remote);
 

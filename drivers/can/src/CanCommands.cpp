@@ -1,9 +1,11 @@
-// The console command `can`: bring the ISA card's CAN channels up and down,
+// The console command `can`: bring the board's CAN channels up and down,
 // send and dump frames in can-utils' text form, and show each channel's
 // state and counters (docs/can/driver.md).
 //
-// The console owns one driver object per channel of the board's card,
-// can0 and can1 (sja1000/IsaSja1000Channel.hpp). `up` installs a channel
+// The console owns one driver object per channel, can0 and can1
+// (sja1000/BoardCanChannel.hpp): the ISA card's two chips, or on a node
+// that owns a PCI bus the chips of the Kvaser PCIcan cards it finds at
+// boot, then the ISA card's (placeChannels()). `up` installs a channel
 // with the system agent and keeps one open on it, so the chip stays on the
 // bus between commands; `down` closes and uninstalls it again. The console
 // task is the channel's owner: `up` registers it for the driver's events,
@@ -12,7 +14,9 @@
 // commands that wait (send, dump) wait for the driver's events, never by
 // polling, and always with a time-out.
 #include <sja1000/CanNetworkLink.hpp>
-#include <sja1000/IsaSja1000Channel.hpp>
+#include <sja1000/BoardCanChannel.hpp>
+#include <sja1000/KvaserPciCard.hpp>
+#include <pci/ConfigSpace.hpp>
 
 #include <can/FrameText.hpp>
 #include <can/IsoTpReceiver.hpp>
@@ -40,11 +44,65 @@ using dcos::taskAgent;
 using shell::CommandResult;
 
 constexpr unsigned kChannels = 2;
-IsaSja1000Channel consoleChannels[kChannels] = {
-    IsaSja1000Channel("can0", kIsaCardDefaultBase, kIsaCardDefaultIrq0),
-    IsaSja1000Channel("can1", kIsaCardDefaultBase + kIsaSecondChannelOffset, kIsaCardDefaultIrq1),
+BoardCanChannel consoleChannels[kChannels] = {
+    {"can0", kIsaCardDefaultBase, kIsaCardDefaultIrq0},
+    {"can1", kIsaCardDefaultBase + kIsaSecondChannelOffset, kIsaCardDefaultIrq1},
 };
 const char* const kNames[kChannels] = {"can0", "can1"};
+
+// Gives the channels to the chips of the Kvaser PCIcan cards on this
+// node's PCI bus, in the order the bus has them, each card's interrupt
+// routed first; the channels left over stay the ISA card's. Once, at the
+// first use (the root task's networkBootStart, before any shell); what it
+// finds wrong with a card it says on @p out, and that card is passed over.
+void placeChannels(runtime::CharacterSink& out)
+{
+    static bool placed = false;
+    if (placed) {
+        return;
+    }
+    placed = true;
+    if (!bsp::ownsPciBus()) {
+        return;
+    }
+    const pci::ConfigSpace config;
+    if (config.probe() != Status::Ok) {
+        runtime::format(out, "can: no PCI configuration mechanism #1 answers; the ISA card's channels only\r\n");
+        return;
+    }
+    // Bounded by the functions a bus can have; a card probe() refuses ends
+    // the search only when it is the last there is.
+    constexpr unsigned kMostCards = 32;
+    unsigned next = 0;
+    for (unsigned index = 0; index < kMostCards && next < kChannels; ++index) {
+        KvaserPciProblem problem;
+        const dcos::Result<KvaserPciCard> found = KvaserPciCard::probe(config, index, &problem);
+        if (!found.ok()) {
+            if (problem.fault == KvaserPciFault::NoCard) {
+                break;
+            }
+            runtime::format(out, "can: Kvaser PCIcan %u passed over: %s (BAR%u): %s\r\n", index,
+                            kvaserPciFaultName(problem.fault), problem.bar, dcos::statusName(found.status()));
+            continue;
+        }
+        const KvaserPciCard& card = found.value();
+        const Status routed = bsp::routePciInterrupt(card.bus(), card.device(),
+                                                     static_cast<uint8_t>(card.interruptPin() - 1),
+                                                     card.interruptLine());
+        if (routed != Status::Ok) {
+            runtime::format(out, "can: Kvaser PCIcan at %02x:%02x.%x passed over: its interrupt (irq %u) cannot "
+                                 "be routed: %s\r\n",
+                            card.bus(), card.device(), card.function(), card.interruptLine(),
+                            dcos::statusName(routed));
+            continue;
+        }
+        for (unsigned chip = 0; chip < card.channelCount() && next < kChannels; ++chip) {
+            if (consoleChannels[next].placeOnPciCard(card, chip) == Status::Ok) {
+                ++next;
+            }
+        }
+    }
+}
 
 // The console task's events for the driver; bit 0 is the console's input.
 constexpr uint32_t kReceiveEvent = 1u << 20;
@@ -150,22 +208,12 @@ bool parseMilliseconds(shell::Shell& shell, const char* text, unsigned long& ms)
 // unless it is already; says why not on @p out.
 bool install(runtime::CharacterSink& out, unsigned channel)
 {
-    IsaSja1000Channel& driver = consoleChannels[channel];
+    BoardCanChannel& driver = consoleChannels[channel];
     if (driver.installed()) {
         return true;
     }
-    iobus::IsaConflict conflict;
-    const dcos::Result<dcos::ObjectId> installed = driver.install(kNames[channel], dcos::Visibility::Regional,
-                                                                  &conflict);
+    const dcos::Result<dcos::ObjectId> installed = driver.install(dcos::Visibility::Regional, out);
     if (!installed.ok()) {
-        if (installed.status() == Status::AlreadyExists) {
-            char text[96];
-            iobus::IsaResourceManager::describe(conflict, text, sizeof text);
-            runtime::format(out, "error: %s\r\n", text);
-        } else {
-            runtime::format(out, "error: cannot install %s: %s\r\n", kNames[channel],
-                            dcos::statusName(installed.status()));
-        }
         return false;
     }
     // The device belongs to the system, so that no task's recovery
@@ -173,7 +221,7 @@ bool install(runtime::CharacterSink& out, unsigned channel)
     (void)systemAgent.XferOwnership(installed.value(), dcos::ObjectId{});
     const Status opened = systemAgent.Open(installed.value());
     if (opened != Status::Ok) {
-        runtime::format(out, "error: no SJA1000 answers at 0x%03x: %s\r\n", driver.base(),
+        runtime::format(out, "error: no SJA1000 answers at 0x%03x: %s\r\n", driver.basePort(),
                         dcos::statusName(opened));
         (void)driver.uninstall(); // Not open, so it goes.
         return false;
@@ -185,15 +233,22 @@ bool install(runtime::CharacterSink& out, unsigned channel)
 // prints; says why not on @p out.
 bool setBitRate(runtime::CharacterSink& out, unsigned channel, uint32_t rate)
 {
-    IsaSja1000Channel& driver = consoleChannels[channel];
+    BoardCanChannel& driver = consoleChannels[channel];
     const Status set = systemAgent.Control(driver.id(), Sja1000Controller::kSetBitRate, &rate, sizeof rate);
     if (set != Status::Ok) {
         runtime::format(out, "error: cannot set the bit rate: %s\r\n", dcos::statusName(set));
         return false;
     }
     const BusState state = stateOf(channel);
-    runtime::format(out, "%s up at 0x%03x irq %u: %lu bit/s, sample point %u.%u %%, %s\r\n", kNames[channel],
-                    driver.base(), driver.irq(), static_cast<unsigned long>(state.bitRate),
+    // The ISA card's line is as it always was; a PCI card's names the card.
+    char place[48] = "";
+    if (driver.onPciCard()) {
+        char where[44];
+        driver.describePlace(where, sizeof where);
+        runtime::formatToBuffer(place, sizeof place, " (%s)", where);
+    }
+    runtime::format(out, "%s up at 0x%03x irq %u%s: %lu bit/s, sample point %u.%u %%, %s\r\n", kNames[channel],
+                    driver.basePort(), driver.irq(), place, static_cast<unsigned long>(state.bitRate),
                     state.samplePointPermille / 10, state.samplePointPermille % 10, stateName(state.errorState));
     return true;
 }
@@ -242,7 +297,7 @@ CommandResult down(shell::Shell& shell, int argc, char** argv)
     if (!soleUpChannel(shell, argc, argv, "can down <channel>", channel)) {
         return CommandResult::Failed;
     }
-    IsaSja1000Channel& driver = consoleChannels[channel];
+    BoardCanChannel& driver = consoleChannels[channel];
     while (systemAgent.Close(driver.id()) == Status::Ok) {
     }
     const Status removed = driver.uninstall();
@@ -929,6 +984,7 @@ constexpr shell::Subcommand kSubcommands[] = {
 
 CommandResult canCommand(shell::Shell& shell, int argc, char** argv)
 {
+    placeChannels(shell.output());
     return shell::runSubcommand(shell, argc, argv, kSubcommands);
 }
 
@@ -941,7 +997,8 @@ DCOS_SHELL_COMMAND_DETAILED(canShellCommand, "can", "bring CAN channels up and d
                             "queue <channel> <id>#<data>... | events <channel> [count] [ms] | "
                             "policy <channel> auto|manual | restart <channel> | filter <channel> all|ext|std [id mask] | "
                             "attach <channel> | detach <channel>",
-                            "  channels: can0 (0x280, irq 10) and can1 (0x2a0, irq 11) of the ISA SJA1000 card\r\n"
+                            "  channels: can0 (0x280, irq 10) and can1 (0x2a0, irq 11) of the ISA SJA1000 card;\r\n"
+                            "  on a node with a PCI bus the Kvaser PCIcan chips first ('can up' says where)\r\n"
                             "  frames: <id>#<data> as can-utils' cansend writes them: 3 hex digits for a standard\r\n"
                             "  identifier, 8 for an extended one; <id>#R[n] is a remote frame\r\n"
                             "  dump prints frames as candump does; send waits for the frame to be acknowledged\r\n"
@@ -960,6 +1017,7 @@ namespace dcos::internal {
 
 void networkBootStart()
 {
+    sja1000::placeChannels(bsp::console());
     char rate[16];
     for (unsigned channel = 0; channel < sja1000::kChannels; ++channel) {
         if (boot::findCommandLineOption(dcos::bootInfo().commandLine, sja1000::kNames[channel], rate, sizeof rate)) {

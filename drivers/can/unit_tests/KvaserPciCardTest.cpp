@@ -4,6 +4,7 @@
 // onto the bus against FakeSja1000 chips answering in the card's BAR1, as
 // QEMU's kvaser_pci model lays the card out.
 #include <sja1000/KvaserPciCard.hpp>
+#include <sja1000/BoardCanChannel.hpp>
 #include <sja1000/PciSja1000Channel.hpp>
 
 #include <pci/ConfigSpace.hpp>
@@ -19,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <string>
 #include <memory>
 #include <vector>
 
@@ -476,6 +478,98 @@ TEST_F(PciSja1000ChannelTest, TheSecondChipOfACardCannotTakeTheSharedLineToo)
     EXPECT_EQ(second.install("can-pci1", dcos::Visibility::Local).status(), Status::Busy);
     EXPECT_TRUE(enabledAtTheCard()) << "the first channel's interrupt is untouched";
     EXPECT_FALSE(second.installed());
+}
+
+// -- the board's channel: the ISA card's until placed on a PCI card -------------
+
+class StringSink final : public runtime::CharacterSink {
+public:
+    void put(char character) override { text.push_back(character); }
+    std::string text;
+};
+
+class BoardCanChannelTest : public PciSja1000ChannelTest {
+protected:
+    void TearDown() override
+    {
+        dcos::fake::playSuperUser(kSuperUser);
+        for (sja1000::BoardCanChannel* channel : {&can0, &can1}) {
+            while (systemAgent.Close(channel->id()) == Status::Ok) {
+            }
+            if (channel->installed()) {
+                EXPECT_EQ(channel->uninstall(), Status::Ok);
+            }
+        }
+        PciSja1000ChannelTest::TearDown();
+    }
+
+    sja1000::BoardCanChannel can0{"can0", 0x280, 10};
+    sja1000::BoardCanChannel can1{"can1", 0x2A0, 11};
+    StringSink out;
+};
+
+TEST_F(BoardCanChannelTest, AChannelIsTheIsaCardsUntilPlaced)
+{
+    EXPECT_FALSE(can0.onPciCard());
+    EXPECT_EQ(can0.basePort(), 0x280);
+    EXPECT_EQ(can0.irq(), 10);
+    char place[48];
+    can0.describePlace(place, sizeof place);
+    EXPECT_STREQ(place, "ISA card");
+}
+
+TEST_F(BoardCanChannelTest, PlacedOnTheCardItInstallsThereOnTheCardsLine)
+{
+    const KvaserPciCard card = probe();
+    ASSERT_EQ(can0.placeOnPciCard(card, 0), Status::Ok);
+    EXPECT_TRUE(can0.onPciCard());
+    EXPECT_EQ(can0.basePort(), kChipPorts);
+    EXPECT_EQ(can0.irq(), kLine);
+    char place[48];
+    can0.describePlace(place, sizeof place);
+    EXPECT_STREQ(place, "PCI 00:04.0, Kvaser PCIcan chip 0");
+
+    const Result<ObjectId> id = can0.install(dcos::Visibility::Local, out);
+    ASSERT_TRUE(id.ok()) << out.text;
+    EXPECT_EQ(can0.id(), id.value());
+    EXPECT_TRUE(out.text.empty()) << out.text;
+    EXPECT_TRUE(enabledAtTheCard());
+    ASSERT_EQ(iobus_fake::installedIsrs().size(), 1u);
+    EXPECT_EQ(iobus_fake::installedIsrs()[0].line, kLine);
+    EXPECT_EQ(can0.uninstall(), Status::Ok);
+    EXPECT_FALSE(enabledAtTheCard());
+}
+
+TEST_F(BoardCanChannelTest, AChipTheCardDoesNotHaveLeavesTheChannelWhereItWas)
+{
+    EXPECT_EQ(can0.placeOnPciCard(probe(), 1), Status::InvalidArgument);
+    EXPECT_EQ(can0.placeOnPciCard(KvaserPciCard{}, 0), Status::InvalidArgument);
+    EXPECT_FALSE(can0.onPciCard());
+    EXPECT_EQ(can0.basePort(), 0x280);
+}
+
+TEST_F(BoardCanChannelTest, AChannelOnceInstalledKeepsItsPlace)
+{
+    const KvaserPciCard card = probe();
+    ASSERT_EQ(can0.placeOnPciCard(card, 0), Status::Ok);
+    ASSERT_TRUE(can0.install(dcos::Visibility::Local, out).ok()) << out.text;
+    EXPECT_EQ(can0.placeOnPciCard(card, 0), Status::Busy) << "installed";
+    ASSERT_EQ(can0.uninstall(), Status::Ok);
+    EXPECT_EQ(can0.placeOnPciCard(card, 0), Status::Busy) << "a network interface may still name it";
+    EXPECT_TRUE(can0.onPciCard());
+}
+
+TEST_F(BoardCanChannelTest, TwoChipsOnOneLineSayWhyTheSecondCannotInstall)
+{
+    addChip();
+    const KvaserPciCard card = probe();
+    ASSERT_EQ(can0.placeOnPciCard(card, 0), Status::Ok);
+    ASSERT_EQ(can1.placeOnPciCard(card, 1), Status::Ok);
+    ASSERT_TRUE(can0.install(dcos::Visibility::Local, out).ok()) << out.text;
+    EXPECT_EQ(can1.install(dcos::Visibility::Local, out).status(), Status::Busy);
+    EXPECT_EQ(out.text, "error: cannot install can1 on the PCI card (irq 11): another driver has the card's "
+                        "interrupt line\r\n");
+    EXPECT_FALSE(can1.installed());
 }
 
 } // namespace

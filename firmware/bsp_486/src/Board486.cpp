@@ -198,6 +198,12 @@ bool interruptCutShort(unsigned& line)
 
 unsigned spareInterruptLine(unsigned which) { return which == 0 ? 5 : 11; }
 
+// The ISA board has no PCI bus: nothing answers at the configuration
+// ports, and an ISA card might.
+bool ownsPciBus() { return false; }
+
+dcos::Status routePciInterrupt(uint8_t, uint8_t, uint8_t, unsigned) { return dcos::Status::NotSupported; }
+
 uint32_t unexpectedInterruptCount(unsigned line) { return line < interruptLineCount ? unexpected[line] : 0; }
 
 uint32_t spuriousInterruptCount() { return spurious; }

@@ -691,6 +691,47 @@ unsigned spareInterruptLine(unsigned which)
     return (isNode3 ? node3SpareLines : node2SpareLines)[which != 0 ? 1 : 0];
 }
 
+bool ownsPciBus() { return !isNode3; }
+
+dcos::Status routePciInterrupt(uint8_t bus, uint8_t device, uint8_t pin, unsigned line)
+{
+    if (isNode3) {
+        return dcos::Status::NotSupported; // Node 2 owns the bus and the I/O APIC.
+    }
+    if (line >= interruptLineCount || line == systemTickLine || line == interProcessorLine ||
+        (ownedLines >> line & 1u) == 0) {
+        return dcos::Status::InvalidArgument;
+    }
+    // Only the MP table knows where a PCI pin arrives: the default
+    // configurations have no PCI bus (MP spec 5.1).
+    IoApicRoute route{};
+    if (!mpValid || !mp.pciRoute(bus, device, pin, route) || route.pin >= ioApic.pinCount()) {
+        return dcos::Status::NotFound;
+    }
+    arch_x86::InterruptGuard guard;
+    if (registered[line].handler != nullptr) {
+        return dcos::Status::Busy;
+    }
+    // One pin, one line: another line taken to be on that pin (an ISA line
+    // the table does not name, which findRoutes() put on its own pin) is
+    // routed nowhere now, since the pin is the device's.
+    for (unsigned other = 0; other < interruptLineCount; ++other) {
+        if (other != line && routes[other].routed && routes[other].pin == route.pin) {
+            if (registered[other].handler != nullptr) {
+                return dcos::Status::Busy;
+            }
+            routes[other] = LineRoute{};
+        }
+    }
+    if (routes[line].routed && routes[line].pin != route.pin) {
+        (void)ioApic.setMasked(routes[line].pin, true); // The line's old pin now carries nothing of it.
+    }
+    routes[line] = {true, route.pin, route.activeLow, route.levelTriggered};
+    // Masked until a handler is attached (applyMask() unmasks it then).
+    (void)ioApic.route(route.pin, vectorOf(line), bootstrapApicId(), route.activeLow, route.levelTriggered, true);
+    return dcos::Status::Ok;
+}
+
 uint32_t unexpectedInterruptCount(unsigned line) { return line < interruptLineCount ? unexpected[line] : 0; }
 
 uint32_t spuriousInterruptCount() { return apicSpuriousCount; }

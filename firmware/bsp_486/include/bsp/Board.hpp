@@ -106,6 +106,23 @@ dcos::Result<dcos::DateTime> readRealTimeClock();
 /// node 2 of the dual-Pentium board, 12 and 13 on its node 3.
 unsigned spareInterruptLine(unsigned which);
 
+/// Whether this node owns a PCI bus (configuration mechanism #1) whose
+/// devices are its own to probe and drive: false on the ISA board, which
+/// has none, and on node 3 of the dual-Pentium board, which leaves the bus
+/// to node 2 (seed 5.3: node 3 reaches the world only through node 2).
+bool ownsPciBus();
+
+/// Makes interrupt line @p line carry interrupt pin @p pin (0 for INTA#
+/// to 3 for INTD#) of PCI device @p device on bus @p bus, as the board's
+/// interrupt routing says that pin arrives: level triggered, active low,
+/// wherever the MP table puts it. @p line is the Interrupt Line the BIOS
+/// wrote in the device's configuration header. Call before attaching the
+/// line. NotSupported on a node that does not own a PCI bus; NotFound when
+/// the board's tables route the pin nowhere; InvalidArgument for a line
+/// this node cannot take (another node's, the tick's, line 2) and Busy
+/// while a handler is attached to it.
+dcos::Status routePciInterrupt(uint8_t bus, uint8_t device, uint8_t pin, unsigned line);
+
 /// Interrupts that arrived on a line with no handler (and were masked).
 uint32_t unexpectedInterruptCount(unsigned line);
 
