@@ -19,8 +19,8 @@ pytestmark = pytest.mark.xdist_group("test_labvm")
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from dcoslab.labvm import lab_vm  # noqa: E402,F401 (the fixture)
-from labvm import (CanFrame, LabVM, LabVMError, SlcanError, SlcanSetup, Sja1000Setup, check_command,  # noqa: E402
-                   parse_checks, run)
+from labvm import (CanFrame, KvaserPciSetup, LabVM, LabVMError, SlcanError, SlcanSetup,  # noqa: E402
+                   Sja1000Setup, check_command, parse_checks, run)
 
 # Bounds for a hung VM, not speed targets.
 BOOT_TIMEOUT = 240
@@ -344,5 +344,31 @@ def test_the_sja1000_card_setup_gives_the_device_the_driver_and_the_interfaces()
             Sja1000Setup("/tmp/lab/hub.sock", **bad)
     with pytest.raises(ValueError, match="comma"):
         Sja1000Setup("/tmp/lab,x/hub.sock")
+    with pytest.raises(ValueError, match="both be can0"):
+        LabVM("true", slcan=SlcanSetup(), sja1000=card)
+
+
+def test_the_kvaser_pci_card_setup_gives_the_device_the_driver_and_the_interfaces():
+    card = KvaserPciSetup("/tmp/lab/hub.sock", buses=("can0",), name="linux", bitrate=250000)
+    assert card.device_argument() == ("lab-kvaser-pci,channels=1,hub=/tmp/lab/hub.sock,hub-name=linux,"
+                                      "hub-realtime=on,hub-timeout=60,bus0=can0")
+    assert card.load_line() == "kvaser_pci"
+    assert card.setup_lines() == ["ip link set can0 type can bitrate 250000", "ip link set can0 up"]
+    # Linux names every chip the card carries, wired or not: chip 2 of four is can2, and only wired chips come up.
+    four = KvaserPciSetup("/tmp/lab/hub.sock", buses=(None, "can0", "can1", None), bitrate=125000)
+    assert four.device_argument().startswith("lab-kvaser-pci,channels=4,")
+    assert four.device_argument().endswith(",bus1=can0,bus2=can1")
+    assert four.interface(2) == "can2" and [name for _, _, name in four.channels] == ["can1", "can2"]
+    assert four.setup_lines() == ["ip link set can1 type can bitrate 125000", "ip link set can1 up",
+                                  "ip link set can2 type can bitrate 125000", "ip link set can2 up"]
+    assert KvaserPciSetup("/tmp/lab/hub.sock", bitrate=None).setup_lines() == []
+    for bad in ({"buses": ()}, {"buses": ("can0",) * 5}, {"buses": (None, None)}, {"name": "lin.ux"},
+                {"buses": ("can 0",)}):
+        with pytest.raises(ValueError):
+            KvaserPciSetup("/tmp/lab/hub.sock", **bad)
+    with pytest.raises(ValueError):
+        card.interface(1)
+    with pytest.raises(ValueError, match="comma"):
+        KvaserPciSetup("/tmp/lab,x/hub.sock")
     with pytest.raises(ValueError, match="both be can0"):
         LabVM("true", slcan=SlcanSetup(), sja1000=card)

@@ -27,16 +27,17 @@ if os.path.isdir(os.path.join(_TESTS_RENODE, "labvm")) and _TESTS_RENODE not in 
     sys.path.insert(0, _TESTS_RENODE)
 
 try:
-    from labvm import (BITRATE_CODES, CanFrame, CheckResult, LabVM, LabVMError, LabVMSetupError,  # noqa: F401
-                       Result, SlcanError, SlcanPort, SlcanSetup, Sja1000Setup, built_qemu_x86_64, check_command,
-                       obtain_kernel, parse_checks, run)
+    from labvm import (BITRATE_CODES, CanFrame, CheckResult, KvaserPciSetup, LabVM, LabVMError,  # noqa: F401
+                       LabVMSetupError, Result, SlcanError, SlcanPort, SlcanSetup, Sja1000Setup, built_qemu_x86_64,
+                       check_command, obtain_kernel, parse_checks, run)
 except ImportError as error:  # an installed DCOS without the source tree's tests_renode/labvm
     raise ImportError(f"the lab VM lives in the DCOS source tree (tests_renode/labvm), not found from "
                       f"{_TESTS_RENODE}: {error}") from None
 
 __all__ = [
-    "BITRATE_CODES", "CanFrame", "CheckResult", "LabVM", "LabVMError", "LabVMSetupError", "Result", "SlcanError",
-    "SlcanPort", "SlcanSetup", "Sja1000Setup", "built_qemu_x86_64", "check_command", "lab_vm", "obtain_kernel", "parse_checks", "run",
+    "BITRATE_CODES", "CanFrame", "CheckResult", "KvaserPciSetup", "LabVM", "LabVMError", "LabVMSetupError", "Result",
+    "SlcanError", "SlcanPort", "SlcanSetup", "Sja1000Setup", "built_qemu_x86_64", "check_command", "lab_vm",
+    "obtain_kernel", "parse_checks", "run",
 ]
 
 

@@ -19,8 +19,8 @@ import sys
 from . import initramfs
 from .kernel import DEFAULT_CACHE, LabVMSetupError, obtain_kernel
 from .slcan import BITRATE_CODES
-from .vm import DEFAULT_9P_CACHE, DEFAULT_BOOT_TIMEOUT, DEFAULT_COMMAND_TIMEOUT, DEFAULT_QEMU, LabVM, LabVMError, \
-    SlcanSetup, Sja1000Setup
+from .vm import DEFAULT_9P_CACHE, DEFAULT_BOOT_TIMEOUT, DEFAULT_COMMAND_TIMEOUT, DEFAULT_QEMU, KvaserPciSetup, LabVM, \
+    LabVMError, SlcanSetup, Sja1000Setup
 
 VM_FAILED = 125
 
@@ -38,6 +38,10 @@ def _add_vm_options(parser):
                         help="put our ISA SJA1000 card (isa-sja1000) in the VM, joined to the lab CAN bus hub at "
                              "this unix socket, with Linux's sja1000_isa driver loaded for it; runs the VM on the "
                              "QEMU built with the lab's models (tests_renode/qemu/build_qemu.sh)")
+    parser.add_argument("--kvaser-hub", metavar="SOCKET",
+                        help="put our Kvaser PCIcan (lab-kvaser-pci, one chip) in the VM instead, joined to the "
+                             "lab CAN bus hub at this unix socket, with Linux's kvaser_pci driver loaded for it; "
+                             "the --sja1000-bus, --sja1000-bitrate and --sja1000-name options apply to it")
     parser.add_argument("--sja1000-bus", default="can0", metavar="BUS",
                         help="the hub's bus channel 0 is wired to (can0); it is can0 in the VM")
     parser.add_argument("--sja1000-bitrate", type=int, default=500000, metavar="BIT/S",
@@ -56,7 +60,8 @@ def _add_vm_options(parser):
     parser.add_argument("--boot-timeout", type=float, default=DEFAULT_BOOT_TIMEOUT, metavar="S",
                         help=f"seconds the VM may take to boot (default {DEFAULT_BOOT_TIMEOUT:.0f})")
     parser.add_argument("--qemu", default=None,
-                        help=f"the QEMU binary (default {DEFAULT_QEMU}, or the built one with --sja1000-hub)")
+                        help=f"the QEMU binary (default {DEFAULT_QEMU}, or the built one with --sja1000-hub or "
+                             "--kvaser-hub)")
     parser.add_argument("--qemu-arg", action="append", default=[], metavar="ARG",
                         help="one more QEMU argument as it is (repeatable), e.g. --qemu-arg=-device ...")
     parser.add_argument("--memory", type=int, default=1024, metavar="MIB", help="guest memory (1024 MiB)")
@@ -72,9 +77,14 @@ def _add_vm_options(parser):
 def _vm(args, command, interactive=False, console_log=None):
     slcan = SlcanSetup(args.slcan_interface, args.slcan_bitrate) if args.slcan else None
     sja1000 = None
+    if args.sja1000_hub and args.kvaser_hub:
+        raise ValueError("--sja1000-hub and --kvaser-hub would both make can0; give one of them")
     if args.sja1000_hub:
         sja1000 = Sja1000Setup(os.path.abspath(args.sja1000_hub), bus0=args.sja1000_bus, name=args.sja1000_name,
                                bitrate=args.sja1000_bitrate or None)
+    elif args.kvaser_hub:
+        sja1000 = KvaserPciSetup(os.path.abspath(args.kvaser_hub), buses=(args.sja1000_bus,), name=args.sja1000_name,
+                                 bitrate=args.sja1000_bitrate or None)
     return LabVM(command, cwd=os.getcwd(), vcan=args.vcan, slcan=slcan, sja1000=sja1000, setup=args.setup,
                  load=args.load,
                  modules=args.module,

@@ -168,6 +168,68 @@ class Sja1000Setup:
         return lines
 
 
+class KvaserPciSetup:
+    """The lab's Kvaser PCIcan (QEMU device lab-kvaser-pci) in the VM, its chips on buses of the lab CAN bus hub,
+    driven by Linux's own kvaser_pci driver (docs/guide/lab-vm.md, "The Kvaser PCI card").
+
+    The card carries one chip per entry of `buses` (1 to 4; a real PCIcan has 1, 2 or 4): chip n is wired to
+    buses[n], or to no bus for None (a chip alone on its bus). Linux's driver counts the chips and makes one
+    interface per chip, can0 for chip 0 and so on, whether wired or not. The card's link joins the hub as a
+    real-time participant (hub-realtime=on), like Sja1000Setup's. The BIOS places the card and routes its INTA#
+    (to 10 or 11 on QEMU's pc machine, shared with the virtio-9p device's INTx, which PCI allows). With a bitrate
+    the setup configures and brings up the interface of each wired chip; with None it leaves that to the command.
+    Use it as LabVM's `sja1000=`, in place of a Sja1000Setup.
+    """
+
+    def __init__(self, hub, buses=("can0",), name="linux", bitrate=500000, hub_timeout=60):
+        buses = tuple(buses)
+        if not 1 <= len(buses) <= 4:
+            raise ValueError(f"a Kvaser PCIcan carries 1 to 4 chips, not {len(buses)}")
+        if not any(buses):
+            raise ValueError("the card needs at least one chip on a bus")
+        for bus in buses:
+            if bus is not None and not re.match(r"^[A-Za-z0-9_-]{1,32}$", bus):
+                raise ValueError(f"{bus!r} is not a lab bus name")
+        if not re.match(r"^[A-Za-z0-9_-]{1,32}$", name):
+            raise ValueError(f"{name!r} is not a hub participant name (one word, no dots)")
+        if "," in hub:
+            raise ValueError(f"the hub's socket path {hub!r} may not contain a comma (a QEMU option separator)")
+        self.hub = hub
+        self.buses = buses
+        self.name = name
+        self.bitrate = bitrate
+        self.hub_timeout = hub_timeout
+
+    @property
+    def channels(self):
+        """The chips wired to a bus: (chip, bus, interface name in the VM)."""
+        return [(index, bus, f"can{index}") for index, bus in enumerate(self.buses) if bus]
+
+    def interface(self, channel=0):
+        """The VM's interface name for a chip of the card: the driver names every chip, in order."""
+        if not 0 <= channel < len(self.buses):
+            raise ValueError(f"the card carries {len(self.buses)} chips, not chip {channel}")
+        return f"can{channel}"
+
+    def device_argument(self):
+        properties = [f"channels={len(self.buses)}", f"hub={self.hub}", f"hub-name={self.name}", "hub-realtime=on",
+                      f"hub-timeout={self.hub_timeout}"]
+        properties += [f"bus{index}={bus}" for index, bus in enumerate(self.buses) if bus]
+        return "lab-kvaser-pci," + ",".join(properties)
+
+    def load_line(self):
+        """The modprobe line: kvaser_pci binds to the card by its PCI identity and takes no options."""
+        return "kvaser_pci"
+
+    def setup_lines(self):
+        if self.bitrate is None:
+            return []
+        lines = []
+        for _, _, name in self.channels:
+            lines += [f"ip link set {name} type can bitrate {int(self.bitrate)}", f"ip link set {name} up"]
+        return lines
+
+
 class Result:
     """What one run of the lab VM gave."""
 
@@ -213,9 +275,10 @@ class LabVM:
         host through the unix socket `slcan_socket_path`; `slcan` then is a
         connected SlcanPort unless connect_slcan=False (another program will).
     setup: more shell lines run before the command, in the chroot, with -e.
-    sja1000: a Sja1000Setup: our ISA SJA1000 card on the lab hub's buses, with Linux's sja1000_isa driver
-        loaded at boot (can0, can1); the VM then runs on the QEMU built with the lab's models unless qemu
-        names another. Not together with slcan (both would be can0).
+    sja1000: one of the lab's SJA1000 cards on the lab hub's buses, with its Linux driver loaded at boot: a
+        Sja1000Setup (the ISA card, sja1000_isa) or a KvaserPciSetup (the Kvaser PCIcan, kvaser_pci); can0,
+        can1, ... The VM then runs on the QEMU built with the lab's models unless qemu names another. Not
+        together with slcan (both would be can0).
     load: modprobe lines run at boot, e.g. "sja1000_isa port=0x2a0 irq=10".
     modules: more modules to put in the initramfs (loadable on demand).
     files: {relative name: str or bytes} placed under /run/labvm/files/.
@@ -390,7 +453,7 @@ class LabVM:
             argv += ["-chardev", f"socket,id=s1,path={self.slcan_socket_path},server=on,wait=off",
                      "-serial", "chardev:s1"]
         if self.sja1000 is not None:
-            # QEMU's default x86_64 machine is pc (i440FX with a PIIX3 ISA bridge), so an ISA card fits.
+            # QEMU's default x86_64 machine is pc (i440FX with a PIIX3 ISA bridge): an ISA card fits, and a PCI one.
             argv += ["-machine", "pc", *BUILT_QEMU_FIRMWARE, "-device", self.sja1000.device_argument()]
         return argv + self.qemu_args
 

@@ -2,8 +2,9 @@
  * The link that joins a board to the lab's hub ("labbus-link"): the
  * lock-step of the board's emulated clock with the other boards', and the
  * message channel of every device of the board that takes part in a lab
- * bus or line (the SJA1000 CAN card, isa_sja1000.c; the RS-485 UART,
- * isa_rs485.c). docs/protocols/labbus.md specifies the protocol.
+ * bus or line (the SJA1000 CAN cards, isa_sja1000.c and pci_kvaser_lab.c,
+ * through their chips, sja1000_lab_chip.c; the RS-485 UART, isa_rs485.c).
+ * docs/protocols/labbus.md specifies the protocol.
  *
  * This program is free software; you can redistribute it and/or
  * modify it under the terms of the GNU General Public License as

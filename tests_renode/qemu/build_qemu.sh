@@ -3,7 +3,8 @@
 # source (apt-get source qemu) with our device models from tests_renode/models/
 # compiled in: qemu-system-i386, which runs every board, and
 # qemu-system-x86_64, which runs the lab VM (Debian's 64-bit Linux) when it
-# carries one of our cards, e.g. the ISA SJA1000 for Linux's sja1000_isa.
+# carries one of our cards, e.g. the ISA SJA1000 for Linux's sja1000_isa or
+# the Kvaser PCIcan for its kvaser_pci.
 #
 #   tests_renode/qemu/build_qemu.sh               build if needed, print the path
 #   tests_renode/qemu/build_qemu.sh --print-path  print where qemu-system-i386 for
@@ -148,9 +149,12 @@ say "source: $tree (QEMU $(cat "$tree/VERSION"), Debian $(head -n 1 "$tree/debia
 # -- our models ---------------------------------------------------------------
 # Every C file and header in tests_renode/models/ goes to hw/misc/dcos/
 # (the models include their shared headers, e.g. labbus_link.h, from their
-# own folder), and every C file is listed in hw/misc/meson.build, for ISA
-# machines. Stale copies are removed, and files are only rewritten when they
-# change, so ninja recompiles only what changed.
+# own folder), and every C file is listed in hw/misc/meson.build: a PCI
+# card's front end (pci_*.c) when the target has PCI (CONFIG_PCI), every
+# other file, the shared ones (the SJA1000 chip core, the link) included,
+# when it has an ISA bus (CONFIG_ISA_BUS). Both targets built here, i386
+# and x86_64, have both. Stale copies are removed, and files are only
+# rewritten when they change, so ninja recompiles only what changed.
 model_tree="$tree/hw/misc/dcos"
 mkdir -p "$model_tree"
 for copied in "$model_tree"/*.c "$model_tree"/*.h; do
@@ -163,6 +167,10 @@ for model in "$models_dir"/*.c "$models_dir"/*.h; do
     name=$(basename "$model")
     cmp -s "$model" "$model_tree/$name" || cp "$model" "$model_tree/$name"
     case "$name" in
+    pci_*.c)
+        meson_lines="${meson_lines}softmmu_ss.add(when: 'CONFIG_PCI', if_true: files('dcos/$name')) # dcos model
+"
+        ;;
     *.c)
         meson_lines="${meson_lines}softmmu_ss.add(when: 'CONFIG_ISA_BUS', if_true: files('dcos/$name')) # dcos model
 "
