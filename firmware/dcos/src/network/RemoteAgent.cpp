@@ -268,6 +268,12 @@ Result<CallSlot*> openRemoteCall(Task& self, RemoteService service, ObjectId id)
     if (inInterruptContext()) {
         return Status::InInterrupt; // A remote transaction blocks its caller.
     }
+    if (Scheduler::dispatchHeld()) {
+        // Nor can a task that holds dispatch block: blockOn would return at
+        // once and leave it linked in the slot's wait queue, where the next
+        // reply on that slot would wake it instead of that call's caller.
+        return Status::Deadlock;
+    }
     const Result<NextHop> hop = NetworkInterfacesManager::Resolve(id.node());
     if (!hop.ok()) {
         // A node the tables do not know stays "remote object unreachable",
@@ -516,6 +522,14 @@ Result<ObjectId> askForName(ObjectType type, const char* name, uint8_t except, b
     const uint64_t begun = readCounter();
     if (inInterruptContext()) {
         return Status::InInterrupt;
+    }
+    if (Scheduler::dispatchHeld()) {
+        // The query would block its caller, which cannot while it holds
+        // dispatch (see openRemoteCall). The application loader holds it
+        // while it checks that the names it declares are free, and that
+        // check is of this node's tables: a name query then answers from
+        // them alone.
+        return Status::NotFound;
     }
     Task& self = Scheduler::current();
     CallSlot* slot;
