@@ -74,6 +74,8 @@ THREAD_METRIC_REPORT := $(BUILD)/bench/thread_metric.json
 FOOTPRINT_REPORT := $(BUILD)/bench/footprint.json
 BUDGET_REPORT := $(BUILD)/bench/budgets.json
 REMOTE_REPORT := $(BUILD)/bench/remote.json
+# The dual-Pentium board's figures: primitives on the other node of the board, interrupt latency.
+P5SMP_REPORT := $(BUILD)/bench/p5smp.json
 FLASH_REPORT := $(BUILD)/bench/flash.json
 BENCH_BUDGETS := tests_renode/bench/budgets.toml
 # STRICT=1 makes 'make bench' fail on every figure that offends its budget

@@ -223,6 +223,21 @@ def test_api_suite_on_node_3(boot, p5smp, name):
     emulator.expect_exit(EXIT_PASS, timeout=120)
 
 
+def test_a_remote_call_with_dispatch_held_is_refused_on_node_2(boot, p5smp):
+    """RemoteDispatchHeldTest.cpp: Deadlock at once, never a blocked caller; then node 3 answers the same call."""
+    emulator, _ = boot_both_nodes(boot, p5smp, kind="test")
+    emulator.send("test remoteheld --exit\r")
+    emulator.expect(r"TEST remoteheld: (PASS|FAIL)", timeout=120)
+    emulator.expect_exit(EXIT_PASS, timeout=120)
+
+
+def test_a_remote_call_with_dispatch_held_is_refused_on_node_3(boot, p5smp):
+    emulator, node3 = boot_both_nodes(boot, p5smp, kind="test")
+    node3.send("test remoteheld --exit\r")
+    node3.expect(r"TEST remoteheld: (PASS|FAIL)", timeout=120)
+    emulator.expect_exit(EXIT_PASS, timeout=120)
+
+
 def test_a_second_processor_that_never_answers_is_reported_and_node_2_runs_on(boot, p5smp, tmp_path):
     """The MP table names a second processor at an APIC id nothing answers: STARTUP goes unanswered."""
     emulator, stub, table = boot_at_the_kernel_entry(boot, p5smp, tmp_path)
@@ -266,6 +281,19 @@ def test_node_3_uses_a_semaphore_on_node_2_over_shared_memory(boot, p5smp):
     served = remote.net_counters(emulator)
     assert served["served"] == len(remote_transactions.SEMAPHORE_SEQUENCE), served
     assert remote.net_counters(node3)["unreachable"] == 0
+    # Every message crossed the rings with its interrupt: what one node sent the other received and was
+    # interrupted for, and each interrupt's latency was measured from the sender's stamp.
+    counts = {}
+    for console, node in ((emulator, 2), (node3, 3)):
+        line = console.command("shm")
+        match = re.search(rf"shm node {node} to node {5 - node}: (.*)", line)
+        assert match, line
+        counts[node] = {key: int(value) for key, value in re.findall(r"(\w+)=(\d+)", match.group(1))}
+    for sender, receiver in ((2, 3), (3, 2)):
+        assert counts[sender]["sent"] > 0 and counts[sender]["sent"] == counts[receiver]["received"], counts
+        assert 0 < counts[receiver]["interrupts"] <= counts[sender]["sent"], counts
+        assert 0 < counts[receiver]["latency_min"] <= counts[receiver]["latency_max"] < 10_000_000, counts
+    assert all(counts[node][key] == 0 for node in (2, 3) for key in ("ring_full", "not_signalled", "corrupted"))
 
 
 # QEMU's own Kvaser PCIcan model (hw/net/can/can_kvaser_pci.c), which we did not write, twice on one of

@@ -10,11 +10,27 @@
 
 namespace bsp {
 
+namespace {
+
+// The low half of the Pentium's time-stamp counter (RDTSC, which the i486
+// lacks: this file is built for the dual-Pentium board only).
+uint32_t timeStamp()
+{
+    uint32_t low;
+    uint32_t high;
+    asm volatile("rdtsc" : "=a"(low), "=d"(high));
+    return low;
+}
+
+} // namespace
+
 void SharedMemoryArea::layOut()
 {
     magic = 0;
     toNode3.reset();
     toNode2.reset();
+    signalledAt[0] = 0;
+    signalledAt[1] = 0;
     version = kVersion;
     magic = kMagic;
 }
@@ -51,7 +67,16 @@ void SharedMemoryLink::Stop()
 
 void SharedMemoryLink::onSignal(void* context)
 {
+    const uint32_t now = timeStamp();
     auto* link = static_cast<SharedMemoryLink*>(context);
+    // From the other node's stamp of its last signal: when it signalled
+    // again before this routine ran, the latency of that later one.
+    const uint32_t latency = now - SharedMemoryArea::at().signalledAt[link->ownPhysical_ ^ 1u];
+    SharedMemoryLinkStatistics& counts = link->statistics_;
+    counts.latencyLast = latency;
+    counts.latencyMin = counts.interrupts == 0 || latency < counts.latencyMin ? latency : counts.latencyMin;
+    counts.latencyMax = latency > counts.latencyMax ? latency : counts.latencyMax;
+    ++counts.interrupts;
     (void)dcos::taskAgent.PostEvent(link->receiver_, link->receiveEvent_);
 }
 
@@ -84,6 +109,7 @@ dcos::Status SharedMemoryLink::Send(const dcos::SystemMessage& message)
         return dcos::Status::Busy;
     }
     ++statistics_.sent;
+    area.signalledAt[ownPhysical_] = timeStamp();
     if (!signalOtherNode()) {
         ++statistics_.notSignalled;
     }

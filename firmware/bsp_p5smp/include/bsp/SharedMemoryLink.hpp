@@ -17,6 +17,7 @@
 
 #include <dcos/NetworkLink.hpp>
 
+#include <stddef.h>
 #include <stdint.h>
 
 namespace bsp {
@@ -26,11 +27,19 @@ namespace bsp {
 struct SharedMemoryArea {
     static constexpr uintptr_t kAddress = 0x00F0'0000u;
     static constexpr uint32_t kMagic = 0x44534D4Eu; // "NMSD": laid out
-    static constexpr uint32_t kVersion = 1;
+    static constexpr uint32_t kVersion = 2;
     uint32_t magic;
     uint32_t version;
     SharedMemoryRing toNode3;
     SharedMemoryRing toNode2;
+    /// The low half of the time-stamp counter as each node last raised the
+    /// other's interrupt, written by the sender just before it does (index:
+    /// the sending processor). The receiver's routine reads it to measure
+    /// the inter-processor interrupt's latency, modulo 2^32: 32 bits are
+    /// written in one store, where a 64-bit stamp could be read half new.
+    /// Both processors' counters start at the board's reset and count the
+    /// same clock.
+    volatile uint32_t signalledAt[2];
 
     /// The area at kAddress.
     static SharedMemoryArea& at() { return *reinterpret_cast<SharedMemoryArea*>(kAddress); }
@@ -39,6 +48,8 @@ struct SharedMemoryArea {
     bool laidOut() const { return magic == kMagic && version == kVersion; }
 };
 static_assert(sizeof(SharedMemoryArea) <= 0x1'0000, "the area fits its 64 KiB");
+static_assert(offsetof(SharedMemoryArea, toNode2) == 1296 && offsetof(SharedMemoryArea, signalledAt) == 2584,
+              "the layout docs/protocols/shared-memory.md gives");
 
 /// What a link counted since it started.
 struct SharedMemoryLinkStatistics {
@@ -47,6 +58,14 @@ struct SharedMemoryLinkStatistics {
     uint32_t ringFull = 0;     ///< Sends refused: the other node took nothing for 64 messages.
     uint32_t notSignalled = 0; ///< Messages whose interrupt the local APIC did not deliver (the reader finds them at its next one).
     uint32_t corrupted = 0;    ///< Receives that found the ring's indices overwritten.
+    /// Inter-processor interrupts taken, and their latency from the
+    /// sender's stamp to this node's routine, in counts of the time-stamp
+    /// counter (one per processor clock; one per emulated nanosecond under
+    /// the lab's -icount): the last one, the least and the most.
+    uint32_t interrupts = 0;
+    uint32_t latencyLast = 0;
+    uint32_t latencyMin = 0;
+    uint32_t latencyMax = 0;
 };
 
 class SharedMemoryLink final : public dcos::NetworkLink {
