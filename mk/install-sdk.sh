@@ -1,20 +1,23 @@
 #!/bin/sh
 # Installs DCOS for building applications outside the source tree.
 #
-#   mk/install-sdk.sh <prefix> <library> <minimal library> <production image> <board flags file> <emulator> <host tools bin>
+#   mk/install-sdk.sh <prefix> <emulator> <host tools bin> <board> <library> <minimal library> <image> <board flags file> [<board> ...]
 #
 # Called by 'make install PREFIX=<prefix>' and, for the tree's own 'make app',
-# with the prefix build/sdk. Lays out:
+# with the prefix build/sdk; mk/sdk.mk passes the ISA 486 board (486) and
+# the dual-Pentium board (p5smp), five arguments each. Lays out:
 #
 #   include/                     the firmware's public and internal headers
-#   lib/dcos/486/libdcos486.a    the kernel, board support, shell and drivers
-#   lib/dcos/486/libdcos486-minimal.a  the minimal kernel configuration: the system,
+#   lib/dcos/<board>/libdcos<board>.a  the kernel, board support, shell and drivers
+#   lib/dcos/<board>/libdcos<board>-minimal.a  the minimal kernel configuration: the system,
 #                                scheduler, task and timer agents and board support
-#   lib/dcos/486/link.ld         the image's memory layout
-#   lib/dcos/486/dcos486.elf     the plain controller image (no application)
+#   lib/dcos/<board>/link.ld     the image's memory layout (the same for every board)
+#   lib/dcos/<board>/<image>     the plain controller image (no application): dcos486.elf, dcos-p5smp.elf
+#   lib/dcos/p5smp/include/      the dual-Pentium board's own headers, found before include/ by
+#                                that board's builds only (its bsp/BoardTick.hpp is not the 486's)
+#   share/dcos/board-<board>.mk  the compiler and linker flags, checks and emulated board of each board
 #   share/dcos/application.mk    the application build (see its header)
-#   share/dcos/board-486.mk      the compiler and linker flags of the 486 board
-#   share/dcos/boards/           the emulated boards
+#   share/dcos/boards/           the emulated boards, each with its board's plain image
 #   share/dcos/python/           the emulator lab (dcoslab), its launcher and the distributed plant (plant.py)
 #   share/dcos/pytest.ini        pytest settings for applications' tests
 #   share/dcos/tools/            the i486 instruction check, the configuration error summary,
@@ -35,14 +38,21 @@
 # when their content changes, so a repeated install is quick and keeps times.
 set -eu
 
-[ $# -eq 7 ] || { echo "usage: $0 <prefix> <library> <minimal library> <production image> <board flags file> <emulator> <host tools bin>" >&2; exit 2; }
+usage="usage: $0 <prefix> <emulator> <host tools bin> <board> <library> <minimal library> <image> <board flags file> [<board> ...]"
+[ $# -ge 8 ] && [ $(( ($# - 3) % 5 )) -eq 0 ] || { echo "$usage" >&2; exit 2; }
 prefix=$1
-library=$2
-minimal_library=$3
-image=$4
-board_flags=$5
-emulator=$6
-host_tools_bin=$7
+emulator=$2
+host_tools_bin=$3
+shift 3
+
+# A board whose headers replace common ones of the same name (bsp/BoardTick.hpp:
+# each board inlines its own tick timer) has them installed apart, in
+# lib/dcos/<board>/include/, which application.mk puts first for that board.
+board_include_target() {
+    case "$1" in
+        firmware/bsp_p5smp/include) echo p5smp ;;
+    esac
+}
 
 # Copies a file if it differs, creating directories on the way, with mode
 # $3 (default 644: readable by everyone, whatever the source's mode, e.g. a
@@ -70,18 +80,32 @@ link() {
 }
 
 for include_dir in firmware/*/include drivers/*/include fieldbus/*/include; do
+    board=$(board_include_target "$include_dir")
+    destination="$prefix/include"
+    [ -z "$board" ] || destination="$prefix/lib/dcos/$board/include"
     (cd "$include_dir" && find . -name '*.hpp' -type f) | while read -r header; do
-        put "$include_dir/$header" "$prefix/include/$header"
+        put "$include_dir/$header" "$destination/$header"
     done
 done
 
-put "$library" "$prefix/lib/dcos/486/libdcos486.a"
-put "$minimal_library" "$prefix/lib/dcos/486/libdcos486-minimal.a"
-put firmware/boot/link.ld "$prefix/lib/dcos/486/link.ld"
-put "$image" "$prefix/lib/dcos/486/dcos486.elf"
+# Each board: its libraries, linker script, plain image and flags. The
+# emulated board each one names (DCOS_BOARD_EMULATED) gets that image as
+# its production image below.
+emulated_images=$(mktemp)
+while [ $# -gt 0 ]; do
+    board=$1 library=$2 minimal_library=$3 image=$4 board_flags=$5
+    shift 5
+    put "$library" "$prefix/lib/dcos/$board/libdcos$board.a"
+    put "$minimal_library" "$prefix/lib/dcos/$board/libdcos$board-minimal.a"
+    put firmware/boot/link.ld "$prefix/lib/dcos/$board/link.ld"
+    put "$image" "$prefix/lib/dcos/$board/$(basename "$image")"
+    put "$board_flags" "$prefix/share/dcos/board-$board.mk"
+    emulated=$(sed -n 's/^DCOS_BOARD_EMULATED := *//p' "$board_flags")
+    [ -n "$emulated" ] || { echo "$0: $board_flags names no DCOS_BOARD_EMULATED" >&2; exit 1; }
+    printf '%s lib/dcos/%s/%s\n' "$emulated" "$board" "$(basename "$image")" >> "$emulated_images"
+done
 
 put mk/application.mk "$prefix/share/dcos/application.mk"
-put "$board_flags" "$prefix/share/dcos/board-486.mk"
 put host_tools/isa_check/check_i486.py "$prefix/share/dcos/tools/check_i486.py"
 put host_tools/app_build/explain_configuration_error.py "$prefix/share/dcos/tools/explain_configuration_error.py"
 put tests_renode/pytest.ini "$prefix/share/dcos/pytest.ini"
@@ -108,13 +132,16 @@ for module in tests_renode/dcoslab/*.py; do
     put "$module" "$prefix/share/dcos/python/dcoslab/$(basename "$module")"
 done
 
-# The boards, with the plain controller image as their production image.
+# The boards, with their board's plain controller image as their production
+# image (the first board's, for an emulated board no installed board names).
 for board in tests_renode/boards/*.json; do
     rewritten=$(mktemp)
-    /usr/bin/python3 - "$board" "$rewritten" <<'PYTHON'
+    /usr/bin/python3 - "$board" "$rewritten" "$emulated_images" <<'PYTHON'
 import json, sys
 board = json.load(open(sys.argv[1], encoding="utf-8"))
-board["images"] = {"production": "lib/dcos/486/dcos486.elf"}
+images = [line.split() for line in open(sys.argv[3], encoding="utf-8") if line.strip()]
+production = dict(images).get(board["name"], images[0][1])
+board["images"] = {"production": production}
 with open(sys.argv[2], "w", encoding="utf-8") as handle:
     json.dump(board, handle, indent=4)
     handle.write("\n")
@@ -122,6 +149,7 @@ PYTHON
     put "$rewritten" "$prefix/share/dcos/boards/$(basename "$board")"
     rm -f "$rewritten"
 done
+rm -f "$emulated_images"
 
 # Tells dcoslab it runs from an installation (tests_renode/dcoslab/layout.py).
 layout=$(mktemp)
