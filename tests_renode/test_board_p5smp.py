@@ -223,6 +223,18 @@ def test_api_suite_on_node_3(boot, p5smp, name):
     emulator.expect_exit(EXIT_PASS, timeout=120)
 
 
+@pytest.mark.parametrize("tested", ["node2", "node3"])
+def test_each_line_interrupts_only_the_node_that_owns_it(boot, p5smp, tested):
+    """NodeLinesTest.cpp, after both consoles' lines (IRQ 4 for node 2, IRQ 7 for node 3) have interrupted."""
+    emulator, node3 = boot_both_nodes(boot, p5smp, kind="test")
+    for _ in range(3):
+        assert "p5smp" in emulator.command("version") and "p5smp" in node3.command("version")
+    console = node3 if tested == "node3" else emulator
+    console.send("test nodelines --exit\r")
+    console.expect(r"TEST nodelines: (PASS|FAIL)", timeout=120)
+    emulator.expect_exit(EXIT_PASS, timeout=120)
+
+
 def test_a_remote_call_with_dispatch_held_is_refused_on_node_2(boot, p5smp):
     """RemoteDispatchHeldTest.cpp: Deadlock at once, never a blocked caller; then node 3 answers the same call."""
     emulator, _ = boot_both_nodes(boot, p5smp, kind="test")
