@@ -98,12 +98,13 @@ test-emulator: firmware sdk
 # The reports of the last run are removed first, so that the verdict never
 # reads a figure a failed step left behind.
 bench: deps
-	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH) $(IMAGE_486) $(IMAGE_486_MINIMAL) $(IMAGE_486_TEST_COUNTING) $(FOOTPRINT_MAP) $(FOOTPRINT_MAP_MINIMAL) $(IMAGE_P5SMP_TEST)
-	@rm -f $(PRIMITIVES_REPORT) $(THREAD_METRIC_REPORT) $(REMOTE_REPORT) $(P5SMP_REPORT) $(FLASH_REPORT) $(FOOTPRINT_REPORT) $(BUDGET_REPORT)
+	@$(MAKE) --no-print-directory $(IMAGE_486_BENCH) $(IMAGE_486) $(IMAGE_486_MINIMAL) $(IMAGE_486_TEST_COUNTING) $(FOOTPRINT_MAP) $(FOOTPRINT_MAP_MINIMAL) $(IMAGE_P5SMP_TEST) $(IMAGE_P5SMP_BENCH)
+	@rm -f $(PRIMITIVES_REPORT) $(THREAD_METRIC_REPORT) $(REMOTE_REPORT) $(P5SMP_REPORT) $(P5SMP_KERNEL_REPORT) $(P5SMP_PRIMITIVES_REPORT) $(FLASH_REPORT) $(FOOTPRINT_REPORT) $(BUDGET_REPORT)
 	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board isa486 --output $(BENCH_REPORT) --primitives $(PRIMITIVES_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/thread_metric/run_thread_metric.py --board isa486 --output $(THREAD_METRIC_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/bench/remote_bench.py --output $(REMOTE_REPORT) --budgets $(BENCH_BUDGETS)
 	@$(PYTHON) tests_renode/bench/p5smp_bench.py --output $(P5SMP_REPORT)
+	@$(PYTHON) tests_renode/bench/run_benchmarks.py --board p5smp --kvm off --output $(P5SMP_KERNEL_REPORT) --primitives $(P5SMP_PRIMITIVES_REPORT) --can $(BUILD)/bench/can-p5smp.json --modbus $(BUILD)/bench/modbus-p5smp.json --budgets $(BENCH_BUDGETS)
 	@$(MAKE) --no-print-directory card loader host-tools
 	@$(PYTHON) tests_renode/bench/flash_bench.py --output $(FLASH_REPORT)
 	@$(PYTHON) tests_renode/bench/footprint.py --maps $(FOOTPRINT_MAPS) --build-directory $(FW_BUILD) --output $(FOOTPRINT_REPORT) --budgets $(BENCH_BUDGETS)

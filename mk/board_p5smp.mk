@@ -100,3 +100,4 @@ $(FWP5_BUILD)/%.S.o: %.S $(FWP5_FLAGS_STAMP)
 	$(Q)g++ $(FWP5_ASFLAGS) -c $< -o $@
 
 -include $(shell find $(FWP5_BUILD) -name '*.d' 2>/dev/null)
+
