@@ -100,4 +100,3 @@ $(FWP5_BUILD)/%.S.o: %.S $(FWP5_FLAGS_STAMP)
 	$(Q)g++ $(FWP5_ASFLAGS) -c $< -o $@
 
 -include $(shell find $(FWP5_BUILD) -name '*.d' 2>/dev/null)
-
