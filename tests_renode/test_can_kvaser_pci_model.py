@@ -12,7 +12,7 @@ Xilinx version, INTA# gated by the add-on interrupt enable, and the reset.
 The chips' own behaviour on the lab bus is proven elsewhere: on the ISA card
 by test_can_bus.py and test_can_driver.py (the same chip core,
 sja1000_lab_chip.c), and on this card by Linux's driver in
-test_can_kvaser_pci_linux.py. Here a chip raises its interrupt by itself: in
+test_can_sja1000_linux.py (its pci run). Here a chip raises its interrupt by itself: in
 self test mode on its lone bus (no hub), a self reception request completes
 without acknowledge (TI) and receives the frame (RI).
 

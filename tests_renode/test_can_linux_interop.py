@@ -89,6 +89,7 @@ bus.shutdown()
 VM_SCRIPT = r"""
 . /run/labvm/lib.sh
 cd /tmp
+""" + vmworld.PHASE_SHELL + r"""
 # slcan's queue is 10 frames; the kernel's ISO-TP sender puts consecutive frames in it faster than the
 # serial line takes them, and a full queue drops the frame (seen: the last one of a transfer).
 ip link set can0 txqueuelen 1000
@@ -97,17 +98,7 @@ candump -L can0 >/tmp/trace.log &
 trace=$!
 
 # -- raw frames both ways --
-timeout 150 candump -L -n 3 can0 >/tmp/raw.log &
-raw=$!
-timeout 150 candump -n 1 can0,7F1:7FF >/dev/null &
-go=$!
-labvm_wait_receiver can0 raw 7f1 30
-labvm_wait_receiver can0 raw 0 30
-echo "@@READY raw@@"
-wait $go
-cansend can0 123#11223344
-wait $raw
-echo "@@RAW"; cut -d' ' -f2- /tmp/raw.log; echo "@@END RAW@@"
+raw_phase 123#11223344
 
 # -- python-can as a peer --
 timeout 150 /usr/bin/python3 /run/labvm/files/peer.py
@@ -160,15 +151,7 @@ while :; do
 done
 
 # -- the session's trace --
-# candump writes each frame as it comes: stop it once the last frame of the session is in.
-deadline=$(( $(labvm_uptime) + 30 ))
-while ! grep -q " can0 __LAST_FRAME__\$" /tmp/trace.log; do
-    [ "$(labvm_uptime)" -lt "$deadline" ] || { echo "no __LAST_FRAME__ in the trace in 30 s" >&2; break; }
-    sleep 0.05
-done
-kill -INT $trace
-wait $trace
-echo "@@TRACE"; cut -d' ' -f2- /tmp/trace.log; echo "@@END TRACE@@"
+end_trace __LAST_FRAME__
 echo "@@QDISC $(tc -s qdisc show dev can0 | tr '\n' ' ')@@"
 """.replace("__MESSAGE__", " ".join(f"{byte:02X}" for byte in MESSAGE)).replace("__LAST_FRAME__", LAST_FRAME)
 

@@ -19,24 +19,13 @@ import re
 
 import pytest
 
-from dcoslab import remote
 from dcoslab.board import load_board
 from dcoslab.node_console import NodeConsole
-from dcoslab.remote import REQUEST, REPLY, created, net_counters, wait_tally
+from dcoslab.remote import REQUEST, REPLY, created, dcos_frames as frames, net_counters, wait_tally
 from dcoslab.remote import publish as remote_publish, subscribe as remote_subscribe
 
-BIT_RATE = 500_000
-WATCHDOG_MS = 50       # DCOS_CONFIG_REMOTE_WATCHDOG_MS
-SILENT_PERIODS = 4     # DCOS_CONFIG_REMOTE_SILENT_PERIODS
-RELAYED = 0x21         # a publication frame a gateway relays (docs/protocols/remote-transactions.md)
-SEQUENCE = ["count {}", "acquire {} 0", "count {}", "acquire {} 0", "acquire {} 200", "release {}", "release {}",
-            "release {}", "count {}"]
-
-
-def configure(board, lines, timeout=120):
-    for line in lines:
-        output = board.command(line, timeout=timeout)
-        assert "error:" not in output, (line, output)
+# The same bit rate, watchdog, calls and sequence as the gateway between two CAN buses.
+from test_remote_gateway import BIT_RATE, RELAYED, SEQUENCE, SILENT_PERIODS, WATCHDOG_MS, call, configure
 
 
 @pytest.fixture
@@ -57,22 +46,6 @@ def nodes(canlab):
                     "can attach can0"])
     configure(three, ["net map 1 130.1.0.1", "net route 130.1.0.0/16 130.3.0.2"])
     return lab, one, two, three
-
-
-def call(board, line):
-    """A `remote` primitive's (status, value, milliseconds)."""
-    status, value, us = remote.call(board, line)
-    return status, value, us / 1000
-
-
-def frames(lab, kind):
-    """The bus log's DCOS frames of one message type: (priority, destination, source, data)."""
-    found = []
-    for record in lab.hub.frames():
-        raw = record.frame.id
-        if record.outcome == "ok" and record.frame.extended and (raw >> 16) & 0xFF == kind:
-            found.append((raw >> 24, (raw >> 8) & 0xFF, raw & 0xFF, bytes(record.frame.data)))
-    return found
 
 
 def test_node_3_uses_a_semaphore_on_node_1_through_node_2(nodes):

@@ -21,7 +21,6 @@ budgets (the single-node tables of run_benchmarks.py are the isa486 board's; the
 """
 
 import argparse
-import json
 import os
 import re
 import statistics
@@ -34,6 +33,7 @@ from dcoslab.board import REPOSITORY, load_board  # noqa: E402
 from dcoslab.emulator import Emulator, EmulatorError  # noqa: E402
 from dcoslab.node_console import NodeConsole  # noqa: E402
 from dcoslab.remote import call, created  # noqa: E402
+from run_benchmarks import write_json  # noqa: E402
 
 
 IMAGE_KIND = "test"
@@ -128,11 +128,7 @@ def main():
     print("  under -icount the other processor takes an interrupt when the emulator next runs it (see above)")
     report = {"board": board.name, "image": board.images[IMAGE_KIND], "calls_per_primitive": arguments.calls,
               "call_priority": CALL_PRIORITY, "round_trips": directions, "interrupts": interrupts}
-    os.makedirs(os.path.dirname(os.path.abspath(arguments.output)), exist_ok=True)
-    with open(arguments.output, "w", encoding="utf-8") as handle:
-        json.dump(report, handle, indent=2)
-        handle.write("\n")
-    print(f"wrote {arguments.output}")
+    write_json(arguments.output, report)
     return 0
 
 

@@ -6,7 +6,8 @@ boards and hub, and its tests take the script's phases in turn
 pieces, closes them whatever happened, and hands the lab plugin what a
 failing test's report shows: every console, the VM's, and the bus log.
 The helpers below are the phases' common words: the frames as candump -L
-writes them, the hub's "go" frames, and the VM's marked output sections.
+writes them, the hub's "go" frames, and the VM's marked output sections;
+PHASE_SHELL holds the VM's side of the phases the scripts share.
 """
 
 import os
@@ -14,6 +15,42 @@ import time
 
 from .canbus import Frame
 from .emulator import Emulator
+
+
+# Shell functions of the VM scripts that run in phases against a board on the lab bus can0; a script puts
+# them after `. /run/labvm/lib.sh`, whose functions they call.
+PHASE_SHELL = r"""
+# raw_phase FRAME...: frames both ways. candump takes the board's frame (sent before the phase's go frame),
+# the go frame 7F1 and then each FRAME, which cansend puts on can0 once the go frame came; @@READY raw@@
+# once the receivers listen, and the frames as the section RAW.
+raw_phase() {
+    timeout 150 candump -L -n $(($# + 2)) can0 >/tmp/raw.log &
+    _raw=$!
+    timeout 150 candump -n 1 can0,7F1:7FF >/dev/null &
+    _go=$!
+    labvm_wait_receiver can0 raw 7f1 30
+    labvm_wait_receiver can0 raw 0 30
+    echo "@@READY raw@@"
+    wait $_go
+    for _frame in "$@"; do
+        cansend can0 "$_frame"
+    done
+    wait $_raw
+    echo "@@RAW"; cut -d' ' -f2- /tmp/raw.log; echo "@@END RAW@@"
+}
+# end_trace LAST_FRAME: stops the session's trace (candump -L can0 >/tmp/trace.log, its pid in $trace) once
+# LAST_FRAME is in (candump writes each frame as it comes) and prints it as the section TRACE.
+end_trace() {
+    _deadline=$(( $(labvm_uptime) + 30 ))
+    while ! grep -q " can0 $1\$" /tmp/trace.log; do
+        [ "$(labvm_uptime)" -lt "$_deadline" ] || { echo "no $1 in the trace in 30 s" >&2; break; }
+        sleep 0.05
+    done
+    kill -INT $trace
+    wait $trace
+    echo "@@TRACE"; cut -d' ' -f2- /tmp/trace.log; echo "@@END TRACE@@"
+}
+"""
 
 
 class Report:
