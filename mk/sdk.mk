@@ -24,7 +24,8 @@ BOARD_FLAGS_486 := $(BUILD)/486/board-486.mk
 LIBRARY_P5SMP := $(BUILD)/p5smp/libdcosp5smp.a
 LIBRARY_P5SMP_MINIMAL := $(BUILD)/p5smp/libdcosp5smp-minimal.a
 BOARD_FLAGS_P5SMP := $(BUILD)/p5smp/board-p5smp.mk
-FWP5_MINIMAL_OBJS := $(filter-out $(FWP5_REPLACED_OBJS),$(FW_MINIMAL_OBJS)) $(FWP5_OWN_OBJS)
+# The minimal configuration has no shell: the board's console commands stay out, as the kernel's do.
+FWP5_MINIMAL_OBJS := $(filter-out $(FWP5_REPLACED_OBJS),$(FW_MINIMAL_OBJS)) $(filter-out %Commands.cpp.o,$(FWP5_OWN_OBJS))
 APPLICATION_MAKEFILE := $(SDK_STAGE)/share/dcos/application.mk
 # The emulator's path changes with its sources (tests_renode/qemu/build_qemu.sh).
 QEMU_BINARY := $(shell $(QEMU_BUILD_SCRIPT) --print-path)

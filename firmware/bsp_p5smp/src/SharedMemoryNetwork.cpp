@@ -3,7 +3,8 @@
 // SharedMemory on each node, 130.3.0.<node>/16, physical address the
 // processor, carried by a SharedMemoryLink, and the other node mapped and
 // its physical address set, so that a primitive given the other node's id
-// goes over it at once. The console command `shm` shows the link's counts.
+// goes over it at once. The console command `shm` shows the link's counts
+// (SharedMemoryCommands.cpp).
 #include <bsp/P5smpBoard.hpp>
 #include <bsp/SharedMemoryLink.hpp>
 
@@ -11,8 +12,6 @@
 #include <dcos/NetworkInterfacesManager.hpp>
 #include <dcos/internal/NetworkBootHooks.hpp>
 #include <runtime/Format.hpp>
-#include <shell/Shell.hpp>
-#include <shell/ShellCommand.hpp>
 
 namespace {
 
@@ -26,36 +25,13 @@ dcos::NetworkAddress addressOf(uint16_t node)
 }
 constexpr uint8_t kPrefixLength = 16;
 
-shell::CommandResult shm(shell::Shell& shell, int argc, char**)
-{
-    if (argc != 1) {
-        return shell::CommandResult::UsageError;
-    }
-    if (!link.started()) {
-        shell.print("shm: not started (%s)\r\n",
-                    bsp::otherNodeRunning() ? "see the boot report" : "the board's other node does not run");
-        return shell::CommandResult::Ok;
-    }
-    const bsp::SharedMemoryLinkStatistics s = link.statistics();
-    shell.print("shm node %u to node %u: sent=%lu received=%lu ring_full=%lu not_signalled=%lu corrupted=%lu "
-                "interrupts=%lu latency_last=%lu latency_min=%lu latency_max=%lu\r\n",
-                unsigned(bsp::nodeId()), unsigned(bsp::otherNodeId()), static_cast<unsigned long>(s.sent),
-                static_cast<unsigned long>(s.received), static_cast<unsigned long>(s.ringFull),
-                static_cast<unsigned long>(s.notSignalled), static_cast<unsigned long>(s.corrupted),
-                static_cast<unsigned long>(s.interrupts), static_cast<unsigned long>(s.latencyLast),
-                static_cast<unsigned long>(s.latencyMin), static_cast<unsigned long>(s.latencyMax));
-    return shell::CommandResult::Ok;
-}
-
 } // namespace
 
-DCOS_SHELL_COMMAND_DETAILED(shmCommand, "shm", "show the shared-memory network's counts (dual-Pentium board)", "shm",
-                            "  sent, received: messages through the rings; ring_full: sends refused, the other node\r\n"
-                            "  took nothing for 64 messages; not_signalled: interrupts the local APIC did not deliver;\r\n"
-                            "  corrupted: receives that found a ring's indices overwritten\r\n"
-                            "  interrupts: the other node's interrupts taken; latency: from its stamp to this node's\r\n"
-                            "  routine, in time-stamp counts (processor clocks; emulated ns under -icount)",
-                            shm);
+namespace bsp {
+
+const SharedMemoryLink& boardSharedMemoryLink() { return link; }
+
+} // namespace bsp
 
 namespace dcos::internal {
 

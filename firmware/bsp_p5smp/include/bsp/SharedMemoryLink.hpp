@@ -97,4 +97,7 @@ private:
     SharedMemoryLinkStatistics statistics_{};
 };
 
+/// The link the board's network runs on (SharedMemoryNetwork.cpp), for its counts.
+const SharedMemoryLink& boardSharedMemoryLink();
+
 } // namespace bsp
