@@ -223,6 +223,13 @@ def test_api_suite_on_node_3(boot, p5smp, name):
     emulator.expect_exit(EXIT_PASS, timeout=120)
 
 
+# The on-target tests of the dual board alone (test_kernel_core.py checks that some emulator test runs each).
+P5SMP_TARGET_TESTS = [
+    "nodelines",   # each line interrupts only the node that owns it (NodeLinesTest.cpp)
+    "remoteheld",  # a remote call with dispatch held is refused (RemoteDispatchHeldTest.cpp)
+]
+
+
 @pytest.mark.parametrize("tested", ["node2", "node3"])
 def test_each_line_interrupts_only_the_node_that_owns_it(boot, p5smp, tested):
     """NodeLinesTest.cpp, after both consoles' lines (IRQ 4 for node 2, IRQ 7 for node 3) have interrupted."""
