@@ -96,6 +96,15 @@ def test_a_power_cut_at_the_revert_of_a_trial_that_never_confirmed(boot, isa486,
 # header sector, its payload's 243 sectors one by one, and the pending
 # state: 245 writes. Cut before the first, in the middle, and before the
 # payload's last sector; the cut before the pending state is below.
+# How long dcos-flash waits for each answer before it says "no answer"
+# (exit 4). This board runs in host time, so on a host busy with other
+# emulators (a lab VM beside it in the suite) a write that did not fail can
+# take seconds to be answered; 4 s was once too short, and dcos-flash gave up
+# before the board reached the cut write. The wait is spent only once, after
+# the cut.
+ANSWER_TIMEOUT_MS = "10000"
+
+
 def assert_cut(cut):
     """dcos-flash's end at the cut: the board stopped at the failed write,
     so nothing answered (exit 4). On a busy host the board's ATA driver may
@@ -121,7 +130,7 @@ def test_a_power_cut_during_a_download_leaves_the_card_as_it_was_and_the_downloa
     emulator.expect(r"stage: recovery: waiting for an image on this serial line")
     emulator.release_console()
     cut = subprocess.run([os.path.join(BIN, "dcos-flash"), "-d", f"unix:{emulator.console_socket_path}",
-                          "-k", DEVELOPMENT_KEY, "--timeout-ms", "4000", "--retries", "0", image],
+                          "-k", DEVELOPMENT_KEY, "--timeout-ms", ANSWER_TIMEOUT_MS, "--retries", "0", image],
                          capture_output=True, text=True, timeout=300)
     assert_cut(cut)
     if cut.returncode == 4:
@@ -155,7 +164,7 @@ def test_a_power_cut_before_a_whole_download_is_marked_pending_leaves_it_a_trial
     emulator.expect(r"stage: recovery: waiting for an image on this serial line")
     emulator.release_console()
     cut = subprocess.run([os.path.join(BIN, "dcos-flash"), "-d", f"unix:{emulator.console_socket_path}",
-                          "-k", DEVELOPMENT_KEY, "--timeout-ms", "4000", "--retries", "0", image],
+                          "-k", DEVELOPMENT_KEY, "--timeout-ms", ANSWER_TIMEOUT_MS, "--retries", "0", image],
                          capture_output=True, text=True, timeout=300)
     assert_cut(cut)
     emulator.wait_power_cut()
