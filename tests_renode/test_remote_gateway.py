@@ -21,7 +21,7 @@ import pytest
 
 from dcoslab import remote
 from dcoslab.canbus import Frame
-from dcoslab.remote import REPLY, REQUEST, created, net_counters, wait_tally
+from dcoslab.remote import REPLY, REQUEST, SEMAPHORE_SEQUENCE, created, net_counters, semaphore_sequence, wait_tally
 from dcoslab.remote import publish as remote_publish, subscribe as remote_subscribe
 
 BIT_RATE = 500_000
@@ -72,28 +72,21 @@ def frames(lab, bus, kind):
     return found
 
 
-SEQUENCE = ["count {}", "acquire {} 0", "count {}", "acquire {} 0", "acquire {} 200", "release {}", "release {}",
-            "release {}", "count {}"]
+SEQUENCE = SEMAPHORE_SEQUENCE
 
 
 def test_a_semaphore_behind_a_gateway_answers_as_a_local_one(triple):
     lab, one, two, three = triple
-    far_semaphore = created(three, "remote sem 1 2", "RSEM")
-    local_semaphore = created(three, "remote sem 1 2", "RSEM")
+    far_semaphore, far = semaphore_sequence(one, three)
     assert far_semaphore.startswith("0x0003")
-    far = [call(one, step.format(far_semaphore)) for step in SEQUENCE]
-    local = [call(three, step.format(local_semaphore)) for step in SEQUENCE]
-    assert [(status, value) for status, value, _ in far] == [(status, value) for status, value, _ in local]
-    assert [status for status, _, _ in far] == [
-        "ok", "ok", "ok", "would block", "timed out", "ok", "ok", "invalid argument", "ok"]
     # A call that does not wait crosses both buses: the header and the
     # request on can0, the request on can1, a reply on each; against node 2's
     # direct call on node 3, two frames, it takes two to three times as long.
     direct = call(two, f"count {far_semaphore}")[2]
-    routed_trips = {ms for (status, _, ms), step in zip(far, SEQUENCE) if "200" not in step}
+    routed_trips = {us / 1000 for (status, _, us), step in zip(far, SEQUENCE) if "200" not in step}
     assert all(2 * direct < trip < 3 * direct for trip in routed_trips), (far, direct)
     # The 200 ms wait was node 3's; the answer came back through node 2 after it.
-    assert 200 <= far[4][2] < 200 + 2 * SILENT_PERIODS * WATCHDOG_MS
+    assert 200 <= far[4][2] / 1000 < 200 + 2 * SILENT_PERIODS * WATCHDOG_MS
     # On can0: node 1's routed requests to node 2, each a route header naming
     # node 3 and the request; node 2's replies. On can1: node 2's own requests
     # to node 3 and node 3's replies. No routed frame reaches can1.

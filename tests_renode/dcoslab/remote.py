@@ -80,6 +80,29 @@ def call(board, line, timeout=120):
     return parse_result(board.command("remote " + line, timeout=timeout))
 
 
+# The calls the remote semaphore tests make on a counting semaphore of count 1 and maximum 2, and what each
+# answers, remote or local: the same sequence wherever the semaphore is.
+SEMAPHORE_SEQUENCE = ["count {}", "acquire {} 0", "count {}", "acquire {} 0", "acquire {} 200", "release {}",
+                      "release {}", "release {}", "count {}"]
+SEMAPHORE_STATUSES = ["ok", "ok", "ok", "would block", "timed out", "ok", "ok", "invalid argument", "ok"]
+
+
+def semaphore_sequence(caller, owner):
+    """SEMAPHORE_SEQUENCE from caller on a new semaphore of owner's, and from owner on a twin of it.
+
+    Checks that the two give the same statuses and values, those of
+    SEMAPHORE_STATUSES, and returns the far semaphore's id and the caller's
+    results as call() gives them: (status, value, microseconds) per call."""
+    far_semaphore = created(owner, "remote sem 1 2", "RSEM")
+    local_semaphore = created(owner, "remote sem 1 2", "RSEM")
+    far = [call(caller, step.format(far_semaphore)) for step in SEMAPHORE_SEQUENCE]
+    local = [call(owner, step.format(local_semaphore)) for step in SEMAPHORE_SEQUENCE]
+    assert [(status, value) for status, value, _ in far] == [(status, value) for status, value, _ in local], \
+        (far, local)
+    assert [status for status, _, _ in far] == SEMAPHORE_STATUSES, far
+    return far_semaphore, far
+
+
 def dcos_frames(lab, kind, records=None):
     """The bus log's DCOS frames of a message type, as (priority, destination, source, data).
 
