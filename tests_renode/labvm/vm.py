@@ -102,7 +102,42 @@ def built_qemu_x86_64():
     return path
 
 
-class Sja1000Setup:
+class _HubCardSetup:
+    """What both SJA1000 cards' setups share: their buses and name at the lab CAN bus hub, checked, the hub's
+    properties of their QEMU device, and the lines that configure and bring up each wired chip's interface
+    (the interface names come from the card's `channels`, whose last field each is)."""
+
+    def __init__(self, hub, buses, name, bitrate, hub_timeout, what):
+        if not any(buses):
+            raise ValueError(f"the card needs at least one {what} on a bus")
+        for bus in buses:
+            if bus is not None and not re.match(r"^[A-Za-z0-9_-]{1,32}$", bus):
+                raise ValueError(f"{bus!r} is not a lab bus name")
+        if not re.match(r"^[A-Za-z0-9_-]{1,32}$", name):
+            raise ValueError(f"{name!r} is not a hub participant name (one word, no dots)")
+        if "," in hub:
+            raise ValueError(f"the hub's socket path {hub!r} may not contain a comma (a QEMU option separator)")
+        self.hub = hub
+        self.buses = tuple(buses)
+        self.name = name
+        self.bitrate = bitrate
+        self.hub_timeout = hub_timeout
+
+    def hub_properties(self):
+        """The QEMU device's properties that join the card to the hub, its wired buses last."""
+        properties = [f"hub={self.hub}", f"hub-name={self.name}", "hub-realtime=on", f"hub-timeout={self.hub_timeout}"]
+        return properties + [f"bus{index}={bus}" for index, bus in enumerate(self.buses) if bus]
+
+    def setup_lines(self):
+        if self.bitrate is None:
+            return []
+        lines = []
+        for *_, name in self.channels:
+            lines += [f"ip link set {name} type can bitrate {int(self.bitrate)}", f"ip link set {name} up"]
+        return lines
+
+
+class Sja1000Setup(_HubCardSetup):
     """Our ISA SJA1000 card (QEMU device isa-sja1000) in the VM, on buses of the lab CAN bus hub, driven by
     Linux's own sja1000_isa driver (docs/guide/lab-vm.md, "The ISA SJA1000 card").
 
@@ -116,22 +151,9 @@ class Sja1000Setup:
 
     def __init__(self, hub, bus0="can0", bus1=None, name="linux", bitrate=500000, iobase=0x280, irq0=5, irq1=7,
                  hub_timeout=60):
-        if not bus0 and not bus1:
-            raise ValueError("the card needs at least one channel on a bus")
-        for bus in (bus0, bus1):
-            if bus is not None and not re.match(r"^[A-Za-z0-9_-]{1,32}$", bus):
-                raise ValueError(f"{bus!r} is not a lab bus name")
-        if not re.match(r"^[A-Za-z0-9_-]{1,32}$", name):
-            raise ValueError(f"{name!r} is not a hub participant name (one word, no dots)")
-        if "," in hub:
-            raise ValueError(f"the hub's socket path {hub!r} may not contain a comma (a QEMU option separator)")
-        self.hub = hub
-        self.buses = (bus0, bus1)
-        self.name = name
-        self.bitrate = bitrate
+        super().__init__(hub, (bus0, bus1), name, bitrate, hub_timeout, "channel")
         self.iobase = iobase
         self.irqs = (irq0, irq1)
-        self.hub_timeout = hub_timeout
 
     @property
     def channels(self):
@@ -148,10 +170,8 @@ class Sja1000Setup:
         raise ValueError(f"channel {channel} of the card is not wired to a bus")
 
     def device_argument(self):
-        properties = [f"iobase={self.iobase:#x}", f"irq0={self.irqs[0]}", f"irq1={self.irqs[1]}", f"hub={self.hub}",
-                      f"hub-name={self.name}", "hub-realtime=on", f"hub-timeout={self.hub_timeout}"]
-        properties += [f"bus{index}={bus}" for index, bus in enumerate(self.buses) if bus]
-        return "isa-sja1000," + ",".join(properties)
+        properties = [f"iobase={self.iobase:#x}", f"irq0={self.irqs[0]}", f"irq1={self.irqs[1]}"]
+        return "isa-sja1000," + ",".join(properties + self.hub_properties())
 
     def load_line(self):
         """The modprobe line: sja1000_isa takes arrays, one entry per chip (its clk defaults to 16 MHz)."""
@@ -159,16 +179,8 @@ class Sja1000Setup:
         return (f"sja1000_isa port={','.join(f'{port:#x}' for _, port, _, _ in channels)} "
                 f"irq={','.join(str(irq) for _, _, irq, _ in channels)}")
 
-    def setup_lines(self):
-        if self.bitrate is None:
-            return []
-        lines = []
-        for _, _, _, name in self.channels:
-            lines += [f"ip link set {name} type can bitrate {int(self.bitrate)}", f"ip link set {name} up"]
-        return lines
 
-
-class KvaserPciSetup:
+class KvaserPciSetup(_HubCardSetup):
     """The lab's Kvaser PCIcan (QEMU device lab-kvaser-pci) in the VM, its chips on buses of the lab CAN bus hub,
     driven by Linux's own kvaser_pci driver (docs/guide/lab-vm.md, "The Kvaser PCI card").
 
@@ -185,20 +197,7 @@ class KvaserPciSetup:
         buses = tuple(buses)
         if not 1 <= len(buses) <= 4:
             raise ValueError(f"a Kvaser PCIcan carries 1 to 4 chips, not {len(buses)}")
-        if not any(buses):
-            raise ValueError("the card needs at least one chip on a bus")
-        for bus in buses:
-            if bus is not None and not re.match(r"^[A-Za-z0-9_-]{1,32}$", bus):
-                raise ValueError(f"{bus!r} is not a lab bus name")
-        if not re.match(r"^[A-Za-z0-9_-]{1,32}$", name):
-            raise ValueError(f"{name!r} is not a hub participant name (one word, no dots)")
-        if "," in hub:
-            raise ValueError(f"the hub's socket path {hub!r} may not contain a comma (a QEMU option separator)")
-        self.hub = hub
-        self.buses = buses
-        self.name = name
-        self.bitrate = bitrate
-        self.hub_timeout = hub_timeout
+        super().__init__(hub, buses, name, bitrate, hub_timeout, "chip")
 
     @property
     def channels(self):
@@ -212,22 +211,11 @@ class KvaserPciSetup:
         return f"can{channel}"
 
     def device_argument(self):
-        properties = [f"channels={len(self.buses)}", f"hub={self.hub}", f"hub-name={self.name}", "hub-realtime=on",
-                      f"hub-timeout={self.hub_timeout}"]
-        properties += [f"bus{index}={bus}" for index, bus in enumerate(self.buses) if bus]
-        return "lab-kvaser-pci," + ",".join(properties)
+        return "lab-kvaser-pci," + ",".join([f"channels={len(self.buses)}"] + self.hub_properties())
 
     def load_line(self):
         """The modprobe line: kvaser_pci binds to the card by its PCI identity and takes no options."""
         return "kvaser_pci"
-
-    def setup_lines(self):
-        if self.bitrate is None:
-            return []
-        lines = []
-        for _, _, name in self.channels:
-            lines += [f"ip link set {name} type can bitrate {int(self.bitrate)}", f"ip link set {name} up"]
-        return lines
 
 
 class Result:
