@@ -120,6 +120,12 @@ static void sja_card_realize(DeviceState *dev, Error **errp)
     ERRP_GUARD();
     ISADevice *isa = ISA_DEVICE(dev);
     IsaSja1000State *card = ISA_SJA1000(dev);
+    LabBusLinkConfig config = {
+        .path = card->hub_path,
+        .name = card->hub_name,
+        .timeout_s = card->hub_timeout_s,
+        .realtime = card->hub_realtime,
+    };
     unsigned i;
 
     if (card->iobase > 0x10000 - SJA_CARD_PORTS ||
@@ -145,44 +151,20 @@ static void sja_card_realize(DeviceState *dev, Error **errp)
                    "; each channel needs its own line", card->irq_line[0]);
         return;
     }
-    for (i = 0; i < SJA_CARD_CHANNELS; i++) {
-        bool named = card->bus_name[i] && *card->bus_name[i];
-
-        if (named && !(card->hub_path && *card->hub_path)) {
-            error_setg(errp, "isa-sja1000: bus%u=%s needs hub=<socket of the "
-                       "lab bus hub>", i, card->bus_name[i]);
-            return;
-        }
-    }
-    if (card->hub_path && *card->hub_path) {
-        LabBusLinkConfig config = {
-            .path = card->hub_path,
-            .name = card->hub_name,
-            .timeout_s = card->hub_timeout_s,
-            .realtime = card->hub_realtime,
-        };
-
-        card->link = labbus_board_link_join(OBJECT(card), &config, errp);
-        if (!card->link) {
-            return;
-        }
+    if (!sja1000_card_join_hub(OBJECT(card), TYPE_ISA_SJA1000, card->bus_name,
+                               SJA_CARD_CHANNELS, &config, &card->link,
+                               errp)) {
+        return;
     }
 
     memory_region_init_io(&card->io, OBJECT(dev), &sja_card_ops, card,
                           TYPE_ISA_SJA1000, SJA_CARD_PORTS);
     isa_register_ioport(isa, &card->io, card->iobase);
     for (i = 0; i < SJA_CARD_CHANNELS; i++) {
-        Sja1000Channel *ch = &card->chan[i];
-
-        sja1000_chip_init(ch, isa_get_irq(isa, card->irq_line[i]),
-                          card->link);
-        if (card->bus_name[i] && *card->bus_name[i]) {
-            char label[8];
-
-            snprintf(label, sizeof(label), "%u", i);
-            if (!sja1000_chip_attach(ch, card->bus_name[i], label, errp)) {
-                return;
-            }
+        if (!sja1000_card_chip_start(&card->chan[i], i,
+                                     isa_get_irq(isa, card->irq_line[i]),
+                                     card->link, card->bus_name[i], errp)) {
+            return;
         }
     }
 }

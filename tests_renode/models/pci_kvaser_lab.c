@@ -320,7 +320,12 @@ static void kvaser_realize(PCIDevice *pci, Error **errp)
 {
     ERRP_GUARD();
     LabKvaserPciState *card = LAB_KVASER_PCI(pci);
-    bool hub = card->hub_path && *card->hub_path;
+    LabBusLinkConfig config = {
+        .path = card->hub_path,
+        .name = card->hub_name,
+        .timeout_s = card->hub_timeout_s,
+        .realtime = card->hub_realtime,
+    };
     unsigned i;
 
     if (card->channels < 1 || card->channels > KVASER_MAX_CHIPS) {
@@ -338,24 +343,11 @@ static void kvaser_realize(PCIDevice *pci, Error **errp)
                        card->bus_name[i], card->channels);
             return;
         }
-        if (named && !hub) {
-            error_setg(errp, "lab-kvaser-pci: bus%u=%s needs hub=<socket of "
-                       "the lab bus hub>", i, card->bus_name[i]);
-            return;
-        }
     }
-    if (hub) {
-        LabBusLinkConfig config = {
-            .path = card->hub_path,
-            .name = card->hub_name,
-            .timeout_s = card->hub_timeout_s,
-            .realtime = card->hub_realtime,
-        };
-
-        card->link = labbus_board_link_join(OBJECT(card), &config, errp);
-        if (!card->link) {
-            return;
-        }
+    if (!sja1000_card_join_hub(OBJECT(card), TYPE_LAB_KVASER_PCI,
+                               card->bus_name, card->channels, &config,
+                               &card->link, errp)) {
+        return;
     }
 
     pci->config[PCI_INTERRUPT_PIN] = 1; /* INTA# */
@@ -378,16 +370,9 @@ static void kvaser_realize(PCIDevice *pci, Error **errp)
     card->chip_irqs = qemu_allocate_irqs(kvaser_chip_irq, card,
                                          card->channels);
     for (i = 0; i < card->channels; i++) {
-        Sja1000Channel *ch = &card->chan[i];
-
-        sja1000_chip_init(ch, card->chip_irqs[i], card->link);
-        if (card->bus_name[i] && *card->bus_name[i]) {
-            char label[8];
-
-            snprintf(label, sizeof(label), "%u", i);
-            if (!sja1000_chip_attach(ch, card->bus_name[i], label, errp)) {
-                return;
-            }
+        if (!sja1000_card_chip_start(&card->chan[i], i, card->chip_irqs[i],
+                                     card->link, card->bus_name[i], errp)) {
+            return;
         }
     }
 }

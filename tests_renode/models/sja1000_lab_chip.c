@@ -1787,6 +1787,42 @@ bool sja1000_chip_attach(Sja1000Channel *ch, const char *bus,
     return ch->port >= 0;
 }
 
+bool sja1000_card_join_hub(Object *card, const char *device,
+                           char *const *bus_names, unsigned chips,
+                           const LabBusLinkConfig *config, LabBusLink **link,
+                           Error **errp)
+{
+    bool hub = config->path && *config->path;
+    unsigned i;
+
+    *link = NULL;
+    for (i = 0; i < chips; i++) {
+        if (bus_names[i] && *bus_names[i] && !hub) {
+            error_setg(errp, "%s: bus%u=%s needs hub=<socket of the lab bus "
+                       "hub>", device, i, bus_names[i]);
+            return false;
+        }
+    }
+    if (hub) {
+        *link = labbus_board_link_join(card, config, errp);
+        return *link != NULL;
+    }
+    return true;
+}
+
+bool sja1000_card_chip_start(Sja1000Channel *ch, unsigned index, qemu_irq irq,
+                             LabBusLink *link, const char *bus, Error **errp)
+{
+    char label[8];
+
+    sja1000_chip_init(ch, irq, link);
+    if (!bus || !*bus) {
+        return true;
+    }
+    snprintf(label, sizeof(label), "%u", index);
+    return sja1000_chip_attach(ch, bus, label, errp);
+}
+
 void sja1000_chip_teardown(Sja1000Channel *ch)
 {
     chan_drop_events(ch);

@@ -133,6 +133,27 @@ void sja1000_chip_init(Sja1000Channel *ch, qemu_irq irq, LabBusLink *link);
 bool sja1000_chip_attach(Sja1000Channel *ch, const char *bus,
                          const char *label, Error **errp);
 
+/*
+ * What a card's realize does for its chips' buses, the same on every card:
+ * a chip named to a bus (bus_names[i] set and not empty, for the first
+ * chips of them) needs a hub (config->path); with a hub, the board's link
+ * is joined (labbus_board_link_join, shared with the board's other lab
+ * devices) and stored in *link, which is NULL without one. device names
+ * the card in the messages. false with errp set on failure.
+ */
+bool sja1000_card_join_hub(Object *card, const char *device,
+                           char *const *bus_names, unsigned chips,
+                           const LabBusLinkConfig *config, LabBusLink **link,
+                           Error **errp);
+
+/*
+ * Makes chip index of a card (sja1000_chip_init) and, when bus is set and
+ * not empty, wires it to that lab bus as the port labelled with its index
+ * (<hub-name>.<index>). false with errp set if the hub refuses the port.
+ */
+bool sja1000_card_chip_start(Sja1000Channel *ch, unsigned index, qemu_irq irq,
+                             LabBusLink *link, const char *bus, Error **errp);
+
 /* A CPU read of register addr (0..SJA1000_CHIP_REGISTERS - 1). */
 uint8_t sja1000_chip_read(Sja1000Channel *ch, unsigned addr);
 
