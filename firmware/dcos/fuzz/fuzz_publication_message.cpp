@@ -47,9 +47,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         // A relay header (a relayed publication's, "Across a gateway") is
         // never a publication's frame, and encodes back to itself.
         uint16_t relayNode = 0;
-        if (decodeRelayHeader(frame, length, relayNode)) {
+        uint8_t crossed = 0;
+        if (decodeRelayHeader(frame, length, relayNode, &crossed)) {
+            FUZZ_CHECK(crossed < kRelayCrossings);
             uint8_t again[kRelayHeaderBytes];
-            encodeRelayHeader(relayNode, again);
+            encodeRelayHeader(relayNode, again, crossed);
             FUZZ_CHECK(length == kRelayHeaderBytes && std::memcmp(again, frame, length) == 0);
             PublicationPart notAPart;
             FUZZ_CHECK(decodePublicationPart(frame, length, notAPart) != PublicationMessageError::None);

@@ -254,8 +254,16 @@ TEST(PublicationMessageTest, ARelayHeaderNamesTheNodeAndIsNoPublicationFrame)
     EXPECT_EQ(node, 0x0103);
     PublicationPart part;
     EXPECT_NE(decodePublicationPart(header, kRelayHeaderBytes, part), PublicationMessageError::None);
-    const uint8_t reserved[kRelayHeaderBytes] = {0xFF, 0x01, 0x00, 0x03};
-    EXPECT_FALSE(decodeRelayHeader(reserved, kRelayHeaderBytes, node));
+    const uint8_t tooFar[kRelayHeaderBytes] = {0xFF, kRelayCrossings, 0x00, 0x03};
+    EXPECT_FALSE(decodeRelayHeader(tooFar, kRelayHeaderBytes, node)) << "crossed more gateways than a frame may";
+    // A frame relayed again counts the gateways it crossed before.
+    encodeRelayHeader(0x0103, header, 2);
+    EXPECT_EQ(std::vector<uint8_t>(header, header + kRelayHeaderBytes), (std::vector<uint8_t>{0xFF, 0x02, 0x01, 0x03}));
+    uint8_t crossed = 0;
+    ASSERT_TRUE(decodeRelayHeader(header, kRelayHeaderBytes, node, &crossed));
+    EXPECT_EQ(crossed, 2);
+    encodeRelayHeader(0x0103, header, 200);
+    EXPECT_EQ(header[1], kRelayCrossings - 1) << "held to the last crossing";
     const uint8_t other[kRelayHeaderBytes] = {0xFE, 0x00, 0x00, 0x03};
     EXPECT_FALSE(decodeRelayHeader(other, kRelayHeaderBytes, node));
     EXPECT_FALSE(decodeRelayHeader(header, 3, node));

@@ -229,6 +229,9 @@ TEST(NameQueryTest, TheDecoderRefusesWhatNoNodeSends)
     bad = frames[2];
     bad[7] = 1;
     EXPECT_EQ(decodeNameQueryPart(bad.data(), bad.size(), part), NameQueryError::ReservedBits);
+    bad = frames[2];
+    bad[6] = kNameRelays + 1; // More relays than a routed request has hops.
+    EXPECT_EQ(decodeNameQueryPart(bad.data(), bad.size(), part), NameQueryError::ReservedBits);
     for (ObjectType type : {ObjectType::None, ObjectType::Process, ObjectType::DsmSubscription,
                             ObjectType::NetworkInterface, ObjectType::Module, ObjectType::Reserved15}) {
         bad = frames[0];
@@ -236,6 +239,25 @@ TEST(NameQueryTest, TheDecoderRefusesWhatNoNodeSends)
         EXPECT_EQ(decodeNameQueryPart(bad.data(), bad.size(), part), NameQueryError::BadType)
             << static_cast<int>(type);
     }
+}
+
+TEST(NameQueryTest, ARelayedQueryCarriesItsRelaysLeftInPartTwosByteSixNotInTheName)
+{
+    uint8_t frames[kNameQueryFrames][kRemoteMessageBytes];
+    encodeNameQuery(static_cast<uint8_t>(ObjectType::Semaphore), 9, "abcdefghijklmno", frames, 2);
+    EXPECT_EQ(Frame(std::to_array(frames[2])), (Frame{0x8A, 0x09, 'm', 'n', 'o', 0, 2, 0}));
+    NameQueryAssembler assembler;
+    for (const uint8_t(&frame)[kRemoteMessageBytes] : frames) {
+        NameQueryPart part;
+        ASSERT_EQ(decodeNameQueryPart(frame, kRemoteMessageBytes, part), NameQueryError::None);
+        (void)assembler.take(part);
+    }
+    EXPECT_STREQ(assembler.name(), "abcdefghijklmno") << "the relay count is not read as a name byte";
+    EXPECT_EQ(assembler.relays(), 2);
+    // A count above the most is held to it when encoded; a plain query carries 0.
+    encodeNameQuery(static_cast<uint8_t>(ObjectType::Semaphore), 9, "pump", frames, 200);
+    EXPECT_EQ(frames[2][6], kNameRelays);
+    EXPECT_EQ(nameQuery(static_cast<uint8_t>(ObjectType::Semaphore), 9, "pump")[2][6], 0);
 }
 
 TEST(NameQueryTest, PartsOutOfTurnOrOfAnotherQueryAndMalformedNamesMakeNoQuery)

@@ -142,20 +142,23 @@ bool PublicationFilter::take(uint16_t sequence, uint64_t nowNs)
     return true;
 }
 
-void encodeRelayHeader(uint16_t node, uint8_t (&bytes)[kRelayHeaderBytes])
+void encodeRelayHeader(uint16_t node, uint8_t (&bytes)[kRelayHeaderBytes], uint8_t crossedBefore)
 {
     bytes[0] = 0xFF;
-    bytes[1] = 0;
+    bytes[1] = crossedBefore < kRelayCrossings ? crossedBefore : kRelayCrossings - 1;
     bytes[2] = static_cast<uint8_t>(node >> 8);
     bytes[3] = static_cast<uint8_t>(node);
 }
 
-bool decodeRelayHeader(const uint8_t* bytes, size_t length, uint16_t& node)
+bool decodeRelayHeader(const uint8_t* bytes, size_t length, uint16_t& node, uint8_t* crossedBefore)
 {
-    if (length != kRelayHeaderBytes || bytes[0] != 0xFF || bytes[1] != 0) {
+    if (length != kRelayHeaderBytes || bytes[0] != 0xFF || bytes[1] >= kRelayCrossings) {
         return false;
     }
     node = static_cast<uint16_t>((bytes[2] << 8) | bytes[3]);
+    if (crossedBefore != nullptr) {
+        *crossedBefore = bytes[1];
+    }
     return true;
 }
 

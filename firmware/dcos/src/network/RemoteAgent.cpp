@@ -511,13 +511,26 @@ Status forwardAlarm(ObjectId timer, RemoteAlarmKind kind, const AlarmNotificatio
 // Any interface, any sender: the call slot of a name query, asked of every node.
 constexpr uint8_t kAnyInterface = 0xFF;
 
+// How a name query goes beyond the buses it is broadcast on.
+struct NameRelay {
+    // Sent to each route's gateway too, as a relayed query with @p relays
+    // left for the gateway to pass on; not at all when false.
+    bool throughGateways = false;
+    uint8_t relays = 0;
+    // The node that relayed the query to this one (its interface and
+    // physical address), which gets no relayed query back.
+    uint8_t fromInterface = 0xFF;
+    uint32_t fromPhysical = NetworkLink::kBroadcast;
+};
+
 // NameToObject asked of other nodes: the query broadcast on every attached
-// link but @p except (kAnyInterface: none), and, @p throughGateways, sent
-// to each route's gateway too, which asks the buses beyond it. The first
-// node that has a visible object of that type and name answers with its
-// id; when none does, every node stays silent, and after the watchdog's
-// silent periods the answer is NotFound.
-Result<ObjectId> askForName(ObjectType type, const char* name, uint8_t except, bool throughGateways)
+// link but @p except (kAnyInterface: none), and, as @p relay says, sent to
+// each route's gateway too, which asks the buses beyond it and, with relays
+// left, its own routes' gateways. The first node that has a visible object
+// of that type and name answers with its id; when none does, every node
+// stays silent, and after the watchdog's silent periods the answer is
+// NotFound.
+Result<ObjectId> askForName(ObjectType type, const char* name, uint8_t except, const NameRelay& relay)
 {
     const uint64_t begun = readCounter();
     if (inInterruptContext()) {
@@ -548,13 +561,19 @@ Result<ObjectId> askForName(ObjectType type, const char* name, uint8_t except, b
         }
     }
     NextHop gateways[NetworkTables::kRoutes];
-    const size_t gatewayCount = throughGateways ? gatewayHops(gateways) : 0;
+    const size_t gatewayCount = relay.throughGateways ? gatewayHops(gateways) : 0;
+    // The broadcast query, and the one relayed to gateways, which differ
+    // in the relays left only.
     uint8_t frames[kNameQueryFrames][kRemoteMessageBytes];
+    uint8_t relayedFrames[kNameQueryFrames][kRemoteMessageBytes];
     encodeNameQuery(static_cast<uint8_t>(type), slot->transaction, name, frames);
+    encodeNameQuery(static_cast<uint8_t>(type), slot->transaction, name, relayedFrames, relay.relays);
     // The parts in a row, to one destination; false when the link did not take one.
     const auto sendQuery = [&](uint8_t interface, uint32_t destination) {
+        const bool relayed = destination != NetworkLink::kBroadcast;
         for (size_t part = 0; part < kNameQueryFrames; ++part) {
-            if (!sendMessage(interface, SystemMessageType::NameQuery, self.priority, destination, frames[part])) {
+            if (!sendMessage(interface, SystemMessageType::NameQuery, self.priority, destination,
+                             relayed ? relayedFrames[part] : frames[part])) {
                 return false;
             }
         }
@@ -567,7 +586,9 @@ Result<ObjectId> askForName(ObjectType type, const char* name, uint8_t except, b
             }
         }
         for (size_t i = 0; i < gatewayCount; ++i) {
-            (void)sendQuery(gateways[i].interface, gateways[i].physical);
+            if (gateways[i].interface != relay.fromInterface || gateways[i].physical != relay.fromPhysical) {
+                (void)sendQuery(gateways[i].interface, gateways[i].physical);
+            }
         }
     });
     if (!found.ok()) {
@@ -583,10 +604,10 @@ Result<ObjectId> askForName(ObjectType type, const char* name, uint8_t except, b
 
 // NameToObject asked of every node this node reaches (RemoteForward.hpp's
 // resolver): those on its buses, and through its routes' gateways those
-// one gateway beyond.
+// up to kRouteHops gateways beyond, as far as a routed request goes.
 Result<ObjectId> forwardName(ObjectType type, const char* name)
 {
-    return askForName(type, name, kAnyInterface, true);
+    return askForName(type, name, kAnyInterface, NameRelay{true, kNameRelays});
 }
 
 // The caller's instructions of @p slot's transaction, which got its final
@@ -747,10 +768,12 @@ void removeRelay(ObjectId publisher, uint8_t interface)
     }
 }
 
-// Passes a frame of @p publisher, which arrived on @p from, to every
-// interface that asked for it, behind its relay header, at the frame's
-// priority. A withdrawal ends the relay.
-void relayPublication(uint8_t from, const SystemMessage& message, ObjectId publisher, bool withdrawal)
+// Passes a frame of @p publisher, which arrived on @p from after crossing
+// @p crossed gateways (0: heard on the publisher's own bus), to every interface
+// that asked for it, behind its relay header, at the frame's priority. A
+// withdrawal ends the relay.
+void relayPublication(uint8_t from, const SystemMessage& message, ObjectId publisher, bool withdrawal,
+                      uint8_t crossed = 0)
 {
     {
         Lock lock;
@@ -758,8 +781,13 @@ void relayPublication(uint8_t from, const SystemMessage& message, ObjectId publi
             return;
         }
     }
+    if (crossed >= kRelayCrossings) {
+        Lock lock;
+        ++statistics.unrouted; // Relays in a circle: the frame went as far as any may.
+        return;
+    }
     uint8_t header[kRelayHeaderBytes];
-    encodeRelayHeader(publisher.node(), header);
+    encodeRelayHeader(publisher.node(), header, crossed);
     for (Relay& relay : relays) {
         uint8_t to;
         {
@@ -788,6 +816,7 @@ struct RelayHeard {
     uint8_t interface = 0;
     uint32_t source = 0;
     uint16_t node = 0;
+    uint8_t crossedBefore = 0; // Gateways the frame crossed before the one that sent it.
 };
 
 RelayHeard relaysHeard[kRelays];
@@ -865,11 +894,13 @@ void onNodeStarted(const SystemMessage& message)
 }
 
 // A relayed publication frame arrived on @p interface: a relay header, or
-// the frame it names the node of. Relayed frames are not relayed again: a
-// publisher is read one gateway beyond its bus.
+// the frame it names the node of. A gateway passes it on to the buses
+// whose subscribers opened the publisher through it, one crossing more, so
+// a publisher is read as many gateways away as a routed Open reaches.
 void onRelayedPublication(uint8_t interface, const SystemMessage& message)
 {
     uint16_t origin = 0;
+    uint8_t crossedBefore = 0;
     RelayHeard* heard = nullptr;
     {
         Lock lock;
@@ -881,9 +912,9 @@ void onRelayedPublication(uint8_t interface, const SystemMessage& message)
                 free = &entry;
             }
         }
-        if (decodeRelayHeader(message.data, message.length, origin)) {
+        if (decodeRelayHeader(message.data, message.length, origin, &crossedBefore)) {
             RelayHeard* const slot = heard != nullptr ? heard : (free != nullptr ? free : &relaysHeard[0]);
-            *slot = RelayHeard{true, interface, message.source, origin};
+            *slot = RelayHeard{true, interface, message.source, origin, crossedBefore};
             return;
         }
         if (heard == nullptr) {
@@ -891,6 +922,7 @@ void onRelayedPublication(uint8_t interface, const SystemMessage& message)
             return;
         }
         origin = heard->node;
+        crossedBefore = heard->crossedBefore;
         heard->used = false; // A header names the one frame after it.
     }
     PublicationPart part;
@@ -903,6 +935,9 @@ void onRelayedPublication(uint8_t interface, const SystemMessage& message)
         ++statistics.publicationParts;
     }
     DsmManager::deliverPublication(interface, origin, part, TimerAgent::Uptime());
+    // As a gateway further on: the frame crossed the sender too, before this one.
+    relayPublication(interface, message, publisherOn(origin, part.index),
+                     part.kind == PublicationPartKind::Withdrawal, static_cast<uint8_t>(crossedBefore + 1));
 }
 
 // ---- the serving side ---------------------------------------------------------
@@ -1190,10 +1225,15 @@ void onNameQuery(uint8_t interface, const SystemMessage& message)
     if (!gathering.assembler.take(part)) {
         return;
     }
+    if (!relay && gathering.assembler.relays() != 0) {
+        countMalformed(); // Only a query to a gateway alone is passed on.
+        return;
+    }
     RemoteRequest request;
     request.service = RemoteService::NameToObject;
     request.transaction = gathering.assembler.transaction();
     request.object = gathering.assembler.type();
+    request.argument = gathering.assembler.relays();
     admitRequest(interface, message, request, reinterpret_cast<const uint8_t*>(gathering.assembler.name()), 0,
                  localNode(), 0, relay);
 }
@@ -1544,8 +1584,12 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
         Result<ObjectId> found = localNameToObject(type, name, scope);
         if (!found.ok() && entry.relay) {
             // Asked as a gateway: the buses beyond, not the one it came
-            // from, and no further gateway (a query is relayed once).
-            found = askForName(type, name, entry.interface, false);
+            // from, and with relays left the routes' gateways, but not the
+            // one that asked, each with one relay fewer.
+            const uint8_t relaysLeft = static_cast<uint8_t>(request.argument);
+            const NameRelay further{relaysLeft > 0, static_cast<uint8_t>(relaysLeft > 0 ? relaysLeft - 1 : 0),
+                                    entry.interface, entry.source};
+            found = askForName(type, name, entry.interface, further);
             if (found.ok()) {
                 Lock lock;
                 ++statistics.forwarded;
@@ -1562,14 +1606,10 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
         if (routed) {
             // As a gateway: the publisher's frames are relayed to the bus the
             // Open came from from now on, and the gateway opens it itself,
-            // so its node sends its latest page again, relayed too. A
-            // publisher behind a further gateway is not: relayed frames are
-            // not relayed again.
-            const Result<NextHop> hop = NetworkInterfacesManager::Resolve(id.node());
-            if (hop.ok() && hop.value().via.raw() != hop.value().destination.raw()) {
-                reply.status = Status::NotSupported;
-                break;
-            }
+            // so its node sends its latest page again, relayed too. For a
+            // publisher behind a further gateway that Open is routed on, and
+            // that gateway relays the frames to this one's bus, from where
+            // this one relays them again (onRelayedPublication).
             {
                 Lock lock;
                 if (!addRelay(id, entry.interface)) {

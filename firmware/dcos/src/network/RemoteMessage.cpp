@@ -208,7 +208,7 @@ const char* nameQueryErrorName(NameQueryError error)
 }
 
 void encodeNameQuery(uint8_t type, uint8_t transaction, const char* name,
-                     uint8_t (&frames)[kNameQueryFrames][kRemoteMessageBytes])
+                     uint8_t (&frames)[kNameQueryFrames][kRemoteMessageBytes], uint8_t relays)
 {
     char padded[kNameQueryNameBytes]{};
     for (size_t i = 0; i + 1 < kNameQueryNameBytes && name[i] != '\0'; ++i) {
@@ -223,6 +223,7 @@ void encodeNameQuery(uint8_t type, uint8_t transaction, const char* name,
             frame[2 + i] = i < count ? static_cast<uint8_t>(padded[part * kNameBytesPerPart + i]) : 0;
         }
     }
+    frames[kNameQueryFrames - 1][2 + kLastPartNameBytes] = relays < kNameRelays ? relays : kNameRelays;
 }
 
 NameQueryError decodeNameQueryPart(const uint8_t* bytes, size_t length, NameQueryPart& part)
@@ -232,7 +233,7 @@ NameQueryError decodeNameQueryPart(const uint8_t* bytes, size_t length, NameQuer
     }
     const uint8_t number = bytes[0] >> kNamePartShift;
     if (number >= kNameQueryFrames || (bytes[0] & kNameReservedMask) != 0 ||
-        (number == kNameQueryFrames - 1 && (bytes[6] != 0 || bytes[7] != 0))) {
+        (number == kNameQueryFrames - 1 && (bytes[6] > kNameRelays || bytes[7] != 0))) {
         return NameQueryError::ReservedBits;
     }
     const uint8_t type = bytes[0] & kNameTypeMask;
@@ -244,6 +245,11 @@ NameQueryError decodeNameQueryPart(const uint8_t* bytes, size_t length, NameQuer
     part.type = type;
     part.transaction = bytes[1];
     __builtin_memcpy(part.bytes, bytes + 2, kNameBytesPerPart);
+    if (number == kNameQueryFrames - 1) {
+        // Byte 6 is the relays left, not a name byte: the name ends at byte 5.
+        part.relays = bytes[2 + kLastPartNameBytes];
+        part.bytes[kLastPartNameBytes] = 0;
+    }
     return NameQueryError::None;
 }
 
@@ -495,6 +501,7 @@ bool NameQueryAssembler::take(const NameQueryPart& part)
         return false;
     }
     next_ = 0;
+    relays_ = part.relays;
     // Well formed: 1 to 15 characters, then NULs only.
     size_t length = 0;
     while (length < kNameQueryNameBytes && name_[length] != '\0') {

@@ -50,19 +50,27 @@ constexpr size_t kWithdrawalBytes = 2;
 // message type 0x21 (RelayedPublication), each frame right after a relay
 // header that names the publisher's node:
 //
-//     relay header   byte 0 0xFF, byte 1 zero, bytes 2-3 the logical node
+//     relay header   byte 0 0xFF, byte 1 the gateways the frame crossed
+//                    before this one (0 to kRelayCrossings - 1), bytes 2-3
+//                    the logical node
 //
 // A receiver takes the frame that follows a header from the same sender as
 // that node's, and drops a frame that follows none: without its node the
-// publisher's index names nothing.
+// publisher's index names nothing. A gateway that relays a relayed frame
+// further counts one more crossing; a frame that crossed kRelayCrossings
+// gateways goes no further, so relays set up in a circle end.
 
 /// Bytes of a relay header.
 constexpr size_t kRelayHeaderBytes = 4;
+/// The most gateways a publication frame crosses: as many as a routed
+/// request's hops (RemoteMessage.hpp's kRouteHops).
+constexpr uint8_t kRelayCrossings = 4;
 
-/// The relay header naming @p node.
-void encodeRelayHeader(uint16_t node, uint8_t (&bytes)[kRelayHeaderBytes]);
-/// Whether a relayed frame of @p length bytes is a relay header; the node into @p node.
-bool decodeRelayHeader(const uint8_t* bytes, size_t length, uint16_t& node);
+/// The relay header naming @p node, for a frame that crossed @p crossedBefore gateways before this one.
+void encodeRelayHeader(uint16_t node, uint8_t (&bytes)[kRelayHeaderBytes], uint8_t crossedBefore = 0);
+/// Whether a relayed frame of @p length bytes is a relay header; the node
+/// into @p node and, when not null, the crossings before into @p crossedBefore.
+bool decodeRelayHeader(const uint8_t* bytes, size_t length, uint16_t& node, uint8_t* crossedBefore = nullptr);
 
 /// What a frame is.
 enum class PublicationPartKind : uint8_t {

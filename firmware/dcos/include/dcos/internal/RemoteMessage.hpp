@@ -344,7 +344,13 @@ RemoteMessageError decodeRouteHeader(const uint8_t* bytes, size_t length, RouteH
 //     byte 1   transaction number, as in a request
 //     part 0   bytes 2-7 name bytes 0-5
 //     part 1   bytes 2-7 name bytes 6-11
-//     part 2   bytes 2-5 name bytes 12-15, bytes 6-7 zero
+//     part 2   bytes 2-5 name bytes 12-15, byte 6 relays left (0 to
+//              kNameRelays), byte 7 zero
+//
+// Byte 6 of part 2 matters only in a query sent to one node, a gateway,
+// alone (a relayed query): how many further gateways that gateway may pass
+// the query on to (docs/protocols/remote-transactions.md, "Gateways"). A
+// broadcast query carries 0.
 //
 // The name is NUL-padded to 16 bytes: 1 to 15 characters and at least one
 // NUL. A node that has an object of that type and name visible to the
@@ -354,18 +360,23 @@ RemoteMessageError decodeRouteHeader(const uint8_t* bytes, size_t length, RouteH
 /// Frames of one name query, and the bytes of the name field.
 constexpr size_t kNameQueryFrames = 3;
 constexpr size_t kNameQueryNameBytes = 16;
+/// The most relays a relayed name query may have left: with the first
+/// gateway's own, a name is found up to kRouteHops gateways away, as far as
+/// a routed request reaches.
+constexpr uint8_t kNameRelays = kRouteHops - 1;
 
 struct NameQueryPart {
     uint8_t part = 0;        ///< 0, 1 or 2.
     uint8_t type = 0;        ///< The ObjectType's value.
     uint8_t transaction = 0;
     uint8_t bytes[6]{};      ///< The name bytes it carries (4 in part 2).
+    uint8_t relays = 0;      ///< Part 2's relays left, 0 to kNameRelays (0 in parts 0 and 1).
 };
 
 enum class NameQueryError : uint8_t {
     None,
     WrongLength,   ///< Not eight bytes.
-    ReservedBits,  ///< A part number 3, bits 5-4 set, or part 2's last two bytes not zero.
+    ReservedBits,  ///< A part number 3, bits 5-4 set, part 2's byte 7 not zero or its byte 6 above kNameRelays.
     BadType,       ///< A type whose objects have no names (see isNamedObjectType).
 };
 
@@ -376,9 +387,10 @@ bool isNamedObjectType(uint8_t type);
 const char* nameQueryErrorName(NameQueryError error);
 
 /// The three frames asking for the object of @p type named @p name (1 to
-/// 15 characters; longer names are cut, which no table holds anyway).
+/// 15 characters; longer names are cut, which no table holds anyway), with
+/// @p relays left for a relayed query (held to kNameRelays).
 void encodeNameQuery(uint8_t type, uint8_t transaction, const char* name,
-                     uint8_t (&frames)[kNameQueryFrames][kRemoteMessageBytes]);
+                     uint8_t (&frames)[kNameQueryFrames][kRemoteMessageBytes], uint8_t relays = 0);
 
 /// Decodes one frame of @p length bytes; None and @p part filled in, or why not.
 NameQueryError decodeNameQueryPart(const uint8_t* bytes, size_t length, NameQueryPart& part);
@@ -392,6 +404,8 @@ public:
 
     uint8_t type() const { return type_; }
     uint8_t transaction() const { return transaction_; }
+    /// The relays left that part 2 carried.
+    uint8_t relays() const { return relays_; }
     /// The name, NUL-terminated.
     const char* name() const { return name_; }
 
@@ -399,6 +413,7 @@ private:
     uint8_t next_ = 0;
     uint8_t type_ = 0;
     uint8_t transaction_ = 0;
+    uint8_t relays_ = 0;
     char name_[kNameQueryNameBytes]{};
 };
 
