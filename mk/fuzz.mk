@@ -1,6 +1,6 @@
 # Fuzzing the CAN link layer (fieldbus/can), the Modbus stack
-# (fieldbus/modbus), the host Modbus tools and the kernel's network tables
-# (firmware/dcos/fuzz) with libFuzzer.
+# (fieldbus/modbus), the host Modbus tools, the host CAN library's gs_usb
+# decoder and the kernel's network tables (firmware/dcos/fuzz) with libFuzzer.
 #
 #   make fuzz        builds the fuzz targets, replays each seed corpus once,
 #                    then fuzzes each target for FUZZ_SECONDS; fails on any crash
@@ -13,7 +13,7 @@
 # caused it is kept in $(FUZZ_BUILD)/artifacts/<target>/.
 
 FUZZ_BUILD := $(BUILD)/fuzz
-# Fuzzing time per target; twenty targets, so 'make test' spends about 300 s here.
+# Fuzzing time per target; some two dozen targets, run $(JOBS) at a time by 'make test'.
 FUZZ_SECONDS ?= 15
 FUZZ_TARGETS := frame isotp slcan frametext
 FUZZ_CORPUS := fieldbus/can/fuzz/corpus
@@ -29,6 +29,12 @@ MODBUS_FUZZ_REPORT := $(BUILD)/reports/fuzz-modbus-tests.xml
 HOST_MODBUS_FUZZ_TARGETS := modbus_arguments modbus_sim_config modbus_frames
 HOST_MODBUS_FUZZ_CORPUS := host_tools/modbus/fuzz/corpus
 HOST_MODBUS_FUZZ_REPORT := $(BUILD)/reports/fuzz-host-modbus-tests.xml
+# The host CAN library's reading of what a gs_usb adapter sends over USB
+# (host_tools/can/fuzz): its bulk IN transfers and its answers to
+# DEVICE_CONFIG and BT_CONST, with the bit timing computed from the latter.
+HOSTCAN_FUZZ_TARGETS := gsusb_frames
+HOSTCAN_FUZZ_CORPUS := host_tools/can/fuzz/corpus
+HOSTCAN_FUZZ_REPORT := $(BUILD)/reports/fuzz-hostcan-tests.xml
 # The kernel's parsers of outside input (firmware/dcos/fuzz): the network
 # interfaces manager's address text and tables, which the console sets, and
 # the remote transaction and publication messages every node decodes from the bus.
@@ -101,6 +107,12 @@ MODBUS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(MODBUS_FUZZ_TARGETS)
 HOST_MODBUS_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,$(HOSTMODBUS_SRCS) fieldbus/modbus/src/Crc16.cpp)
 HOST_MODBUS_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/modbus/fuzz/fuzz_%.cpp.o,$(HOST_MODBUS_FUZZ_TARGETS))
 HOST_MODBUS_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOST_MODBUS_FUZZ_TARGETS))
+# The error frames' reading is SocketCAN's own (SocketCanTransport.cpp's
+# decodeErrorFrame), which the gs_usb decoder shares.
+HOSTCAN_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,host_tools/can/src/GsUsbProtocol.cpp \
+	host_tools/can/src/SocketCanTransport.cpp $(CAN_PORTABLE_SRCS))
+HOSTCAN_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/can/fuzz/fuzz_%.cpp.o,$(HOSTCAN_FUZZ_TARGETS))
+HOSTCAN_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOSTCAN_FUZZ_TARGETS))
 DCOS_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/dcos/src/network/NetworkAddress.cpp.o \
 	$(FUZZ_BUILD)/firmware/dcos/src/network/RemoteMessage.cpp.o \
 	$(FUZZ_BUILD)/firmware/dcos/src/network/PublicationMessage.cpp.o \
@@ -141,6 +153,7 @@ P5SMP_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(P5SMP_FUZZ_TARGETS))
 	$(FLASH_FUZZ_LIBRARY_OBJS) $(FLASH_FUZZ_TARGET_OBJS) $(SEI_FUZZ_LIBRARY_OBJS) $(SEI_FUZZ_TARGET_OBJS) \
 	$(MON_FUZZ_LIBRARY_OBJS) $(MON_FUZZ_TARGET_OBJS) $(CONFIG_FUZZ_LIBRARY_OBJS) $(CONFIG_FUZZ_TARGET_OBJS)
 .SECONDARY: $(P5SMP_FUZZ_LIBRARY_OBJS) $(P5SMP_FUZZ_TARGET_OBJS)
+.SECONDARY: $(HOSTCAN_FUZZ_LIBRARY_OBJS) $(HOSTCAN_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
@@ -151,12 +164,13 @@ fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARI
 	$(IMAGE_FUZZ_BINARIES) $(HOST_IMAGE_FUZZ_BINARIES) $(FLASH_FUZZ_BINARIES) $(SEI_FUZZ_BINARIES) \
 	$(MON_FUZZ_BINARIES) $(CONFIG_FUZZ_BINARIES)
 fuzz-targets: $(P5SMP_FUZZ_BINARIES)
+fuzz-targets: $(HOSTCAN_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite. The groups run side by side,
 # $(JOBS) at a time (each libFuzzer run takes one core), and every group
 # runs even when another fails (-k): the exit status says whether any did.
-FUZZ_RUN_GROUPS := CAN MODBUS HOST_MODBUS DCOS IMAGE HOST_IMAGE FLASH SEI MON CONFIG P5SMP
+FUZZ_RUN_GROUPS := CAN MODBUS HOST_MODBUS HOSTCAN DCOS IMAGE HOST_IMAGE FLASH SEI MON CONFIG P5SMP
 CAN_FUZZ_CORPUS = $(FUZZ_CORPUS)
 CAN_FUZZ_REPORT = $(FUZZ_REPORT)
 CAN_FUZZ_TARGETS = $(FUZZ_TARGETS)
@@ -187,6 +201,12 @@ $(HOST_MODBUS_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/mod
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
 	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lfmt -lmodbus
+
+$(HOSTCAN_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/can/fuzz/fuzz_%.cpp.o \
+		$(HOSTCAN_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^
 
 $(DCOS_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/firmware/dcos/fuzz/fuzz_%.cpp.o $(DCOS_FUZZ_LIBRARY_OBJS)
 	@mkdir -p $(dir $@)

@@ -55,7 +55,7 @@ host-tests: $(HOST_TEST_BINARY)
 $(HOST_TEST_BINARY): $(HOST_OBJS)
 	@mkdir -p $(dir $@)
 	@echo "  CXX     $@"
-	$(Q)g++ -o $@ $^ -lgtest -lgtest_main -pthread $(HOST_TOOLS_LIBS) $(HOSTMON_LIBS)
+	$(Q)g++ -o $@ $^ -lgtest -lgtest_main -pthread $(HOST_TOOLS_LIBS) $(HOSTMON_LIBS) $(HOSTCAN_LIBS)
 
 HOST_FLAGS_STAMP := $(HOST_BUILD)/flags.stamp
 $(HOST_FLAGS_STAMP): FORCE

@@ -8,6 +8,10 @@ HOST_TOOLS_BIN := $(HOST_TOOLS_BUILD)/bin
 # The host CAN library: transports behind one interface (host_tools/can).
 HOSTCAN_SRCS := $(wildcard host_tools/can/src/*.cpp)
 HOSTCAN_TEST_SRCS := $(wildcard host_tools/can/unit_tests/*.cpp)
+# gs_usb adapters are reached through Debian's libusb-1.0 (libusb-1.0-0-dev),
+# so every program that links the library links it too; the source names
+# the header's folder itself, so no include path is needed.
+HOSTCAN_LIBS := $(shell pkg-config --libs libusb-1.0 2>/dev/null || echo -lusb-1.0)
 # The host Modbus library (host_tools/modbus): argument and configuration
 # checks, device identification framing, the simulator's behaviours, on
 # Debian's libmodbus and toml++ (the shared library, hence the defines).
@@ -56,7 +60,7 @@ $(DCOS_CAN): $(BUILD)/host/host_tools/can/tools/dcos-can.cpp.o $(patsubst %,$(BU
 	firmware/dcos/src/network/TimeSyncMessage.cpp)
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS)
+	$(Q)g++ -o $@ $^ $(HOST_TOOLS_LIBS) $(HOSTCAN_LIBS)
 
 # The Modbus tools need only the stack's CRC from fieldbus/modbus.
 HOSTMODBUS_OBJS := $(patsubst %,$(BUILD)/host/%.o,$(HOSTMODBUS_SRCS) fieldbus/modbus/src/Crc16.cpp)
@@ -82,14 +86,14 @@ $(DCOS_FLASH): $(BUILD)/host/host_tools/flash/tools/dcos-flash.cpp.o \
 		$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto $(HOSTCAN_LIBS)
 
 $(DCOS_CONFIG): $(BUILD)/host/host_tools/config/tools/dcos-config.cpp.o \
 	$(patsubst %,$(BUILD)/host/%.o,$(HOSTCONFIG_SRCS) $(SEI_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS) \
 		$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto -ltomlplusplus
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto -ltomlplusplus $(HOSTCAN_LIBS)
 
 # dcos-mon: the configuration protocol's client and requests (host_tools/config)
 # to start and renew the stream, its own link and reader (host_tools/mon).
@@ -98,4 +102,4 @@ $(DCOS_MON): $(BUILD)/host/host_tools/mon/tools/dcos-mon.cpp.o \
 		$(BOOT_RECORD_SRCS) $(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto -ltomlplusplus $(HOSTMON_LIBS)
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto -ltomlplusplus $(HOSTMON_LIBS) $(HOSTCAN_LIBS)

@@ -16,6 +16,8 @@ libfmt-dev:formats the host tools' output
 nlohmann-json3-dev:writes the host tools' --json output
 libmodbus-dev:the Modbus RTU master and slave of dcos-modbus and dcos-modbus-sim (host_tools/modbus)
 libtomlplusplus-dev:toml++, which parses dcos-modbus-sim's configuration files and the node configurations dcos-config saves and restores
+libusb-1.0-0-dev:libusb, through which the host tools drive gs_usb CAN adapters (candleLight, CANable) from user space, without the kernel's gs_usb driver or root (-i gsusb, host_tools/can)
+libhidapi-dev:hidapi, through which the host tools drive a controller's reset and recovery lines on a USB HID adapter
 libcairo2-dev:cairo, with which dcos-mon draws its trend plots (PNG) and its tests read them back (host_tools/mon)
 openssl:an ECDSA implementation we did not write, which checks dcos-image's signatures and makes keys it signs with (tests_renode/test_host_tools_image.py)
 libmbedtls-dev:mbedTLS, the vetted SHA-256 and ECDSA P-256 with which dcos-image signs controller images and the image verifier checks them

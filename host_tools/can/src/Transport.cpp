@@ -1,3 +1,4 @@
+#include <hostcan/GsUsbTransport.hpp>
 #include <hostcan/LabBusTransport.hpp>
 #include <hostcan/SlcanTransport.hpp>
 #include <hostcan/SocketCanTransport.hpp>
@@ -59,6 +60,13 @@ std::unique_ptr<Transport> openTransport(const std::string& spec, TransportError
             return SlcanTransport::open(path, std::string(prefix) == "slcan-socket:", bitRate, error);
         }
     }
+    if (spec == "gsusb" || startsWith(spec, "gsusb:") || startsWith(spec, "gsusb@")) {
+        const std::optional<GsUsbSpec> parsed = parseGsUsbSpec(spec, error);
+        if (!parsed) {
+            return nullptr;
+        }
+        return GsUsbTransport::open(parsed->serial, parsed->bitRate, parsed->name, error);
+    }
     if (startsWith(spec, "lab:")) {
         // lab:<socket path>:<bus>; the path may hold colons, the bus name does not.
         const std::string rest = spec.substr(4);
@@ -73,7 +81,7 @@ std::unique_ptr<Transport> openTransport(const std::string& spec, TransportError
     if (spec.find(':') != std::string::npos || spec.find('/') != std::string::npos) {
         error = {TransportError::Kind::BadArgument,
                  "'" + spec + "' is not an interface: write a SocketCAN interface (can0), slcan:<device>[@<bit rate>], "
-                              "slcan-socket:<path>[@<bit rate>] or lab:<hub socket>:<bus>"};
+                              "slcan-socket:<path>[@<bit rate>], gsusb[:<serial>][@<bit rate>] or lab:<hub socket>:<bus>"};
         return nullptr;
     }
     return SocketCanTransport::open(spec, error);

@@ -8,13 +8,17 @@
 //     dcos-can -i can0 isotp-send -s 7E0 -d 7E8 "01 02 03 ..."   (as can-utils' isotpsend)
 //     dcos-can -i can0 isotp-recv -s 7E8 -d 7E0 [-t MS]          (as isotprecv)
 //     ... isotp-send/isotp-recv --kernel: through the kernel's ISO-TP socket
+//     dcos-can -i gsusb:<serial>@500000 dump      a gs_usb adapter (candleLight) through libusb
+//     dcos-can list [--json]                       the SocketCAN interfaces and gs_usb adapters present
 //
-// Exit status: 0 done; 1 dump ended before -n frames, or send was refused;
-// 2 bad arguments; 3 the interface kind is not available here (no
-// SocketCAN in this kernel, no such device); 4 the interface failed
-// (open, I/O, the other end went away).
+// Exit status: 0 done (list: always, adapters or none); 1 dump ended before
+// -n frames, or send was refused; 2 bad arguments; 3 the interface kind is
+// not available here (no SocketCAN in this kernel, no such device, no such
+// gs_usb adapter); 4 the interface failed (open, I/O, the other end went
+// away, the adapter was unplugged).
 #include <hostcan/IsoTpEndpoint.hpp>
 #include <hostcan/KernelIsoTp.hpp>
+#include <hostcan/LibUsbGsDevice.hpp>
 #include <hostcan/Transport.hpp>
 
 #include <can/FrameText.hpp>
@@ -30,9 +34,12 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -125,12 +132,17 @@ public:
     {
         using namespace dcos::internal;
         uint16_t node = 0;
-        if (decodeRelayHeader(frame.data(), frame.length(), node)) {
+        uint8_t crossed = 0;
+        if (decodeRelayHeader(frame.data(), frame.length(), node, &crossed)) {
             relayed_[id.source()] = node;
             DataDecoding out;
             out.key = "publication";
-            out.text = fmt::format("relay header: node {}", node);
+            out.text = crossed == 0 ? fmt::format("relay header: node {}", node)
+                                    : fmt::format("relay header: node {}, {} gateways before", node, crossed);
             out.json = {{"relay_node", node}};
+            if (crossed != 0) {
+                out.json["gateways_before"] = crossed;
+            }
             return out;
         }
         const auto found = relayed_.find(id.source());
@@ -673,6 +685,88 @@ bool parseBytes(const std::string& text, std::vector<uint8_t>& bytes)
     return true;
 }
 
+// The CAN network interfaces Linux has: those whose /sys/class/net/<name>/type
+// is ARPHRD_CAN (280, include/uapi/linux/if_arp.h), sorted by name.
+constexpr int kArphrdCan = 280;
+
+std::vector<std::string> socketCanInterfaces()
+{
+    std::vector<std::string> names;
+    std::error_code problem;
+    for (std::filesystem::directory_iterator entry("/sys/class/net", problem), end; !problem && entry != end;
+         entry.increment(problem)) {
+        std::ifstream typeFile(entry->path() / "type");
+        int type = 0;
+        if (typeFile >> type && type == kArphrdCan) {
+            names.push_back(entry->path().filename().string());
+        }
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+// `dcos-can list`: what -i can name here. Finding nothing is an answer,
+// not a failure, so the exit status is 0 either way.
+int list(bool json)
+{
+    const std::vector<std::string> interfaces = socketCanInterfaces();
+    TransportError usbError;
+    const std::vector<hostcan::GsUsbAdapterInfo> adapters = hostcan::LibUsbGsDevice::list(true, usbError);
+    if (json) {
+        nlohmann::json out = {{"socketcan", interfaces}, {"gsusb", nlohmann::json::array()}};
+        for (const hostcan::GsUsbAdapterInfo& a : adapters) {
+            nlohmann::json adapter = {{"bus", a.bus},
+                                      {"address", a.address},
+                                      {"vid", fmt::format("{:04x}", a.vendor)},
+                                      {"pid", fmt::format("{:04x}", a.product)},
+                                      {"serial", a.serial},
+                                      {"product", a.productName},
+                                      {"channels", nullptr}};
+            if (a.channels) {
+                adapter["channels"] = *a.channels;
+            }
+            if (!a.serial.empty()) {
+                adapter["interface"] = "gsusb:" + a.serial;
+            }
+            if (!a.problem.empty()) {
+                adapter["problem"] = a.problem;
+            }
+            out["gsusb"].push_back(adapter);
+        }
+        if (usbError) {
+            out["usb_error"] = usbError.message;
+        }
+        fmt::print("{}\n", out.dump());
+        return kExitOk;
+    }
+    if (interfaces.empty()) {
+        fmt::print("SocketCAN interfaces: none\n");
+    } else {
+        fmt::print("SocketCAN interfaces:\n");
+        for (const std::string& name : interfaces) {
+            fmt::print("  -i {}\n", name);
+        }
+    }
+    if (usbError) {
+        fmt::print("gs_usb adapters: cannot look ({})\n", usbError.message);
+    } else if (adapters.empty()) {
+        fmt::print("gs_usb adapters: none\n");
+    } else {
+        fmt::print("gs_usb adapters:\n");
+        for (const hostcan::GsUsbAdapterInfo& a : adapters) {
+            const std::string name = a.serial.empty() ? std::string("(serial unknown)") : "-i gsusb:" + a.serial;
+            std::string channels;
+            if (a.channels) {
+                channels = fmt::format(", {} channel{}", *a.channels, *a.channels == 1 ? "" : "s");
+            }
+            fmt::print("  {}  bus {:03} address {:03}  {:04x}:{:04x}  {}{}{}\n", name, a.bus, a.address, a.vendor,
+                       a.product, a.productName.empty() ? "?" : a.productName, channels,
+                       a.problem.empty() ? "" : "  (" + a.problem + ")");
+        }
+    }
+    return kExitOk;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -681,14 +775,20 @@ int main(int argc, char** argv)
                  "dcos-can"};
     app.set_version_flag("--version", std::string("dcos-can ") + dcos::versionString);
     app.require_subcommand(1);
-    app.footer("exit status: 0 done, 1 incomplete (dump ended early, send refused), 2 bad arguments, "
+    app.footer("exit status: 0 done (list: always), 1 incomplete (dump ended early, send refused), 2 bad arguments, "
                "3 interface not available here, 4 interface failed\n"
                "interfaces: can0 (SocketCAN), slcan:/dev/ttyACM0[@bitrate], slcan-socket:/path[@bitrate], "
-               "lab:<hub socket>:<bus> (the emulator lab's CAN bus)");
+               "gsusb[:<serial>][@bitrate] (a gs_usb adapter through libusb), "
+               "lab:<hub socket>:<bus> (the emulator lab's CAN bus); `dcos-can list` shows them");
     std::string interface;
     bool json = false;
-    app.add_option("-i,--interface", interface, "the CAN interface")->required();
+    // Required by every command but list, which is checked after parsing.
+    app.add_option("-i,--interface", interface, "the CAN interface");
     app.add_flag("--json", json, "machine-readable output: one JSON object per line");
+
+    CLI::App* listCommand =
+        app.add_subcommand("list", "the SocketCAN interfaces and gs_usb adapters present (-i needs none)");
+    listCommand->add_flag("--json", json, "one JSON object");
 
     DumpOptions dumpOptions;
     CLI::App* dumpCommand = app.add_subcommand("dump", "print frames as candump does");
@@ -741,6 +841,14 @@ int main(int argc, char** argv)
         return code == 0 ? kExitOk : kExitUsage;
     }
     dumpOptions.errors = !noErrors;
+    if (*listCommand) {
+        return list(json);
+    }
+    if (interface.empty()) {
+        fmt::print(stderr, "dcos-can: -i,--interface is required, e.g. -i can0 or -i gsusb (`dcos-can list` shows "
+                           "what is there)\n");
+        return kExitUsage;
+    }
 
     std::vector<can::CanFrame> parsed;
     if (*sendCommand && !parseFrames(frames, parsed)) {

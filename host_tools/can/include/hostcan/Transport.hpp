@@ -1,5 +1,5 @@
 // One way to reach a CAN bus from a Linux host, behind one interface, so
-// that every host tool takes `-i can0`, `-i slcan:/dev/ttyACM0` or a lab bus
+// that every host tool takes `-i can0`, `-i slcan:/dev/ttyACM0`, `-i gsusb` or a lab bus
 // alike and does the same thing with it (docs/guide/host-can.md).
 //
 // Transports hand over whole frames, with the time they were received and,
@@ -86,9 +86,12 @@ public:
 ///     can0, vcan0, slcan0 ...         SocketCAN network interface (raw socket, error frames on)
 ///     slcan:/dev/ttyACM0[@bitrate]    an slcan (Lawicel) adapter on a serial device, default 500000 bit/s
 ///     slcan-socket:/path[@bitrate]    an slcan adapter behind a unix socket (we play the host side)
+///     gsusb[@bitrate]                 the first gs_usb adapter (candleLight, CANable) found by libusb, default 500000 bit/s
+///     gsusb:<serial>[@bitrate]        the gs_usb adapter with that USB serial number (`dcos-can list`)
 ///     lab:/path/to/hub.sock:bus       a participant of the lab's CAN bus hub (docs/protocols/labbus.md)
 ///
-/// BadArgument for a name of none of these forms.
+/// BadArgument for a name of none of these forms; NotAvailable when the
+/// device named is not there (no such serial device, no gs_usb adapter).
 std::unique_ptr<Transport> openTransport(const std::string& spec, TransportError& error);
 
 } // namespace hostcan
