@@ -308,6 +308,58 @@ def test_node_3_uses_a_semaphore_on_node_2_over_shared_memory(boot, p5smp):
     assert all(counts[node][key] == 0 for node in (2, 3) for key in ("ring_full", "not_signalled", "corrupted"))
 
 
+def lent(console, line):
+    """A `remote` call on console: (status, value)."""
+    status, value, _ = remote.call(console, line)
+    return status, value
+
+
+def test_node_3_uses_a_pool_and_a_heap_of_node_2_through_their_shared_memory(boot, p5smp):
+    """Pools and heaps by another node's id (seed 7.7, 7.8) between the board's nodes: node 2 lends its buffers,
+    node 3 writes into them and node 2 reads what it wrote; only the node that holds one returns it."""
+    emulator, node3 = boot_both_nodes(boot, p5smp, kind="test")
+    pool = remote.created(emulator, "remote pool", "RPOOL")
+    heap = remote.created(emulator, "remote heap", "RHEAP")
+    assert pool.startswith("0x0002") and heap.startswith("0x0002")
+    # Node 3 takes all eight buffers; the ninth Allocate finds the pool empty, as a local one would.
+    buffers = []
+    for _ in range(8):
+        status, address = lent(node3, f"alloc {pool}")
+        assert status == "ok" and address >= 0x100000, (status, address)
+        buffers.append(address)
+    assert len(set(buffers)) == 8 and all(b % 4 == 0 for b in buffers), buffers
+    assert lent(node3, f"alloc {pool}")[0] == "out of memory"
+    # The memory is the same on both processors: what node 3 writes, node 2 reads, and the other way.
+    assert lent(node3, f"poke 0x{buffers[0]:x} 0x600dcafe") == ("ok", 0x600DCAFE)
+    assert lent(emulator, f"peek 0x{buffers[0]:x}") == ("ok", 0x600DCAFE)
+    assert lent(emulator, f"poke 0x{buffers[7]:x} 12345") == ("ok", 12345)
+    assert lent(node3, f"peek 0x{buffers[7]:x}") == ("ok", 12345)
+    # Node 2 counts the eight as allocated until node 3 returns them, and its own tasks cannot return them
+    # behind node 3's back (the pool would then see node 3's return as a second one and disable itself).
+    assert lent(emulator, f"free {pool} {buffers[1]}")[0] == "not owner"
+    pools = emulator.command("pools")
+    assert re.search(r"lent\s+64\s+8\s+0\s", pools), pools
+    # A buffer not handed to node 3, and one returned twice, are refused without touching the pool.
+    assert lent(node3, f"free {pool} {buffers[0] + 4}")[0] == "invalid argument"
+    for address in buffers:
+        assert lent(node3, f"free {pool} {address}")[0] == "ok"
+    assert lent(node3, f"free {pool} {buffers[3]}")[0] == "invalid argument"
+    assert re.search(r"lent\s+64\s+8\s+8\s", emulator.command("pools")), emulator.command("pools")
+    # A heap's segments the same way, of the sizes asked.
+    status, segment = lent(node3, f"halloc {heap} 300")
+    assert status == "ok", status
+    assert lent(node3, f"poke 0x{segment + 296:x} 7") == ("ok", 7)
+    assert lent(emulator, f"peek 0x{segment + 296:x}") == ("ok", 7)
+    assert lent(node3, f"halloc {heap} 100000")[0] == "out of memory"
+    assert lent(node3, f"hfree {heap} {segment}")[0] == "ok"
+    counters = remote.net_counters(emulator)
+    assert (counters["memory-lent"], counters["memory-returned"]) == (9, 9), counters
+    assert counters["served"] >= 9 + 2 + 2, counters
+    # A pool of node 2 asked for from node 2 itself is the local call, unchanged.
+    status, mine = lent(emulator, f"alloc {pool}")
+    assert status == "ok" and lent(emulator, f"free {pool} {mine}")[0] == "ok"
+
+
 # QEMU's own Kvaser PCIcan model (hw/net/can/can_kvaser_pci.c), which we did not write, twice on one of
 # QEMU's CAN buses: the PCI front end of our SJA1000 driver finds both cards by enumeration, routes their
 # interrupt pins through the I/O APIC as the MP table says, and moves frames from one to the other.

@@ -133,6 +133,23 @@ def test_errors_come_back_as_the_local_call_gives_them(pair):
     assert call(one, "count 0x0007" + semaphore[6:])[0] == "remote object unreachable"
 
 
+def test_a_pool_or_heap_of_a_node_across_the_bus_is_refused_without_a_frame(pair):
+    """A buffer or segment is memory of its node (seed 7.7, 7.8): over CAN nobody can address it, so the call is
+    refused on the caller's node at once, before anything is sent (docs/protocols/remote-transactions.md)."""
+    lab, one, two = pair
+    pool = created(two, "remote pool", "RPOOL")
+    heap = created(two, "remote heap", "RHEAP")
+    before = len(dcos_frames(lab, REQUEST))
+    assert call(one, f"alloc {pool}")[:2] == ("not supported", 0)
+    assert call(one, f"free {pool} 1048576")[0] == "not supported"
+    assert call(one, f"halloc {heap} 64")[:2] == ("not supported", 0)
+    assert call(one, f"hfree {heap} 1048576")[0] == "not supported"
+    assert len(dcos_frames(lab, REQUEST)) == before
+    # On its own node the pool works as ever.
+    status, buffer, _ = call(two, f"alloc {pool}")
+    assert status == "ok" and call(two, f"free {pool} {buffer}")[0] == "ok"
+
+
 def test_a_dead_node_gives_unreachable_within_the_watchdog_and_node_1_carries_on(pair):
     lab, one, two = pair
     semaphore = created(two, "remote sem 1", "RSEM")

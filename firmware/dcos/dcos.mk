@@ -25,7 +25,8 @@ DCOS_PORTABLE_SRCS := \
 	firmware/dcos/src/network/PublicationMessage.cpp \
 	firmware/dcos/src/network/TimeSyncMessage.cpp \
 	firmware/dcos/src/network/ClockServo.cpp \
-	firmware/dcos/src/network/RemoteForward.cpp
+	firmware/dcos/src/network/RemoteForward.cpp \
+	firmware/dcos/src/network/RemoteMemoryHolds.cpp
 
 # Kernel sources that run only on the target: task switching, the tick, traps.
 DCOS_TARGET_SRCS := \

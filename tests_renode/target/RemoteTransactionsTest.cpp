@@ -14,6 +14,9 @@
 //     RKILL <status>              KillTask's status
 //     RHALT                       the node stops for good (halt)
 //     RPORT <id>                  the porter's port was created
+//     RPOOL <id>, RHEAP <id>      a global pool (eight 64-byte buffers) or
+//                                 heap (4 KiB) was created, to be used from
+//                                 the other node of the dual-Pentium board
 //     RPGOT <count> <priorities> <last message>
 //                                 what the porter has received: how many
 //                                 messages, the first byte of each of the
@@ -25,7 +28,9 @@
 // priority, to show that a request of lower priority waits for it.
 #include "KernelTestSupport.hpp"
 
+#include <dcos/BufferPoolAgent.hpp>
 #include <dcos/DsmAgent.hpp>
+#include <dcos/HeapAgent.hpp>
 #include <dcos/MessagePortAgent.hpp>
 #include <dcos/SemaphoreAgent.hpp>
 #include <dcos/TaskAgent.hpp>
@@ -58,6 +63,13 @@ volatile uint32_t listenerEvents = 0;
 volatile uint32_t listenerSignals = 0;
 
 void listenerSignal(unsigned signal) { listenerSignals = listenerSignals | (1u << signal); }
+
+// The areas of the pool and heap `remote pool` and `remote heap` create;
+// one of each at a time.
+constexpr size_t kLentBufferBytes = 64;
+constexpr size_t kLentBuffers = 8;
+alignas(8) uint8_t lentPoolArea[dcos::BufferPoolAgent::AreaBytes(kLentBufferBytes, kLentBuffers)];
+alignas(8) uint8_t lentHeapArea[4096];
 
 void listenerEntry(uintptr_t)
 {
@@ -186,6 +198,32 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
             return CommandResult::UsageError;
         }
         return reportCreated(shell, "RSEM", semaphoreAgent.Create(attributes));
+    }
+    if (textEquals(verb, "pool") && argc == 2) {
+        return reportCreated(shell, "RPOOL",
+                             dcos::bufferPoolAgent.Create(lentPoolArea, sizeof lentPoolArea, kLentBufferBytes, "lent",
+                                                          dcos::Visibility::Global));
+    }
+    if (textEquals(verb, "heap") && argc == 2) {
+        return reportCreated(shell, "RHEAP",
+                             dcos::heapAgent.Create(lentHeapArea, sizeof lentHeapArea, "lentheap",
+                                                    dcos::Visibility::Global));
+    }
+    if ((textEquals(verb, "peek") && argc == 3) || (textEquals(verb, "poke") && argc == 4)) {
+        // A 32-bit word of memory at an address a buffer or segment call
+        // gave, read or written from this node: the proof that the two
+        // nodes of the board see the same memory there.
+        unsigned long address = 0, word = 0;
+        if (!shell::Shell::parseUnsigned(argv[2], address) || (address & 3) != 0 || address < 0x1000 ||
+            (argc == 4 && !shell::Shell::parseUnsigned(argv[3], word))) {
+            return CommandResult::UsageError;
+        }
+        volatile uint32_t* const at = reinterpret_cast<volatile uint32_t*>(address);
+        if (argc == 4) {
+            *at = static_cast<uint32_t>(word);
+        }
+        shell.print("RRES ok %lu 0\r\n", static_cast<unsigned long>(*at));
+        return CommandResult::Ok;
     }
     if (textEquals(verb, "delete") && argc == 3 && parseObjectId(argv[2], id)) {
         shell.print("RRES %s 0 0\r\n", dcos::statusName(semaphoreAgent.Delete(id)));
@@ -414,6 +452,18 @@ CommandResult remote(shell::Shell& shell, int argc, char** argv)
     } else if (textEquals(verb, "receive") && extra == 0) {
         dcos::Message message;
         status = dcos::messagePortAgent.Receive(id, message, dcos::kPoll);
+    } else if (textEquals(verb, "alloc") && extra == 0) {
+        const Result<void*> buffer = dcos::bufferPoolAgent.Allocate(id);
+        status = buffer.status();
+        value = buffer.ok() ? static_cast<uint32_t>(reinterpret_cast<uintptr_t>(buffer.value())) : 0;
+    } else if (textEquals(verb, "free") && extra == 1) {
+        status = dcos::bufferPoolAgent.Return(id, reinterpret_cast<void*>(argument));
+    } else if (textEquals(verb, "halloc") && extra == 1) {
+        const Result<void*> segment = dcos::heapAgent.Allocate(id, argument);
+        status = segment.status();
+        value = segment.ok() ? static_cast<uint32_t>(reinterpret_cast<uintptr_t>(segment.value())) : 0;
+    } else if (textEquals(verb, "hfree") && extra == 1) {
+        status = dcos::heapAgent.Return(id, reinterpret_cast<void*>(argument));
     } else if (textEquals(verb, "holder") && extra == 0) {
         const Result<ObjectId> holder = semaphoreAgent.GetHolder(id);
         status = holder.status();
@@ -441,7 +491,9 @@ DCOS_SHELL_COMMAND_DETAILED(
     "post [at=P] [tick] <id> <events> | signal [at=P] [tick] <id> <n> | state [at=P] [tick] <task> | "
     "priority [at=P] [tick] <task> | holder [at=P] [tick] <semaphore> | port | portgot | "
     "send [at=P] [tick] <port> <priority*256+first byte> | receive [tick] <port> | self | timer | "
-    "give <timer> <task> | alarm <timer> watchdog|periodic|day <ms> <events> | cancel <timer> | events <ms> | halt",
+    "give <timer> <task> | alarm <timer> watchdog|periodic|day <ms> <events> | cancel <timer> | events <ms> | halt | "
+    "pool | heap | alloc <pool> | free <pool> <address> | halloc <heap> <bytes> | hfree <heap> <address> | "
+    "peek <address> | poke <address> <word>",
     "  sem: a global semaphore; listener: a task that collects events and signals (got shows them)\r\n"
     "  hog: a task that keeps the processor busy at a priority for a time\r\n"
     "  waiter: a task that acquires the semaphore for ever; kill: KillTask\r\n"
@@ -450,6 +502,8 @@ DCOS_SHELL_COMMAND_DETAILED(
     "  send: sixteen bytes counting up from the argument's low byte, at the priority in its second byte\r\n"
     "  timer: a global timer of the console; give: XferOwnership; alarm: its events to the owner; events: the console's\r\n"
     "  halt: this node stops for good, interrupts off, as a hung processor does\r\n"
+    "  pool, heap: a global pool of eight 64-byte buffers, a global 4 KiB heap; alloc/free, halloc/hfree use them\r\n"
+    "  peek, poke: a 32-bit word at an address such a call gave (value in RRES)\r\n"
     "  prints RRES <status> <value> <microseconds taken>",
     remote);
 

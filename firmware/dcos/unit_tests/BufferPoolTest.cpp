@@ -131,6 +131,26 @@ TEST(BufferPoolTest, OnlyTheHolderOrAnyoneForSystemBuffersMayReturn)
     EXPECT_EQ(pool.audit(), Status::Ok);
 }
 
+TEST(BufferPoolTest, ALentBufferComesBackOnlyUnderTheLentTag)
+{
+    // Lent to another node's task (RemoteMemoryHolds.hpp): neither a task of
+    // this node nor the system may return it, so it cannot be freed twice
+    // behind the other node's back.
+    Area area(BufferPoolAgent::AreaBytes(16, 2));
+    BufferPool pool;
+    ASSERT_EQ(pool.initialise(area.data(), area.size(), 16, 5), Status::Ok);
+    void* lent = pool.allocate(BufferPool::kLentHolder).value();
+    EXPECT_EQ(pool.release(lent, kTaskA), Status::NotOwner);
+    EXPECT_EQ(pool.release(lent, BufferPool::kSystemHolder), Status::NotOwner);
+    EXPECT_EQ(pool.transfer(lent, kTaskA, kTaskB), Status::NotOwner);
+    uint16_t holder = 0;
+    ASSERT_TRUE(pool.holderOf(pool.indexOfBuffer(lent), holder));
+    EXPECT_EQ(holder, BufferPool::kLentHolder);
+    EXPECT_EQ(pool.release(lent, BufferPool::kLentHolder), Status::Ok);
+    EXPECT_FALSE(pool.isCorrupted());
+    EXPECT_EQ(pool.audit(), Status::Ok);
+}
+
 TEST(BufferPoolTest, ReclaimReturnsExactlyTheHoldersBuffers)
 {
     Area area(BufferPoolAgent::AreaBytes(8, 10));

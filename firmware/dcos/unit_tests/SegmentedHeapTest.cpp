@@ -67,6 +67,18 @@ TEST(SegmentedHeapTest, HeldLinksAreFoundOnlyBehindACheckedHeader)
     EXPECT_EQ(heap.linksIfAllocated(offset), nullptr) << "a returned segment";
 }
 
+TEST(SegmentedHeapTest, ALentSegmentComesBackOnlyUnderTheLentTag)
+{
+    Area area(512);
+    SegmentedHeap heap;
+    ASSERT_EQ(heap.initialise(area.data(), area.size(), 5), Status::Ok);
+    void* const lent = heap.allocate(40, SegmentedHeap::kLentHolder).value();
+    EXPECT_EQ(heap.release(lent, kTaskA), Status::NotOwner);
+    EXPECT_EQ(heap.release(lent, SegmentedHeap::kSystemHolder), Status::NotOwner);
+    EXPECT_EQ(heap.release(lent, SegmentedHeap::kLentHolder), Status::Ok);
+    EXPECT_FALSE(heap.isCorrupted());
+}
+
 TEST(SegmentedHeapTest, AFreshHeapIsOneFreeSegment)
 {
     Area area(1024);

@@ -43,7 +43,11 @@
 // Errors common to every primitive that takes a pool id: InvalidId for the
 // null id, a forged index or a free slot; WrongType for an id of another
 // object type; StaleId for a pool deleted since; Remote for a pool on
-// another node (served by the network manager once it exists).
+// another node the network tables do not know. Allocate and Return of a
+// pool on another node that shares this node's memory (the dual-Pentium
+// board's other node) are carried by the remote agent; across a fieldbus
+// they fail with NotSupported, since nobody there can address the buffer
+// (docs/protocols/remote-transactions.md, "Pools and heaps").
 #pragma once
 
 #include <dcos/ObjectId.hpp>

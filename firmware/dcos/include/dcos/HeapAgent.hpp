@@ -38,7 +38,9 @@
 // 7.8). A pointer outside the heap is refused with InvalidArgument.
 //
 // Errors common to every primitive that takes a heap id: InvalidId, WrongType,
-// StaleId and Remote, as for every agent.
+// StaleId and Remote, as for every agent. Allocate and Return of a heap on
+// another node that shares this node's memory are carried as for pools
+// (BufferPoolAgent.hpp); across a fieldbus they fail with NotSupported.
 #pragma once
 
 #include <dcos/ObjectId.hpp>

@@ -7,6 +7,7 @@
 #include <dcos/internal/KernelConfig.hpp>
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/MemoryAreaServices.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/TaskManager.hpp>
 #include <dcos/internal/ConfigurationService.hpp>
@@ -153,7 +154,7 @@ void start()
 [[gnu::noinline]] Result<PoolObject*> resolveFully(ObjectId id)
 {
     // The table gives InvalidId, WrongType, Remote (another node's object,
-    // served by the network manager once it exists) and StaleId.
+    // which Allocate and Return forward to the remote agent) and StaleId.
     start();
     const Result<PoolObject**> entry = poolTable.resolve(id);
     if (!entry.ok()) {
@@ -269,40 +270,71 @@ Result<void*> BufferPoolManager::Allocate(ObjectId id)
 {
     Task* const task = memory_area::callerTask();
     const uint16_t holder = memory_area::holderOf(task, BufferPool::kSystemHolder);
-    Lock lock;
-    const Result<PoolObject*> object = lookup(id);
-    if (!object.ok()) {
-        return object.status();
-    }
-    BufferPool& pool = object.value()->pool;
-    const Result<void*> buffer = pool.allocate(holder);
-    if (buffer.ok()) {
-        const uint32_t index = pool.indexOfBuffer(buffer.value());
-        if (task != nullptr) {
-            takeHeld(task->heldBuffers, heldHandle(object.value(), index));
+    {
+        Lock lock;
+        const Result<PoolObject*> object = lookup(id);
+        if (object.ok()) {
+            BufferPool& pool = object.value()->pool;
+            const Result<void*> buffer = pool.allocate(holder);
+            if (buffer.ok()) {
+                const uint32_t index = pool.indexOfBuffer(buffer.value());
+                if (task != nullptr) {
+                    takeHeld(task->heldBuffers, heldHandle(object.value(), index));
+                }
+            }
+            return buffer;
+        }
+        if (object.status() != Status::Remote) {
+            return object.status();
         }
     }
-    return buffer;
+    // Another node's pool: its node hands out the buffer, if it shares memory with this one.
+    return forwardRemoteAllocate(RemoteService::PoolAllocate, id, 0);
 }
 
 Status BufferPoolManager::Return(ObjectId id, void* buffer)
 {
     Task* const task = memory_area::callerTask();
     const uint16_t holder = memory_area::holderOf(task, BufferPool::kSystemHolder);
+    {
+        Lock lock;
+        const Result<PoolObject*> object = lookup(id);
+        if (object.ok()) {
+            BufferPool& pool = object.value()->pool;
+            // Off the caller's list only if the caller holds it: release() then
+            // succeeds. A system buffer is on no list.
+            const uint32_t index = pool.indexOfBuffer(buffer);
+            uint16_t current = BufferPool::kFreeMark;
+            if (task != nullptr && pool.holderOf(index, current) && current == holder) {
+                giveHeld(task->heldBuffers, heldHandle(object.value(), index), pool.linksOf(index));
+            }
+            return pool.release(buffer, holder);
+        }
+        if (object.status() != Status::Remote) {
+            return object.status();
+        }
+    }
+    return forwardRemoteReturn(RemoteService::PoolReturn, id, buffer);
+}
+
+Result<void*> BufferPoolManager::AllocateLent(ObjectId id)
+{
     Lock lock;
     const Result<PoolObject*> object = lookup(id);
     if (!object.ok()) {
         return object.status();
     }
-    BufferPool& pool = object.value()->pool;
-    // Off the caller's list only if the caller holds it: release() then
-    // succeeds. A system buffer is on no list.
-    const uint32_t index = pool.indexOfBuffer(buffer);
-    uint16_t current = BufferPool::kFreeMark;
-    if (task != nullptr && pool.holderOf(index, current) && current == holder) {
-        giveHeld(task->heldBuffers, heldHandle(object.value(), index), pool.linksOf(index));
+    return object.value()->pool.allocate(BufferPool::kLentHolder);
+}
+
+Status BufferPoolManager::ReturnLent(ObjectId id, void* buffer)
+{
+    Lock lock;
+    const Result<PoolObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
     }
-    return pool.release(buffer, holder);
+    return object.value()->pool.release(buffer, BufferPool::kLentHolder);
 }
 
 Result<BufferPoolStatistics> BufferPoolManager::GetStatistics(ObjectId id)

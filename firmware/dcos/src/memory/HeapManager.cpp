@@ -8,6 +8,7 @@
 #include <dcos/internal/KernelContext.hpp>
 #include <dcos/internal/MemoryAreaServices.hpp>
 #include <dcos/internal/ObjectTable.hpp>
+#include <dcos/internal/RemoteForward.hpp>
 #include <dcos/internal/ResourceRecovery.hpp>
 #include <dcos/internal/SegmentedHeap.hpp>
 #include <dcos/internal/TaskManager.hpp>
@@ -55,7 +56,7 @@ void start()
 [[gnu::noinline]] Result<HeapObject*> resolveFully(ObjectId id)
 {
     // The table gives InvalidId, WrongType, Remote (another node's object,
-    // served by the network manager once it exists) and StaleId.
+    // which Allocate and Return forward to the remote agent) and StaleId.
     start();
     const Result<HeapObject**> entry = heapTable.resolve(id);
     if (!entry.ok()) {
@@ -241,23 +242,58 @@ DCOS_CONFIGURATION_SERVICE Status HeapManager::Delete(ObjectId id)
 Result<void*> HeapManager::Allocate(ObjectId id, size_t bytes)
 {
     Task* const task = memory_area::callerTask();
-    Lock lock;
-    const Result<HeapObject*> object = lookup(id);
-    if (!object.ok()) {
-        return object.status();
+    {
+        Lock lock;
+        const Result<HeapObject*> object = lookup(id);
+        if (object.ok()) {
+            return allocateFor(*object.value(), bytes, task);
+        }
+        if (object.status() != Status::Remote) {
+            return object.status();
+        }
     }
-    return allocateFor(*object.value(), bytes, task);
+    // Another node's heap: its node hands out the segment, if it shares memory with this one.
+    if (bytes > 0xFFFFFFFFu) {
+        return Status::NoMemory;
+    }
+    return forwardRemoteAllocate(RemoteService::HeapAllocate, id, static_cast<uint32_t>(bytes));
 }
 
 Status HeapManager::Return(ObjectId id, void* segment)
 {
     Task* const task = memory_area::callerTask();
+    {
+        Lock lock;
+        const Result<HeapObject*> object = lookup(id);
+        if (object.ok()) {
+            return releaseFor(*object.value(), segment, task);
+        }
+        if (object.status() != Status::Remote) {
+            return object.status();
+        }
+    }
+    return forwardRemoteReturn(RemoteService::HeapReturn, id, segment);
+}
+
+Result<void*> HeapManager::AllocateLent(ObjectId id, size_t bytes)
+{
     Lock lock;
     const Result<HeapObject*> object = lookup(id);
     if (!object.ok()) {
         return object.status();
     }
-    return releaseFor(*object.value(), segment, task);
+    // On no task's list: the remote agent keeps the lent ones (RemoteMemoryHolds.hpp).
+    return object.value()->heap.allocate(bytes, SegmentedHeap::kLentHolder);
+}
+
+Status HeapManager::ReturnLent(ObjectId id, void* segment)
+{
+    Lock lock;
+    const Result<HeapObject*> object = lookup(id);
+    if (!object.ok()) {
+        return object.status();
+    }
+    return object.value()->heap.release(segment, SegmentedHeap::kLentHolder);
 }
 
 Result<HeapStatistics> HeapManager::GetStatistics(ObjectId id)

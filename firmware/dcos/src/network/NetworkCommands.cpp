@@ -150,7 +150,8 @@ void listRemote(shell::Shell& shell)
         {"alarms-notified", s.alarmsNotified}, {"alarm-owners-lost", s.alarmOwnersLost},
         {"alarms-dropped", s.alarmsDropped},
         {"nodes-started", s.nodesStarted}, {"holds-freed", s.holdsFreed},
-        {"timers-of-restarted", s.timersOfRestarted}, {"no-flash-service", s.noFlashService},
+        {"timers-of-restarted", s.timersOfRestarted}, {"memory-lent", s.memoryLent},
+        {"memory-returned", s.memoryReturned}, {"memory-reclaimed", s.memoryReclaimed}, {"no-flash-service", s.noFlashService},
     };
     printCounters(shell, counters);
     // The last transaction's instructions on each side, in an image with an

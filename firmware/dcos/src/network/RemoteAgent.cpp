@@ -15,6 +15,9 @@
 #include <dcos/internal/RemoteAgent.hpp>
 #include <dcos/internal/FlashServiceHooks.hpp>
 #include <dcos/internal/RemoteForward.hpp>
+#include <dcos/internal/RemoteMemoryHolds.hpp>
+#include <dcos/internal/BufferPoolManager.hpp>
+#include <dcos/internal/HeapManager.hpp>
 #include <dcos/internal/Scheduler.hpp>
 #include <dcos/internal/SemaphoreManager.hpp>
 #include <dcos/internal/TaskManager.hpp>
@@ -286,6 +289,12 @@ Result<CallSlot*> openRemoteCall(Task& self, RemoteService service, ObjectId id)
     // routed requests).
     const bool routed = hop.value().via.raw() != hop.value().destination.raw();
     const uint8_t interface = hop.value().interface;
+    if (isMemoryService(service) && (routed || !withinController(interface))) {
+        // A buffer or segment is memory of its node (seed 7.7, 7.8): only a
+        // node that shares that memory, over the board's own link, can use
+        // its address. Refused here, before anything is sent.
+        return Status::NotSupported;
+    }
     Lock lock;
     if (links[interface] == nullptr) {
         return Status::Unreachable;
@@ -871,6 +880,106 @@ void announceStart(uint8_t interface)
         sendMessage(interface, SystemMessageType::NodeStarted, kAnnouncementPriority, NetworkLink::kBroadcast, data);
 }
 
+// ---- pools and heaps lent to nodes that share this node's memory -------------
+
+// Which node holds each buffer and segment lent (RemoteMemoryHolds.hpp). Under the lock.
+RemoteMemoryHolds memoryHolds;
+
+// The address of a buffer or segment as a request carries it.
+uint32_t addressOf(const void* pointer) { return static_cast<uint32_t>(reinterpret_cast<uintptr_t>(pointer)); }
+void* pointerAt(uint32_t address) { return reinterpret_cast<void*>(static_cast<uintptr_t>(address)); }
+
+// Returns @p address, lent, to @p area, a pool or a heap.
+Status returnLent(ObjectId area, uint32_t address)
+{
+    return area.type() == ObjectType::BufferPool ? BufferPoolManager::ReturnLent(area, pointerAt(address))
+                                                 : HeapManager::ReturnLent(area, pointerAt(address));
+}
+
+// A pool's or heap's Allocate or Return asked by a task of another node:
+// performed with the lent tag, the buffer or segment noted as that node's.
+// Only for a node that shares this node's memory, over the board's own
+// link and not through a gateway: any other could not use the address.
+// @p value: the address handed out.
+Status serveMemory(const RemoteRequest& request, const ServedEntry& entry, ObjectId area, uint32_t& value)
+{
+    if (entry.node != localNode() || !withinController(entry.interface)) {
+        return Status::NotSupported;
+    }
+    const Result<uint16_t> requester = NetworkInterfacesManager::NodeAt(entry.interface, entry.source);
+    if (!requester.ok()) {
+        return Status::NotSupported; // A sender the tables do not name cannot be held to its buffers.
+    }
+    const uint16_t node = requester.value();
+    if (request.service == RemoteService::PoolAllocate || request.service == RemoteService::HeapAllocate) {
+        {
+            Lock lock;
+            if (!memoryHolds.hasRoom()) {
+                return Status::Busy;
+            }
+        }
+        const Result<void*> got = request.service == RemoteService::PoolAllocate
+                                      ? BufferPoolManager::AllocateLent(area)
+                                      : HeapManager::AllocateLent(area, request.argument);
+        if (!got.ok()) {
+            return got.status();
+        }
+        bool noted;
+        {
+            Lock lock;
+            noted = memoryHolds.add(area, addressOf(got.value()), node);
+            statistics.memoryLent += noted ? 1 : 0;
+        }
+        if (!noted) {
+            // Another worker took the last entry meanwhile: nothing is lent untracked.
+            (void)returnLent(area, addressOf(got.value()));
+            return Status::Busy;
+        }
+        value = addressOf(got.value());
+        return Status::Ok;
+    }
+    Status status;
+    {
+        Lock lock;
+        status = memoryHolds.check(area, request.argument, node);
+    }
+    if (status != Status::Ok) {
+        return status;
+    }
+    status = returnLent(area, request.argument);
+    if (status == Status::Ok || status == Status::StaleId || status == Status::Corrupted) {
+        // Back, or its pool or heap is gone or disabled: either way no longer lent.
+        Lock lock;
+        memoryHolds.remove(area, request.argument);
+        statistics.memoryReturned += status == Status::Ok ? 1 : 0;
+    }
+    return status;
+}
+
+// Returns everything @p node held of this node's pools and heaps: its tasks
+// of before are gone. How many buffers and segments.
+size_t reclaimMemoryOf(uint16_t node)
+{
+    constexpr size_t kBatch = 4;
+    size_t reclaimed = 0;
+    for (;;) {
+        RemoteMemoryHolds::Hold batch[kBatch];
+        size_t taken;
+        {
+            Lock lock;
+            taken = memoryHolds.takeHoldsOf(node, batch, kBatch);
+        }
+        for (size_t i = 0; i < taken; ++i) {
+            // A pool or heap deleted meanwhile answers StaleId: nothing to give back.
+            (void)returnLent(batch[i].area, batch[i].address);
+        }
+        reclaimed += taken;
+        if (taken < kBatch) {
+            return reclaimed;
+        }
+    }
+}
+
 // Another node started: what this node keeps for its tasks of before is
 // given up, as when those tasks are found gone (a held semaphore freed and
 // its waiters told the holder ended; a timer it owned deleted). Its node
@@ -887,8 +996,10 @@ void onNodeStarted(const SystemMessage& message)
     }
     const size_t holds = freeHoldsOfNode(announcement.node);
     const size_t timers = TimerManager::dropTimersOwnedOnNode(announcement.node);
+    const size_t memory = reclaimMemoryOf(announcement.node);
     Lock lock;
     ++statistics.nodesStarted;
+    statistics.memoryReclaimed += static_cast<uint32_t>(memory);
     statistics.holdsFreed += static_cast<uint32_t>(holds);
     statistics.timersOfRestarted += static_cast<uint32_t>(timers);
 }
@@ -1626,6 +1737,10 @@ RemoteReply perform(const RemoteRequest& request, ServedEntry& entry)
         replyWith(reply, DsmManager::serveRemoteOpen(id, withinController(entry.interface)));
         break;
     }
+    case RemoteService::PoolAllocate:
+    case RemoteService::PoolReturn:
+    case RemoteService::HeapAllocate:
+    case RemoteService::HeapReturn: reply.status = serveMemory(request, entry, id, reply.value); break;
     case RemoteService::PortSend: {
         // Sent as any local task sends: the port's own checks (priority,
         // buffers, deletion) answer for it.

@@ -64,6 +64,26 @@ Result<ObjectId> remoteNameToObject(ObjectType type, const char* name)
     return resolver(type, name);
 }
 
+Result<void*> forwardRemoteAllocate(RemoteService service, ObjectId id, uint32_t argument)
+{
+    const Result<uint32_t> reply = forwardRemote(service, id, argument);
+    if (!reply.ok()) {
+        return reply.status();
+    }
+    // Both nodes map all of the board's memory at the same addresses, so the
+    // serving node's address is this node's pointer.
+    return reinterpret_cast<void*>(static_cast<uintptr_t>(reply.value()));
+}
+
+Status forwardRemoteReturn(RemoteService service, ObjectId id, const void* address)
+{
+    const uintptr_t value = reinterpret_cast<uintptr_t>(address);
+    if (value > 0xFFFFFFFFu) {
+        return Status::InvalidArgument; // Not an address of a 32-bit node's memory (a host build's pointer).
+    }
+    return forwardRemote(service, id, static_cast<uint32_t>(value)).status();
+}
+
 Result<uint32_t> forwardRemote(RemoteService service, ObjectId id, uint32_t argument)
 {
     RemoteForwarder const forwarder = remoteForwarder;

@@ -52,6 +52,10 @@ const char* remoteServiceName(RemoteService service)
     case RemoteService::HeldRelease: return "held-release";
     case RemoteService::TimerSetAlarm: return "set-alarm";
     case RemoteService::TimerCancelAlarm: return "cancel-alarm";
+    case RemoteService::PoolAllocate: return "pool-allocate";
+    case RemoteService::PoolReturn: return "pool-return";
+    case RemoteService::HeapAllocate: return "heap-allocate";
+    case RemoteService::HeapReturn: return "heap-return";
     }
     return "?";
 }

@@ -64,6 +64,11 @@ public:
     static constexpr uint16_t kSystemHolder = 0xFFFF;
     /// Reserved: what holderOf() reports for a free buffer; never a valid holder.
     static constexpr uint16_t kFreeMark = 0xFFFE;
+    /// The holder tag of buffers lent to a task of another node that shares
+    /// this node's memory (RemoteMemoryHolds.hpp): only the remote agent,
+    /// returning them for that node, holds this tag, so no task of this node
+    /// can return such a buffer behind the other node's back. Never a task's.
+    static constexpr uint16_t kLentHolder = 0xFFFD;
     /// Smallest buffer size, in bytes.
     static constexpr size_t kMinimumBufferSize = BufferPoolAgent::kMinimumBufferSize;
     /// Most buffers one pool can hold (16-bit indices, one value marks the list's end).

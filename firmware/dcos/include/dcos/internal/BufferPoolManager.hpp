@@ -56,6 +56,12 @@ public:
     static Result<void*> Allocate(ObjectId pool);
     /// Implements BufferPoolAgent::Return.
     static Status Return(ObjectId pool, void* buffer);
+    /// Allocate of a buffer or segment lent to a task of another node,
+    /// held by the lent tag (BufferPool::kLentHolder), whoever calls: the
+    /// remote agent's worker (RemoteMemoryHolds.hpp). O(1).
+    static Result<void*> AllocateLent(ObjectId pool);
+    /// Return of a lent buffer, by the remote agent for the node that held it. O(1).
+    static Status ReturnLent(ObjectId pool, void* buffer);
     /// Implements BufferPoolAgent::GetStatistics.
     static Result<BufferPoolStatistics> GetStatistics(ObjectId pool);
     /// Finds a pool visible from @p askingScope by name. O(N).

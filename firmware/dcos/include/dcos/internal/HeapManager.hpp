@@ -48,6 +48,12 @@ public:
     static Result<void*> Allocate(ObjectId heap, size_t bytes);
     /// Implements HeapAgent::Return.
     static Status Return(ObjectId heap, void* segment);
+    /// Allocate of a buffer or segment lent to a task of another node,
+    /// held by the lent tag (BufferPool::kLentHolder), whoever calls: the
+    /// remote agent's worker (RemoteMemoryHolds.hpp). O(1).
+    static Result<void*> AllocateLent(ObjectId heap, size_t bytes);
+    /// Return of a lent segment, by the remote agent for the node that held it. O(1).
+    static Status ReturnLent(ObjectId heap, void* segment);
     /// Implements HeapAgent::GetStatistics.
     static Result<HeapStatistics> GetStatistics(ObjectId heap);
     /// Finds a heap visible from @p askingScope by name. O(N).

@@ -30,8 +30,8 @@ namespace dcos::internal::memory_area {
 /// [0x1000, 0x1FFF] and never meets the reserved tags at the top of the range.
 [[gnu::always_inline]] inline uint16_t holderOfTask(ObjectId task) { return static_cast<uint16_t>(task.raw()); }
 
-static_assert(static_cast<uint16_t>(ObjectId(0xFFFF, ObjectType::Task, ObjectId::kMaxIndex).raw()) < 0xFFFE,
-              "a task's holder tag must differ from the system's and from the free mark");
+static_assert(static_cast<uint16_t>(ObjectId(0xFFFF, ObjectType::Task, ObjectId::kMaxIndex).raw()) < 0xFFFD,
+              "a task's holder tag must differ from the system's, the free mark and the lent mark");
 
 /// The task that holds memory the caller takes: the running task, or null
 /// for the system in an interrupt handler and before the scheduler starts.

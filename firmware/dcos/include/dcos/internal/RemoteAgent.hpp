@@ -108,6 +108,10 @@ struct RemoteStatistics {
     uint32_t nodesStarted = 0;     ///< Other nodes' announcements that they started, heard on any interface.
     uint32_t holdsFreed = 0;       ///< Binary semaphores freed because their holder's node started again.
     uint32_t timersOfRestarted = 0; ///< Timers deleted because their owner's node started again.
+    // Pools and heaps lent to nodes that share this node's memory (docs/protocols/remote-transactions.md).
+    uint32_t memoryLent = 0;       ///< Buffers and segments handed to other nodes' tasks.
+    uint32_t memoryReturned = 0;   ///< Of those, returned by their node.
+    uint32_t memoryReclaimed = 0;  ///< Of those, returned because their node started again.
     // The flash protocol (docs/protocols/flash.md, "On CAN").
     uint32_t noFlashService = 0;   ///< Flashing frames received by an image without the flash service.
     // The instruction counts of the last transaction (the remote bench).

@@ -100,6 +100,16 @@ void setRemoteNameResolver(RemoteNameResolver resolver);
     return remoteNameToObject(type, name);
 }
 
+/// Allocate of another node's pool or heap (@p service PoolAllocate, or
+/// HeapAllocate with the bytes in @p argument): the address the node handed
+/// out, as a pointer of this node (the two share memory), or why not;
+/// Status::Remote when no remote agent runs. Out of line: only a miss path calls it.
+[[gnu::noinline]] Result<void*> forwardRemoteAllocate(RemoteService service, ObjectId id, uint32_t argument);
+
+/// Return of a buffer or segment of another node's pool or heap
+/// (@p service PoolReturn or HeapReturn): its status.
+[[gnu::noinline]] Status forwardRemoteReturn(RemoteService service, ObjectId id, const void* address);
+
 /// Forwards a request for another node's object, or Status::Remote when no
 /// remote agent runs. Out of line: only an agent's miss path calls it.
 [[gnu::noinline]] Result<uint32_t> forwardRemote(RemoteService service, ObjectId id, uint32_t argument);

@@ -61,10 +61,28 @@ enum class RemoteService : uint8_t {
     TimerSetAlarm = 14,
     /// CancelAlarm by the timer's owner; argument: the owner's id.
     TimerCancelAlarm = 15,
+    /// BufferPoolAgent::Allocate; argument: 0; value: the buffer's address.
+    /// Only between nodes that share memory (docs/protocols/remote-transactions.md,
+    /// "Pools and heaps"): the address is the serving node's memory.
+    PoolAllocate = 16,
+    /// BufferPoolAgent::Return; argument: the buffer's address.
+    PoolReturn = 17,
+    /// HeapAgent::Allocate; argument: the bytes asked for; value: the segment's address.
+    HeapAllocate = 18,
+    /// HeapAgent::Return; argument: the segment's address.
+    HeapReturn = 19,
 };
 
 /// The last service value assigned.
-constexpr uint8_t kLastRemoteService = 15;
+constexpr uint8_t kLastRemoteService = 19;
+
+/// Whether @p service hands out or takes back memory of the serving node,
+/// which only a node that shares that memory can use.
+constexpr bool isMemoryService(RemoteService service)
+{
+    return service == RemoteService::PoolAllocate || service == RemoteService::PoolReturn ||
+           service == RemoteService::HeapAllocate || service == RemoteService::HeapReturn;
+}
 
 /// The value of a reply NotSupported to SemaphoreAcquire or
 /// SemaphoreRelease of a binary semaphore: ask again with HeldAcquire or

@@ -64,6 +64,9 @@ class SegmentedHeap {
 public:
     /// The holder tag of segments that belong to the system: any holder may return them.
     static constexpr uint16_t kSystemHolder = 0xFFFF;
+    /// The holder tag of segments lent to a task of another node
+    /// (BufferPool::kLentHolder says why). Never a task's.
+    static constexpr uint16_t kLentHolder = 0xFFFD;
     /// Bytes of a segment's header.
     static constexpr size_t kHeaderBytes = HeapAgent::kHeaderBytes;
     /// Alignment and size granularity of segments.
