@@ -29,15 +29,12 @@ import tempfile
 
 import pytest
 
-from dcoslab.board import load_board
-from dcoslab.canlab import CanLab
-from dcoslab.cards import BIN, DEVELOPMENT_KEY, card_state, new_card, signed
-from dcoslab.remote import attach_node
+from dcoslab.cards import card_state
 from dcoslab.slcan_bridge import SlcanBridge
 from dcoslab.vmworld import BridgedWorld, attach_reports, hold_world, vm_status
 from labvm import LabVM
-from labvm.gsusb_gadget import LAB_VM_LOAD
-from test_flash_labvm import BITRATE, BOOT_TIMEOUT, NODE, PACE, STEP, WORK_ROOT, carried, tiny_image
+from labvm.gsusb_gadget import LAB_VM_LOAD, VM_SHELL
+from test_flash_labvm import BOOT_TIMEOUT, NODE, STEP, WORK_ROOT, boot_node_on_card, carried
 
 pytestmark = pytest.mark.xdist_group("test_flash_gsusb_labvm")
 
@@ -53,27 +50,7 @@ def vm_script():
     return f"""
 . /run/labvm/lib.sh
 cd /tmp
-S=/run/gsusb/status
-C=/run/gsusb/control
-status() {{ sed -n "s/^$1=//p" $S; }}
-gsusb() {{
-    _n=$(( $(status commands) + 1 ))
-    echo "$*" >$C
-    _deadline=$(( $(labvm_uptime) + 30 ))
-    until grep -qx "commands=$_n" $S; do
-        [ "$(labvm_uptime)" -lt $_deadline ] || {{ echo "@@FAILED the gadget did not do $*@@"; exit 1; }}
-        sleep 0.1
-    done
-}}
-wait_for() {{
-    _deadline=$(( $(labvm_uptime) + $1 )); _what=$2; shift 2
-    until "$@"; do
-        [ "$(labvm_uptime)" -lt $_deadline ] || {{ echo "@@FAILED no $_what@@"; cat $S; exit 1; }}
-        sleep 0.1
-    done
-}}
-at_least() {{ [ "$(status $1)" -ge "$2" ]; }}
-bound() {{ [ "$(status bound)" = 1 ]; }}
+{VM_SHELL}
 trap 'echo "----- gadget log -----"; cat /tmp/gadget.log' EXIT
 cp {files}/dcos-flash ./dcos-flash && chmod 755 ./dcos-flash
 /usr/bin/python3 -u {files}/gsusb_gadget.py --serial {SERIAL} >/tmp/gadget.log 2>&1 &
@@ -88,7 +65,8 @@ flash=$!
 wait_for 300 "{UNPLUG_AFTER_FRAMES} frames of the transfer" at_least to_bus $(( $(status to_bus) + {UNPLUG_AFTER_FRAMES} ))
 gsusb unplug
 wait $flash
-echo "@@CUT $(cat /tmp/cut.out /tmp/cut.err | tr '\\n' ' ') status=$?@@"
+cut=$?
+echo "@@CUT $(cat /tmp/cut.out /tmp/cut.err | tr '\\n' ' ') status=$cut@@"
 
 # Plugged back in: the tool resumes where the node stopped taking blocks.
 gsusb replug
@@ -107,15 +85,8 @@ def world():
     work = tempfile.TemporaryDirectory(dir=WORK_ROOT)
 
     def build(world):
-        image = tiny_image(work.name)
-        card = new_card(work.name, ("A", signed(work.name, "1.0.0"), False))
-        world.card = card
-        world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BITRATE},
-                           {"board1": {"bus0": "can0", "card": card}}, pace=PACE, timeout=BOOT_TIMEOUT)
-        world.board = world.lab.board("board1")
-        attach_node(world.board, NODE, [], BITRATE, timeout=STEP)
-        files = {"dcos-flash": carried(os.path.join(BIN, "dcos-flash")), "tiny.dcos": carried(image),
-                 "key.pem": carried(DEVELOPMENT_KEY), "gsusb_gadget.py": carried(GADGET)}
+        files = boot_node_on_card(world, work.name)
+        files["gsusb_gadget.py"] = carried(GADGET)
         socket_path = os.path.join(work.name, "bus.sock")
         # No gs_usb module: the adapter is the tool's alone, through libusb.
         world.vm = LabVM(vm_script(), files=files, load=[m for m in LAB_VM_LOAD if m != "gs_usb"],

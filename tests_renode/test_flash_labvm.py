@@ -73,21 +73,27 @@ def carried(path):
         return handle.read()
 
 
+def boot_node_on_card(world, work):
+    """The world's board: the 486 booting from a card with 1.0.0 confirmed in slot A, node NODE on the paced lab
+    bus can0 (world.card, world.lab, world.board). Returns the files the VM's tool needs: dcos-flash, the signed
+    2.0.0 image (tiny.dcos) and the development key."""
+    image = tiny_image(work)
+    world.card = new_card(work, ("A", signed(work, "1.0.0"), False))
+    world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BITRATE},
+                       {"board1": {"bus0": "can0", "card": world.card}}, pace=PACE, timeout=BOOT_TIMEOUT)
+    world.board = world.lab.board("board1")
+    attach_node(world.board, NODE, [], BITRATE, timeout=STEP)
+    return {"dcos-flash": carried(os.path.join(BIN, "dcos-flash")), "tiny.dcos": carried(image),
+            "key.pem": carried(DEVELOPMENT_KEY)}
+
+
 @pytest.fixture(scope="module")
 def world():
     os.makedirs(WORK_ROOT, exist_ok=True)
     work = tempfile.TemporaryDirectory(dir=WORK_ROOT)
 
     def build(world):
-        image = tiny_image(work.name)
-        card = new_card(work.name, ("A", signed(work.name, "1.0.0"), False))
-        world.card = card
-        world.lab = CanLab(world.boot, load_board("isa486"), {"can0": BITRATE},
-                           {"board1": {"bus0": "can0", "card": card}}, pace=PACE, timeout=BOOT_TIMEOUT)
-        world.board = world.lab.board("board1")
-        attach_node(world.board, NODE, [], BITRATE, timeout=STEP)
-        files = {"dcos-flash": carried(os.path.join(BIN, "dcos-flash")), "tiny.dcos": carried(image),
-                 "key.pem": carried(DEVELOPMENT_KEY)}
+        files = boot_node_on_card(world, work.name)
         start_bridged_vm(world, vm_script(), BITRATE, files, BOOT_TIMEOUT, 1200)
 
     with work:

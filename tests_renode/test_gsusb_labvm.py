@@ -29,7 +29,7 @@ import pytest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from labvm import CanFrame, LabVM, LabVMError, SlcanError, SlcanPort  # noqa: E402
-from labvm.gsusb_gadget import LAB_VM_LOAD  # noqa: E402
+from labvm.gsusb_gadget import LAB_VM_LOAD, VM_SHELL  # noqa: E402
 
 # The module's tests share a module-scoped lab VM: xdist (--dist loadgroup in
 # pytest.ini) keeps them on one worker, in order.
@@ -134,40 +134,10 @@ out["state_reset"] = control(VENDOR_IN, 14, 0, 12)
 print("@@USBFS " + json.dumps(out, sort_keys=True) + "@@", flush=True)
 """
 
-VM_SCRIPT = r"""
+VM_SCRIPT = (r"""
 . /run/labvm/lib.sh
 cd /tmp
-S=/run/gsusb/status
-C=/run/gsusb/control
-fail() {
-    echo "@@FAILED $*@@"
-    echo "----- gadget status -----"; cat $S
-    echo "----- can0 -----"; ip -details -statistics link show can0
-    echo "----- kernel log -----"; dmesg | tail -n 20
-    exit 1
-}
-status() { sed -n "s/^$1=//p" $S; }
-# gsusb COMMAND...: a control command to the gadget, waiting until it is done.
-gsusb() {
-    _n=$(( $(status commands) + 1 ))
-    echo "$*" >$C
-    _deadline=$(( $(labvm_uptime) + 30 ))
-    until grep -qx "commands=$_n" $S; do
-        [ "$(labvm_uptime)" -lt $_deadline ] || fail "the gadget did not do '$*' in 30 s"
-        sleep 0.1
-    done
-}
-# wait_for SECONDS WHAT TEST...: polls TEST until it succeeds.
-wait_for() {
-    _deadline=$(( $(labvm_uptime) + $1 )); _what=$2; shift 2
-    until "$@"; do
-        [ "$(labvm_uptime)" -lt $_deadline ] || fail "no $_what"
-        sleep 0.1
-    done
-}
-at_least() { [ "$(status $1)" -ge "$2" ]; }  # the gadget's counter $1 has reached $2
-has_can0() { [ -e /sys/class/net/can0 ]; }
-no_can0() { [ ! -e /sys/class/net/can0 ]; }
+""" + VM_SHELL + r"""
 bound_interfaces() { ls /sys/bus/usb/drivers/gs_usb | grep ':' | tr '\n' ' '; }
 bring_up() {
     ip link set can0 type can bitrate 500000
@@ -304,7 +274,7 @@ quit=$?
 echo "@@QUIT status=$quit can0=$(has_can0 && echo present || echo gone) gadget=$(ls /sys/kernel/config/usb_gadget)@@"
 echo "@@STATUS-BEGIN@@"; cat $S; echo "@@STATUS-END@@"
 echo "@@DMESG-BEGIN@@"; dmesg | grep -E 'gs_usb|usb 1-1'; echo "@@DMESG-END@@"
-""".replace("__SERIAL__", SERIAL).replace("__RX_COUNT__", str(len(RX_FRAMES))).replace(
+""").replace("__SERIAL__", SERIAL).replace("__RX_COUNT__", str(len(RX_FRAMES))).replace(
     "__TX_SENDS__", " ".join(TX_SENDS)).replace("__TX_COUNT__", str(len(TX_SENDS))).replace(
     "__BURST_COUNT__", str(len(BURST))).replace("__QUEUE_LIMIT__", str(QUEUE_LIMIT)).replace(
     "__QUEUED_COUNT__", str(len(QUEUED)))

@@ -28,7 +28,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from dcoslab.board import REPOSITORY  # noqa: E402
 from labvm import CanFrame, LabVM, LabVMError, SlcanError, SlcanPort  # noqa: E402
-from labvm.gsusb_gadget import LAB_VM_LOAD  # noqa: E402
+from labvm.gsusb_gadget import LAB_VM_LOAD, VM_SHELL  # noqa: E402
 
 pytestmark = pytest.mark.xdist_group("test_gsusb_libusb_labvm")
 
@@ -55,40 +55,10 @@ RX_EXPECTED = [(0x123, False, False, 4, "11223344"), (0x1ABCDEF0, True, False, 2
 TX_SENDS = ["321#DEADBEEF", "12345678#01", "7FF#R", "1FFFFFFF#R", "000#", "555#0102030405060708"]
 TX_EXPECTED = ["t3214DEADBEEF", "T12345678101", "r7FF0", "R1FFFFFFF0", "t0000", "t55580102030405060708"]
 
-VM_SCRIPT = r"""
+VM_SCRIPT = (r"""
 . /run/labvm/lib.sh
 cd /tmp
-S=/run/gsusb/status
-C=/run/gsusb/control
-fail() {
-    echo "@@FAILED $*@@"
-    echo "----- gadget status -----"; cat $S
-    echo "----- kernel log -----"; dmesg | tail -n 20
-    exit 1
-}
-status() { sed -n "s/^$1=//p" $S; }
-gsusb() {
-    _n=$(( $(status commands) + 1 ))
-    echo "$*" >$C
-    _deadline=$(( $(labvm_uptime) + 30 ))
-    until grep -qx "commands=$_n" $S; do
-        [ "$(labvm_uptime)" -lt $_deadline ] || fail "the gadget did not do '$*' in 30 s"
-        sleep 0.1
-    done
-}
-wait_for() {
-    _deadline=$(( $(labvm_uptime) + $1 )); _what=$2; shift 2
-    until "$@"; do
-        [ "$(labvm_uptime)" -lt $_deadline ] || fail "no $_what"
-        sleep 0.1
-    done
-}
-at_least() { [ "$(status $1)" -ge "$2" ]; }
-started() { [ "$(status started)" = 1 ]; }
-stopped() { [ "$(status started)" = 0 ]; }
-bound() { [ "$(status bound)" = 1 ]; }
-has_can0() { [ -e /sys/class/net/can0 ]; }
-no_can0() { [ ! -e /sys/class/net/can0 ]; }
+""" + VM_SHELL + r"""
 # report NAME STATUS: the exit status, stdout and stderr of a dcos-can run kept in /tmp/NAME.*
 report() {
     echo "@@EXIT $1=$2@@"
@@ -163,7 +133,7 @@ report replug $?
 echo quit >$C
 wait $gadget
 echo "@@STATUS-BEGIN@@"; cat $S; echo "@@STATUS-END@@"
-""".replace("__SERIAL__", SERIAL).replace("__RX_COUNT__", str(len(RX_FRAMES))).replace(
+""").replace("__SERIAL__", SERIAL).replace("__RX_COUNT__", str(len(RX_FRAMES))).replace(
     "__TX_SENDS__", " ".join(TX_SENDS)).replace("__TX_COUNT__", str(len(TX_SENDS)))
 
 

@@ -21,8 +21,8 @@ import pytest
 
 from dcoslab import remote
 from dcoslab.canbus import Frame
-from dcoslab.remote import REPLY, REQUEST, SEMAPHORE_SEQUENCE, created, net_counters, semaphore_sequence, wait_tally
-from dcoslab.remote import publish as remote_publish, subscribe as remote_subscribe
+from dcoslab.remote import REPLY, REQUEST, SEMAPHORE_SEQUENCE, created, net_counters, read_pages_across, \
+    semaphore_sequence, wait_tally
 
 BIT_RATE = 500_000
 ROUTED = 0x13
@@ -290,16 +290,10 @@ RELAYED = 0x21
 
 def test_a_publisher_behind_the_gateway_is_read_through_it(triple):
     lab, one, two, three = triple
-    publisher = remote_publish(three, "level", count=20)
-    assert publisher.startswith("0x00038")
     # Node 1 opens node 3's publisher through node 2, which from then on
     # relays its frames onto can0, each behind a header naming node 3.
-    remote_subscribe(one, publisher)
-    wait_tally(lab, one, lambda status, _: status != "busy", "the subscriber to open")
-    three.command("pubsub go")
-    status, counts = wait_tally(lab, one, lambda _, c: c["last"] == 20, "the 20th page")
-    assert status == "ok"
-    assert (counts["received"], counts["repeats"], counts["torn"], counts["gaps"]) == (20, 0, 0, 0), counts
+    publisher = read_pages_across(lab, three, one)
+    assert publisher.startswith("0x00038")
     lab.hub.wait_until(lab.hub.now_ns + 5_000_000, 60)
     relayed = frames(lab, "can0", RELAYED)
     headers, parts = relayed[0::2], relayed[1::2]

@@ -163,6 +163,21 @@ def wait_tally(lab, board, predicate, what, timeout=120):
         lab.hub.wait_until(lab.hub.now_ns + 20_000_000, timeout)
 
 
+def read_pages_across(lab, writer, reader, pages=20):
+    """A global publisher "level" on writer, read by a subscriber on reader until its pages-th page.
+
+    Checks the subscriber saw every page once, none torn, none missing, and
+    returns the publisher's id; the writer goes on publishing nothing more."""
+    publisher = publish(writer, "level", count=pages)
+    subscribe(reader, publisher)
+    wait_tally(lab, reader, lambda status, _: status != "busy", "the subscriber to open")
+    writer.command("pubsub go")
+    status, counts = wait_tally(lab, reader, lambda _, c: c["last"] == pages, f"page {pages}")
+    assert status == "ok"
+    assert (counts["received"], counts["repeats"], counts["torn"], counts["gaps"]) == (pages, 0, 0, 0), counts
+    return publisher
+
+
 def publication_records(lab, bus=None):
     """The bus log's publication frames (of any bus, or of bus), as the hub's records."""
     records = []

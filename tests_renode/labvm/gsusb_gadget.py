@@ -267,6 +267,47 @@ BITRATE_CODES = {10000: 0, 20000: 1, 50000: 2, 100000: 3, 125000: 4, 250000: 5, 
 # full speed, as candleLight (an STM32F0) does.
 LAB_VM_LOAD = ("configfs", "libcomposite", "usb_f_fs", "dummy_hcd is_high_speed=0", "gs_usb")
 
+# Shell functions of the VM scripts that drive the adapter, after `. /run/labvm/lib.sh` (whose labvm_uptime they
+# call), for the test modules that use it (test_gsusb_labvm.py, test_gsusb_libusb_labvm.py,
+# test_flash_gsusb_labvm.py). Every wait has a bound; fail prints what the adapter and the kernel say.
+VM_SHELL = r"""
+S=/run/gsusb/status
+C=/run/gsusb/control
+fail() {
+    echo "@@FAILED $*@@"
+    echo "----- gadget status -----"; cat $S
+    if [ -e /sys/class/net/can0 ]; then echo "----- can0 -----"; ip -details -statistics link show can0; fi
+    echo "----- kernel log -----"; dmesg | tail -n 20
+    exit 1
+}
+# status KEY: the gadget's status value KEY.
+status() { sed -n "s/^$1=//p" $S; }
+# gsusb COMMAND...: a control command to the gadget, waiting until it is done.
+gsusb() {
+    _n=$(( $(status commands) + 1 ))
+    echo "$*" >$C
+    _deadline=$(( $(labvm_uptime) + 30 ))
+    until grep -qx "commands=$_n" $S; do
+        [ "$(labvm_uptime)" -lt $_deadline ] || fail "the gadget did not do '$*' in 30 s"
+        sleep 0.1
+    done
+}
+# wait_for SECONDS WHAT TEST...: polls TEST until it succeeds.
+wait_for() {
+    _deadline=$(( $(labvm_uptime) + $1 )); _what=$2; shift 2
+    until "$@"; do
+        [ "$(labvm_uptime)" -lt $_deadline ] || fail "no $_what"
+        sleep 0.1
+    done
+}
+at_least() { [ "$(status $1)" -ge "$2" ]; }  # the gadget's counter $1 has reached $2
+started() { [ "$(status started)" = 1 ]; }
+stopped() { [ "$(status started)" = 0 ]; }
+bound() { [ "$(status bound)" = 1 ]; }
+has_can0() { [ -e /sys/class/net/can0 ]; }
+no_can0() { [ ! -e /sys/class/net/can0 ]; }
+"""
+
 CONFIGFS = "/sys/kernel/config"
 GADGETS = CONFIGFS + "/usb_gadget"
 WAKE_SIGNAL = signal.SIGURG  # sent to the bulk IN writer thread to abort a transfer the host never took
