@@ -18,11 +18,6 @@ namespace {
 constexpr int kGoneChecks = 10;
 constexpr std::chrono::milliseconds kGoneCheckInterval{50};
 
-} // namespace
-
-
-namespace {
-
 // USB 2.0 specification, table 9-13: bmAttributes bits 1..0 give the
 // transfer type, and bit 7 of bEndpointAddress the direction.
 constexpr uint8_t kEndpointDirectionIn = 0x80;
