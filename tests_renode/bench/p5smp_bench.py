@@ -8,7 +8,8 @@ the first processor, node 3 on the second, joined by the shared-memory network
 - the round trip of each primitive the remote agent carries, called on the other node of the same board,
   in both directions, beside the same call on the caller's own object: microseconds of emulated time from
   the call to its return (the caller's uptime, as the `remote` console command of the test image measures
-  it);
+  it); a pool's Allocate and Return among them, which only nodes that share memory carry
+  (docs/protocols/remote-transactions.md, "Pools and heaps");
 - the latency of the inter-processor interrupt that carries each message: from the sender's stamp of the
   time-stamp counter, just before it raises the other processor's line 2, to the receiving node's routine
   (`shm`), in emulated nanoseconds.
@@ -45,6 +46,8 @@ PRIMITIVES = (
     ("PostEvent", "post {listener} 0x1"),
     ("MessagePortSend", "send {port} " + str(5 * 256 + 1)),
 )
+# Allocate and Return of a pool's buffer, measured in pairs (the test image's pool holds eight buffers).
+POOL_PRIMITIVES = ("BufferPoolAllocate", "BufferPoolReturn")
 # The callers' priority: more urgent than the test image's listener (10) and porter (9), less than the
 # remote agent's receiver (0), as in remote_bench.py.
 CALL_PRIORITY = 8
@@ -54,7 +57,8 @@ def objects_on(console):
     """A semaphore (never exhausted), the listener task and the porter's port, created on one node."""
     return {"semaphore": created(console, "remote sem 1000000", "RSEM"),
             "listener": created(console, "remote listener", "RTASK"),
-            "port": created(console, "remote port", "RPORT")}
+            "port": created(console, "remote port", "RPORT"),
+            "pool": created(console, "remote pool", "RPOOL")}
 
 
 def spread(values):
@@ -68,6 +72,13 @@ def round_trips(caller, objects, calls):
         verb, rest = command.format(**objects).split(" ", 1)
         line = f"{verb} at={CALL_PRIORITY} {rest}"
         measured = [call(caller, line) for _ in range(calls)]
+        results[name] = {"status": sorted({status for status, _, _ in measured}),
+                         "round_trip_us": spread([us for _, _, us in measured])}
+    allocated, returned = [], []
+    for _ in range(calls):
+        allocated.append(call(caller, f"alloc at={CALL_PRIORITY} {objects['pool']}"))
+        returned.append(call(caller, f"free at={CALL_PRIORITY} {objects['pool']} {allocated[-1][1]}"))
+    for name, measured in zip(POOL_PRIMITIVES, (allocated, returned)):
         results[name] = {"status": sorted({status for status, _, _ in measured}),
                          "round_trip_us": spread([us for _, _, us in measured])}
     return results
@@ -114,7 +125,7 @@ def main():
     print(f"The dual-Pentium board: primitives on the other node of the board over shared memory "
           f"({arguments.calls} calls each; emulated time, -icount, both processors)")
     print(f"  {'primitive':28} " + "".join(f"{direction:>30}" for direction in directions))
-    for name, _ in PRIMITIVES:
+    for name in [name for name, _ in PRIMITIVES] + list(POOL_PRIMITIVES):
         cells = []
         for direction in directions.values():
             trip = direction[name]["round_trip_us"]
