@@ -790,11 +790,6 @@ void relayPublication(uint8_t from, const SystemMessage& message, ObjectId publi
             return;
         }
     }
-    if (crossed >= kRelayCrossings) {
-        Lock lock;
-        ++statistics.unrouted; // Relays in a circle: the frame went as far as any may.
-        return;
-    }
     uint8_t header[kRelayHeaderBytes];
     encodeRelayHeader(publisher.node(), header, crossed);
     for (Relay& relay : relays) {
@@ -807,6 +802,11 @@ void relayPublication(uint8_t from, const SystemMessage& message, ObjectId publi
             to = relay.interface;
             if (withdrawal) {
                 endRelay(relay);
+            }
+            if (crossed >= kRelayCrossings) {
+                // Relays set up in a circle: the frame went as far as any may.
+                ++statistics.unrouted;
+                continue;
             }
         }
         if (sendBytes(to, SystemMessageType::RelayedPublication, message.priority, NetworkLink::kBroadcast, header,
