@@ -75,6 +75,12 @@ CONFIG_FUZZ_REPORT := $(BUILD)/reports/fuzz-config-tests.xml
 P5SMP_FUZZ_TARGETS := mp_table shared_memory_ring
 P5SMP_FUZZ_CORPUS := firmware/bsp_p5smp/fuzz/corpus
 P5SMP_FUZZ_REPORT := $(BUILD)/reports/fuzz-p5smp-tests.xml
+# dcos-flash --recover's reading of what an MCP2221A answers over USB HID
+# (host_tools/flash/fuzz): every reply, and whole conversations of the
+# reset and strap sequence with a scripted device.
+HOSTFLASH_FUZZ_TARGETS := mcp2221_reports
+HOSTFLASH_FUZZ_CORPUS := host_tools/flash/fuzz/corpus
+HOSTFLASH_FUZZ_REPORT := $(BUILD)/reports/fuzz-hostflash-tests.xml
 
 FUZZ_CXX := clang++
 # toml++ is compiled into the fuzz targets as Debian's shared library, which
@@ -145,6 +151,10 @@ P5SMP_FUZZ_LIBRARY_OBJS := $(FUZZ_BUILD)/firmware/bsp_p5smp/src/MpTable.cpp.o \
 	$(FUZZ_BUILD)/firmware/bsp_p5smp/src/SharedMemoryRing.cpp.o
 P5SMP_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/firmware/bsp_p5smp/fuzz/fuzz_%.cpp.o,$(P5SMP_FUZZ_TARGETS))
 P5SMP_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(P5SMP_FUZZ_TARGETS))
+HOSTFLASH_FUZZ_LIBRARY_OBJS := $(patsubst %,$(FUZZ_BUILD)/%.o,host_tools/flash/src/Mcp2221.cpp \
+	host_tools/flash/src/Mcp2221Lines.cpp)
+HOSTFLASH_FUZZ_TARGET_OBJS := $(patsubst %,$(FUZZ_BUILD)/host_tools/flash/fuzz/fuzz_%.cpp.o,$(HOSTFLASH_FUZZ_TARGETS))
+HOSTFLASH_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(HOSTFLASH_FUZZ_TARGETS))
 # Reached only through the pattern rule below, the objects would count as
 # intermediate files and be deleted after every build.
 .SECONDARY: $(FUZZ_LIBRARY_OBJS) $(FUZZ_TARGET_OBJS) $(MODBUS_FUZZ_LIBRARY_OBJS) $(MODBUS_FUZZ_TARGET_OBJS) \
@@ -154,6 +164,7 @@ P5SMP_FUZZ_BINARIES := $(patsubst %,$(FUZZ_BUILD)/fuzz_%,$(P5SMP_FUZZ_TARGETS))
 	$(MON_FUZZ_LIBRARY_OBJS) $(MON_FUZZ_TARGET_OBJS) $(CONFIG_FUZZ_LIBRARY_OBJS) $(CONFIG_FUZZ_TARGET_OBJS)
 .SECONDARY: $(P5SMP_FUZZ_LIBRARY_OBJS) $(P5SMP_FUZZ_TARGET_OBJS)
 .SECONDARY: $(HOSTCAN_FUZZ_LIBRARY_OBJS) $(HOSTCAN_FUZZ_TARGET_OBJS)
+.SECONDARY: $(HOSTFLASH_FUZZ_LIBRARY_OBJS) $(HOSTFLASH_FUZZ_TARGET_OBJS)
 
 .PHONY: fuzz test-fuzz fuzz-targets
 
@@ -165,12 +176,13 @@ fuzz-targets: $(FUZZ_BINARIES) $(MODBUS_FUZZ_BINARIES) $(HOST_MODBUS_FUZZ_BINARI
 	$(MON_FUZZ_BINARIES) $(CONFIG_FUZZ_BINARIES)
 fuzz-targets: $(P5SMP_FUZZ_BINARIES)
 fuzz-targets: $(HOSTCAN_FUZZ_BINARIES)
+fuzz-targets: $(HOSTFLASH_FUZZ_BINARIES)
 
 # A target that does not build is reported as a failed test case, so the
 # summary shows it instead of a missing suite. The groups run side by side,
 # $(JOBS) at a time (each libFuzzer run takes one core), and every group
 # runs even when another fails (-k): the exit status says whether any did.
-FUZZ_RUN_GROUPS := CAN MODBUS HOST_MODBUS HOSTCAN DCOS IMAGE HOST_IMAGE FLASH SEI MON CONFIG P5SMP
+FUZZ_RUN_GROUPS := CAN MODBUS HOST_MODBUS HOSTCAN DCOS IMAGE HOST_IMAGE FLASH SEI MON CONFIG P5SMP HOSTFLASH
 CAN_FUZZ_CORPUS = $(FUZZ_CORPUS)
 CAN_FUZZ_REPORT = $(FUZZ_REPORT)
 CAN_FUZZ_TARGETS = $(FUZZ_TARGETS)
@@ -262,6 +274,18 @@ $(FUZZ_FLAGS_STAMP): FORCE
 	@mkdir -p $(dir $@)
 	@echo '$(FUZZ_COMPILE_FLAGS) $(FUZZ_LINK_FLAGS)' > $@.new
 	@cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
+
+# dcos-flash's headers (host_tools/flash/include) likewise, for its objects only.
+$(HOSTFLASH_FUZZ_BINARIES): $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/host_tools/flash/fuzz/fuzz_%.cpp.o \
+		$(HOSTFLASH_FUZZ_LIBRARY_OBJS)
+	@mkdir -p $(dir $@)
+	@echo "  LD      $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_LINK_FLAGS) -o $@ $^ -lfmt
+
+$(HOSTFLASH_FUZZ_LIBRARY_OBJS) $(HOSTFLASH_FUZZ_TARGET_OBJS): $(FUZZ_BUILD)/%.cpp.o: %.cpp $(FUZZ_FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	@echo "  CXX     $@"
+	$(Q)$(FUZZ_CXX) $(FUZZ_COMPILE_FLAGS) -Ihost_tools/flash/include -c $< -o $@
 
 $(FUZZ_BUILD)/%.cpp.o: %.cpp $(FUZZ_FLAGS_STAMP)
 	@mkdir -p $(dir $@)

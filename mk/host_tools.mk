@@ -24,6 +24,11 @@ IMAGE_SRCS := $(wildcard firmware/image/src/*.cpp)
 HOSTIMAGE_SRCS := $(wildcard host_tools/image/src/*.cpp)
 # dcos-flash's link to a node (host_tools/flash), on the protocol's own code (firmware/flash).
 HOSTFLASH_SRCS := $(wildcard host_tools/flash/src/*.cpp)
+# dcos-flash --recover drives a node's reset and strap lines on an MCP2221A
+# through Debian's hidapi (libhidapi-dev), hidraw back end; only the tool
+# links it: the unit tests drive the same sequence through a fake device.
+HOSTFLASH_HIDAPI_SRCS := host_tools/flash/hidapi/HidapiDevice.cpp
+HOSTFLASH_HIDAPI_LIBS := $(shell pkg-config --libs hidapi-hidraw 2>/dev/null || echo -lhidapi-hidraw)
 # dcos-config's scan, requests and link to the nodes (host_tools/config), on
 # the configuration protocol's own code (firmware/sei).
 HOSTCONFIG_SRCS := $(wildcard host_tools/config/src/*.cpp)
@@ -82,11 +87,11 @@ $(DCOS_IMAGE) $(DCOS_CARD): $(HOST_TOOLS_BIN)/%: $(BUILD)/host/host_tools/image/
 	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto
 
 $(DCOS_FLASH): $(BUILD)/host/host_tools/flash/tools/dcos-flash.cpp.o \
-	$(patsubst %,$(BUILD)/host/%.o,$(HOSTFLASH_SRCS) $(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS) \
-		$(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
+	$(patsubst %,$(BUILD)/host/%.o,$(HOSTFLASH_SRCS) $(HOSTFLASH_HIDAPI_SRCS) $(FLASH_PORTABLE_SRCS) $(IMAGE_SRCS) \
+		$(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS) $(HOSTCAN_SRCS) $(CAN_PORTABLE_SRCS))
 	@mkdir -p $(dir $@)
 	@echo "  LD      $@"
-	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto $(HOSTCAN_LIBS)
+	$(Q)g++ -o $@ $^ -lfmt -lmbedcrypto $(HOSTCAN_LIBS) $(HOSTFLASH_HIDAPI_LIBS)
 
 $(DCOS_CONFIG): $(BUILD)/host/host_tools/config/tools/dcos-config.cpp.o \
 	$(patsubst %,$(BUILD)/host/%.o,$(HOSTCONFIG_SRCS) $(SEI_PORTABLE_SRCS) $(IMAGE_SRCS) $(HOSTIMAGE_SRCS) $(BOOT_RECORD_SRCS) \

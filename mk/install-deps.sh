@@ -45,6 +45,7 @@ qemu-system-x86:runs the lab VM, Debian's Linux with real SocketCAN, as this mac
 busybox-static:makes the lab VM's initramfs: its /init, modprobe and depmod
 iproute2:creates the lab VM's vcan and slcan interfaces (ip link)
 can-utils:candump, cansend, slcand, isotpsend and isotprecv, run in the lab VM against the Linux CAN stack (tests_renode/test_labvm.py)
+gpiod:gpioset, gpioget and gpioinfo, run in the lab VM against Linux's hid-mcp2221 gpiochip on the emulated MCP2221A (tests_renode/test_mcp2221_labvm.py)
 python3-can:python-can, tested in the lab VM against real SocketCAN (tests_renode/test_labvm.py)
 python3-pymodbus:a Modbus implementation we did not write: slave and master against dcos-modbus and dcos-modbus-sim (tests_renode/test_host_tools_modbus.py), and the builder and checker of the RTU frames the emulator tests exchange with the controller's RS-485 line (tests_renode/test_modbus_rs485.py)
 python3-serial-asyncio:pymodbus's serial slave is built on it (pymodbus only recommends it)

@@ -21,6 +21,7 @@
 #include <boot/TrialWatchdog.hpp>
 #include <boot/ConfigurationBlock.hpp>
 #include <bsp/BoardReset.hpp>
+#include <bsp/RecoveryStrap.hpp>
 #include <flash/CanFlashServer.hpp>
 #include <flash/FlashSession.hpp>
 #include <flash/SerialFramer.hpp>
@@ -542,6 +543,15 @@ extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
 {
     setUpConsole();
     say("DCOS stage loader %s, from BIOS drive 0x%02lx", dcos::versionString, static_cast<unsigned long>(bootDrive));
+    // The recovery strap is sampled once, as the board starts, as a strap
+    // is: what the line does later does not change this start. It sends
+    // the node into recovery whatever its card holds, so that an image
+    // that hangs at boot, which no watchdog ends once it is confirmed, can
+    // still be replaced (docs/guide/flashing.md).
+    const bool strapped = bsp::recoveryStrapSet();
+    if (strapped) {
+        say("the recovery strap is set");
+    }
     if (!enableA20()) {
         recovery("the A20 gate cannot be enabled: no memory above 1 MiB");
     }
@@ -596,7 +606,15 @@ extern "C" [[noreturn]] void stageMain(uint32_t bootDrive)
         if (!boot::BootStateStore::writeNext(store, stored, cleared)) {
             recovery("asked to stay in recovery, and the boot state cannot be written");
         }
-        recovery("a flash tool asked the node to stay in recovery");
+        recovery(strapped ? "the recovery strap is set, and a flash tool asked the node to stay in recovery"
+                          : "a flash tool asked the node to stay in recovery");
+    }
+    if (strapped) {
+        // Before any slot is loaded or the boot state changes: the card
+        // stays as it is, and the next start without the strap boots what
+        // it would have booted.
+        recoverySequence = stored.present ? stored.state.sequence : 0;
+        recovery("the recovery strap is set");
     }
     const boot::BootDecision decision = boot::BootSequence::decide(
         store, stored, [&](uint8_t slot) { return loadAndVerify(disk, slot, memoryEnd); });

@@ -5,6 +5,8 @@
 //     dcos-flash -d DEVICE -k KEY.pem [-n NODE] IMAGE.dcos [--no-restart] [--resume]
 //     dcos-flash (-i IFACE -n NODE | -d DEVICE) info
 //     dcos-flash (-i IFACE -n NODE | -d DEVICE) -k KEY.pem restart [--recovery]
+//     dcos-flash (-i IFACE -n NODE | -d DEVICE) --recover [--bridge SERIAL|/dev/hidrawN]
+//                [--reset-pin N] [--strap-pin N] [-k KEY.pem IMAGE.dcos]
 //
 // IFACE is a CAN interface as every DCOS tool takes it (can0,
 // slcan:/dev/ttyACM0, lab:/hub.sock:can0), NODE the node's CAN node
@@ -19,14 +21,23 @@
 // --no-restart); the image must then confirm (boot confirm), or the node
 // reverts. On CAN the tool then waits for that outcome (unless --no-wait).
 //
+// --recover first brings the node into the stage loader's recovery through
+// its reset line and recovery strap, wired to two GPIO pins of a Microchip
+// MCP2221A USB bridge (hidapi): it pulls the strap low, pulses reset, waits
+// until the node answers in recovery, releases the strap, and then goes on
+// with the command (an image to flash, info), or stops there.
+//
 // Every command takes --json. Exit status: 0 done (and, when waited for,
 // confirmed); 1 refused by the node (authentication, the image, the node
 // id), or the trial reverted, with the reason; 2 bad arguments; 3 the
 // device, interface or a file is not available; 4 the link failed (no
 // answer, the line closed), the key is not P-256, or the trial's outcome
-// did not come in time.
+// did not come in time. With --recover: 3 no MCP2221A found, 4 it answered
+// nonsense or the node did not come up in recovery in time.
 #include <hostflash/CanFlashLink.hpp>
 #include <hostflash/FlashLink.hpp>
+#include <hostflash/HidapiDevice.hpp>
+#include <hostflash/Mcp2221Lines.hpp>
 #include <hostflash/SerialFlashLink.hpp>
 
 #include <hostimage/SigningKey.hpp>
@@ -90,6 +101,14 @@ struct Options {
     long timeoutMs = 2000;
     int retries = 3;
     bool json = false;
+    // --recover: the reset and strap lines on an MCP2221A.
+    bool recover = false;
+    std::string bridge;
+    unsigned resetPin = 0;
+    unsigned strapPin = 1;
+    long resetMs = 100;
+    long recoveryTimeoutS = 60;
+    bool recovered = false; // Set once the node answered in recovery.
 };
 
 // One request and its reply, sent again on silence up to the retry count.
@@ -472,6 +491,9 @@ int flashImage(Conversation& conversation, const Options& options)
                            {"retransmissions", conversation.retransmissions()},
                            {"pending", true},
                            {"restarted", restarted}};
+        if (options.recovered) {
+            out["recovered"] = true;
+        }
         if (wait) {
             out["trial"] = trialOutcomeName(outcome);
         }
@@ -497,6 +519,85 @@ int flashImage(Conversation& conversation, const Options& options)
     return outcome == TrialOutcome::NoAnswer ? kExitFailed : kExitRefused;
 }
 
+// Asks the node once a second, up to @p timeout, until it answers Hello
+// in the stage loader's recovery: its node id, or nothing.
+std::optional<uint16_t> waitForRecovery(hostflash::FlashLink& link, std::chrono::seconds timeout)
+{
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    uint8_t tag = 0x40;
+    while (std::chrono::steady_clock::now() < deadline) {
+        FlashMessage hello;
+        hello.type = MessageType::Hello;
+        hello.tag = ++tag;
+        FlashMessage reply;
+        std::string why;
+        const auto asked = std::chrono::steady_clock::now();
+        if (link.exchange(hello, reply, std::chrono::milliseconds(1000), why) == LinkError::None &&
+            reply.type == MessageType::HelloReply && reply.mode == flash::NodeMode::Recovery) {
+            return reply.node;
+        }
+        std::this_thread::sleep_until(asked + std::chrono::seconds(1));
+    }
+    return std::nullopt;
+}
+
+int lineFailure(const hostflash::LineResult& result)
+{
+    return fail(result.error == hostflash::LineError::BadArgument ? kExitUsage : kExitFailed,
+                fmt::format("recovery lines: {}", result.message));
+}
+
+// --recover: the strap low, a pulse on reset, the node's answer in
+// recovery, the strap released. Whatever fails after the strap went low,
+// the strap is released again (as far as the bridge still answers), so
+// that the node's next start is an ordinary one.
+int recoverNode(hostflash::FlashLink& link, Options& options)
+{
+    hostflash::HidOpenError openError = hostflash::HidOpenError::None;
+    std::string why;
+    const std::unique_ptr<hostflash::HidapiDevice> device = hostflash::HidapiDevice::open(options.bridge, openError, why);
+    if (!device) {
+        return fail(kExitNotAvailable,
+                    fmt::format("recovery lines: {}", why));
+    }
+    hostflash::Mcp2221Lines lines(*device, hostflash::LineWiring{options.resetPin, options.strapPin});
+    if (const hostflash::LineResult configured = lines.configure(); !configured.ok()) {
+        return lineFailure(configured);
+    }
+    const auto started = std::chrono::steady_clock::now();
+    hostflash::LineResult result = lines.setStrap(true);
+    if (result.ok()) {
+        result = lines.pulseReset(std::chrono::milliseconds(options.resetMs));
+    }
+    if (!result.ok()) {
+        (void)lines.setStrap(false);
+        return lineFailure(result);
+    }
+    if (!options.json) {
+        fmt::print(stderr, "recovery strap on GP{} pulled low, reset pulsed on GP{} for {} ms; waiting up to {} s "
+                           "for the node in recovery\n",
+                   options.strapPin, options.resetPin, options.resetMs, options.recoveryTimeoutS);
+    }
+    const std::optional<uint16_t> node = waitForRecovery(link, std::chrono::seconds(options.recoveryTimeoutS));
+    const hostflash::LineResult released = lines.setStrap(false);
+    if (!node) {
+        return fail(kExitFailed, fmt::format("the node did not answer in recovery within {} s after the reset",
+                                             options.recoveryTimeoutS));
+    }
+    if (!released.ok()) {
+        return lineFailure(released);
+    }
+    options.recovered = true;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (!options.json) {
+        fmt::print(stderr, "node {}: in the stage loader's recovery ({:.1f} s after the reset); strap released\n",
+                   *node, seconds);
+    } else if (options.image.empty()) {
+        fmt::print("{}\n", nlohmann::json{{"node", *node}, {"recovered", true}, {"seconds", seconds}}.dump());
+    }
+    return kExitOk;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -504,8 +605,9 @@ int main(int argc, char** argv)
     CLI::App app{"dcos-flash: put a signed image on a controller over CAN or its serial line", "dcos-flash"};
     app.set_version_flag("--version", std::string("dcos-flash ") + dcos::versionString);
     app.footer("exit status: 0 done (and confirmed, when waited for), 1 refused by the node or the trial reverted, "
-               "2 bad arguments, 3 device, interface or file not available, 4 link failed, key not P-256, or no "
-               "outcome in time\n"
+               "2 bad arguments, 3 device, interface, file or MCP2221A not available, 4 link failed, key not "
+               "P-256, no outcome in time, or (--recover) the MCP2221A answered nonsense or the node did not come "
+               "up in recovery\n"
                "interfaces: can0 (SocketCAN), slcan:/dev/ttyACM0[@bitrate], lab:/path/hub.sock:can0 (the lab bus)\n"
                "devices: /dev/ttyUSB0 (115200 bit/s 8N1), unix:/path (the emulated board's console)");
     Options options;
@@ -541,6 +643,20 @@ int main(int argc, char** argv)
         app.add_subcommand("restart", "restart the node (needs -k): into its image, or with --recovery into the "
                                       "stage loader's recovery");
     restartCommandLine->add_flag("--recovery", options.recovery, "stay in the stage loader's recovery on this start");
+    app.add_flag("--recover", options.recover,
+                 "first bring the node into recovery through its reset line and recovery strap on an MCP2221A "
+                 "(then flash IMAGE if given)");
+    app.add_option("--bridge", options.bridge,
+                   "--recover: the MCP2221A, by USB serial number or hidraw path (default: the first one)");
+    app.add_option("--reset-pin", options.resetPin, "--recover: the MCP2221A's GP pin on the reset line")
+        ->check(CLI::Range(0u, 3u));
+    app.add_option("--strap-pin", options.strapPin, "--recover: the MCP2221A's GP pin on the recovery strap")
+        ->check(CLI::Range(0u, 3u));
+    app.add_option("--reset-ms", options.resetMs, "--recover: how long reset is held low")
+        ->check(CLI::Range(1L, 10000L));
+    app.add_option("--recovery-timeout", options.recoveryTimeoutS,
+                   "--recover: seconds to wait for the node to answer in recovery after the reset")
+        ->check(CLI::Range(1L, 3600L));
 
     try {
         app.parse(argc, argv);
@@ -554,8 +670,12 @@ int main(int argc, char** argv)
     if (!options.interface.empty() && options.node < 0) {
         return fail(kExitUsage, "on CAN, -n names the node's CAN node number");
     }
-    if (!*infoCommand && !*restartCommandLine && (options.image.empty() || options.key.empty())) {
+    const bool recoverOnly = options.recover && !*infoCommand && !*restartCommandLine && options.image.empty();
+    if (!*infoCommand && !*restartCommandLine && !recoverOnly && (options.image.empty() || options.key.empty())) {
         return fail(kExitUsage, "flashing needs an image and -k KEY.pem (or the 'info' command)");
+    }
+    if (options.recover && options.resetPin == options.strapPin) {
+        return fail(kExitUsage, "--reset-pin and --strap-pin name the same pin");
     }
     if (*restartCommandLine && options.key.empty()) {
         return fail(kExitUsage, "restart needs -k KEY.pem: only an authenticated session restarts a node");
@@ -581,6 +701,11 @@ int main(int argc, char** argv)
                     : error == LinkError::NotAvailable ? kExitNotAvailable
                                                        : kExitFailed,
                     why);
+    }
+    if (options.recover) {
+        if (const int recovered = recoverNode(*link, options); recovered != kExitOk || recoverOnly) {
+            return recovered;
+        }
     }
     Conversation conversation(*link, options);
     if (*infoCommand) {
