@@ -103,7 +103,7 @@ echo "@@BITRATE $(status bitrate) host_format=$(status host_format)@@"
 
 # -- frames onto the bus through libusb --
 echoes=$(status echoes)
-timeout 60 ./dcos-can -i gsusb:__SERIAL__ send __TX_SENDS__ >/tmp/tx.out 2>/tmp/tx.err
+timeout 60 ./dcos-can -i gsusb:__SERIAL__ send --timeout-ms 30000 __TX_SENDS__ >/tmp/tx.out 2>/tmp/tx.err
 report tx $?
 wait_for 30 "echo of every frame" at_least echoes $((echoes + __TX_COUNT__))
 echo "@@SENT tx@@"

@@ -303,6 +303,26 @@ TransportError GsUsbTransport::send(const can::CanFrame& frame, std::chrono::mil
     return {};
 }
 
+TransportError GsUsbTransport::drain(std::chrono::milliseconds timeout)
+{
+    const auto deadline = Clock::now() + timeout;
+    while (framesInFlight() > 0) {
+        if (gone_) {
+            return gone_;
+        }
+        if (Clock::now() >= deadline) {
+            return {TransportError::Kind::Refused,
+                    name_ + ": the adapter confirmed " + std::to_string(framesInFlight()) +
+                        (framesInFlight() == 1 ? " frame" : " frames") + " not within " +
+                        std::to_string(timeout.count()) + " ms (is any other node acknowledging them?)"};
+        }
+        if (TransportError e = pump(deadline)) {
+            return e;
+        }
+    }
+    return {};
+}
+
 Received GsUsbTransport::receive(std::chrono::milliseconds timeout, TransportError& error)
 {
     const auto deadline = Clock::now() + timeout;

@@ -496,6 +496,11 @@ int send(hostcan::Transport& transport, const std::vector<can::CanFrame>& parsed
         }
         sent.push_back({{"id", frame.id()}, {"extended", frame.isExtended()}, {"data", hex(frame)}});
     }
+    // Sent means on the bus: a USB adapter confirms each frame, and ending
+    // before it did could take the last ones off the bus.
+    if (TransportError error = transport.drain(std::chrono::milliseconds(timeoutMs))) {
+        return fail(error);
+    }
     if (json) {
         fmt::print("{}\n", nlohmann::json{{"interface", transport.name()}, {"sent", sent}}.dump());
     }
@@ -803,7 +808,7 @@ int main(int argc, char** argv)
     long sendTimeoutMs = 1000;
     CLI::App* sendCommand = app.add_subcommand("send", "send frames written as cansend takes them");
     sendCommand->add_option("frames", frames, "<id>#<data>, e.g. 123#DEADBEEF, 1ABCDEF0#01.02, 123#R")->required();
-    sendCommand->add_option("--timeout-ms", sendTimeoutMs, "how long a full interface queue is waited for")
+    sendCommand->add_option("--timeout-ms", sendTimeoutMs, "how long a full interface queue, and at the end a USB adapter's confirmation of the last frames, is waited for")
         ->check(CLI::Range(0L, 600'000L));
 
     double seconds = 1.0;

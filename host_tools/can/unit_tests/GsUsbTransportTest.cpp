@@ -483,6 +483,34 @@ TEST(GsUsbTransportTest, ClosingLetsTheFramesInFlightReachTheBusFirst)
     EXPECT_EQ(state->calls.back().data, Bytes(8, 0));
 }
 
+TEST(GsUsbTransportTest, DrainWaitsForEveryEchoAndSaysHowManyNeverCame)
+{
+    auto state = candleLight();
+    state->echo = false; // The adapter keeps them until the test hands their echoes in.
+    TransportError error;
+    std::unique_ptr<GsUsbTransport> transport = openOn(state, 500'000, error);
+    ASSERT_TRUE(transport) << error.message;
+    const can::CanFrame frame = can::CanFrame::makeData(0x100, can::IdFormat::Standard, nullptr, 0).value();
+    for (uint32_t i = 0; i < 3; ++i) {
+        ASSERT_FALSE(transport->send(frame, 100ms));
+    }
+    // Two echoes come, with a frame of the bus between them; the third does not.
+    state->in.push_back({gsusb::encodeHostFrame(gsusb::hostFrameFor(frame, 0, 0)), Status::Ok});
+    state->in.push_back({rxFrame(0x555, 1, {0x99}), Status::Ok});
+    state->in.push_back({gsusb::encodeHostFrame(gsusb::hostFrameFor(frame, 2, 0)), Status::Ok});
+    const TransportError unconfirmed = transport->drain(30ms);
+    EXPECT_EQ(unconfirmed.kind, TransportError::Kind::Refused);
+    EXPECT_NE(unconfirmed.message.find("confirmed 1 frame not within 30 ms"), std::string::npos)
+        << unconfirmed.message;
+    EXPECT_EQ(transport->framesInFlight(), 1u);
+    const Received r = transport->receive(20ms, error);
+    ASSERT_EQ(r.kind, Received::Kind::Frame) << "the bus's frame is kept for receive";
+    EXPECT_EQ(r.frame.id(), 0x555u);
+    state->in.push_back({gsusb::encodeHostFrame(gsusb::hostFrameFor(frame, 1, 0)), Status::Ok});
+    EXPECT_FALSE(transport->drain(30ms)) << "every frame confirmed";
+    EXPECT_EQ(transport->framesInFlight(), 0u);
+}
+
 TEST(GsUsbTransportTest, OpeningFailuresSayWhichRequestAndWhy)
 {
     {

@@ -83,6 +83,10 @@ public:
     /// adapter is unplugged, Protocol for a transfer that makes no sense.
     Received receive(std::chrono::milliseconds timeout, TransportError& error) override;
     std::optional<uint32_t> bitRate() const override { return bitRate_; }
+    /// Waits at most @p timeout for the echo of every frame in flight:
+    /// Refused, with the count, for those the adapter did not confirm;
+    /// frames and events that arrive meanwhile are kept for receive().
+    TransportError drain(std::chrono::milliseconds timeout) override;
 
     /// The bit timing the adapter was set to.
     const gsusb::BitTimingChoice& timing() const { return timing_; }

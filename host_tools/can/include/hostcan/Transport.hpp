@@ -79,6 +79,18 @@ public:
 
     /// The interface's bit rate when the transport knows it, for bus load.
     virtual std::optional<uint32_t> bitRate() const = 0;
+
+    /// Waits at most @p timeout until every frame sent has left the
+    /// transport's own hands: Refused, saying how many, when some are still
+    /// unconfirmed. A tool calls it before it ends, since closing some
+    /// interfaces (a USB adapter's reset) takes queued frames off the bus.
+    /// Transports whose frames outlive them (SocketCAN's kernel queue, an
+    /// slcan adapter's) have nothing to wait for.
+    virtual TransportError drain(std::chrono::milliseconds timeout)
+    {
+        (void)timeout;
+        return {};
+    }
 };
 
 /// Opens the transport a `-i` argument names:
