@@ -88,7 +88,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         const size_t length = std::strlen(assembler.name());
         FUZZ_CHECK(length >= 1 && length < kNameQueryNameBytes);
         uint8_t again[kNameQueryFrames][kRemoteMessageBytes];
-        encodeNameQuery(assembler.type(), assembler.transaction(), assembler.name(), again);
+        encodeNameQuery(assembler.type(), assembler.transaction(), assembler.name(), again, assembler.relays());
         FUZZ_CHECK(std::memcmp(again, lastParts, sizeof again) == 0);
     }
     ContinuedRequestAssembler portSends; // Port sends and held acquires.
