@@ -265,12 +265,15 @@ const char* trialOutcomeName(TrialOutcome outcome)
     return "?";
 }
 
-// Asks the restarted node once a second until its boot state says how the
-// trial of @p slot ended: confirmed, or reverted by the stage loader.
-TrialOutcome waitForTrial(hostflash::FlashLink& link, uint8_t slot, const Options& options)
+// Asks the node for its Hello reply once a second, up to @p timeout, until
+// @p done takes one: what it returned, or @p none when the time ran out.
+// Tags count up from @p firstTag, so that a late reply to an earlier Hello
+// is not taken for the current one.
+template <typename Result, typename Done>
+Result pollHello(hostflash::FlashLink& link, std::chrono::seconds timeout, uint8_t firstTag, Result none, Done done)
 {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(options.confirmTimeoutS);
-    uint8_t tag = 0x80;
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    uint8_t tag = firstTag;
     while (std::chrono::steady_clock::now() < deadline) {
         FlashMessage hello;
         hello.type = MessageType::Hello;
@@ -280,17 +283,29 @@ TrialOutcome waitForTrial(hostflash::FlashLink& link, uint8_t slot, const Option
         const auto asked = std::chrono::steady_clock::now();
         if (link.exchange(hello, reply, std::chrono::milliseconds(1000), why) == LinkError::None &&
             reply.type == MessageType::HelloReply) {
-            if (reply.mode == flash::NodeMode::Recovery) {
-                return TrialOutcome::Recovery;
-            }
-            const auto trial = static_cast<boot::TrialState>(reply.trial);
-            if (trial == boot::TrialState::None) {
-                return reply.confirmedSlot == slot ? TrialOutcome::Confirmed : TrialOutcome::Reverted;
+            if (const std::optional<Result> result = done(reply)) {
+                return *result;
             }
         }
         std::this_thread::sleep_until(asked + std::chrono::seconds(1));
     }
-    return TrialOutcome::NoAnswer;
+    return none;
+}
+
+// Asks the restarted node once a second until its boot state says how the
+// trial of @p slot ended: confirmed, or reverted by the stage loader.
+TrialOutcome waitForTrial(hostflash::FlashLink& link, uint8_t slot, const Options& options)
+{
+    return pollHello(link, std::chrono::seconds(options.confirmTimeoutS), 0x80, TrialOutcome::NoAnswer,
+                     [slot](const FlashMessage& reply) -> std::optional<TrialOutcome> {
+                         if (reply.mode == flash::NodeMode::Recovery) {
+                             return TrialOutcome::Recovery;
+                         }
+                         if (static_cast<boot::TrialState>(reply.trial) == boot::TrialState::None) {
+                             return reply.confirmedSlot == slot ? TrialOutcome::Confirmed : TrialOutcome::Reverted;
+                         }
+                         return std::nullopt;
+                     });
 }
 
 // Hello, the node id checked on a serial line, and Authenticate with the
@@ -523,22 +538,13 @@ int flashImage(Conversation& conversation, const Options& options)
 // in the stage loader's recovery: its node id, or nothing.
 std::optional<uint16_t> waitForRecovery(hostflash::FlashLink& link, std::chrono::seconds timeout)
 {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    uint8_t tag = 0x40;
-    while (std::chrono::steady_clock::now() < deadline) {
-        FlashMessage hello;
-        hello.type = MessageType::Hello;
-        hello.tag = ++tag;
-        FlashMessage reply;
-        std::string why;
-        const auto asked = std::chrono::steady_clock::now();
-        if (link.exchange(hello, reply, std::chrono::milliseconds(1000), why) == LinkError::None &&
-            reply.type == MessageType::HelloReply && reply.mode == flash::NodeMode::Recovery) {
-            return reply.node;
-        }
-        std::this_thread::sleep_until(asked + std::chrono::seconds(1));
-    }
-    return std::nullopt;
+    return pollHello(link, timeout, 0x40, std::optional<uint16_t>(),
+                     [](const FlashMessage& reply) -> std::optional<std::optional<uint16_t>> {
+                         if (reply.mode == flash::NodeMode::Recovery) {
+                             return std::optional<uint16_t>(reply.node);
+                         }
+                         return std::nullopt;
+                     });
 }
 
 int lineFailure(const hostflash::LineResult& result)
