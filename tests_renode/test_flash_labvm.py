@@ -16,14 +16,13 @@ emulated CPU, answers within the node's ISO-TP time-outs (1 s emulated,
 
 import json
 import os
-import subprocess
 import tempfile
 
 import pytest
 
 from dcoslab.board import REPOSITORY, load_board
 from dcoslab.canlab import CanLab
-from dcoslab.cards import BIN, DEVELOPMENT_KEY, card_state, new_card, signed
+from dcoslab.cards import BIN, DEVELOPMENT_KEY, card_state, new_card, signed, signed_loop
 from dcoslab.remote import attach_node
 from dcoslab.vmworld import BridgedWorld, attach_reports, hold_world, start_bridged_vm, vm_status
 
@@ -40,16 +39,7 @@ WORK_ROOT = os.path.join(REPOSITORY, "build", "labvm-flash")
 
 def tiny_image(work):
     """A signed image of 16 KiB of payload: a loop and a page of data, linked at 1 MiB, never started."""
-    source, obj, elf = (os.path.join(work, name) for name in ("tiny.S", "tiny.o", "tiny.elf"))
-    with open(source, "w", encoding="ascii") as handle:
-        handle.write(".globl _start\n.text\n_start: jmp _start\n.data\n.fill 16384,1,0x5a\n")
-    subprocess.run(["gcc", "-m32", "-c", source, "-o", obj], check=True)
-    subprocess.run(["ld", "-m", "elf_i386", "-nostdlib", "-static", "-N", "-Ttext=0x100000", "-o", elf, obj],
-                   check=True, capture_output=True)
-    image = os.path.join(work, "tiny.dcos")
-    subprocess.run([os.path.join(BIN, "dcos-image"), "sign", "-k", DEVELOPMENT_KEY, "--board", "isa486",
-                    "--version", "2.0.0", "-o", image, elf], check=True, capture_output=True)
-    return image
+    return signed_loop(work, "tiny", "2.0.0", data_bytes=16384)
 
 
 def vm_script():

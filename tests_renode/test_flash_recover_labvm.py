@@ -22,7 +22,6 @@ time-outs.
 import json
 import os
 import socket
-import subprocess
 import tempfile
 import threading
 import time
@@ -31,7 +30,7 @@ import pytest
 
 from dcoslab.board import REPOSITORY, load_board
 from dcoslab.canlab import CanLab
-from dcoslab.cards import BIN, DEVELOPMENT_KEY, card_state, new_card, signed
+from dcoslab.cards import BIN, DEVELOPMENT_KEY, card_state, new_card, signed, signed_loop
 from dcoslab.vmworld import BridgedWorld, attach_reports, hold_world, vm_status
 
 pytestmark = pytest.mark.xdist_group("test_flash_recover_labvm")
@@ -47,16 +46,7 @@ BRIDGE = os.path.join(REPOSITORY, "tests_renode", "labvm", "mcp2221_bridge.py")
 
 def hanging_image(work):
     """A signed image that loops at its first instruction: it never confirms, never answers."""
-    source, obj, elf = (os.path.join(work, name) for name in ("hang.S", "hang.o", "hang.elf"))
-    with open(source, "w", encoding="ascii") as handle:
-        handle.write(".globl _start\n.text\n_start: jmp _start\n")
-    subprocess.run(["gcc", "-m32", "-c", source, "-o", obj], check=True)
-    subprocess.run(["ld", "-m", "elf_i386", "-nostdlib", "-static", "-N", "-Ttext=0x100000", "-o", elf, obj],
-                   check=True, capture_output=True)
-    image = os.path.join(work, "hang.dcos")
-    subprocess.run([os.path.join(BIN, "dcos-image"), "sign", "-k", DEVELOPMENT_KEY, "--board", "isa486",
-                    "--version", "1.0.0", "-o", image, elf], check=True, capture_output=True)
-    return image
+    return signed_loop(work, "hang", "1.0.0")
 
 
 class Relay:

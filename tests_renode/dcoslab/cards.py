@@ -32,6 +32,22 @@ def signed(directory, version, firmware="dcos486.elf", key=DEVELOPMENT_KEY):
     return path
 
 
+def signed_loop(directory, name, version, data_bytes=0):
+    """A signed isa486 image whose code is one jump to itself, linked at 1 MiB, with data_bytes of 0x5a after it:
+    an image that never answers and never confirms, of a chosen size. Its path, directory/name.dcos."""
+    source, obj, elf = (os.path.join(str(directory), f"{name}.{suffix}") for suffix in ("S", "o", "elf"))
+    with open(source, "w", encoding="ascii") as handle:
+        handle.write(".globl _start\n.text\n_start: jmp _start\n")
+        if data_bytes:
+            handle.write(f".data\n.fill {data_bytes},1,0x5a\n")
+    subprocess.run(["gcc", "-m32", "-c", source, "-o", obj], check=True)
+    subprocess.run(["ld", "-m", "elf_i386", "-nostdlib", "-static", "-N", "-Ttext=0x100000", "-o", elf, obj],
+                   check=True, capture_output=True)
+    image = os.path.join(str(directory), f"{name}.dcos")
+    tool("dcos-image", "sign", "-k", DEVELOPMENT_KEY, "--board", "isa486", "--version", version, "-o", image, elf)
+    return image
+
+
 def signed_application(directory, source, version="1.0.0"):
     """The application in the folder @p source (one of the repository's, e.g.
     tests_renode/monitor/ramp_app) built against the staged SDK in
